@@ -1,0 +1,78 @@
+#include "app/cli.h"
+
+#include <CLI/CLI.hpp>
+#include <ostream>
+
+#include "app/commands.h"
+#include "lsys/deriver.h"
+
+namespace sylva::app {
+
+int Report(const Diagnostic& d, std::ostream& err) {
+  err << d.Format();
+  if (d.severity != Severity::kError) return kExitOk;
+  return d.kind == ErrorKind::kRuntime ? kExitRuntime : kExitBadInput;
+}
+
+int Report(const DiagnosticList& list, std::ostream& err) {
+  int code = kExitOk;
+  for (const auto& d : list.items) {
+    int c = Report(d, err);
+    if (c == kExitBadInput || code == kExitOk) code = c;
+  }
+  return code;
+}
+
+static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
+  cmd->add_option("file", f.file, "grammar file (.lsys)")->required();
+  cmd->add_option("-n,--steps", f.steps, "derivation steps (default: the grammar's)")
+      ->check(CLI::Range(0, lsys::kMaxDerivationLengthForDerive));
+  cmd->add_option("--seed", f.seed, "seed of the random numbers (default: the grammar's)");
+  cmd->add_option("-D,--define", f.defines, "override a #define: NAME=VALUE (repeatable)");
+  cmd->add_option("--threads", f.threads, "worker threads (default: all cores)")
+      ->check(CLI::Range(0, 256));
+  cmd->add_option("--max-modules", f.maxModules,
+                  "stop with an error when the word would grow past this many modules "
+                  "(default 268435456)")
+      ->check(CLI::Range(uint64_t(1), lsys::kMaxModulesCap));
+}
+
+int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  CLI::App app{"Sylva: L-system grammars and particle systems", "sylva"};
+  app.require_subcommand(1, 1);
+  app.set_version_flag("--version", "sylva 0.1.0");
+
+  DeriveCommand derive;
+  CLI::App* d = app.add_subcommand("derive", "derive a grammar and print the word or statistics");
+  AddDeriveFlags(d, derive.derive);
+  d->add_flag("--stats", derive.stats, "print statistics instead of the word");
+  d->add_flag("--interpret", derive.interpret,
+              "apply the interpretation rules (the word the turtle reads)");
+  d->add_option("-o,--output", derive.output, "write the word to this file");
+
+  DeriveFlags check;
+  CLI::App* c = app.add_subcommand("check", "parse and check a grammar; print diagnostics");
+  c->add_option("file", check.file, "grammar file (.lsys)")->required();
+  c->add_option("-D,--define", check.defines, "override a #define: NAME=VALUE (repeatable)");
+
+  std::vector<std::string> rev(args.rbegin(), args.rend());
+  try {
+    app.parse(rev);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) {
+      out << (e.get_name() == "CallForVersion" ? std::string(e.what()) + "\n" : app.help());
+      if (e.get_name() == "CallForHelp") {
+        for (auto* sub : app.get_subcommands()) out << sub->help();
+      }
+      return kExitOk;
+    }
+    err << "sylva: error: " << e.what() << "\n";
+    err << "run 'sylva --help' for usage\n";
+    return kExitBadInput;
+  }
+  if (d->parsed()) return RunDerive(derive, out, err);
+  if (c->parsed()) return RunCheck(check, out, err);
+  return kExitBadInput;
+}
+
+}  // namespace sylva::app

@@ -1,0 +1,162 @@
+// sylva derive / sylva check
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <ostream>
+
+#include "app/cli.h"
+#include "app/commands.h"
+#include "core/atomic_file.h"
+#include "core/parallel.h"
+#include "lsys/deriver.h"
+#include "lsys/parser.h"
+
+namespace sylva::app {
+
+static bool ParseDefines(const std::vector<std::string>& defs, lsys::ParseOptions* opt,
+                         std::ostream& err) {
+  for (const auto& d : defs) {
+    size_t eq = d.find('=');
+    std::string name = d.substr(0, eq);
+    bool okName = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
+    for (char ch : name) okName &= std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+    if (eq == std::string::npos || !okName) {
+      err << "sylva: error: -D expects NAME=VALUE, got '" << d << "'\n";
+      return false;
+    }
+    std::string value = d.substr(eq + 1);
+    char* end = nullptr;
+    double v = std::strtod(value.c_str(), &end);
+    if (value.empty() || *end != '\0' || !std::isfinite(v)) {
+      err << "sylva: error: -D " << name << ": '" << value << "' is not a number\n";
+      return false;
+    }
+    opt->overrides[name] = v;
+  }
+  return true;
+}
+
+// Parses the grammar, printing diagnostics. Returns the grammar or sets *exit.
+static std::optional<lsys::Grammar> Load(const DeriveFlags& f, std::ostream& err, int* exit) {
+  lsys::ParseOptions opt;
+  if (!ParseDefines(f.defines, &opt, err)) {
+    *exit = kExitBadInput;
+    return std::nullopt;
+  }
+  lsys::ParseResult r = lsys::ParseGrammarFile(f.file, opt);
+  *exit = Report(r.diagnostics, err);
+  if (!r.grammar) {
+    if (*exit == kExitOk) *exit = kExitBadInput;
+    return std::nullopt;
+  }
+  return std::move(r.grammar);
+}
+
+int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err) {
+  int exit = kExitOk;
+  auto g = Load(flags, err, &exit);
+  return g ? kExitOk : exit;
+}
+
+static void PrintStats(const lsys::Grammar& g, const lsys::DeriveResult& r, int threads,
+                       uint64_t seed, std::ostream& out) {
+  char line[256];
+  out << "grammar: " << g.path << " (" << g.name << ")\n";
+  std::snprintf(line, sizeof line, "steps: %d  seed: %llu  threads: %d\n",
+                int(r.steps.size()) - 1, static_cast<unsigned long long>(seed), threads);
+  out << line;
+  out << "step       modules      time\n";
+  uint64_t produced = 0;
+  for (const auto& s : r.steps) {
+    if (s.step > 0) produced += s.modules;
+    std::snprintf(line, sizeof line, "%4d %13llu %9.4f s\n", s.step,
+                  static_cast<unsigned long long>(s.modules), s.seconds);
+    out << line;
+  }
+  std::vector<uint64_t> count(g.symbols.size(), 0);
+  for (lsys::SymbolId s : r.word.symbols) ++count[s];
+  out << "modules: " << r.word.size() << "\n";
+  out << "per symbol:\n";
+  for (size_t s = 0; s < count.size(); ++s) {
+    if (!count[s]) continue;
+    std::string name = g.symbols.name(lsys::SymbolId(s));
+    int a = g.symbols.arity(lsys::SymbolId(s));
+    if (a) name += "/" + std::to_string(a);
+    std::snprintf(line, sizeof line, "  %-12s %13llu\n", name.c_str(),
+                  static_cast<unsigned long long>(count[s]));
+    out << line;
+  }
+  double rate = r.seconds > 0 ? double(produced) / r.seconds : 0;
+  std::snprintf(line, sizeof line,
+                "time: %.4f s (%llu modules produced, %.1f million modules/s)\n", r.seconds,
+                static_cast<unsigned long long>(produced), rate / 1e6);
+  out << line;
+  std::snprintf(line, sizeof line, "word memory: %.1f MiB\n", double(r.word.MemoryBytes()) / (1 << 20));
+  out << line;
+}
+
+int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err) {
+  int exit = kExitOk;
+  auto g = Load(cmd.derive, err, &exit);
+  if (!g) return exit;
+
+  lsys::DeriveOptions opt;
+  if (cmd.derive.steps) opt.steps = *cmd.derive.steps;
+  opt.seed = cmd.derive.seed;
+  opt.threads = cmd.derive.threads;
+  if (cmd.derive.maxModules) opt.maxModules = cmd.derive.maxModules;
+  // Progress on a terminal, once a derivation has run for a second.
+  const bool tty = &err == &std::cerr && isatty(2);
+  const auto start = std::chrono::steady_clock::now();
+  bool shown = false;
+  if (tty) {
+    opt.progress = [&](int step, int steps, uint64_t modules) {
+      double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (t < 1.0) return;
+      shown = true;
+      std::fprintf(stderr, "\rstep %d/%d: %llu modules   ", step, steps,
+                   static_cast<unsigned long long>(modules));
+    };
+  }
+  auto r = lsys::Derive(*g, opt);
+  if (shown) std::fprintf(stderr, "\r%60s\r", "");
+  if (!r) return Report(r.error(), err);
+  lsys::Word* word = &r->word;
+  lsys::Word interpreted;
+  if (cmd.interpret) {
+    auto w = lsys::Interpret(*g, r->word, opt);
+    if (!w) return Report(w.error(), err);
+    interpreted = std::move(w).value();
+    word = &interpreted;
+  }
+  if (cmd.stats) {
+    int threads = cmd.derive.threads > 0 ? cmd.derive.threads : sylva::ThreadPool::HardwareThreads();
+    PrintStats(*g, *r, threads, opt.seed.value_or(g->seed), out);
+    return kExitOk;
+  }
+  if (cmd.output.empty()) {
+    lsys::FormatWord(*word, g->symbols, [&](std::string_view s) { out.write(s.data(), s.size()); });
+    out << '\n';
+    out.flush();
+    if (!out) {
+      err << "sylva: error: cannot write to standard output\n";
+      return kExitRuntime;
+    }
+    return kExitOk;
+  }
+  AtomicFile file;
+  if (Status s = file.Open(cmd.output); !s.ok()) return Report(s.error(), err);
+  Status ws;
+  lsys::FormatWord(*word, g->symbols, [&](std::string_view s) {
+    if (ws.ok()) ws = file.Write(s);
+  });
+  if (ws.ok()) ws = file.Write("\n");
+  if (ws.ok()) ws = file.Commit();
+  if (!ws.ok()) return Report(ws.error(), err);
+  return kExitOk;
+}
+
+}  // namespace sylva::app

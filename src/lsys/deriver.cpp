@@ -1,0 +1,546 @@
+#include "lsys/deriver.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <string>
+
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "lsys/matcher.h"
+
+namespace sylva::lsys {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Purposes of random draws; combined with the pass depth into the stream key.
+enum : uint64_t { kAxiomDraws = 0, kMainDraws = 1, kDecompositionDraws = 2, kInterpretDraws = 3 };
+
+constexpr uint32_t kIdentity = 0xFFFFFFFFu;
+constexpr size_t kMinChunk = 16384;
+
+Diagnostic LimitError(const std::string& what) {
+  Diagnostic d;
+  d.kind = ErrorKind::kRuntime;
+  d.message = what;
+  return d;
+}
+
+// Table for sections whose production per symbol is fixed and parameter-free.
+struct StaticTable {
+  bool usable = false;
+  std::vector<uint32_t> offset, length;  // per symbol, into flat
+  std::vector<SymbolId> flat;            // padded by 8 for over-copying
+};
+
+StaticTable BuildStaticTable(const Grammar& g, const Section& sec) {
+  StaticTable t;
+  const size_t nsym = g.symbols.size();
+  t.offset.resize(nsym);
+  t.length.resize(nsym);
+  for (size_t s = 0; s < nsym; ++s) {
+    const auto& list = sec.bySymbol[s];
+    t.offset[s] = uint32_t(t.flat.size());
+    if (list.empty()) {
+      t.flat.push_back(SymbolId(s));
+      t.length[s] = 1;
+      continue;
+    }
+    const Production& p = sec.productions[list[0]];
+    if (p.HasContext() || p.condition || p.weight || !p.successor.params.empty() ||
+        g.symbols.arity(SymbolId(s)) != 0)
+      return t;  // not usable
+    for (SymbolId x : p.successor.symbols) t.flat.push_back(x);
+    t.length[s] = uint32_t(p.successor.symbols.size());
+  }
+  t.flat.resize(t.flat.size() + 8, 0);
+  t.usable = true;
+  return t;
+}
+
+struct Chunk {
+  size_t begin = 0, end = 0;
+  uint64_t inParam = 0;                 // parameter offset of `begin` in the input
+  uint64_t outModules = 0, outParams = 0;
+  uint64_t outModuleAt = 0, outParamAt = 0;
+  bool changed = false;
+  std::optional<Diagnostic> error;
+};
+
+// One parallel rewriting pass of one section over a word.
+class Pass {
+ public:
+  Pass(const Grammar& g, const Section& sec, const StaticTable& table, ThreadPool& pool,
+       uint64_t seed, uint64_t purpose, uint64_t step, int stepForMessages,
+       uint64_t maxModules)
+      : g_(g), sec_(sec), table_(table), pool_(pool), seed_(seed), purpose_(purpose),
+        step_(step), stepForMessages_(stepForMessages), maxModules_(maxModules) {
+    for (const auto& p : sec.productions) maxFormals_ = std::max<size_t>(maxFormals_, p.formalCount);
+    for (const auto& p : sec.productions) needsMatch_ |= p.HasContext();
+  }
+
+  Status Run(const Word& in, Word& out, bool* changed);
+
+ private:
+  void SplitChunks(const Word& in);
+  Status Allocate(Word& out, bool outHasParams);
+  // General path.
+  bool Choose(const WordView& w, size_t i, double* formals, uint32_t* choice, Chunk& c);
+  void Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams);
+  void Fail(Chunk& c, const Production& p, const EvalError& e, int column, size_t i);
+
+  const Grammar& g_;
+  const Section& sec_;
+  const StaticTable& table_;
+  ThreadPool& pool_;
+  uint64_t seed_, purpose_, step_;
+  int stepForMessages_;
+  uint64_t maxModules_;
+  size_t maxFormals_ = 0;
+  bool needsMatch_ = false;
+  std::vector<Chunk> chunks_;
+  PodBuffer<uint32_t> choice_;
+  PodBuffer<uint32_t> match_;
+};
+
+void Pass::SplitChunks(const Word& in) {
+  const size_t n = in.size();
+  size_t count = 1;
+  if (n >= 2 * kMinChunk && pool_.threads() > 1)
+    count = std::min<size_t>(size_t(pool_.threads()) * 8, n / kMinChunk);
+  chunks_.assign(count, Chunk{});
+  for (size_t k = 0; k < count; ++k) {
+    chunks_[k].begin = n * k / count;
+    chunks_[k].end = n * (k + 1) / count;
+    chunks_[k].inParam = in.paramStart.empty() ? 0 : in.paramStart[chunks_[k].begin];
+  }
+}
+
+Status Pass::Allocate(Word& out, bool outHasParams) {
+  uint64_t modules = 0, params = 0;
+  for (auto& c : chunks_) {
+    c.outModuleAt = modules;
+    c.outParamAt = params;
+    modules += c.outModules;
+    params += c.outParams;
+  }
+  if (modules > maxModules_) {
+    return LimitError("derivation step " + std::to_string(stepForMessages_) +
+                      " would make the word " + std::to_string(modules) +
+                      " modules long, more than the limit of " + std::to_string(maxModules_) +
+                      " (--max-modules)");
+  }
+  if (params > kMaxParams) {
+    return LimitError("derivation step " + std::to_string(stepForMessages_) +
+                      " would need " + std::to_string(params) +
+                      " parameters, more than the limit of " + std::to_string(kMaxParams));
+  }
+  out.Clear();
+  out.symbols.ResizeUninitialized(size_t(modules) + 16);  // slack for over-copying
+  out.symbols.ResizeUninitialized(size_t(modules));
+  if (outHasParams && params > 0) {
+    out.params.ResizeUninitialized(size_t(params));
+    out.paramStart.ResizeUninitialized(size_t(modules) + 1);
+    out.paramStart[size_t(modules)] = uint32_t(params);
+  }
+  return {};
+}
+
+void Pass::Fail(Chunk& c, const Production& p, const EvalError& e, int column, size_t i) {
+  if (c.error) return;
+  Diagnostic d = MakeError(SourceLoc{p.loc.file, p.loc.line, e.column ? e.column : column},
+                           e.message + " (module " + std::to_string(i + 1) + " of the word, step " +
+                               std::to_string(stepForMessages_) + ")",
+                           1, p.sourceLine);
+  c.error = std::move(d);
+}
+
+bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice, Chunk& c) {
+  const SymbolId sym = w.symbols[i];
+  const auto& list = sec_.bySymbol[sym];
+  RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2, 0};
+  const double* pp = w.paramStart ? w.params + w.paramStart[i] : nullptr;
+  const int arity = g_.symbols.arity(sym);
+  for (size_t li = 0; li < list.size(); ++li) {
+    const Production& p = sec_.productions[list[li]];
+    auto matches = [&](const Production& q) -> int {  // 1 yes, 0 no, -1 error
+      for (int k = 0; k < arity; ++k) formals[q.pred.firstFormal + k] = pp[k];
+      if (!q.left.empty() && !MatchLeft(q, w, i, formals)) return 0;
+      if (!q.right.empty() && !MatchRight(q, w, i, formals)) return 0;
+      if (q.condition) {
+        double v;
+        EvalError e;
+        if (!q.condition->Eval(formals, rng, &v, &e)) {
+          Fail(c, q, e, q.conditionColumn, i);
+          return -1;
+        }
+        if (v == 0) return 0;
+      }
+      return 1;
+    };
+    int m = matches(p);
+    if (m < 0) return false;
+    if (m == 0) continue;
+    if (!p.weight) {
+      *choice = list[li];
+      return true;
+    }
+    // Stochastic: draw among every matching production that carries a weight.
+    double weights[64];
+    uint32_t cands[64];
+    int nc = 0;
+    double total = 0;
+    for (size_t lj = li; lj < list.size() && nc < 64; ++lj) {
+      const Production& q = sec_.productions[list[lj]];
+      if (!q.weight) continue;
+      if (lj != li) {
+        int mq = matches(q);
+        if (mq < 0) return false;
+        if (mq == 0) continue;
+      }
+      double wv;
+      EvalError e;
+      if (!q.weight->Eval(formals, rng, &wv, &e)) {
+        Fail(c, q, e, q.weightColumn, i);
+        return false;
+      }
+      if (wv < 0) {
+        e.message = "negative probability weight";
+        Fail(c, q, e, q.weightColumn, i);
+        return false;
+      }
+      weights[nc] = wv;
+      cands[nc++] = list[lj];
+      total += wv;
+    }
+    if (total <= 0) {
+      *choice = kIdentity;
+      return true;
+    }
+    double r = rng.Uniform() * total;
+    int pick = nc - 1;
+    for (int k = 0; k < nc; ++k) {
+      if (r < weights[k]) {
+        pick = k;
+        break;
+      }
+      r -= weights[k];
+    }
+    *choice = cands[pick];
+    return true;
+  }
+  *choice = kIdentity;
+  return true;
+}
+
+void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams) {
+  std::vector<double> formals(maxFormals_ + 1);
+  size_t o = c.outModuleAt;
+  uint64_t po = c.outParamAt;
+  SymbolId* osym = out.symbols.data();
+  uint32_t* ostart = out.paramStart.empty() ? nullptr : out.paramStart.data();
+  double* opar = out.params.empty() ? nullptr : out.params.data();
+  const auto& arities = g_.symbols.arities();
+  for (size_t i = c.begin; i < c.end; ++i) {
+    const SymbolId sym = w.symbols[i];
+    const uint32_t ch = choice_.empty() ? kIdentity : choice_[i];
+    if (ch == kIdentity) {
+      osym[o] = sym;
+      if (ostart) {
+        ostart[o] = uint32_t(po);
+        const int a = arities[sym];
+        if (a) {
+          const double* src = in.params.data() + in.paramStart[i];
+          for (int k = 0; k < a; ++k) opar[po + k] = src[k];
+          po += a;
+        }
+      }
+      ++o;
+      continue;
+    }
+    const Production& p = sec_.productions[ch];
+    const Successor& s = p.successor;
+    if (!s.allConstant) {
+      // Bind formals for the chosen production.
+      const int a = arities[sym];
+      if (a) {
+        const double* src = in.params.data() + in.paramStart[i];
+        for (int k = 0; k < a; ++k) formals[p.pred.firstFormal + k] = src[k];
+      }
+      if (!p.left.empty()) MatchLeft(p, w, i, formals.data());
+      if (!p.right.empty()) MatchRight(p, w, i, formals.data());
+    }
+    RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2 + 1, 0};
+    size_t e = 0;
+    for (SymbolId x : s.symbols) {
+      osym[o] = x;
+      if (ostart) {
+        ostart[o] = uint32_t(po);
+        const int a = arities[x];
+        for (int k = 0; k < a; ++k, ++e) {
+          double v;
+          EvalError err;
+          if (!s.params[e].Eval(formals.data(), rng, &v, &err)) {
+            Fail(c, p, err, 0, i);
+            return;
+          }
+          opar[po++] = v;
+        }
+      }
+      ++o;
+    }
+  }
+}
+
+Status Pass::Run(const Word& in, Word& out, bool* changed) {
+  SplitChunks(in);
+  const size_t n = in.size();
+  const bool inHasParams = in.HasParams();
+
+  // Fast path: a fixed table of parameter-free successors.
+  if (table_.usable && !inHasParams) {
+    const SymbolId* sym = in.symbols.data();
+    const uint32_t* len = table_.length.data();
+    pool_.ParallelFor(chunks_.size(), [&](size_t k) {
+      Chunk& c = chunks_[k];
+      uint64_t total = 0;
+      for (size_t i = c.begin; i < c.end; ++i) total += len[sym[i]];
+      c.outModules = total;
+    });
+    if (Status s = Allocate(out, false); !s.ok()) return s;
+    const uint32_t* off = table_.offset.data();
+    const SymbolId* flat = table_.flat.data();
+    SymbolId* dst0 = out.symbols.data();
+    pool_.ParallelFor(chunks_.size(), [&](size_t k) {
+      Chunk& c = chunks_[k];
+      SymbolId* dst = dst0 + c.outModuleAt;
+      // Over-copying 8 symbols is safe up to 8 before the chunk's own end;
+      // past that it would overwrite the next chunk's output.
+      SymbolId* const safeEnd = dst + (c.outModules >= 8 ? c.outModules - 8 : 0);
+      for (size_t i = c.begin; i < c.end; ++i) {
+        const SymbolId s = sym[i];
+        const uint32_t l = len[s];
+        const SymbolId* src = flat + off[s];
+        if (l <= 8 && dst <= safeEnd) {
+          std::memcpy(dst, src, 16);  // over-copy; the table is padded
+        } else {
+          std::memcpy(dst, src, size_t(l) * sizeof(SymbolId));
+        }
+        dst += l;
+      }
+    });
+    // Changed unless every symbol maps to itself.
+    bool any = false;
+    for (size_t s = 0; s < table_.length.size() && !any; ++s)
+      any = !sec_.bySymbol[s].empty();
+    *changed = any && n > 0;
+    return {};
+  }
+
+  // General path.
+  WordView w;
+  w.symbols = in.symbols.data();
+  w.size = n;
+  w.paramStart = inHasParams ? in.paramStart.data() : nullptr;
+  w.params = inHasParams ? in.params.data() : nullptr;
+  w.skip = g_.contextSkip.data();
+  if (needsMatch_) {
+    match_.ResizeUninitialized(n);
+    ComputeBracketMatch(in.symbols.data(), n, match_.data());
+    w.bracketMatch = match_.data();
+  }
+  choice_.ResizeUninitialized(n);
+  const auto& arities = g_.symbols.arities();
+  pool_.ParallelFor(chunks_.size(), [&](size_t k) {
+    Chunk& c = chunks_[k];
+    std::vector<double> formals(maxFormals_ + 1);
+    uint64_t modules = 0, params = 0;
+    for (size_t i = c.begin; i < c.end; ++i) {
+      const SymbolId sym = w.symbols[i];
+      uint32_t ch = kIdentity;
+      if (!sec_.bySymbol[sym].empty()) {
+        if (!Choose(w, i, formals.data(), &ch, c)) return;
+      }
+      choice_[i] = ch;
+      if (ch == kIdentity) {
+        modules += 1;
+        params += arities[sym];
+      } else {
+        const Successor& s = sec_.productions[ch].successor;
+        modules += s.symbols.size();
+        params += s.params.size();
+        c.changed = true;
+      }
+    }
+    c.outModules = modules;
+    c.outParams = params;
+  });
+  for (auto& c : chunks_) {
+    if (c.error) return *c.error;
+  }
+  uint64_t totalParams = 0;
+  for (auto& c : chunks_) totalParams += c.outParams;
+  if (Status s = Allocate(out, totalParams > 0); !s.ok()) return s;
+  pool_.ParallelFor(chunks_.size(),
+                    [&](size_t k) { Write(w, in, out, chunks_[k], totalParams > 0); });
+  for (auto& c : chunks_) {
+    if (c.error) return *c.error;
+  }
+  *changed = false;
+  for (auto& c : chunks_) *changed |= c.changed;
+  return {};
+}
+
+// Removes each cut symbol and the rest of its branch (up to, not including,
+// the `]` that closes it, or to the end of the word). In place.
+void ApplyCut(Word& w, SymbolId cut) {
+  const size_t n = w.size();
+  const bool hasParams = w.HasParams();
+  size_t o = 0;
+  uint32_t po = 0;
+  for (size_t i = 0; i < n;) {
+    if (w.symbols[i] == cut) {
+      int depth = 0;
+      for (; i < n; ++i) {
+        SymbolId s = w.symbols[i];
+        if (s == kOpenBracket) ++depth;
+        else if (s == kCloseBracket && depth-- == 0) break;
+      }
+      continue;
+    }
+    if (hasParams) {
+      uint32_t a = w.paramStart[i], b = w.paramStart[i + 1];
+      w.paramStart[o] = po;
+      for (uint32_t k = a; k < b; ++k) w.params[po++] = w.params[k];
+    }
+    w.symbols[o++] = w.symbols[i];
+    ++i;
+  }
+  w.symbols.ResizeUninitialized(o);
+  if (hasParams) {
+    w.paramStart[o] = po;
+    w.paramStart.ResizeUninitialized(o + 1);
+    w.params.ResizeUninitialized(po);
+    if (po == 0) {
+      w.paramStart.clear();
+    }
+  }
+}
+
+bool ContainsSymbol(const Word& w, SymbolId s) {
+  return std::find(w.symbols.begin(), w.symbols.end(), s) != w.symbols.end();
+}
+
+Expected<Word> BuildAxiom(const Grammar& g, uint64_t seed) {
+  Word w;
+  const Successor& a = g.axiom;
+  RandomStream rng{seed, kAxiomDraws, 0, 0, 0};
+  size_t e = 0;
+  std::vector<double> values;
+  for (SymbolId s : a.symbols) {
+    values.clear();
+    for (int k = 0; k < g.symbols.arity(s); ++k, ++e) {
+      double v;
+      EvalError err;
+      if (!a.params[e].Eval(nullptr, rng, &v, &err)) {
+        return MakeError(g.axiomLoc, err.message + " in the axiom");
+      }
+      values.push_back(v);
+    }
+    w.Append(s, values);
+  }
+  return w;
+}
+
+// Runs passes of a decomposition or interpretation section until nothing
+// changes or the maximum depth is reached.
+Status RunSection(const Grammar& g, const Section& sec, ThreadPool& pool, uint64_t seed,
+                  uint64_t purpose, uint64_t step, int stepForMessages, uint64_t maxModules,
+                  Word& word) {
+  if (sec.empty()) return {};
+  StaticTable table = BuildStaticTable(g, sec);
+  Word next;
+  for (int depth = 0; depth < sec.maxDepth; ++depth) {
+    Pass pass(g, sec, table, pool, seed, purpose | (uint64_t(depth) << 8), step, stepForMessages,
+              maxModules);
+    bool changed = false;
+    if (Status s = pass.Run(word, next, &changed); !s.ok()) return s;
+    if (!changed) break;
+    word.symbols.swap(next.symbols);
+    word.params.swap(next.params);
+    word.paramStart.swap(next.paramStart);
+  }
+  return {};
+}
+
+}  // namespace
+
+Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
+  const auto t0 = Clock::now();
+  const uint64_t seed = options.seed.value_or(g.seed);
+  const int steps = options.steps >= 0 ? options.steps : g.derivationLength;
+  if (steps > kMaxDerivationLengthForDerive) {
+    Diagnostic d;
+    d.message = "derivation length " + std::to_string(steps) + " is more than the limit of " +
+                std::to_string(kMaxDerivationLengthForDerive);
+    return d;
+  }
+  const uint64_t maxModules = std::min(options.maxModules, kMaxModulesCap);
+  ThreadPool pool(options.threads);
+
+  DeriveResult result;
+  auto axiom = BuildAxiom(g, seed);
+  if (!axiom) return axiom.error();
+  result.word = std::move(axiom).value();
+  if (result.word.size() > maxModules) {
+    return LimitError("the axiom has " + std::to_string(result.word.size()) +
+                      " modules, more than the limit of " + std::to_string(maxModules));
+  }
+  result.steps.push_back(StepStats{0, result.word.size(), 0});
+
+  const StaticTable table = BuildStaticTable(g, g.main);
+  Word next;
+  bool fixedPoint = false;
+  for (int step = 1; step <= steps; ++step) {
+    const auto ts = Clock::now();
+    if (!fixedPoint) {
+      bool changed = false;
+      Pass pass(g, g.main, table, pool, seed, kMainDraws, uint64_t(step), step, maxModules);
+      if (Status s = pass.Run(result.word, next, &changed); !s.ok()) return s.error();
+      std::swap(result.word, next);
+      if (Status s = RunSection(g, g.decomposition, pool, seed, kDecompositionDraws,
+                                uint64_t(step), step, maxModules, result.word);
+          !s.ok())
+        return s.error();
+      if (g.cutSymbol && ContainsSymbol(result.word, *g.cutSymbol)) {
+        ApplyCut(result.word, *g.cutSymbol);
+        changed = true;
+      }
+      // With no production applied and no randomness, every later step
+      // gives this same word.
+      if (!changed && g.decomposition.empty() && !g.usesRandom) fixedPoint = true;
+    }
+    const double secs = std::chrono::duration<double>(Clock::now() - ts).count();
+    result.steps.push_back(StepStats{step, result.word.size(), secs});
+    if (options.progress) options.progress(step, steps, result.word.size());
+  }
+  next = Word();
+  result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return result;
+}
+
+Expected<Word> Interpret(const Grammar& g, const Word& word, const DeriveOptions& options) {
+  Word w = word;
+  if (g.interpretation.empty()) return w;
+  ThreadPool pool(options.threads);
+  const uint64_t seed = options.seed.value_or(g.seed);
+  const uint64_t maxModules = std::min(options.maxModules, kMaxModulesCap);
+  if (Status s = RunSection(g, g.interpretation, pool, seed, kInterpretDraws, 0, 0, maxModules, w);
+      !s.ok())
+    return s.error();
+  return w;
+}
+
+}  // namespace sylva::lsys

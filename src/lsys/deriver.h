@@ -1,0 +1,67 @@
+// Deriving words: parallel rewriting of a Grammar.
+//
+// Each step rewrites every module of the word of step k from that word
+// (parallel rewriting), then applies decomposition (up to its maximum
+// depth) and cut. The word is split into chunks that threads process in
+// two passes, after Lipp, Wonka & Wimmer, "Parallel generation of
+// multiple L-systems" (Computers & Graphics 34(5), 2010):
+//   1. choose a production per module and count the output size per chunk;
+//   2. prefix-sum the sizes, then write every chunk at its own offset.
+// Random draws are keyed by (seed, section, step, module index), never by
+// thread, so the word is the same for any thread count.
+//
+// Grammars whose choice per symbol is fixed and parameter-free (Koch curves,
+// bracketed plants) take a table-driven path that copies successors.
+//
+// Limits: a step that would make the word longer than maxModules, or hold
+// more than kMaxParams parameters, stops with an error naming the step and
+// the size, before any memory for it is allocated.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "core/status.h"
+#include "lsys/grammar.h"
+#include "lsys/word.h"
+
+namespace sylva::lsys {
+
+// 2^28 modules: 512 MiB of symbols for a parameter-free word.
+inline constexpr uint64_t kDefaultMaxModules = uint64_t(1) << 28;
+// 2^29 parameters: 4 GiB of doubles.
+inline constexpr uint64_t kMaxParams = uint64_t(1) << 29;
+inline constexpr uint64_t kMaxModulesCap = 0xFFFFFFF0ull;
+inline constexpr int kMaxDerivationLengthForDerive = 100000;  // steps
+
+struct DeriveOptions {
+  int steps = -1;                   // -1: the grammar's derivation length
+  std::optional<uint64_t> seed;     // overrides `seed:`
+  int threads = 0;                  // 0: all hardware threads
+  uint64_t maxModules = kDefaultMaxModules;
+  // Called after each step (from the calling thread).
+  std::function<void(int step, int steps, uint64_t modules)> progress;
+};
+
+struct StepStats {
+  int step = 0;          // 1-based; 0 is the axiom
+  uint64_t modules = 0;  // after the step
+  double seconds = 0;
+};
+
+struct DeriveResult {
+  Word word;
+  std::vector<StepStats> steps;  // steps[0] is the axiom
+  double seconds = 0;
+};
+
+Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options = {});
+
+// Applies the interpretation section (up to its maximum depth) to a derived
+// word: the word handed to the turtle. Returns a copy when the section is
+// empty.
+Expected<Word> Interpret(const Grammar& g, const Word& word, const DeriveOptions& options = {});
+
+}  // namespace sylva::lsys

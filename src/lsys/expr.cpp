@@ -1,0 +1,619 @@
+// Expression parser, constant folder, code generator and stack machine.
+#include "lsys/expr.h"
+
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+
+#include "core/math.h"
+#include "lsys/expr_parser.h"
+
+namespace sylva::lsys {
+
+Expr Expr::Constant(double v) {
+  Expr e;
+  e.kind_ = Kind::kConstant;
+  e.constant_ = v;
+  return e;
+}
+
+Expr Expr::Formal(uint32_t slot) {
+  Expr e;
+  e.kind_ = Kind::kFormal;
+  e.slot_ = slot;
+  return e;
+}
+
+// ---------------------------------------------------------------------------
+// Evaluation of one operation on values (shared by folding and the VM).
+
+static bool Fail(EvalError* err, int column, const char* msg) {
+  if (err) {
+    err->column = column;
+    err->message = msg;
+  }
+  return false;
+}
+
+static bool Finite(double v, EvalError* err, int column, const char* what) {
+  if (std::isfinite(v)) return true;
+  return Fail(err, column, what);
+}
+
+// Applies a pure (non-random, non-jump) operation to args; result in *out.
+static bool ApplyPure(OpCode op, const double* a, double* out, EvalError* err, int col) {
+  switch (op) {
+    case OpCode::kNeg: *out = -a[0]; return true;
+    case OpCode::kNot: *out = a[0] == 0 ? 1 : 0; return true;
+    case OpCode::kToBool: *out = a[0] != 0 ? 1 : 0; return true;
+    case OpCode::kAdd: *out = a[0] + a[1]; return Finite(*out, err, col, "overflow in '+'");
+    case OpCode::kSub: *out = a[0] - a[1]; return Finite(*out, err, col, "overflow in '-'");
+    case OpCode::kMul: *out = a[0] * a[1]; return Finite(*out, err, col, "overflow in '*'");
+    case OpCode::kDiv:
+      if (a[1] == 0) return Fail(err, col, "division by zero");
+      *out = a[0] / a[1];
+      return Finite(*out, err, col, "overflow in '/'");
+    case OpCode::kMod:
+      if (a[1] == 0) return Fail(err, col, "modulo by zero");
+      *out = std::fmod(a[0], a[1]);
+      return true;
+    case OpCode::kPow:
+    case OpCode::kPowFn:
+      *out = std::pow(a[0], a[1]);
+      return Finite(*out, err, col, "power is not a finite number (negative base, or overflow)");
+    case OpCode::kEq: *out = a[0] == a[1]; return true;
+    case OpCode::kNe: *out = a[0] != a[1]; return true;
+    case OpCode::kLt: *out = a[0] < a[1]; return true;
+    case OpCode::kLe: *out = a[0] <= a[1]; return true;
+    case OpCode::kGt: *out = a[0] > a[1]; return true;
+    case OpCode::kGe: *out = a[0] >= a[1]; return true;
+    case OpCode::kSin: *out = std::sin(a[0] * kDegToRad); return true;
+    case OpCode::kCos: *out = std::cos(a[0] * kDegToRad); return true;
+    case OpCode::kTan:
+      *out = std::tan(a[0] * kDegToRad);
+      return Finite(*out, err, col, "tan is infinite here");
+    case OpCode::kAsin:
+      if (a[0] < -1 || a[0] > 1) return Fail(err, col, "asin argument outside [-1, 1]");
+      *out = std::asin(a[0]) * kRadToDeg;
+      return true;
+    case OpCode::kAcos:
+      if (a[0] < -1 || a[0] > 1) return Fail(err, col, "acos argument outside [-1, 1]");
+      *out = std::acos(a[0]) * kRadToDeg;
+      return true;
+    case OpCode::kAtan: *out = std::atan(a[0]) * kRadToDeg; return true;
+    case OpCode::kAtan2: *out = std::atan2(a[0], a[1]) * kRadToDeg; return true;
+    case OpCode::kSqrt:
+      if (a[0] < 0) return Fail(err, col, "sqrt of a negative number");
+      *out = std::sqrt(a[0]);
+      return true;
+    case OpCode::kExp: *out = std::exp(a[0]); return Finite(*out, err, col, "exp overflows");
+    case OpCode::kLog:
+      if (a[0] <= 0) return Fail(err, col, "log of a number that is not positive");
+      *out = std::log(a[0]);
+      return true;
+    case OpCode::kAbs: *out = std::fabs(a[0]); return true;
+    case OpCode::kFloor: *out = std::floor(a[0]); return true;
+    case OpCode::kCeil: *out = std::ceil(a[0]); return true;
+    case OpCode::kTrunc: *out = std::trunc(a[0]); return true;
+    case OpCode::kSign: *out = a[0] > 0 ? 1 : (a[0] < 0 ? -1 : 0); return true;
+    case OpCode::kMin: *out = a[0] < a[1] ? a[0] : a[1]; return true;
+    case OpCode::kMax: *out = a[0] > a[1] ? a[0] : a[1]; return true;
+    case OpCode::kClamp: *out = a[0] < a[1] ? a[1] : (a[0] > a[2] ? a[2] : a[0]); return true;
+    default: return Fail(err, col, "internal error: not a pure operation");
+  }
+}
+
+static int OpArity(OpCode op) {
+  switch (op) {
+    case OpCode::kNeg: case OpCode::kNot: case OpCode::kToBool:
+    case OpCode::kSin: case OpCode::kCos: case OpCode::kTan: case OpCode::kAsin:
+    case OpCode::kAcos: case OpCode::kAtan: case OpCode::kSqrt: case OpCode::kExp:
+    case OpCode::kLog: case OpCode::kAbs: case OpCode::kFloor: case OpCode::kCeil:
+    case OpCode::kSign: case OpCode::kTrunc: case OpCode::kRan:
+      return 1;
+    case OpCode::kClamp: return 3;
+    default: return 2;
+  }
+}
+
+bool Expr::Run(const double* formals, RandomStream& rng, double* out, EvalError* err) const {
+  double stack[kMaxStack];
+  int sp = 0;
+  const Instr* code = code_.data();
+  const size_t n = code_.size();
+  for (size_t pc = 0; pc < n; ++pc) {
+    const Instr& in = code[pc];
+    switch (in.op) {
+      case OpCode::kConst: stack[sp++] = in.value; break;
+      case OpCode::kFormal: stack[sp++] = formals[in.arg]; break;
+      case OpCode::kAdd: --sp; stack[sp - 1] += stack[sp]; break;
+      case OpCode::kSub: --sp; stack[sp - 1] -= stack[sp]; break;
+      case OpCode::kMul: --sp; stack[sp - 1] *= stack[sp]; break;
+      case OpCode::kLt: --sp; stack[sp - 1] = stack[sp - 1] < stack[sp]; break;
+      case OpCode::kGt: --sp; stack[sp - 1] = stack[sp - 1] > stack[sp]; break;
+      case OpCode::kAndJump:
+        if (stack[sp - 1] == 0) {
+          stack[sp - 1] = 0;
+          pc = in.arg - 1;
+        } else {
+          --sp;
+        }
+        break;
+      case OpCode::kOrJump:
+        if (stack[sp - 1] != 0) {
+          stack[sp - 1] = 1;
+          pc = in.arg - 1;
+        } else {
+          --sp;
+        }
+        break;
+      case OpCode::kJumpIfZero:
+        --sp;
+        if (stack[sp] == 0) pc = in.arg - 1;
+        break;
+      case OpCode::kJump: pc = in.arg - 1; break;
+      case OpCode::kRan: stack[sp - 1] = stack[sp - 1] * rng.Uniform(); break;
+      case OpCode::kUniform:
+        --sp;
+        stack[sp - 1] = stack[sp - 1] + (stack[sp] - stack[sp - 1]) * rng.Uniform();
+        break;
+      case OpCode::kNormal:
+        --sp;
+        stack[sp - 1] = stack[sp - 1] + stack[sp] * rng.Normal();
+        break;
+      default: {
+        int k = OpArity(in.op);
+        sp -= k;
+        double r;
+        if (!ApplyPure(in.op, stack + sp, &r, err, in.column)) return false;
+        stack[sp++] = r;
+      }
+    }
+  }
+  *out = stack[0];
+  // Adds and multiplies skip their own checks in the loop above.
+  if (!std::isfinite(*out)) return Fail(err, code_.empty() ? 0 : code_.back().column,
+                                        "result is not a finite number (overflow)");
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Parsing to an AST, folding, emitting.
+
+namespace {
+
+struct Node {
+  OpCode op;
+  int column;
+  double value = 0;
+  uint32_t slot = 0;
+  std::vector<std::unique_ptr<Node>> kids;
+  bool ternary = false;
+};
+using NodePtr = std::unique_ptr<Node>;
+
+struct FunctionInfo {
+  const char* name;
+  OpCode op;
+  int args;
+};
+
+constexpr FunctionInfo kFunctions[] = {
+    {"sin", OpCode::kSin, 1},     {"cos", OpCode::kCos, 1},     {"tan", OpCode::kTan, 1},
+    {"asin", OpCode::kAsin, 1},   {"acos", OpCode::kAcos, 1},   {"atan", OpCode::kAtan, 1},
+    {"atan2", OpCode::kAtan2, 2}, {"sqrt", OpCode::kSqrt, 1},   {"exp", OpCode::kExp, 1},
+    {"log", OpCode::kLog, 1},     {"pow", OpCode::kPowFn, 2},   {"abs", OpCode::kAbs, 1},
+    {"floor", OpCode::kFloor, 1}, {"ceil", OpCode::kCeil, 1},   {"min", OpCode::kMin, 2},
+    {"max", OpCode::kMax, 2},     {"clamp", OpCode::kClamp, 3}, {"sign", OpCode::kSign, 1},
+    {"trunc", OpCode::kTrunc, 1}, {"ran", OpCode::kRan, 1},     {"uniform", OpCode::kUniform, 2},
+    {"normal", OpCode::kNormal, 2},
+};
+
+bool IsRandom(OpCode op) {
+  return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal;
+}
+
+constexpr int kMaxDepth = 48;
+
+class Parser {
+ public:
+  Parser(std::string_view text, size_t pos, const ExprScope& scope, ExprParseError* err)
+      : t_(text), p_(pos), scope_(scope), err_(err) {}
+
+  NodePtr Parse() { return Ternary(0); }
+  size_t pos() const { return p_; }
+
+ private:
+  void SkipSpace() {
+    while (p_ < t_.size() && (t_[p_] == ' ' || t_[p_] == '\t' || t_[p_] == '\r')) ++p_;
+  }
+  bool Peek(std::string_view s) {
+    SkipSpace();
+    return t_.substr(p_, s.size()) == s;
+  }
+  bool Accept(std::string_view s) {
+    if (!Peek(s)) return false;
+    p_ += s.size();
+    return true;
+  }
+  int Col() const { return int(p_) + 1; }
+  NodePtr Error(int col, std::string msg, int len = 1) {
+    if (err_->message.empty()) {
+      err_->column = col;
+      err_->length = len;
+      err_->message = std::move(msg);
+    }
+    return nullptr;
+  }
+  NodePtr Make(OpCode op, int col, NodePtr a = nullptr, NodePtr b = nullptr) {
+    auto n = std::make_unique<Node>();
+    n->op = op;
+    n->column = col;
+    if (a) n->kids.push_back(std::move(a));
+    if (b) n->kids.push_back(std::move(b));
+    return n;
+  }
+
+  NodePtr Ternary(int depth) {
+    if (depth > kMaxDepth) return Error(Col(), "expression nested too deeply");
+    NodePtr c = Binary(0, depth);
+    if (!c) return nullptr;
+    SkipSpace();
+    int col = Col();
+    if (!Accept("?")) return c;
+    NodePtr a = Ternary(depth + 1);
+    if (!a) return nullptr;
+    if (!Accept(":")) return Error(Col(), "expected ':' in conditional expression");
+    NodePtr b = Ternary(depth + 1);
+    if (!b) return nullptr;
+    auto n = Make(OpCode::kJumpIfZero, col, std::move(c), std::move(a));
+    n->kids.push_back(std::move(b));
+    n->ternary = true;
+    return n;
+  }
+
+  // Precedence levels 0..5: || && equality relational additive multiplicative.
+  NodePtr Binary(int level, int depth) {
+    if (level == 6) return Unary(depth);
+    NodePtr lhs = Binary(level + 1, depth);
+    if (!lhs) return nullptr;
+    for (;;) {
+      SkipSpace();
+      int col = Col();
+      OpCode op;
+      if (!MatchOp(level, &op)) return lhs;
+      NodePtr rhs = Binary(level + 1, depth);
+      if (!rhs) return nullptr;
+      lhs = Make(op, col, std::move(lhs), std::move(rhs));
+    }
+  }
+
+  bool MatchOp(int level, OpCode* op) {
+    switch (level) {
+      case 0: if (Accept("||")) { *op = OpCode::kOrJump; return true; } return false;
+      case 1: if (Accept("&&")) { *op = OpCode::kAndJump; return true; } return false;
+      case 2:
+        if (Accept("==")) { *op = OpCode::kEq; return true; }
+        if (Accept("!=")) { *op = OpCode::kNe; return true; }
+        return false;
+      case 3:
+        if (Accept("<=")) { *op = OpCode::kLe; return true; }
+        if (Accept(">=")) { *op = OpCode::kGe; return true; }
+        if (Accept("<")) { *op = OpCode::kLt; return true; }
+        if (Accept(">")) { *op = OpCode::kGt; return true; }
+        return false;
+      case 4:
+        if (Accept("+")) { *op = OpCode::kAdd; return true; }
+        if (Accept("-")) { *op = OpCode::kSub; return true; }
+        return false;
+      case 5:
+        if (Accept("*")) { *op = OpCode::kMul; return true; }
+        if (Accept("/")) { *op = OpCode::kDiv; return true; }
+        if (Accept("%")) { *op = OpCode::kMod; return true; }
+        return false;
+    }
+    return false;
+  }
+
+  NodePtr Unary(int depth) {
+    if (depth > kMaxDepth) return Error(Col(), "expression nested too deeply");
+    SkipSpace();
+    int col = Col();
+    if (Accept("-")) {
+      NodePtr a = Unary(depth + 1);
+      return a ? Make(OpCode::kNeg, col, std::move(a)) : nullptr;
+    }
+    if (Accept("+")) return Unary(depth + 1);
+    if (Peek("!") && !Peek("!=")) {
+      ++p_;
+      NodePtr a = Unary(depth + 1);
+      return a ? Make(OpCode::kNot, col, std::move(a)) : nullptr;
+    }
+    NodePtr base = Primary(depth);
+    if (!base) return nullptr;
+    SkipSpace();
+    int pcol = Col();
+    if (Accept("^")) {
+      NodePtr e = Unary(depth + 1);
+      if (!e) return nullptr;
+      return Make(OpCode::kPow, pcol, std::move(base), std::move(e));
+    }
+    return base;
+  }
+
+  NodePtr Number() {
+    int col = Col();
+    size_t start = p_;
+    while (p_ < t_.size() && std::isdigit(static_cast<unsigned char>(t_[p_]))) ++p_;
+    if (p_ < t_.size() && t_[p_] == '.') {
+      ++p_;
+      while (p_ < t_.size() && std::isdigit(static_cast<unsigned char>(t_[p_]))) ++p_;
+    }
+    if (p_ < t_.size() && (t_[p_] == 'e' || t_[p_] == 'E')) {
+      size_t q = p_ + 1;
+      if (q < t_.size() && (t_[q] == '+' || t_[q] == '-')) ++q;
+      if (q < t_.size() && std::isdigit(static_cast<unsigned char>(t_[q]))) {
+        p_ = q;
+        while (p_ < t_.size() && std::isdigit(static_cast<unsigned char>(t_[p_]))) ++p_;
+      } else {
+        return Error(col, "malformed number: exponent has no digits", int(q - start));
+      }
+    }
+    std::string s(t_.substr(start, p_ - start));
+    if (s == ".") return Error(col, "malformed number '.'");
+    // A number directly followed by a letter, digit or '.' is malformed (1.2.3, 3x).
+    if (p_ < t_.size() && (std::isalnum(static_cast<unsigned char>(t_[p_])) || t_[p_] == '.' ||
+                           t_[p_] == '_')) {
+      size_t q = p_;
+      while (q < t_.size() && (std::isalnum(static_cast<unsigned char>(t_[q])) || t_[q] == '.' ||
+                               t_[q] == '_'))
+        ++q;
+      return Error(col, "malformed number '" + std::string(t_.substr(start, q - start)) + "'",
+                   int(q - start));
+    }
+    double v = std::strtod(s.c_str(), nullptr);
+    if (!std::isfinite(v)) return Error(col, "number out of range '" + s + "'", int(s.size()));
+    auto n = Make(OpCode::kConst, col);
+    n->value = v;
+    return n;
+  }
+
+  NodePtr Primary(int depth) {
+    SkipSpace();
+    int col = Col();
+    if (p_ >= t_.size()) return Error(col, "expected an expression");
+    char c = t_[p_];
+    if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return Number();
+    if (c == '(') {
+      ++p_;
+      NodePtr e = Ternary(depth + 1);
+      if (!e) return nullptr;
+      if (!Accept(")")) return Error(Col(), "expected ')'");
+      return e;
+    }
+    if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
+      size_t start = p_;
+      while (p_ < t_.size() &&
+             (std::isalnum(static_cast<unsigned char>(t_[p_])) || t_[p_] == '_'))
+        ++p_;
+      std::string name(t_.substr(start, p_ - start));
+      int len = int(name.size());
+      SkipSpace();
+      if (p_ < t_.size() && t_[p_] == '(') return Call(name, col, len, depth);
+      // Formal parameters shadow constants.
+      if (scope_.formals) {
+        for (size_t i = 0; i < scope_.formals->size(); ++i) {
+          if ((*scope_.formals)[i] == name) {
+            auto n = Make(OpCode::kFormal, col);
+            n->slot = uint32_t(i);
+            return n;
+          }
+        }
+      }
+      if (scope_.constants) {
+        auto it = scope_.constants->find(name);
+        if (it != scope_.constants->end()) {
+          if (scope_.usedConstants) scope_.usedConstants->insert(name);
+          auto n = Make(OpCode::kConst, col);
+          n->value = it->second;
+          return n;
+        }
+      }
+      if (name == "pi" || name == "PI") {
+        auto n = Make(OpCode::kConst, col);
+        n->value = kPi;
+        return n;
+      }
+      for (const auto& f : kFunctions) {
+        if (name == f.name) return Error(col, "function '" + name + "' needs arguments", len);
+      }
+      return Error(col, "unknown name '" + name + "' in expression", len);
+    }
+    if (c == ')' || c == ',' || c == ':')
+      return Error(col, "expected an expression before '" + std::string(1, c) + "'");
+    std::string shown = static_cast<unsigned char>(c) >= 32 && static_cast<unsigned char>(c) < 127
+                            ? std::string(1, c)
+                            : "\\x" + std::to_string(static_cast<unsigned char>(c));
+    return Error(col, "unexpected character '" + shown + "' in expression");
+  }
+
+  NodePtr Call(const std::string& name, int col, int len, int depth) {
+    const FunctionInfo* fn = nullptr;
+    for (const auto& f : kFunctions) {
+      if (name == f.name) fn = &f;
+    }
+    if (!fn) return Error(col, "unknown function '" + name + "'", len);
+    ++p_;  // '('
+    auto n = Make(fn->op, col);
+    SkipSpace();
+    if (!Accept(")")) {
+      for (;;) {
+        NodePtr a = Ternary(depth + 1);
+        if (!a) return nullptr;
+        n->kids.push_back(std::move(a));
+        if (Accept(",")) continue;
+        if (Accept(")")) break;
+        return Error(Col(), "expected ',' or ')' in arguments of '" + name + "'");
+      }
+    }
+    if (int(n->kids.size()) != fn->args) {
+      return Error(col,
+                   "function '" + name + "' takes " + std::to_string(fn->args) + " argument" +
+                       (fn->args == 1 ? "" : "s") + ", given " + std::to_string(n->kids.size()),
+                   len);
+    }
+    return n;
+  }
+
+  std::string_view t_;
+  size_t p_;
+  const ExprScope& scope_;
+  ExprParseError* err_;
+};
+
+}  // namespace
+
+class ExprCompiler {
+ public:
+  explicit ExprCompiler(ExprParseError* err) : err_(err) {}
+
+  // Folds constant subtrees in place; false on a compile-time error.
+  bool Fold(Node& n) {
+    for (auto& k : n.kids) {
+      if (!Fold(*k)) return false;
+    }
+    if (n.op == OpCode::kConst || n.op == OpCode::kFormal || IsRandom(n.op)) return true;
+    for (auto& k : n.kids) {
+      if (k->op != OpCode::kConst) {
+        // Short-circuit forms fold when their deciding operand is constant.
+        return FoldPartial(n);
+      }
+    }
+    double args[3], r;
+    if (n.ternary) {
+      r = args[0] = n.kids[0]->value != 0 ? n.kids[1]->value : n.kids[2]->value;
+    } else if (n.op == OpCode::kAndJump) {
+      r = (n.kids[0]->value != 0 && n.kids[1]->value != 0) ? 1 : 0;
+    } else if (n.op == OpCode::kOrJump) {
+      r = (n.kids[0]->value != 0 || n.kids[1]->value != 0) ? 1 : 0;
+    } else {
+      for (size_t i = 0; i < n.kids.size(); ++i) args[i] = n.kids[i]->value;
+      EvalError e;
+      if (!ApplyPure(n.op, args, &r, &e, n.column)) {
+        err_->column = e.column;
+        err_->message = e.message;
+        return false;
+      }
+    }
+    n.op = OpCode::kConst;
+    n.value = r;
+    n.ternary = false;
+    n.kids.clear();
+    return true;
+  }
+
+  bool FoldPartial(Node& n) {
+    const Node& first = *n.kids[0];
+    if (first.op != OpCode::kConst) return true;
+    NodePtr keep;
+    if (n.ternary) {
+      keep = std::move(n.kids[first.value != 0 ? 1 : 2]);
+    } else if (n.op == OpCode::kAndJump && first.value == 0) {
+      n.kids.clear();
+      n.op = OpCode::kConst;
+      n.value = 0;
+      return true;
+    } else if (n.op == OpCode::kOrJump && first.value != 0) {
+      n.kids.clear();
+      n.op = OpCode::kConst;
+      n.value = 1;
+      return true;
+    } else {
+      return true;
+    }
+    Node tmp = std::move(*keep);
+    n = std::move(tmp);
+    return true;
+  }
+
+  void Emit(const Node& n, std::vector<Instr>& code, int depth, int* maxDepth) {
+    auto push = [&](OpCode op, uint32_t arg = 0, double v = 0) {
+      code.push_back(Instr{op, uint16_t(n.column > 65535 ? 65535 : n.column), arg, v});
+    };
+    if (depth > *maxDepth) *maxDepth = depth;
+    switch (n.op) {
+      case OpCode::kConst: push(OpCode::kConst, 0, n.value); return;
+      case OpCode::kFormal: push(OpCode::kFormal, n.slot); return;
+      default: break;
+    }
+    if (n.ternary) {
+      Emit(*n.kids[0], code, depth, maxDepth);
+      size_t jz = code.size();
+      push(OpCode::kJumpIfZero);
+      Emit(*n.kids[1], code, depth, maxDepth);
+      size_t jmp = code.size();
+      push(OpCode::kJump);
+      code[jz].arg = uint32_t(code.size());
+      Emit(*n.kids[2], code, depth, maxDepth);
+      code[jmp].arg = uint32_t(code.size());
+      return;
+    }
+    if (n.op == OpCode::kAndJump || n.op == OpCode::kOrJump) {
+      Emit(*n.kids[0], code, depth, maxDepth);
+      size_t j = code.size();
+      push(n.op);
+      Emit(*n.kids[1], code, depth, maxDepth);
+      push(OpCode::kToBool);
+      code[j].arg = uint32_t(code.size());
+      return;
+    }
+    for (size_t i = 0; i < n.kids.size(); ++i) Emit(*n.kids[i], code, depth + int(i), maxDepth);
+    push(n.op);
+  }
+
+  static bool AnyRandom(const Node& n) {
+    if (IsRandom(n.op)) return true;
+    for (const auto& k : n.kids) {
+      if (AnyRandom(*k)) return true;
+    }
+    return false;
+  }
+
+  bool Finish(const Node& root, Expr* out) {
+    Expr e;
+    if (root.op == OpCode::kConst) {
+      e = Expr::Constant(root.value);
+    } else if (root.op == OpCode::kFormal) {
+      e = Expr::Formal(root.slot);
+    } else {
+      e.kind_ = Expr::Kind::kCode;
+      int maxDepth = 0;
+      Emit(root, e.code_, 1, &maxDepth);
+      if (maxDepth >= Expr::kMaxStack) {
+        err_->column = root.column;
+        err_->message = "expression too complex (evaluation stack deeper than 64)";
+        return false;
+      }
+      e.usesRandom_ = AnyRandom(root);
+    }
+    *out = std::move(e);
+    return true;
+  }
+
+ private:
+  ExprParseError* err_;
+};
+
+bool ParseExpr(std::string_view text, size_t* pos, const ExprScope& scope, Expr* out,
+               ExprParseError* err) {
+  Parser p(text, *pos, scope, err);
+  NodePtr root = p.Parse();
+  if (!root) return false;
+  *pos = p.pos();
+  ExprCompiler c(err);
+  if (!c.Fold(*root)) return false;
+  return c.Finish(*root, out);
+}
+
+}  // namespace sylva::lsys

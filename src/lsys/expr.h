@@ -1,0 +1,88 @@
+// Expressions of the grammar language, compiled once to a compact stack
+// code and evaluated per module with no allocation, map lookup or string
+// work.
+//
+// Constant sub-expressions (numbers, #define constants, pi and the pure
+// functions of them) are folded at compile time. A compiled Expr is one of:
+//   a constant            (most successor parameters: `F(1)`, `+(a0)`)
+//   a formal parameter    (`F(l)`)
+//   code                  (up to kMaxStack deep)
+// Run-time failures (division by zero, a result that is not finite, a
+// function outside its domain) are reported with the column of the
+// operation that failed, never turned into NaN.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/rng.h"
+
+namespace sylva::lsys {
+
+enum class OpCode : uint8_t {
+  kConst, kFormal,
+  kNeg, kNot, kAdd, kSub, kMul, kDiv, kMod, kPow,
+  kEq, kNe, kLt, kLe, kGt, kGe,
+  kAndJump,   // if top == 0: top = 0 and jump; else pop
+  kOrJump,    // if top != 0: top = 1 and jump; else pop
+  kToBool,
+  kJumpIfZero,  // pop; jump if zero
+  kJump,
+  kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2,
+  kSqrt, kExp, kLog, kPowFn, kAbs, kFloor, kCeil, kMin, kMax, kClamp, kSign, kTrunc,
+  kRan, kUniform, kNormal,
+};
+
+struct Instr {
+  OpCode op;
+  uint16_t column;  // of the operation, for run-time errors
+  uint32_t arg;     // formal slot or jump target
+  double value;     // constant
+};
+
+struct EvalError {
+  int column = 0;
+  std::string message;
+};
+
+class Expr {
+ public:
+  enum class Kind : uint8_t { kConstant, kFormal, kCode };
+
+  static Expr Constant(double v);
+  static Expr Formal(uint32_t slot);
+
+  Kind kind() const { return kind_; }
+  bool IsConstant() const { return kind_ == Kind::kConstant; }
+  double constant() const { return constant_; }
+  bool UsesRandom() const { return usesRandom_; }
+
+  // Evaluates with the given formal values; random functions draw from rng.
+  // Returns false and fills *err on a run-time failure.
+  bool Eval(const double* formals, RandomStream& rng, double* out, EvalError* err) const {
+    if (kind_ == Kind::kConstant) {
+      *out = constant_;
+      return true;
+    }
+    if (kind_ == Kind::kFormal) {
+      *out = formals[slot_];
+      return true;
+    }
+    return Run(formals, rng, out, err);
+  }
+
+  static constexpr int kMaxStack = 64;
+
+ private:
+  friend class ExprCompiler;
+  bool Run(const double* formals, RandomStream& rng, double* out, EvalError* err) const;
+
+  Kind kind_ = Kind::kConstant;
+  bool usesRandom_ = false;
+  uint32_t slot_ = 0;
+  double constant_ = 0;
+  std::vector<Instr> code_;
+};
+
+}  // namespace sylva::lsys

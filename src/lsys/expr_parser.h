@@ -1,0 +1,44 @@
+// Parsing expressions from grammar text into Expr.
+//
+// Grammar (C precedence, `^` is power and binds tighter than unary minus on
+// its right: -2^2 = -4):
+//   ternary := or ['?' ternary ':' ternary]
+//   or      := and {'||' and}        and := eq {'&&' eq}
+//   eq      := rel {('=='|'!=') rel} rel := add {('<'|'<='|'>'|'>=') add}
+//   add     := mul {('+'|'-') mul}   mul := unary {('*'|'/'|'%') unary}
+//   unary   := ('-'|'+'|'!') unary | power
+//   power   := primary ['^' unary]
+//   primary := number | name | name '(' args ')' | '(' ternary ')'
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include "core/diagnostic.h"
+#include "lsys/expr.h"
+
+namespace sylva::lsys {
+
+// What names mean inside one expression.
+struct ExprScope {
+  const std::unordered_map<std::string, double>* constants = nullptr;
+  std::unordered_set<std::string>* usedConstants = nullptr;  // may be null
+  const std::vector<std::string>* formals = nullptr;         // slot = index
+};
+
+// Parses one expression starting at text[pos]; stops before the first
+// character that cannot continue it (',' ')' ':' or end) and sets *pos
+// there. Columns in errors are 1 + byte offset into `text` + colBase.
+struct ExprParseError {
+  int column = 0;
+  int length = 1;
+  std::string message;
+};
+
+bool ParseExpr(std::string_view text, size_t* pos, const ExprScope& scope, Expr* out,
+               ExprParseError* err);
+
+}  // namespace sylva::lsys

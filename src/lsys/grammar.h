@@ -1,0 +1,88 @@
+// Grammar: a parsed and checked L-system, ready to derive.
+//
+// Productions are grouped per section (main, decomposition, interpretation)
+// and indexed by predecessor symbol, so choosing a production for a module
+// looks only at the productions of its own symbol, in file order.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "core/diagnostic.h"
+#include "lsys/expr.h"
+#include "lsys/symbols.h"
+#include "lsys/word.h"
+
+namespace sylva::lsys {
+
+// A module with formal parameters, as in a predecessor or a context.
+// Its parameters bind formal slots [firstFormal, firstFormal + arity).
+struct FormalModule {
+  SymbolId symbol = 0;
+  uint16_t firstFormal = 0;
+};
+
+// A successor word: its modules and one Expr per parameter, in order.
+struct Successor {
+  std::vector<SymbolId> symbols;
+  std::vector<Expr> params;
+  bool allConstant = true;  // every parameter is a constant
+};
+
+struct Production {
+  std::vector<FormalModule> left;   // in word order; empty = any
+  FormalModule pred;
+  std::vector<FormalModule> right;  // may contain brackets; empty = any
+  uint16_t formalCount = 0;
+  std::optional<Expr> condition;    // none = always true
+  std::optional<Expr> weight;       // none = not stochastic
+  Successor successor;
+  SourceLoc loc;                    // of the predecessor
+  std::string sourceLine;
+  // Columns of the parts, for run-time error messages.
+  int conditionColumn = 0, weightColumn = 0;
+
+  bool HasContext() const { return !left.empty() || !right.empty(); }
+};
+
+struct Section {
+  std::vector<Production> productions;                // file order
+  std::vector<std::vector<uint32_t>> bySymbol;        // symbol id -> production indices
+  int maxDepth = 1;                                   // decomposition/interpretation passes
+
+  bool empty() const { return productions.empty(); }
+};
+
+struct Tropism {
+  double x = 0, y = -1, z = 0, susceptibility = 0;
+};
+
+struct Grammar {
+  std::string name;             // `lsystem:` or the file name
+  std::string path;             // main file
+  int derivationLength = 0;
+  double angle = 90;            // degrees
+  double step = 1;
+  double width = 1;
+  double widthFactor = 0.7;
+  std::optional<Tropism> tropism;
+  uint64_t seed = 1;
+
+  SymbolTable symbols;
+  Successor axiom;  // parameters are evaluated when a derivation starts (seed)
+  SourceLoc axiomLoc;
+  Section main, decomposition, interpretation;
+
+  // Per symbol id: 1 when context matching skips it (ignore:/consider:).
+  std::vector<uint8_t> contextSkip;
+  std::optional<SymbolId> cutSymbol;  // the id of `%` when the grammar uses it
+  bool usesContext = false;           // some production has a context
+  bool usesRandom = false;            // weights or random functions anywhere
+
+  std::unordered_map<std::string, double> constants;  // after -D overrides
+};
+
+}  // namespace sylva::lsys

@@ -1,0 +1,105 @@
+#include "lsys/matcher.h"
+
+#include <vector>
+
+namespace sylva::lsys {
+
+void ComputeBracketMatch(const SymbolId* symbols, size_t n, uint32_t* match) {
+  std::vector<uint32_t> stack;
+  stack.reserve(256);
+  for (size_t i = 0; i < n; ++i) {
+    SymbolId s = symbols[i];
+    if (s == kOpenBracket) {
+      stack.push_back(uint32_t(i));
+      match[i] = kNoMatch;
+    } else if (s == kCloseBracket) {
+      if (stack.empty()) {
+        match[i] = kNoMatch;
+      } else {
+        uint32_t o = stack.back();
+        stack.pop_back();
+        match[i] = o;
+        match[o] = uint32_t(i);
+      }
+    }
+  }
+}
+
+static inline void Bind(const FormalModule& fm, const WordView& w, size_t j, double* formals) {
+  if (!w.paramStart) return;
+  uint32_t a = w.paramStart[j], b = w.paramStart[j + 1];
+  double* dst = formals + fm.firstFormal;
+  for (uint32_t k = a; k < b; ++k) *dst++ = w.params[k];
+}
+
+bool MatchLeft(const Production& p, const WordView& w, size_t i, double* formals) {
+  size_t j = i;
+  for (size_t c = p.left.size(); c-- > 0;) {
+    SymbolId s;
+    for (;;) {
+      if (j == 0) return false;
+      --j;
+      s = w.symbols[j];
+      if (s == kCloseBracket) {
+        uint32_t m = w.bracketMatch[j];
+        if (m == kNoMatch) return false;
+        j = m;  // skip the sibling branch; the loop steps before its '['
+        continue;
+      }
+      if (s == kOpenBracket || w.skip[s]) continue;  // step out to the parent / ignored
+      break;
+    }
+    if (s != p.left[c].symbol) return false;
+    Bind(p.left[c], w, j, formals);
+  }
+  return true;
+}
+
+bool MatchRight(const Production& p, const WordView& w, size_t i, double* formals) {
+  static constexpr int kMaxNesting = 64;
+  uint32_t opened[kMaxNesting];  // word positions of '[' the context descended into
+  int depth = 0;
+  size_t j = i + 1;
+  const size_t n = w.size;
+  for (const FormalModule& fm : p.right) {
+    if (fm.symbol == kOpenBracket) {
+      while (j < n && w.symbols[j] != kOpenBracket && w.symbols[j] != kCloseBracket &&
+             w.skip[w.symbols[j]])
+        ++j;
+      if (j >= n || w.symbols[j] != kOpenBracket || depth == kMaxNesting) return false;
+      opened[depth++] = uint32_t(j);
+      ++j;
+      continue;
+    }
+    if (fm.symbol == kCloseBracket) {
+      if (depth == 0) return false;
+      uint32_t m = w.bracketMatch[opened[--depth]];
+      if (m == kNoMatch) return false;
+      j = size_t(m) + 1;
+      continue;
+    }
+    SymbolId s;
+    for (;;) {
+      if (j >= n) return false;
+      s = w.symbols[j];
+      if (s == kOpenBracket) {  // a sibling branch the context does not name
+        uint32_t m = w.bracketMatch[j];
+        if (m == kNoMatch) return false;
+        j = size_t(m) + 1;
+        continue;
+      }
+      if (s == kCloseBracket) return false;  // end of this branch
+      if (w.skip[s]) {
+        ++j;
+        continue;
+      }
+      break;
+    }
+    if (s != fm.symbol) return false;
+    Bind(fm, w, j, formals);
+    ++j;
+  }
+  return true;
+}
+
+}  // namespace sylva::lsys

@@ -1,0 +1,1093 @@
+// Grammar file reader. Two stages:
+//   1. Preprocess: split lines, blank out comments (columns are kept), and
+//      splice #include files in place, with recursion and depth checks.
+//   2. Parse line by line: #define, header statements, section keywords,
+//      productions. Each line is parsed on its own, so an error on one line
+//      does not hide the errors on the next.
+// Then: brackets, context skip tables and the warnings.
+#include "lsys/parser.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <set>
+#include <unordered_set>
+
+#include "core/atomic_file.h"
+#include "lsys/expr_parser.h"
+
+namespace sylva::lsys {
+namespace {
+
+struct Line {
+  int file = 0;
+  int number = 0;
+  std::string text;      // comments blanked, same columns
+  std::string original;  // for excerpts
+};
+
+struct Define {
+  SourceLoc loc;
+  std::string line;
+  int length = 1;
+};
+
+struct ArityUse {
+  int arity;
+  SourceLoc loc;
+};
+
+bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+bool IsIdentStart(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+bool IsIdentChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+// Single-character module names besides letters and digits.
+constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_";
+
+// cpfg's @ commands, longest first where they share a prefix.
+constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS",
+                                            "@PD", "@Ts", "@Sx", "@O", "@o",  "@c",  "@v",
+                                            "@M",  "@m",  "@R",  "@D",  "@i",  "@L",  "@b"};
+
+std::string Lower(std::string_view s) {
+  std::string r(s);
+  for (char& c : r) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return r;
+}
+
+std::string Printable(char c) {
+  auto u = static_cast<unsigned char>(c);
+  if (u >= 32 && u < 127) return std::string(1, c);
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "\\x%02x", u);
+  return buf;
+}
+
+class GrammarParser {
+ public:
+  explicit GrammarParser(const ParseOptions& options) : opt_(options) {}
+
+  ParseResult Run(const std::string& text, const std::string& path);
+
+ private:
+  // --- diagnostics ---
+  SourceLoc Loc(const Line& l, int col) const { return SourceLoc{files_[l.file], l.number, col}; }
+  void Error(const Line& l, int col, std::string msg, int len = 1) {
+    if (int(diags_.ErrorCount()) >= kMaxErrors) return;
+    diags_.Add(MakeError(Loc(l, col), std::move(msg), len, l.original));
+  }
+  void Warn(SourceLoc loc, std::string line, std::string msg, int len = 1) {
+    Diagnostic d = MakeError(std::move(loc), std::move(msg), len, std::move(line));
+    d.severity = Severity::kWarning;
+    warnings_.push_back(std::move(d));
+  }
+
+  // --- preprocessing ---
+  std::optional<std::string> Read(const std::string& path) {
+    if (opt_.readFile) return opt_.readFile(path);
+    auto r = ReadFile(path);
+    if (!r) return std::nullopt;
+    return std::move(r).value();
+  }
+  void Preprocess(const std::string& text, const std::string& path, int depth,
+                  std::vector<std::string>& stack);
+
+  // --- parsing ---
+  void ParseLine(const Line& l);
+  bool ParseHeader(const Line& l, size_t pos);
+  void ParseDefine(const Line& l, size_t pos);
+  void ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen);
+  bool LexName(const Line& l, size_t& pos, size_t end, std::string* name);
+  bool ParseActualWord(const Line& l, size_t pos, size_t end, const ExprScope& scope,
+                       Successor* out);
+  struct Formal {
+    std::string name;
+    std::vector<std::string> params;
+    int column = 0;
+    bool wildcard = false;
+  };
+  bool ParseFormalWord(const Line& l, size_t& pos, size_t end, std::vector<Formal>* out);
+  bool ParseConstExpr(const Line& l, size_t pos, size_t end, double* out, Expr* expr = nullptr);
+  bool CheckBrackets(const Line& l, const std::vector<SymbolId>& syms,
+                     const std::vector<int>& cols, const char* what);
+  std::optional<SymbolId> Intern(const Line& l, int col, const std::string& name, int arity);
+  void Finish();
+  void WarnUnmatchable();
+
+  const ParseOptions& opt_;
+  std::vector<std::string> files_;
+  std::vector<Line> lines_;
+  DiagnosticList diags_;
+  std::vector<Diagnostic> warnings_;
+  Grammar g_;
+  Section* section_ = &g_.main;
+  bool haveAxiom_ = false;
+  bool ended_ = false;
+  Successor axiom_;
+  SourceLoc axiomLoc_;
+  std::vector<int> axiomCols_;
+  std::vector<std::string> declared_;  // module: names, longest first
+  std::unordered_map<std::string, Define> defines_;
+  std::unordered_set<std::string> usedConstants_;
+  std::set<std::string> usedOverrides_;
+  std::unordered_map<std::string, ArityUse> arityUse_;
+  std::set<std::string> ignoreNames_, considerNames_;
+  bool haveIgnore_ = false, haveConsider_ = false;
+  std::vector<std::string> productionLines_;
+};
+
+// ---------------------------------------------------------------------------
+// Preprocessing
+
+void GrammarParser::Preprocess(const std::string& text, const std::string& path, int depth,
+                               std::vector<std::string>& stack) {
+  int file = int(files_.size());
+  files_.push_back(path);
+  // Split into lines (\n, \r\n).
+  std::vector<std::string> raw;
+  size_t start = 0;
+  for (size_t i = 0; i <= text.size(); ++i) {
+    if (i == text.size() || text[i] == '\n') {
+      std::string s = text.substr(start, i - start);
+      if (!s.empty() && s.back() == '\r') s.pop_back();
+      raw.push_back(std::move(s));
+      start = i + 1;
+    }
+  }
+  if (!raw.empty() && raw.back().empty() && !text.empty()) raw.pop_back();
+
+  bool inBlock = false;
+  Line blockStart;
+  int blockCol = 0;
+  for (size_t n = 0; n < raw.size(); ++n) {
+    Line l;
+    l.file = file;
+    l.number = int(n) + 1;
+    l.original = raw[n];
+    l.text = raw[n];
+    std::string& t = l.text;
+    for (size_t i = 0; i < t.size(); ++i) {
+      if (inBlock) {
+        if (t[i] == '*' && i + 1 < t.size() && t[i + 1] == '/') {
+          t[i] = t[i + 1] = ' ';
+          ++i;
+          inBlock = false;
+        } else {
+          t[i] = ' ';
+        }
+      } else if (t[i] == '/' && i + 1 < t.size() && t[i + 1] == '*') {
+        inBlock = true;
+        blockStart = l;
+        blockCol = int(i) + 1;
+        t[i] = t[i + 1] = ' ';
+        ++i;
+      } else if (t[i] == '/' && i + 1 < t.size() && t[i + 1] == '/') {
+        for (size_t k = i; k < t.size(); ++k) t[k] = ' ';
+        break;
+      }
+    }
+    // #include splices another file here.
+    size_t p = 0;
+    while (p < t.size() && IsSpace(t[p])) ++p;
+    if (t.compare(p, 8, "#include") == 0) {
+      size_t q = p + 8;
+      while (q < t.size() && IsSpace(t[q])) ++q;
+      char close = q < t.size() && t[q] == '"' ? '"' : (q < t.size() && t[q] == '<' ? '>' : 0);
+      size_t e = close ? t.find(close, q + 1) : std::string::npos;
+      if (!close || e == std::string::npos) {
+        Error(l, int(q) + 1, "expected a file name in quotes after #include");
+        continue;
+      }
+      std::string name = t.substr(q + 1, e - q - 1);
+      std::filesystem::path target(name);
+      if (target.is_relative()) target = std::filesystem::path(path).parent_path() / target;
+      std::string resolved = target.lexically_normal().string();
+      int col = int(q) + 1, len = int(e - q) + 1;
+      if (std::find(stack.begin(), stack.end(), resolved) != stack.end()) {
+        Error(l, col, "#include recursion: '" + name + "' is already being included", len);
+        continue;
+      }
+      if (depth + 1 > kMaxIncludeDepth) {
+        Error(l, col, "#include nested deeper than " + std::to_string(kMaxIncludeDepth), len);
+        continue;
+      }
+      auto content = Read(resolved);
+      if (!content) {
+        Error(l, col, "cannot read included file '" + resolved + "'", len);
+        continue;
+      }
+      stack.push_back(resolved);
+      Preprocess(*content, resolved, depth + 1, stack);
+      stack.pop_back();
+      continue;
+    }
+    lines_.push_back(std::move(l));
+  }
+  if (inBlock) Error(blockStart, blockCol, "unterminated comment: '/*' has no '*/'", 2);
+}
+
+// ---------------------------------------------------------------------------
+// Lexing module names and words
+
+bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string* name) {
+  const std::string& t = l.text;
+  char c = t[pos];
+  for (const auto& d : declared_) {
+    if (pos + d.size() <= end && t.compare(pos, d.size(), d) == 0) {
+      *name = d;
+      pos += d.size();
+      return true;
+    }
+  }
+  if (c == '~') {
+    size_t q = pos + 1;
+    if (q < end && IsIdentStart(t[q])) {
+      while (q < end && IsIdentChar(t[q])) ++q;
+      *name = t.substr(pos, q - pos);
+      pos = q;
+      return true;
+    }
+    Error(l, int(pos) + 1, "expected a surface name after '~'");
+    return false;
+  }
+  if (c == '@') {
+    for (auto cmd : kAtCommands) {
+      if (pos + cmd.size() <= end && t.compare(pos, cmd.size(), cmd) == 0) {
+        *name = std::string(cmd);
+        pos += cmd.size();
+        return true;
+      }
+    }
+    if (pos + 1 < end && std::isalpha(static_cast<unsigned char>(t[pos + 1]))) {
+      *name = t.substr(pos, 2);
+      pos += 2;
+      return true;
+    }
+    Error(l, int(pos) + 1, "expected a command letter after '@'");
+    return false;
+  }
+  if (c == '?') {
+    if (pos + 1 < end && std::isupper(static_cast<unsigned char>(t[pos + 1]))) {
+      *name = t.substr(pos, 2);
+      pos += 2;
+      return true;
+    }
+    Error(l, int(pos) + 1, "expected a query letter after '?' (?P, ?H, ?L, ?U)");
+    return false;
+  }
+  if (std::isalnum(static_cast<unsigned char>(c)) || kModuleChars.find(c) != std::string_view::npos) {
+    *name = std::string(1, c);
+    ++pos;
+    return true;
+  }
+  if (c == '(') {
+    Error(l, int(pos) + 1, "parameter list with no module name before it");
+  } else if (c == ')') {
+    Error(l, int(pos) + 1, "unbalanced ')'");
+  } else {
+    Error(l, int(pos) + 1, "unexpected character '" + Printable(c) + "' in a module word");
+  }
+  return false;
+}
+
+std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std::string& name,
+                                              int arity) {
+  if (arity > kMaxArity) {
+    Error(l, col, "module '" + name + "' has more than " + std::to_string(kMaxArity) +
+                      " parameters");
+    return std::nullopt;
+  }
+  if ((name == "[" || name == "]" || name == "%") && arity > 0) {
+    Error(l, col, "'" + name + "' takes no parameters");
+    return std::nullopt;
+  }
+  auto id = g_.symbols.Intern(name, arity);
+  if (!id) {
+    Error(l, col, "too many distinct modules (the limit is 65535)");
+    return std::nullopt;
+  }
+  auto it = arityUse_.find(name);
+  if (it == arityUse_.end()) {
+    arityUse_.emplace(name, ArityUse{arity, Loc(l, col)});
+  } else if (it->second.arity != arity && name != "[" && name != "]") {
+    // One warning per name.
+    if (it->second.arity >= 0) {
+      Warn(Loc(l, col), l.original,
+           "module '" + name + "' is used with " + std::to_string(arity) + " parameter" +
+               (arity == 1 ? "" : "s") + " here and with " + std::to_string(it->second.arity) +
+               " at line " + std::to_string(it->second.loc.line) + "; they are different modules",
+           int(name.size()));
+      it->second.arity = -1;
+    }
+  }
+  return id;
+}
+
+bool GrammarParser::CheckBrackets(const Line& l, const std::vector<SymbolId>& syms,
+                                  const std::vector<int>& cols, const char* what) {
+  std::vector<int> open;
+  for (size_t i = 0; i < syms.size(); ++i) {
+    if (syms[i] == kOpenBracket) {
+      open.push_back(cols[i]);
+    } else if (syms[i] == kCloseBracket) {
+      if (open.empty()) {
+        Error(l, cols[i], std::string("unbalanced ']' in ") + what);
+        return false;
+      }
+      open.pop_back();
+    }
+  }
+  if (!open.empty()) {
+    Error(l, open.back(), std::string("unbalanced '[' in ") + what + ": no matching ']'");
+    return false;
+  }
+  return true;
+}
+
+bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const ExprScope& scope,
+                                    Successor* out) {
+  const std::string& t = l.text;
+  std::vector<int> cols;
+  std::string_view view(t.data(), end);
+  for (;;) {
+    while (pos < end && IsSpace(t[pos])) ++pos;
+    if (pos >= end) break;
+    int col = int(pos) + 1;
+    std::string name;
+    if (!LexName(l, pos, end, &name)) return false;
+    size_t q = pos;
+    while (q < end && IsSpace(t[q])) ++q;
+    int arity = 0;
+    if (q < end && t[q] == '(') {
+      pos = q + 1;
+      for (;;) {
+        Expr e;
+        ExprParseError err;
+        if (!ParseExpr(view, &pos, scope, &e, &err)) {
+          Error(l, err.column, err.message, err.length);
+          return false;
+        }
+        if (!e.IsConstant()) out->allConstant = false;
+        out->params.push_back(std::move(e));
+        ++arity;
+        while (pos < end && IsSpace(t[pos])) ++pos;
+        if (pos < end && t[pos] == ',') {
+          ++pos;
+          continue;
+        }
+        if (pos < end && t[pos] == ')') {
+          ++pos;
+          break;
+        }
+        if (pos >= end) {
+          Error(l, col + int(name.size()), "unclosed '(' in parameters of '" + name + "'");
+        } else {
+          Error(l, int(pos) + 1, "expected ',' or ')' in parameters of '" + name + "'");
+        }
+        return false;
+      }
+    }
+    auto id = Intern(l, col, name, arity);
+    if (!id) return false;
+    out->symbols.push_back(*id);
+    cols.push_back(col);
+  }
+  return CheckBrackets(l, out->symbols, cols, "word");
+}
+
+bool GrammarParser::ParseFormalWord(const Line& l, size_t& pos, size_t end,
+                                    std::vector<Formal>* out) {
+  const std::string& t = l.text;
+  for (;;) {
+    while (pos < end && IsSpace(t[pos])) ++pos;
+    if (pos >= end || t[pos] == '<' || t[pos] == '>') return true;
+    Formal f;
+    f.column = int(pos) + 1;
+    if (t[pos] == '*') {
+      f.wildcard = true;
+      ++pos;
+      out->push_back(std::move(f));
+      continue;
+    }
+    if (!LexName(l, pos, end, &f.name)) return false;
+    size_t q = pos;
+    while (q < end && IsSpace(t[q])) ++q;
+    if (q < end && t[q] == '(') {
+      pos = q + 1;
+      for (;;) {
+        while (pos < end && IsSpace(t[pos])) ++pos;
+        if (pos >= end || !IsIdentStart(t[pos])) {
+          Error(l, int(pos) + 1, "expected a formal parameter name in '" + f.name + "(...)'");
+          return false;
+        }
+        size_t s = pos;
+        while (pos < end && IsIdentChar(t[pos])) ++pos;
+        f.params.push_back(t.substr(s, pos - s));
+        while (pos < end && IsSpace(t[pos])) ++pos;
+        if (pos < end && t[pos] == ',') {
+          ++pos;
+          continue;
+        }
+        if (pos < end && t[pos] == ')') {
+          ++pos;
+          break;
+        }
+        Error(l, int(pos) + 1,
+              pos >= end ? "unclosed '(' in formal parameters"
+                         : "expected ',' or ')' after a formal parameter");
+        return false;
+      }
+    }
+    out->push_back(std::move(f));
+  }
+}
+
+bool GrammarParser::ParseConstExpr(const Line& l, size_t pos, size_t end, double* out,
+                                   Expr* exprOut) {
+  ExprScope scope{&g_.constants, &usedConstants_, nullptr};
+  std::string_view view(l.text.data(), end);
+  Expr e;
+  ExprParseError err;
+  if (!ParseExpr(view, &pos, scope, &e, &err)) {
+    Error(l, err.column, err.message, err.length);
+    return false;
+  }
+  while (pos < end && IsSpace(l.text[pos])) ++pos;
+  if (pos < end) {
+    Error(l, int(pos) + 1, "unexpected text after expression");
+    return false;
+  }
+  if (exprOut) {
+    *exprOut = e;
+    return true;
+  }
+  if (!e.IsConstant()) {
+    Error(l, int(pos) + 1, "expected a constant expression here (no random functions)");
+    return false;
+  }
+  *out = e.constant();
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Lines
+
+void GrammarParser::ParseDefine(const Line& l, size_t pos) {
+  const std::string& t = l.text;
+  pos += 7;  // #define
+  while (pos < t.size() && IsSpace(t[pos])) ++pos;
+  if (pos >= t.size() || !IsIdentStart(t[pos])) {
+    Error(l, int(pos) + 1, "expected a name after #define");
+    return;
+  }
+  size_t s = pos;
+  while (pos < t.size() && IsIdentChar(t[pos])) ++pos;
+  std::string name = t.substr(s, pos - s);
+  int col = int(s) + 1;
+  if (pos < t.size() && !IsSpace(t[pos])) {
+    Error(l, int(pos) + 1, "expected a space after the name of #define '" + name + "'");
+    return;
+  }
+  if (defines_.count(name)) {
+    Error(l, col, "redefinition of '" + name + "' (first defined at line " +
+                      std::to_string(defines_[name].loc.line) + ")",
+          int(name.size()));
+    return;
+  }
+  while (pos < t.size() && IsSpace(t[pos])) ++pos;
+  if (pos >= t.size()) {
+    Error(l, col, "#define '" + name + "' has no value", int(name.size()));
+    return;
+  }
+  double v;
+  if (!ParseConstExpr(l, pos, t.size(), &v)) return;
+  auto ov = opt_.overrides.find(name);
+  if (ov != opt_.overrides.end()) {
+    v = ov->second;
+    usedOverrides_.insert(name);
+  }
+  g_.constants[name] = v;
+  defines_[name] = Define{Loc(l, col), l.original, int(name.size())};
+}
+
+// Header statements: "keyword:" at the start of a line, case-insensitive.
+bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
+  static const char* kKeywords[] = {"derivation length", "width factor", "maximum depth",
+                                    "lsystem",           "axiom",        "angle",
+                                    "step",              "width",        "tropism",
+                                    "seed",              "ignore",       "consider",
+                                    "module",            "decomposition", "interpretation",
+                                    "homomorphism",      "endlsystem"};
+  const std::string& t = l.text;
+  std::string lower = Lower(t.substr(pos, 20));
+  const char* kw = nullptr;
+  size_t after = 0;
+  for (const char* k : kKeywords) {
+    size_t n = std::strlen(k);
+    if (lower.compare(0, n, k) != 0) continue;
+    size_t q = pos + n;
+    while (q < t.size() && IsSpace(t[q])) ++q;
+    bool colon = q < t.size() && t[q] == ':';
+    bool bare = std::string_view(k) == "endlsystem" || std::string_view(k) == "decomposition" ||
+                std::string_view(k) == "interpretation" || std::string_view(k) == "homomorphism";
+    if (colon) {
+      kw = k;
+      after = q + 1;
+      break;
+    }
+    if (bare && (q >= t.size())) {
+      kw = k;
+      after = q;
+      break;
+    }
+  }
+  if (!kw) return false;
+  std::string k = kw;
+  size_t end = t.size();
+  while (after < end && IsSpace(t[after])) ++after;
+  while (end > after && IsSpace(t[end - 1])) --end;
+  int col = int(pos) + 1;
+  auto needValue = [&]() {
+    if (after < end) return true;
+    Error(l, col, "'" + k + ":' needs a value", int(k.size()));
+    return false;
+  };
+  bool inMain = section_ == &g_.main;
+  auto mainOnly = [&]() {
+    if (inMain) return true;
+    Error(l, col, "'" + k + ":' belongs before the productions, not in a " +
+                      (section_ == &g_.decomposition ? "decomposition" : "interpretation") +
+                      " section",
+          int(k.size()));
+    return false;
+  };
+  if (k == "endlsystem") {
+    ended_ = true;
+    return true;
+  }
+  if (k == "decomposition") {
+    section_ = &g_.decomposition;
+    return true;
+  }
+  if (k == "interpretation" || k == "homomorphism") {
+    section_ = &g_.interpretation;
+    return true;
+  }
+  if (k == "lsystem") {
+    g_.name = t.substr(after, end - after);
+    return true;
+  }
+  if (k == "module") return true;  // collected before parsing
+  if (!needValue()) return true;
+  if (k == "maximum depth") {
+    if (inMain) {
+      Error(l, col, "'maximum depth:' belongs in a decomposition or interpretation section", 13);
+      return true;
+    }
+    double v;
+    if (!ParseConstExpr(l, after, end, &v)) return true;
+    if (v != std::floor(v) || v < 1 || v > 1000) {
+      Error(l, int(after) + 1, "maximum depth must be a whole number from 1 to 1000");
+      return true;
+    }
+    section_->maxDepth = int(v);
+    return true;
+  }
+  if (!mainOnly()) return true;
+  if (k == "axiom") {
+    if (haveAxiom_) {
+      Error(l, col, "second axiom (the first is at line " + std::to_string(axiomLoc_.line) + ")",
+            5);
+      return true;
+    }
+    ExprScope scope{&g_.constants, &usedConstants_, nullptr};
+    Successor s;
+    if (!ParseActualWord(l, after, end, scope, &s)) return true;
+    if (s.symbols.empty()) {
+      Error(l, col, "empty axiom", 5);
+      return true;
+    }
+    haveAxiom_ = true;
+    axiomLoc_ = Loc(l, int(after) + 1);
+    axiom_ = std::move(s);
+    return true;
+  }
+  if (k == "ignore" || k == "consider") {
+    bool ignore = k == "ignore";
+    (ignore ? haveIgnore_ : haveConsider_) = true;
+    size_t p = after;
+    while (p < end) {
+      if (IsSpace(t[p])) {
+        ++p;
+        continue;
+      }
+      int c = int(p) + 1;
+      std::string name;
+      if (!LexName(l, p, end, &name)) return true;
+      if (name == "[" || name == "]") {
+        Error(l, c, "brackets cannot be " + std::string(ignore ? "ignored" : "considered") +
+                        ": they give the branching structure");
+        return true;
+      }
+      (ignore ? ignoreNames_ : considerNames_).insert(name);
+    }
+    return true;
+  }
+  if (k == "tropism") {
+    // Four numbers separated by commas or spaces.
+    std::vector<std::pair<size_t, size_t>> parts;
+    bool commas = t.find(',', after) < end;
+    size_t p = after;
+    while (p < end) {
+      while (p < end && (IsSpace(t[p]) || (commas && t[p] == ','))) ++p;
+      if (p >= end) break;
+      size_t s = p;
+      if (commas) {
+        while (p < end && t[p] != ',') ++p;
+      } else {
+        while (p < end && !IsSpace(t[p])) ++p;
+      }
+      parts.emplace_back(s, p);
+    }
+    if (parts.size() != 4) {
+      Error(l, int(after) + 1, "tropism needs four numbers: X Y Z susceptibility");
+      return true;
+    }
+    double v[4];
+    for (int i = 0; i < 4; ++i) {
+      if (!ParseConstExpr(l, parts[i].first, parts[i].second, &v[i])) return true;
+    }
+    if (v[0] == 0 && v[1] == 0 && v[2] == 0) {
+      Error(l, int(after) + 1, "tropism vector is zero");
+      return true;
+    }
+    g_.tropism = Tropism{v[0], v[1], v[2], v[3]};
+    return true;
+  }
+  double v;
+  if (!ParseConstExpr(l, after, end, &v)) return true;
+  int vcol = int(after) + 1;
+  if (k == "derivation length") {
+    if (v != std::floor(v) || v < 0 || v > kMaxDerivationLength) {
+      Error(l, vcol, "derivation length must be a whole number from 0 to " +
+                         std::to_string(kMaxDerivationLength));
+      return true;
+    }
+    g_.derivationLength = int(v);
+  } else if (k == "angle") {
+    g_.angle = v;
+  } else if (k == "step") {
+    g_.step = v;
+  } else if (k == "width") {
+    g_.width = v;
+  } else if (k == "width factor") {
+    g_.widthFactor = v;
+  } else if (k == "seed") {
+    if (v != std::floor(v) || v < 0 || v > 18446744073709549568.0) {
+      Error(l, vcol, "seed must be a whole number >= 0");
+      return true;
+    }
+    g_.seed = uint64_t(v);
+  }
+  return true;
+}
+
+static size_t FindTopLevel(const std::string& t, size_t from, size_t to, std::string_view what) {
+  int depth = 0;
+  for (size_t i = from; i < to; ++i) {
+    char c = t[i];
+    if (c == '(') ++depth;
+    else if (c == ')') --depth;
+    else if (depth == 0 && t.compare(i, what.size(), what) == 0 && i + what.size() <= to)
+      return i;
+  }
+  return std::string::npos;
+}
+
+void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen) {
+  const std::string& t = l.text;
+  Production p;
+  // LHS: [LEFT <] PRED [> RIGHT] [: CONDITION]
+  size_t lhsEnd = arrow;
+  size_t condAt = FindTopLevel(t, pos, lhsEnd, ":");
+  size_t ctxEnd = condAt == std::string::npos ? lhsEnd : condAt;
+
+  std::vector<Formal> w1, w2, w3;
+  size_t q = pos;
+  if (!ParseFormalWord(l, q, ctxEnd, &w1)) return;
+  std::vector<Formal> *left = nullptr, *pred = &w1, *right = nullptr;
+  if (q < ctxEnd && t[q] == '<') {
+    ++q;
+    left = &w1;
+    if (!ParseFormalWord(l, q, ctxEnd, &w2)) return;
+    pred = &w2;
+  }
+  if (q < ctxEnd && t[q] == '>') {
+    ++q;
+    if (!ParseFormalWord(l, q, ctxEnd, &w3)) return;
+    right = &w3;
+  }
+  if (q < ctxEnd) {
+    Error(l, int(q) + 1, std::string("unexpected '") + t[q] + "' in the predecessor");
+    return;
+  }
+  if (pred->size() != 1 || (*pred)[0].wildcard) {
+    int c = pred->empty() ? int(pos) + 1 : (*pred)[0].column;
+    Error(l, c, pred->empty() ? "production has no predecessor"
+                              : "the predecessor must be exactly one module");
+    return;
+  }
+  auto isWildcard = [](const std::vector<Formal>* w) {
+    return w && w->size() == 1 && (*w)[0].wildcard;
+  };
+  if (left && left->empty()) {
+    Error(l, int(pos) + 1, "empty left context before '<'");
+    return;
+  }
+  if (right && right->empty()) {
+    Error(l, int(ctxEnd), "empty right context after '>'");
+    return;
+  }
+  std::vector<std::string> formals;
+  auto bind = [&](const Formal& f, FormalModule* fm) -> bool {
+    if (f.wildcard) {
+      Error(l, f.column, "'*' stands alone as a context meaning 'any'");
+      return false;
+    }
+    auto id = Intern(l, f.column, f.name, int(f.params.size()));
+    if (!id) return false;
+    fm->symbol = *id;
+    fm->firstFormal = uint16_t(formals.size());
+    for (const auto& name : f.params) {
+      if (std::find(formals.begin(), formals.end(), name) != formals.end()) {
+        Error(l, f.column, "formal parameter '" + name + "' appears twice in this production",
+              int(f.name.size()));
+        return false;
+      }
+      formals.push_back(name);
+    }
+    return true;
+  };
+  if (left && !isWildcard(left)) {
+    for (const auto& f : *left) {
+      if (f.name == "[" || f.name == "]") {
+        Error(l, f.column, "brackets are not allowed in a left context");
+        return;
+      }
+      FormalModule fm;
+      if (!bind(f, &fm)) return;
+      p.left.push_back(fm);
+    }
+  }
+  const Formal& pf = (*pred)[0];
+  if (pf.name == "[" || pf.name == "]" || pf.name == "%") {
+    Error(l, pf.column, "'" + pf.name + "' cannot be rewritten");
+    return;
+  }
+  if (!bind(pf, &p.pred)) return;
+  if (right && !isWildcard(right)) {
+    std::vector<int> cols;
+    for (const auto& f : *right) {
+      FormalModule fm;
+      if (!bind(f, &fm)) return;
+      p.right.push_back(fm);
+      cols.push_back(f.column);
+    }
+    std::vector<SymbolId> syms;
+    for (auto& fm : p.right) syms.push_back(fm.symbol);
+    if (!CheckBrackets(l, syms, cols, "right context")) return;
+  }
+  p.formalCount = uint16_t(formals.size());
+  ExprScope scope{&g_.constants, &usedConstants_, &formals};
+
+  // Condition.
+  if (condAt != std::string::npos) {
+    size_t c = condAt + 1;
+    while (c < lhsEnd && IsSpace(t[c])) ++c;
+    size_t e = lhsEnd;
+    while (e > c && IsSpace(t[e - 1])) --e;
+    if (c >= e) {
+      Error(l, int(condAt) + 1, "empty condition after ':' (write '*' for always)");
+      return;
+    }
+    if (!(e == c + 1 && t[c] == '*')) {
+      std::string_view view(t.data(), e);
+      Expr cond;
+      ExprParseError err;
+      size_t cp = c;
+      if (!ParseExpr(view, &cp, scope, &cond, &err)) {
+        Error(l, err.column, err.message, err.length);
+        return;
+      }
+      if (cp < e) {
+        Error(l, int(cp) + 1, "unexpected text after the condition");
+        return;
+      }
+      p.conditionColumn = int(c) + 1;
+      if (cond.IsConstant() && cond.constant() == 0) {
+        Warn(Loc(l, int(c) + 1), l.original, "condition is always false: production never applies",
+             int(e - c));
+      }
+      if (!(cond.IsConstant() && cond.constant() != 0)) p.condition = std::move(cond);
+    }
+  }
+
+  // RHS: SUCCESSOR [: WEIGHT]
+  size_t rs = arrow + arrowLen;
+  size_t rend = t.size();
+  size_t weightAt = FindTopLevel(t, rs, rend, ":");
+  size_t succEnd = weightAt == std::string::npos ? rend : weightAt;
+  size_t s0 = rs;
+  while (s0 < succEnd && IsSpace(t[s0])) ++s0;
+  size_t s1 = succEnd;
+  while (s1 > s0 && IsSpace(t[s1 - 1])) --s1;
+  if (s0 >= s1) {
+    Error(l, int(arrow) + 1, "empty successor (write '*' for the empty word)",
+          int(arrowLen));
+    return;
+  }
+  if (!(s1 == s0 + 1 && t[s0] == '*')) {
+    if (!ParseActualWord(l, s0, s1, scope, &p.successor)) return;
+  }
+  if (weightAt != std::string::npos) {
+    size_t w = weightAt + 1;
+    while (w < rend && IsSpace(t[w])) ++w;
+    if (w >= rend) {
+      Error(l, int(weightAt) + 1, "expected a probability weight after ':'");
+      return;
+    }
+    std::string_view view(t.data(), rend);
+    Expr weight;
+    ExprParseError err;
+    size_t wp = w;
+    if (!ParseExpr(view, &wp, scope, &weight, &err)) {
+      Error(l, err.column, err.message, err.length);
+      return;
+    }
+    while (wp < rend && IsSpace(t[wp])) ++wp;
+    if (wp < rend) {
+      Error(l, int(wp) + 1, "unexpected text after the weight");
+      return;
+    }
+    if (weight.IsConstant() && weight.constant() < 0) {
+      Error(l, int(w) + 1, "negative probability weight");
+      return;
+    }
+    p.weightColumn = int(w) + 1;
+    p.weight = std::move(weight);
+  }
+  p.loc = Loc(l, pf.column);
+  p.sourceLine = l.original;
+  section_->productions.push_back(std::move(p));
+}
+
+void GrammarParser::ParseLine(const Line& l) {
+  const std::string& t = l.text;
+  size_t pos = 0;
+  while (pos < t.size() && IsSpace(t[pos])) ++pos;
+  if (pos >= t.size()) return;
+  if (t.compare(pos, 7, "#define") == 0 && (pos + 7 >= t.size() || IsSpace(t[pos + 7]))) {
+    ParseDefine(l, pos);
+    return;
+  }
+  if (t[pos] == '#') {
+    size_t e = pos + 1;
+    while (e < t.size() && IsIdentChar(t[e])) ++e;
+    Error(l, int(pos) + 1, "unknown directive '" + t.substr(pos, e - pos) + "'", int(e - pos));
+    return;
+  }
+  if (ParseHeader(l, pos)) return;
+  size_t arrow = FindTopLevel(t, pos, t.size(), "-->");
+  size_t arrowLen = 3;
+  if (arrow == std::string::npos) {
+    arrow = FindTopLevel(t, pos, t.size(), "->");
+    arrowLen = 2;
+  }
+  if (arrow != std::string::npos) {
+    ParseProduction(l, pos, arrow, arrowLen);
+    return;
+  }
+  // Name the problem as precisely as we can.
+  size_t e = pos;
+  while (e < t.size() && (IsIdentChar(t[e]) || t[e] == ' ')) ++e;
+  if (e < t.size() && t[e] == ':' && e > pos) {
+    std::string word = t.substr(pos, e - pos);
+    while (!word.empty() && word.back() == ' ') word.pop_back();
+    Error(l, int(pos) + 1, "unknown statement '" + word + ":'", int(word.size()));
+    return;
+  }
+  Error(l, int(pos) + 1,
+        "expected a production 'PRED --> SUCCESSOR' or a statement such as 'axiom:'");
+}
+
+// ---------------------------------------------------------------------------
+// After all lines
+
+void GrammarParser::WarnUnmatchable() {
+  // Symbols that can occur in a derived word: the axiom and every successor
+  // of the main and decomposition sections; interpretation successors only
+  // feed interpretation.
+  std::vector<uint8_t> occurs(g_.symbols.size(), 0);
+  for (SymbolId s : axiom_.symbols) occurs[s] = 1;
+  for (auto* sec : {&g_.main, &g_.decomposition}) {
+    for (const auto& p : sec->productions) {
+      for (SymbolId s : p.successor.symbols) occurs[s] = 1;
+    }
+  }
+  std::vector<uint8_t> occursInterp = occurs;
+  for (const auto& p : g_.interpretation.productions) {
+    for (SymbolId s : p.successor.symbols) occursInterp[s] = 1;
+  }
+  for (auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation}) {
+    const auto& occ = sec == &g_.interpretation ? occursInterp : occurs;
+    for (size_t i = 0; i < sec->productions.size(); ++i) {
+      const Production& p = sec->productions[i];
+      SymbolId s = p.pred.symbol;
+      const std::string& name = g_.symbols.name(s);
+      if (!occ[s]) {
+        int a = g_.symbols.arity(s);
+        Warn(p.loc, p.sourceLine,
+             "production can never match: no module '" + name + "' with " + std::to_string(a) +
+                 " parameter" + (a == 1 ? "" : "s") + " occurs in the axiom or any successor",
+             int(name.size()));
+        continue;
+      }
+      // Shadowed by an earlier production that always applies.
+      for (size_t j = 0; j < i; ++j) {
+        const Production& q = sec->productions[j];
+        if (q.pred.symbol == s && !q.HasContext() && !q.condition && !q.weight &&
+            !(p.weight && q.weight)) {
+          Warn(p.loc, p.sourceLine,
+               "production never applies: the production at line " +
+                   std::to_string(q.loc.line) + " always matches '" + name + "' first",
+               int(name.size()));
+          break;
+        }
+      }
+    }
+  }
+}
+
+void GrammarParser::Finish() {
+  // Overrides must name a #define.
+  for (const auto& [name, value] : opt_.overrides) {
+    if (!usedOverrides_.count(name)) {
+      Diagnostic d;
+      d.loc.file = files_.empty() ? "" : files_[0];
+      d.message = "-D " + name + ": the grammar has no '#define " + name + "'";
+      diags_.Add(std::move(d));
+    }
+  }
+  if (!haveAxiom_ && !diags_.HasErrors()) {
+    Diagnostic d;
+    d.loc = SourceLoc{files_[0], lines_.empty() ? 1 : lines_.back().number, 0};
+    d.message = "the grammar has no 'axiom:'";
+    diags_.Add(std::move(d));
+  }
+  for (const auto& [name, def] : defines_) {
+    if (!usedConstants_.count(name)) {
+      Warn(def.loc, def.line, "constant '" + name + "' is never used", def.length);
+    }
+  }
+  if (diags_.HasErrors()) return;
+  WarnUnmatchable();
+
+  const size_t nsym = g_.symbols.size();
+  for (auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation}) {
+    sec->bySymbol.assign(nsym, {});
+    for (size_t i = 0; i < sec->productions.size(); ++i) {
+      const Production& p = sec->productions[i];
+      sec->bySymbol[p.pred.symbol].push_back(uint32_t(i));
+      if (p.HasContext()) g_.usesContext = true;
+      if (p.weight) g_.usesRandom = true;
+      if (p.condition && p.condition->UsesRandom()) g_.usesRandom = true;
+      for (const auto& e : p.successor.params) g_.usesRandom |= e.UsesRandom();
+    }
+  }
+  g_.contextSkip.assign(nsym, 0);
+  for (size_t s = 2; s < nsym; ++s) {
+    const std::string& name = g_.symbols.name(SymbolId(s));
+    if (haveConsider_) g_.contextSkip[s] = !considerNames_.count(name);
+    if (haveIgnore_ && ignoreNames_.count(name)) g_.contextSkip[s] = 1;
+  }
+  g_.cutSymbol = g_.symbols.Find("%", 0);
+  g_.axiom = std::move(axiom_);
+  g_.axiomLoc = axiomLoc_;
+}
+
+ParseResult GrammarParser::Run(const std::string& text, const std::string& path) {
+  std::vector<std::string> stack{std::filesystem::path(path).lexically_normal().string()};
+  Preprocess(text, path, 0, stack);
+  g_.path = path;
+  g_.name = std::filesystem::path(path).stem().string();
+  // module: declarations apply to the whole file, wherever they stand.
+  for (const Line& l : lines_) {
+    size_t p = 0;
+    while (p < l.text.size() && IsSpace(l.text[p])) ++p;
+    if (Lower(l.text.substr(p, 6)) != "module") continue;
+    size_t q = p + 6;
+    while (q < l.text.size() && IsSpace(l.text[q])) ++q;
+    if (q >= l.text.size() || l.text[q] != ':') continue;
+    ++q;
+    while (q < l.text.size()) {
+      while (q < l.text.size() && IsSpace(l.text[q])) ++q;
+      size_t s = q;
+      while (q < l.text.size() && !IsSpace(l.text[q]) && l.text[q] != '(' && l.text[q] != ')' &&
+             l.text[q] != ',')
+        ++q;
+      if (q > s) declared_.push_back(l.text.substr(s, q - s));
+      if (q < l.text.size() && !IsSpace(l.text[q])) {
+        Error(l, int(q) + 1, "module names cannot contain '" + Printable(l.text[q]) + "'");
+        break;
+      }
+    }
+  }
+  std::sort(declared_.begin(), declared_.end(),
+            [](const std::string& a, const std::string& b) { return a.size() > b.size(); });
+  for (const Line& l : lines_) {
+    if (ended_) break;
+    ParseLine(l);
+  }
+  Finish();
+  ParseResult r;
+  r.diagnostics = std::move(diags_);
+  for (auto& w : warnings_) r.diagnostics.Add(std::move(w));
+  if (!r.diagnostics.HasErrors()) r.grammar = std::move(g_);
+  return r;
+}
+
+}  // namespace
+
+ParseResult ParseGrammarText(const std::string& text, const std::string& path,
+                             const ParseOptions& options) {
+  GrammarParser p(options);
+  return p.Run(text, path);
+}
+
+ParseResult ParseGrammarFile(const std::string& path, const ParseOptions& options) {
+  std::optional<std::string> text;
+  if (options.readFile) {
+    text = options.readFile(path);
+  } else {
+    auto r = ReadFile(path);
+    if (!r) {
+      ParseResult res;
+      res.diagnostics.Add(r.error());
+      return res;
+    }
+    text = std::move(r).value();
+  }
+  if (!text) {
+    ParseResult res;
+    Diagnostic d;
+    d.loc.file = path;
+    d.message = "cannot read file";
+    res.diagnostics.Add(std::move(d));
+    return res;
+  }
+  return ParseGrammarText(*text, path, options);
+}
+
+}  // namespace sylva::lsys

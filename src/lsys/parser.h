@@ -1,0 +1,42 @@
+// Reading grammar files: preprocessing (comments, #include, #define) and the
+// line-oriented cpfg syntax of ../docs/grammar.md.
+//
+// Every problem is reported as a Diagnostic with file:line:col; parsing goes
+// on after an error to report more (up to kMaxErrors), and a grammar is
+// returned only when there is no error. Warnings: a production that can
+// never match, a constant never used, a module name used with two different
+// parameter counts, a condition that is always false.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "core/diagnostic.h"
+#include "lsys/grammar.h"
+
+namespace sylva::lsys {
+
+inline constexpr int kMaxErrors = 50;
+inline constexpr int kMaxIncludeDepth = 16;
+inline constexpr int kMaxDerivationLength = 100000;
+
+struct ParseOptions {
+  // -D NAME=VALUE: replaces the value of `#define NAME`.
+  std::map<std::string, double> overrides;
+  // Reads a file (for the main file when parsing from disk, and #include).
+  // Default: the file system.
+  std::function<std::optional<std::string>(const std::string& path)> readFile;
+};
+
+struct ParseResult {
+  std::optional<Grammar> grammar;  // set when there are no errors
+  DiagnosticList diagnostics;      // errors and warnings, in file order
+};
+
+ParseResult ParseGrammarFile(const std::string& path, const ParseOptions& options = {});
+ParseResult ParseGrammarText(const std::string& text, const std::string& path,
+                             const ParseOptions& options = {});
+
+}  // namespace sylva::lsys
