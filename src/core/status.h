@@ -51,6 +51,7 @@ class [[nodiscard]] Expected {
   T* operator->() { return &value(); }
   const T* operator->() const { return &value(); }
   T& operator*() & { return value(); }
+  const T& operator*() const& { return value(); }
   const Diagnostic& error() const {
     SYLVA_ASSERT(!ok());
     return std::get<1>(v_);

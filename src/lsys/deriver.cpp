@@ -478,6 +478,7 @@ Status RunSection(const Grammar& g, const Section& sec, ThreadPool& pool, uint64
 }  // namespace
 
 Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
+  SYLVA_ASSERT(g.main.bySymbol.size() == g.symbols.size());  // a Grammar from the parser
   const auto t0 = Clock::now();
   const uint64_t seed = options.seed.value_or(g.seed);
   const int steps = options.steps >= 0 ? options.steps : g.derivationLength;

@@ -1,0 +1,117 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "cli_test_util.h"
+#include "core/atomic_file.h"
+
+namespace sylva::app {
+namespace {
+
+using testing::RunSylva;
+using testing::Scratch;
+using testing::Source;
+using testing::WriteFile;
+
+TEST(Cli, DerivePrintsTheCanonicalWord) {
+  auto r = RunSylva({"derive", Source("grammars/abop/fig2_06a_monopodial.lsys"), "-n", "1"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "!(10)F(1)[&(45)B(0.6,7.07)]/(137.5)A(0.9,7.07)\n");
+  EXPECT_EQ(r.err, "");
+}
+
+TEST(Cli, DefinesSeedsAndSteps) {
+  std::string f = WriteFile("d.lsys", "#define x 1\nseed: 3\naxiom: A(x)\nA(a) --> A(a+ran(1)*0+1)\n");
+  auto r = RunSylva({"derive", f, "-D", "x=5", "-n", "2", "--seed", "9", "--threads", "1"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "A(7)\n");
+}
+
+TEST(Cli, StatsReportCountsPerStepAndSymbol) {
+  auto r = RunSylva({"derive", Source("grammars/abop/fig1_06_koch_island.lsys"), "--stats"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("modules: 3803\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("   3          3803"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  F                     2048\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("million modules/s"), std::string::npos) << r.out;
+}
+
+TEST(Cli, InterpretAppliesInterpretationRules) {
+  auto r = RunSylva({"derive", Source("grammars/abop/fig1_10a_dragon_curve.lsys"), "-n", "1",
+                "--interpret"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "F+F+\n");
+}
+
+TEST(Cli, OutputFileIsWrittenWhole) {
+  std::string out = (Scratch() / "word.txt").string();
+  auto r = RunSylva({"derive", Source("grammars/abop/fig1_24a_bracketed_plant.lsys"), "-n", "1", "-o", out});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(*ReadFile(out), "F[+F]F[-F]F\n");
+}
+
+TEST(Cli, UnwritableOutputIsExitOneAndLeavesNothing) {
+  auto r = RunSylva({"derive", Source("grammars/abop/fig1_24a_bracketed_plant.lsys"), "-o",
+                "/nonexistent-dir/word.txt"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("/nonexistent-dir/word.txt: error: cannot create output file"),
+            std::string::npos)
+      << r.err;
+}
+
+TEST(Cli, FailedDerivationKeepsThePreviousOutputFile) {
+  std::string out = (Scratch() / "keep.txt").string();
+  ASSERT_EQ(RunSylva({"derive", Source("grammars/abop/fig1_24a_bracketed_plant.lsys"), "-n", "0", "-o", out}).code, 0);
+  auto r = RunSylva({"derive", Source("grammars/abop/fig1_06_koch_island.lsys"), "--max-modules", "100",
+                "-o", out});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_EQ(*ReadFile(out), "F\n");
+}
+
+TEST(Cli, LimitReachedIsExitOne) {
+  auto r = RunSylva({"derive", Source("grammars/abop/fig1_06_koch_island.lsys"), "--max-modules", "1000"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("derivation step 3 would make the word 3803 modules long"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.out, "");
+}
+
+TEST(Cli, CheckPrintsWarningsAndSucceeds) {
+  std::string f = WriteFile("warn.lsys", "#define unused 3\naxiom: A\nA --> B\n");
+  auto r = RunSylva({"check", f});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out, "");
+  EXPECT_NE(r.err.find("warn.lsys:1:9: warning: constant 'unused' is never used"), std::string::npos)
+      << r.err;
+}
+
+TEST(Cli, CheckOnEveryCatalogueGrammarIsSilent) {
+  for (auto& e : std::filesystem::directory_iterator(Source("grammars/abop"))) {
+    auto r = RunSylva({"check", e.path().string()});
+    EXPECT_EQ(r.code, 0) << e.path();
+    EXPECT_EQ(r.err, "") << e.path();
+  }
+}
+
+TEST(Cli, BadUsageIsExitTwo) {
+  EXPECT_EQ(RunSylva({}).code, 2);
+  EXPECT_EQ(RunSylva({"frobnicate"}).code, 2);
+  EXPECT_EQ(RunSylva({"derive"}).code, 2);
+  EXPECT_EQ(RunSylva({"derive", Source("grammars/abop/fig1_25_bush.lsys"), "-n", "-3"}).code, 2);
+  EXPECT_EQ(RunSylva({"derive", Source("grammars/abop/fig1_25_bush.lsys"), "--threads", "x"}).code, 2);
+  auto d = RunSylva({"derive", Source("grammars/abop/fig1_25_bush.lsys"), "-D", "novalue"});
+  EXPECT_EQ(d.code, 2);
+  EXPECT_NE(d.err.find("-D expects NAME=VALUE"), std::string::npos) << d.err;
+  auto m = RunSylva({"derive", "/no/such/grammar.lsys"});
+  EXPECT_EQ(m.code, 2);
+  EXPECT_NE(m.err.find("/no/such/grammar.lsys: error: cannot read file"), std::string::npos) << m.err;
+}
+
+TEST(Cli, HelpIsExitZero) {
+  auto r = RunSylva({"--help"});
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.out.find("derive"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sylva::app

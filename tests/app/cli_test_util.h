@@ -1,0 +1,45 @@
+#pragma once
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "app/cli.h"
+
+namespace sylva::app::testing {
+
+struct CliResult {
+  int code = -1;
+  std::string out, err;
+};
+
+inline CliResult RunSylva(std::vector<std::string> args) {
+  std::ostringstream out, err;
+  CliResult r;
+  r.code = RunCli(args, out, err);
+  r.out = out.str();
+  r.err = err.str();
+  return r;
+}
+
+// A scratch folder per test program.
+inline std::filesystem::path Scratch() {
+  auto d = std::filesystem::temp_directory_path() / ("sylva_cli_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+inline std::string WriteFile(const std::string& name, const std::string& text) {
+  auto p = Scratch() / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p.string();
+}
+
+inline std::string Source(const std::string& rel) { return std::string(SYLVA_SOURCE_DIR) + "/" + rel; }
+
+}  // namespace sylva::app::testing

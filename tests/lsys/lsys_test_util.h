@@ -1,0 +1,44 @@
+// Helpers for lsys tests: parse a grammar from text, derive it, print words.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "core/atomic_file.h"
+#include "lsys/deriver.h"
+#include "lsys/parser.h"
+
+namespace sylva::lsys::testing {
+
+inline Grammar MustParse(const std::string& text, const ParseOptions& opt = {}) {
+  ParseResult r = ParseGrammarText(text, "test.lsys", opt);
+  if (!r.grammar) {
+    ADD_FAILURE() << "grammar did not parse:\n" << r.diagnostics.FormatAll() << "\n" << text;
+    return Grammar{};
+  }
+  return std::move(*r.grammar);
+}
+
+inline DeriveResult MustDerive(const Grammar& g, DeriveOptions opt = {}) {
+  auto r = Derive(g, opt);
+  if (!r) {
+    ADD_FAILURE() << "derivation failed: " << r.error().Format();
+    return DeriveResult{};
+  }
+  return std::move(r).value();
+}
+
+// The canonical text of the word derived from `text` in `steps` steps.
+inline std::string DeriveText(const std::string& text, int steps = -1, DeriveOptions opt = {}) {
+  Grammar g = MustParse(text);
+  if (g.main.bySymbol.size() != g.symbols.size()) return "<grammar did not parse>";
+  opt.steps = steps;
+  return FormatWord(MustDerive(g, opt).word, g.symbols);
+}
+
+inline std::string SourcePath(const std::string& rel) {
+  return std::string(SYLVA_SOURCE_DIR) + "/" + rel;
+}
+
+}  // namespace sylva::lsys::testing
