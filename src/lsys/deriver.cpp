@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstring>
+#include <memory>
 #include <string>
 
 #include "core/parallel.h"
@@ -19,6 +20,7 @@ using Clock = std::chrono::steady_clock;
 enum : uint64_t { kAxiomDraws = 0, kMainDraws = 1, kDecompositionDraws = 2, kInterpretDraws = 3 };
 
 constexpr uint32_t kIdentity = 0xFFFFFFFFu;
+constexpr uint32_t kDynamic = 0xFFFFFFFEu;
 constexpr size_t kMinChunk = 16384;
 
 Diagnostic LimitError(const std::string& what) {
@@ -60,6 +62,32 @@ StaticTable BuildStaticTable(const Grammar& g, const Section& sec) {
   return t;
 }
 
+// What Choose needs of a production, packed (16 bytes) and stored per symbol
+// in file order, so trying the productions of a module touches one cache line.
+struct ProdInfo {
+  uint32_t index;        // into Section::productions
+  SymbolId left0;        // the left-context module nearest the predecessor
+  SymbolId right0;       // the first right-context module
+  uint8_t leftKind;      // 0 none; 1 one module, no parameters; 2 anything else
+  uint8_t rightKind;     // same for the right context
+  uint8_t hasCondition;
+  uint8_t hasWeight;
+  uint32_t pad = 0;
+};
+static_assert(sizeof(ProdInfo) == 16);
+
+// Decision table of a symbol whose productions all have at most one
+// parameter-free module of context on each side and no condition or weight:
+// the first-match choice is then a function of the neighbours' symbols
+// alone, looked up in O(1) instead of trying productions in turn. Class 0 of
+// a side is "no neighbour, or a symbol no production names".
+struct ContextTable {
+  std::vector<uint8_t> leftClass, rightClass;  // per symbol id
+  int rightClasses = 1;
+  bool useLeft = false, useRight = false;
+  std::vector<uint32_t> choice;  // [leftClass * rightClasses + rightClass]
+};
+
 struct Chunk {
   size_t begin = 0, end = 0;
   uint64_t inParam = 0;                 // parameter offset of `begin` in the input
@@ -77,8 +105,49 @@ class Pass {
        uint64_t maxModules)
       : g_(g), sec_(sec), table_(table), pool_(pool), seed_(seed), purpose_(purpose),
         step_(step), stepForMessages_(stepForMessages), maxModules_(maxModules) {
-    for (const auto& p : sec.productions) maxFormals_ = std::max<size_t>(maxFormals_, p.formalCount);
-    for (const auto& p : sec.productions) needsMatch_ |= p.HasContext();
+    for (const auto& p : sec.productions) {
+      maxFormals_ = std::max<size_t>(maxFormals_, p.formalCount);
+      needsMatch_ |= p.HasContext();
+      succModules_.push_back(uint32_t(p.successor.symbols.size()));
+      succParams_.push_back(uint32_t(p.successor.params.size()));
+    }
+    // Per symbol: no production (identity), a production that always
+    // applies first (its index), or a choice to make per module.
+    infoStart_.push_back(0);
+    for (size_t sy = 0; sy < sec.bySymbol.size(); ++sy) {
+      for (uint32_t idx : sec.bySymbol[sy]) {
+        const Production& p = sec.productions[idx];
+        ProdInfo pi{};
+        pi.index = idx;
+        auto kind = [&](const std::vector<FormalModule>& ctx) -> uint8_t {
+          if (ctx.empty()) return 0;
+          if (ctx.size() == 1 && g.symbols.arity(ctx[0].symbol) == 0 &&
+              ctx[0].symbol != kOpenBracket && ctx[0].symbol != kCloseBracket)
+            return 1;
+          return 2;
+        };
+        pi.leftKind = kind(p.left);
+        pi.rightKind = kind(p.right);
+        pi.left0 = p.left.empty() ? 0 : p.left.back().symbol;
+        pi.right0 = p.right.empty() ? 0 : p.right.front().symbol;
+        pi.hasCondition = p.condition.has_value();
+        pi.hasWeight = p.weight.has_value();
+        infos_.push_back(pi);
+      }
+      infoStart_.push_back(uint32_t(infos_.size()));
+    }
+    tables_.resize(sec.bySymbol.size());
+    for (size_t sy = 0; sy < sec.bySymbol.size(); ++sy) BuildTable(SymbolId(sy));
+    symChoice_.resize(sec.bySymbol.size());
+    for (size_t s = 0; s < sec.bySymbol.size(); ++s) {
+      const auto& list = sec.bySymbol[s];
+      if (list.empty()) {
+        symChoice_[s] = kIdentity;
+        continue;
+      }
+      const Production& p = sec.productions[list[0]];
+      symChoice_[s] = (p.HasContext() || p.condition || p.weight) ? kDynamic : list[0];
+    }
   }
 
   Status Run(const Word& in, Word& out, bool* changed);
@@ -88,6 +157,9 @@ class Pass {
   Status Allocate(Word& out, bool outHasParams);
   // General path.
   bool Choose(const WordView& w, size_t i, double* formals, uint32_t* choice, Chunk& c);
+  // 1 matches, 0 does not, -1 error (recorded in c).
+  int Matches(const ProdInfo& pi, const WordView& w, size_t i, const double* pp, int arity,
+              double* formals, size_t& prev, size_t& next, RandomStream& rng, Chunk& c);
   void Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams);
   void Fail(Chunk& c, const Production& p, const EvalError& e, int column, size_t i);
 
@@ -100,6 +172,49 @@ class Pass {
   uint64_t maxModules_;
   size_t maxFormals_ = 0;
   bool needsMatch_ = false;
+  std::vector<uint32_t> symChoice_;               // per symbol
+  std::vector<ProdInfo> infos_;                   // per symbol, in file order
+  std::vector<uint32_t> infoStart_;               // symbol -> first info
+  std::vector<std::unique_ptr<ContextTable>> tables_;  // per symbol, or null
+
+  void BuildTable(SymbolId sym) {
+    const ProdInfo* first = infos_.data() + infoStart_[sym];
+    const ProdInfo* last = infos_.data() + infoStart_[sym + 1];
+    if (first == last) return;
+    std::vector<SymbolId> lefts, rights;
+    for (const ProdInfo* pi = first; pi != last; ++pi) {
+      if (pi->leftKind > 1 || pi->rightKind > 1 || pi->hasCondition || pi->hasWeight) return;
+      if (pi->leftKind && std::find(lefts.begin(), lefts.end(), pi->left0) == lefts.end())
+        lefts.push_back(pi->left0);
+      if (pi->rightKind && std::find(rights.begin(), rights.end(), pi->right0) == rights.end())
+        rights.push_back(pi->right0);
+    }
+    if (lefts.empty() && rights.empty()) return;  // context-free: symChoice_ handles it
+    if (lefts.size() > 254 || rights.size() > 254) return;
+    auto t = std::make_unique<ContextTable>();
+    const size_t nsym = g_.symbols.size();
+    t->leftClass.assign(nsym, 0);
+    t->rightClass.assign(nsym, 0);
+    for (size_t k = 0; k < lefts.size(); ++k) t->leftClass[lefts[k]] = uint8_t(k + 1);
+    for (size_t k = 0; k < rights.size(); ++k) t->rightClass[rights[k]] = uint8_t(k + 1);
+    t->useLeft = !lefts.empty();
+    t->useRight = !rights.empty();
+    const int nl = int(lefts.size()) + 1, nr = int(rights.size()) + 1;
+    t->rightClasses = nr;
+    t->choice.assign(size_t(nl * nr), kIdentity);
+    for (int lc = 0; lc < nl; ++lc) {
+      for (int rc = 0; rc < nr; ++rc) {
+        for (const ProdInfo* pi = first; pi != last; ++pi) {  // first match in file order
+          if (pi->leftKind && (lc == 0 || lefts[lc - 1] != pi->left0)) continue;
+          if (pi->rightKind && (rc == 0 || rights[rc - 1] != pi->right0)) continue;
+          t->choice[size_t(lc * nr + rc)] = pi->index;
+          break;
+        }
+      }
+    }
+    tables_[sym] = std::move(t);
+  }
+  std::vector<uint32_t> succModules_, succParams_;  // per production
   std::vector<Chunk> chunks_;
   PodBuffer<uint32_t> choice_;
   PodBuffer<uint32_t> match_;
@@ -157,34 +272,53 @@ void Pass::Fail(Chunk& c, const Production& p, const EvalError& e, int column, s
   c.error = std::move(d);
 }
 
+// Sentinel for "neighbour not looked up yet".
+constexpr size_t kNotLooked = kNoPosition - 1;
+
+int Pass::Matches(const ProdInfo& pi, const WordView& w, size_t i, const double* pp, int arity,
+                  double* formals, size_t& prev, size_t& next, RandomStream& rng, Chunk& c) {
+  if (pi.leftKind) {
+    if (prev == kNotLooked) prev = PrevInContext(w, i);
+    if (prev == kNoPosition || w.symbols[prev] != pi.left0) return 0;
+  }
+  if (pi.rightKind == 1) {
+    if (next == kNotLooked) next = NextInContext(w, i + 1);
+    if (next == kNoPosition || w.symbols[next] != pi.right0) return 0;
+  }
+  const Production& q = sec_.productions[pi.index];
+  for (int k = 0; k < arity; ++k) formals[q.pred.firstFormal + k] = pp[k];
+  if (pi.leftKind == 2 && !MatchLeft(q, w, prev, formals)) return 0;
+  if (pi.rightKind == 2) {
+    if (next == kNotLooked) next = NextInContext(w, i + 1);
+    if (!MatchRight(q, w, i, next, formals)) return 0;
+  }
+  if (pi.hasCondition) {
+    double v;
+    EvalError e;
+    if (!q.condition->Eval(formals, rng, &v, &e)) {
+      Fail(c, q, e, q.conditionColumn, i);
+      return -1;
+    }
+    if (v == 0) return 0;
+  }
+  return 1;
+}
+
 bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice, Chunk& c) {
   const SymbolId sym = w.symbols[i];
-  const auto& list = sec_.bySymbol[sym];
+  const ProdInfo* first = infos_.data() + infoStart_[sym];
+  const ProdInfo* last = infos_.data() + infoStart_[sym + 1];
   RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2, 0};
   const double* pp = w.paramStart ? w.params + w.paramStart[i] : nullptr;
   const int arity = g_.symbols.arity(sym);
-  for (size_t li = 0; li < list.size(); ++li) {
-    const Production& p = sec_.productions[list[li]];
-    auto matches = [&](const Production& q) -> int {  // 1 yes, 0 no, -1 error
-      for (int k = 0; k < arity; ++k) formals[q.pred.firstFormal + k] = pp[k];
-      if (!q.left.empty() && !MatchLeft(q, w, i, formals)) return 0;
-      if (!q.right.empty() && !MatchRight(q, w, i, formals)) return 0;
-      if (q.condition) {
-        double v;
-        EvalError e;
-        if (!q.condition->Eval(formals, rng, &v, &e)) {
-          Fail(c, q, e, q.conditionColumn, i);
-          return -1;
-        }
-        if (v == 0) return 0;
-      }
-      return 1;
-    };
-    int m = matches(p);
+  // Context neighbours, looked up once and shared by every production.
+  size_t prev = kNotLooked, next = kNotLooked;
+  for (const ProdInfo* pi = first; pi != last; ++pi) {
+    int m = Matches(*pi, w, i, pp, arity, formals, prev, next, rng, c);
     if (m < 0) return false;
     if (m == 0) continue;
-    if (!p.weight) {
-      *choice = list[li];
+    if (!pi->hasWeight) {
+      *choice = pi->index;
       return true;
     }
     // Stochastic: draw among every matching production that carries a weight.
@@ -192,14 +326,14 @@ bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice
     uint32_t cands[64];
     int nc = 0;
     double total = 0;
-    for (size_t lj = li; lj < list.size() && nc < 64; ++lj) {
-      const Production& q = sec_.productions[list[lj]];
-      if (!q.weight) continue;
-      if (lj != li) {
-        int mq = matches(q);
+    for (const ProdInfo* qi = pi; qi != last && nc < 64; ++qi) {
+      if (!qi->hasWeight) continue;
+      if (qi != pi) {
+        int mq = Matches(*qi, w, i, pp, arity, formals, prev, next, rng, c);
         if (mq < 0) return false;
         if (mq == 0) continue;
       }
+      const Production& q = sec_.productions[qi->index];
       double wv;
       EvalError e;
       if (!q.weight->Eval(formals, rng, &wv, &e)) {
@@ -212,7 +346,7 @@ bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice
         return false;
       }
       weights[nc] = wv;
-      cands[nc++] = list[lj];
+      cands[nc++] = qi->index;
       total += wv;
     }
     if (total <= 0) {
@@ -262,6 +396,12 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
     }
     const Production& p = sec_.productions[ch];
     const Successor& s = p.successor;
+    if (!ostart) {  // no parameters anywhere in the output: copy the symbols
+      const size_t len = s.symbols.size();
+      if (len) std::memcpy(osym + o, s.symbols.data(), len * sizeof(SymbolId));
+      o += len;
+      continue;
+    }
     if (!s.allConstant) {
       // Bind formals for the chosen production.
       const int a = arities[sym];
@@ -269,8 +409,8 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
         const double* src = in.params.data() + in.paramStart[i];
         for (int k = 0; k < a; ++k) formals[p.pred.firstFormal + k] = src[k];
       }
-      if (!p.left.empty()) MatchLeft(p, w, i, formals.data());
-      if (!p.right.empty()) MatchRight(p, w, i, formals.data());
+      if (!p.left.empty()) MatchLeft(p, w, PrevInContext(w, i), formals.data());
+      if (!p.right.empty()) MatchRight(p, w, i, NextInContext(w, i + 1), formals.data());
     }
     RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2 + 1, 0};
     size_t e = 0;
@@ -357,23 +497,41 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
     Chunk& c = chunks_[k];
     std::vector<double> formals(maxFormals_ + 1);
     uint64_t modules = 0, params = 0;
+    const uint32_t* symChoice = symChoice_.data();
+    const uint32_t* succModules = succModules_.data();
+    const uint32_t* succParams = succParams_.data();
+    const uint8_t* arity = arities.data();
+    bool changed = false;
     for (size_t i = c.begin; i < c.end; ++i) {
       const SymbolId sym = w.symbols[i];
-      uint32_t ch = kIdentity;
-      if (!sec_.bySymbol[sym].empty()) {
-        if (!Choose(w, i, formals.data(), &ch, c)) return;
+      uint32_t ch = symChoice[sym];
+      if (ch == kDynamic) {
+        if (const ContextTable* t = tables_[sym].get()) {
+          int lc = 0, rc = 0;
+          if (t->useLeft) {
+            size_t j = PrevInContext(w, i);
+            if (j != kNoPosition) lc = t->leftClass[w.symbols[j]];
+          }
+          if (t->useRight) {
+            size_t j = NextInContext(w, i + 1);
+            if (j != kNoPosition) rc = t->rightClass[w.symbols[j]];
+          }
+          ch = t->choice[size_t(lc * t->rightClasses + rc)];
+        } else if (!Choose(w, i, formals.data(), &ch, c)) {
+          return;
+        }
       }
       choice_[i] = ch;
       if (ch == kIdentity) {
         modules += 1;
-        params += arities[sym];
+        params += arity[sym];
       } else {
-        const Successor& s = sec_.productions[ch].successor;
-        modules += s.symbols.size();
-        params += s.params.size();
-        c.changed = true;
+        modules += succModules[ch];
+        params += succParams[ch];
+        changed = true;
       }
     }
+    c.changed = changed;
     c.outModules = modules;
     c.outParams = params;
   });

@@ -32,34 +32,57 @@ static inline void Bind(const FormalModule& fm, const WordView& w, size_t j, dou
   for (uint32_t k = a; k < b; ++k) *dst++ = w.params[k];
 }
 
-bool MatchLeft(const Production& p, const WordView& w, size_t i, double* formals) {
-  size_t j = i;
-  for (size_t c = p.left.size(); c-- > 0;) {
-    SymbolId s;
-    for (;;) {
-      if (j == 0) return false;
-      --j;
-      s = w.symbols[j];
-      if (s == kCloseBracket) {
-        uint32_t m = w.bracketMatch[j];
-        if (m == kNoMatch) return false;
-        j = m;  // skip the sibling branch; the loop steps before its '['
-        continue;
-      }
-      if (s == kOpenBracket || w.skip[s]) continue;  // step out to the parent / ignored
-      break;
+size_t PrevInContext(const WordView& w, size_t j) {
+  for (;;) {
+    if (j == 0) return kNoPosition;
+    --j;
+    const SymbolId s = w.symbols[j];
+    if (s == kCloseBracket) {
+      const uint32_t m = w.bracketMatch[j];
+      if (m == kNoMatch) return kNoPosition;
+      j = m;  // skip the sibling branch; the loop steps before its '['
+      continue;
     }
-    if (s != p.left[c].symbol) return false;
+    if (s == kOpenBracket || w.skip[s]) continue;  // step out to the parent / ignored
+    return j;
+  }
+}
+
+size_t NextInContext(const WordView& w, size_t j) {
+  for (;;) {
+    if (j >= w.size) return kNoPosition;
+    const SymbolId s = w.symbols[j];
+    if (s == kOpenBracket) {  // a sibling branch the context does not name
+      const uint32_t m = w.bracketMatch[j];
+      if (m == kNoMatch) return kNoPosition;
+      j = size_t(m) + 1;
+      continue;
+    }
+    if (s == kCloseBracket) return kNoPosition;  // end of this branch
+    if (w.skip[s]) {
+      ++j;
+      continue;
+    }
+    return j;
+  }
+}
+
+bool MatchLeft(const Production& p, const WordView& w, size_t prev, double* formals) {
+  size_t j = prev;
+  for (size_t c = p.left.size(); c-- > 0;) {
+    if (j == kNoPosition || w.symbols[j] != p.left[c].symbol) return false;
     Bind(p.left[c], w, j, formals);
+    if (c) j = PrevInContext(w, j);
   }
   return true;
 }
 
-bool MatchRight(const Production& p, const WordView& w, size_t i, double* formals) {
+bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, double* formals) {
   static constexpr int kMaxNesting = 64;
   uint32_t opened[kMaxNesting];  // word positions of '[' the context descended into
   int depth = 0;
   size_t j = i + 1;
+  bool first = true;
   const size_t n = w.size;
   for (const FormalModule& fm : p.right) {
     if (fm.symbol == kOpenBracket) {
@@ -69,35 +92,22 @@ bool MatchRight(const Production& p, const WordView& w, size_t i, double* formal
       if (j >= n || w.symbols[j] != kOpenBracket || depth == kMaxNesting) return false;
       opened[depth++] = uint32_t(j);
       ++j;
+      first = false;
       continue;
     }
     if (fm.symbol == kCloseBracket) {
       if (depth == 0) return false;
-      uint32_t m = w.bracketMatch[opened[--depth]];
+      const uint32_t m = w.bracketMatch[opened[--depth]];
       if (m == kNoMatch) return false;
       j = size_t(m) + 1;
+      first = false;
       continue;
     }
-    SymbolId s;
-    for (;;) {
-      if (j >= n) return false;
-      s = w.symbols[j];
-      if (s == kOpenBracket) {  // a sibling branch the context does not name
-        uint32_t m = w.bracketMatch[j];
-        if (m == kNoMatch) return false;
-        j = size_t(m) + 1;
-        continue;
-      }
-      if (s == kCloseBracket) return false;  // end of this branch
-      if (w.skip[s]) {
-        ++j;
-        continue;
-      }
-      break;
-    }
-    if (s != fm.symbol) return false;
-    Bind(fm, w, j, formals);
-    ++j;
+    const size_t k = first ? next : NextInContext(w, j);
+    first = false;
+    if (k == kNoPosition || w.symbols[k] != fm.symbol) return false;
+    Bind(fm, w, k, formals);
+    j = k + 1;
   }
   return true;
 }

@@ -32,7 +32,18 @@ struct WordView {
 // Bracket partners of every '[' and ']' (other entries are left unset).
 void ComputeBracketMatch(const SymbolId* symbols, size_t n, uint32_t* match);
 
-bool MatchLeft(const Production& p, const WordView& w, size_t i, double* formals);
-bool MatchRight(const Production& p, const WordView& w, size_t i, double* formals);
+// The nearest module before position j that the left context sees, or
+// kNoPosition (start of the word).
+inline constexpr size_t kNoPosition = ~size_t(0);
+size_t PrevInContext(const WordView& w, size_t j);
+// The first module at or after position j that the right context sees on the
+// current branch, or kNoPosition (end of the branch or of the word).
+size_t NextInContext(const WordView& w, size_t j);
+
+// `prev` / `next` are PrevInContext(w, i) and NextInContext(w, i + 1), which
+// callers compute once per module and share between productions.
+bool MatchLeft(const Production& p, const WordView& w, size_t prev, double* formals);
+bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, double* formals);
+
 
 }  // namespace sylva::lsys
