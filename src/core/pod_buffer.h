@@ -1,14 +1,21 @@
 // PodBuffer<T>: a growable array of trivially copyable T that does not
 // zero-fill on resize. Words of 100+ million modules are sized exactly before
 // they are written, so value-initialising them (as std::vector does) would
-// cost a full extra pass over memory.
+// cost a full extra pass over memory. Buffers of 4 MiB or more are 2 MiB
+// aligned and ask Linux for transparent huge pages: a 250 MB word then takes
+// about 120 page faults instead of 61,000.
 #pragma once
 
-#include <cstddef>
 #include <algorithm>
+#include <cstddef>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <type_traits>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "core/assert.h"
 
@@ -82,15 +89,36 @@ class PodBuffer {
   size_t MemoryBytes() const { return capacity_ * sizeof(T); }
 
  private:
+  struct Free {
+    void operator()(T* p) const { std::free(p); }
+  };
+  static constexpr size_t kHuge = size_t(2) << 20;
+
+  static T* Allocate(size_t cap) {
+    if (cap == 0) return nullptr;
+    const size_t bytes = cap * sizeof(T);
+    void* p;
+    if (bytes >= 2 * kHuge) {
+      p = std::aligned_alloc(kHuge, (bytes + kHuge - 1) / kHuge * kHuge);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+      if (p) madvise(p, bytes, MADV_HUGEPAGE);
+#endif
+    } else {
+      p = std::malloc(bytes);
+    }
+    if (!p) throw std::bad_alloc();
+    return static_cast<T*>(p);
+  }
+
   void Reallocate(size_t cap) {
-    std::unique_ptr<T[]> fresh(cap ? new T[cap] : nullptr);  // default-init: no zeroing
+    std::unique_ptr<T[], Free> fresh(Allocate(cap));  // uninitialised: no zeroing
     if (size_ && cap) std::memcpy(fresh.get(), data_.get(), std::min(size_, cap) * sizeof(T));
     data_ = std::move(fresh);
     capacity_ = cap;
     if (size_ > cap) size_ = cap;
   }
 
-  std::unique_ptr<T[]> data_;
+  std::unique_ptr<T[], Free> data_;
   size_t size_ = 0;
   size_t capacity_ = 0;
 };

@@ -22,6 +22,9 @@ enum : uint64_t { kAxiomDraws = 0, kMainDraws = 1, kDecompositionDraws = 2, kInt
 constexpr uint32_t kIdentity = 0xFFFFFFFFu;
 constexpr uint32_t kDynamic = 0xFFFFFFFEu;
 constexpr size_t kMinChunk = 16384;
+// Successors of up to kOverCopy symbols are copied as one fixed-size block
+// (the table is padded, and the copy stays inside the chunk's own output).
+constexpr size_t kOverCopy = 16;
 
 Diagnostic LimitError(const std::string& what) {
   Diagnostic d;
@@ -57,7 +60,7 @@ StaticTable BuildStaticTable(const Grammar& g, const Section& sec) {
     for (SymbolId x : p.successor.symbols) t.flat.push_back(x);
     t.length[s] = uint32_t(p.successor.symbols.size());
   }
-  t.flat.resize(t.flat.size() + 8, 0);
+  t.flat.resize(t.flat.size() + kOverCopy, 0);
   t.usable = true;
   return t;
 }
@@ -97,14 +100,22 @@ struct Chunk {
   std::optional<Diagnostic> error;
 };
 
+// Buffers reused from step to step, so a derivation allocates (and the
+// kernel zeroes) them once, not at every step.
+struct Scratch {
+  PodBuffer<uint32_t> choice;  // production chosen per module of the input
+  PodBuffer<uint32_t> match;   // bracket partners
+};
+
 // One parallel rewriting pass of one section over a word.
 class Pass {
  public:
   Pass(const Grammar& g, const Section& sec, const StaticTable& table, ThreadPool& pool,
-       uint64_t seed, uint64_t purpose, uint64_t step, int stepForMessages,
+       Scratch& scratch, uint64_t seed, uint64_t purpose, uint64_t step, int stepForMessages,
        uint64_t maxModules)
       : g_(g), sec_(sec), table_(table), pool_(pool), seed_(seed), purpose_(purpose),
-        step_(step), stepForMessages_(stepForMessages), maxModules_(maxModules) {
+        step_(step), stepForMessages_(stepForMessages), maxModules_(maxModules),
+        choice_(scratch.choice), match_(scratch.match) {
     for (const auto& p : sec.productions) {
       maxFormals_ = std::max<size_t>(maxFormals_, p.formalCount);
       needsMatch_ |= p.HasContext();
@@ -216,8 +227,8 @@ class Pass {
   }
   std::vector<uint32_t> succModules_, succParams_;  // per production
   std::vector<Chunk> chunks_;
-  PodBuffer<uint32_t> choice_;
-  PodBuffer<uint32_t> match_;
+  PodBuffer<uint32_t>& choice_;
+  PodBuffer<uint32_t>& match_;
 };
 
 void Pass::SplitChunks(const Word& in) {
@@ -398,7 +409,12 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
     const Successor& s = p.successor;
     if (!ostart) {  // no parameters anywhere in the output: copy the symbols
       const size_t len = s.symbols.size();
-      if (len) std::memcpy(osym + o, s.symbols.data(), len * sizeof(SymbolId));
+      const SymbolId* src = s.symbols.data();
+      if (len <= 4) {
+        for (size_t k = 0; k < len; ++k) osym[o + k] = src[k];
+      } else {
+        std::memcpy(osym + o, src, len * sizeof(SymbolId));
+      }
       o += len;
       continue;
     }
@@ -456,15 +472,15 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
     pool_.ParallelFor(chunks_.size(), [&](size_t k) {
       Chunk& c = chunks_[k];
       SymbolId* dst = dst0 + c.outModuleAt;
-      // Over-copying 8 symbols is safe up to 8 before the chunk's own end;
+      // Over-copying is safe up to kOverCopy before the chunk's own end;
       // past that it would overwrite the next chunk's output.
-      SymbolId* const safeEnd = dst + (c.outModules >= 8 ? c.outModules - 8 : 0);
+      SymbolId* const safeEnd = dst + (c.outModules >= kOverCopy ? c.outModules - kOverCopy : 0);
       for (size_t i = c.begin; i < c.end; ++i) {
         const SymbolId s = sym[i];
         const uint32_t l = len[s];
         const SymbolId* src = flat + off[s];
-        if (l <= 8 && dst <= safeEnd) {
-          std::memcpy(dst, src, 16);  // over-copy; the table is padded
+        if (l <= kOverCopy && dst <= safeEnd) {
+          std::memcpy(dst, src, kOverCopy * sizeof(SymbolId));  // over-copy
         } else {
           std::memcpy(dst, src, size_t(l) * sizeof(SymbolId));
         }
@@ -614,15 +630,16 @@ Expected<Word> BuildAxiom(const Grammar& g, uint64_t seed) {
 
 // Runs passes of a decomposition or interpretation section until nothing
 // changes or the maximum depth is reached.
-Status RunSection(const Grammar& g, const Section& sec, ThreadPool& pool, uint64_t seed,
+Status RunSection(const Grammar& g, const Section& sec, ThreadPool& pool, Scratch& scratch,
+                  uint64_t seed,
                   uint64_t purpose, uint64_t step, int stepForMessages, uint64_t maxModules,
                   Word& word) {
   if (sec.empty()) return {};
   StaticTable table = BuildStaticTable(g, sec);
   Word next;
   for (int depth = 0; depth < sec.maxDepth; ++depth) {
-    Pass pass(g, sec, table, pool, seed, purpose | (uint64_t(depth) << 8), step, stepForMessages,
-              maxModules);
+    Pass pass(g, sec, table, pool, scratch, seed, purpose | (uint64_t(depth) << 8), step,
+              stepForMessages, maxModules);
     bool changed = false;
     if (Status s = pass.Run(word, next, &changed); !s.ok()) return s;
     if (!changed) break;
@@ -660,16 +677,18 @@ Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
   result.steps.push_back(StepStats{0, result.word.size(), 0});
 
   const StaticTable table = BuildStaticTable(g, g.main);
+  Scratch scratch;
   Word next;
   bool fixedPoint = false;
   for (int step = 1; step <= steps; ++step) {
     const auto ts = Clock::now();
     if (!fixedPoint) {
       bool changed = false;
-      Pass pass(g, g.main, table, pool, seed, kMainDraws, uint64_t(step), step, maxModules);
+      Pass pass(g, g.main, table, pool, scratch, seed, kMainDraws, uint64_t(step), step,
+                maxModules);
       if (Status s = pass.Run(result.word, next, &changed); !s.ok()) return s.error();
       std::swap(result.word, next);
-      if (Status s = RunSection(g, g.decomposition, pool, seed, kDecompositionDraws,
+      if (Status s = RunSection(g, g.decomposition, pool, scratch, seed, kDecompositionDraws,
                                 uint64_t(step), step, maxModules, result.word);
           !s.ok())
         return s.error();
@@ -696,7 +715,9 @@ Expected<Word> Interpret(const Grammar& g, const Word& word, const DeriveOptions
   ThreadPool pool(options.threads);
   const uint64_t seed = options.seed.value_or(g.seed);
   const uint64_t maxModules = std::min(options.maxModules, kMaxModulesCap);
-  if (Status s = RunSection(g, g.interpretation, pool, seed, kInterpretDraws, 0, 0, maxModules, w);
+  Scratch scratch;
+  if (Status s = RunSection(g, g.interpretation, pool, scratch, seed, kInterpretDraws, 0, 0,
+                            maxModules, w);
       !s.ok())
     return s.error();
   return w;

@@ -32,41 +32,6 @@ static inline void Bind(const FormalModule& fm, const WordView& w, size_t j, dou
   for (uint32_t k = a; k < b; ++k) *dst++ = w.params[k];
 }
 
-size_t PrevInContext(const WordView& w, size_t j) {
-  for (;;) {
-    if (j == 0) return kNoPosition;
-    --j;
-    const SymbolId s = w.symbols[j];
-    if (s == kCloseBracket) {
-      const uint32_t m = w.bracketMatch[j];
-      if (m == kNoMatch) return kNoPosition;
-      j = m;  // skip the sibling branch; the loop steps before its '['
-      continue;
-    }
-    if (s == kOpenBracket || w.skip[s]) continue;  // step out to the parent / ignored
-    return j;
-  }
-}
-
-size_t NextInContext(const WordView& w, size_t j) {
-  for (;;) {
-    if (j >= w.size) return kNoPosition;
-    const SymbolId s = w.symbols[j];
-    if (s == kOpenBracket) {  // a sibling branch the context does not name
-      const uint32_t m = w.bracketMatch[j];
-      if (m == kNoMatch) return kNoPosition;
-      j = size_t(m) + 1;
-      continue;
-    }
-    if (s == kCloseBracket) return kNoPosition;  // end of this branch
-    if (w.skip[s]) {
-      ++j;
-      continue;
-    }
-    return j;
-  }
-}
-
 bool MatchLeft(const Production& p, const WordView& w, size_t prev, double* formals) {
   size_t j = prev;
   for (size_t c = p.left.size(); c-- > 0;) {

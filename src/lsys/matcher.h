@@ -35,15 +35,52 @@ void ComputeBracketMatch(const SymbolId* symbols, size_t n, uint32_t* match);
 // The nearest module before position j that the left context sees, or
 // kNoPosition (start of the word).
 inline constexpr size_t kNoPosition = ~size_t(0);
-size_t PrevInContext(const WordView& w, size_t j);
+inline size_t PrevInContext(const WordView& w, size_t j);
 // The first module at or after position j that the right context sees on the
 // current branch, or kNoPosition (end of the branch or of the word).
-size_t NextInContext(const WordView& w, size_t j);
+inline size_t NextInContext(const WordView& w, size_t j);
 
 // `prev` / `next` are PrevInContext(w, i) and NextInContext(w, i + 1), which
 // callers compute once per module and share between productions.
 bool MatchLeft(const Production& p, const WordView& w, size_t prev, double* formals);
 bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, double* formals);
 
+
+// --- inline definitions (hot: called once or twice per module) ---
+
+inline size_t PrevInContext(const WordView& w, size_t j) {
+  for (;;) {
+    if (j == 0) return kNoPosition;
+    --j;
+    const SymbolId s = w.symbols[j];
+    if (s == kCloseBracket) {
+      const uint32_t m = w.bracketMatch[j];
+      if (m == kNoMatch) return kNoPosition;
+      j = m;  // skip the sibling branch; the loop steps before its '['
+      continue;
+    }
+    if (s == kOpenBracket || w.skip[s]) continue;  // step out to the parent / ignored
+    return j;
+  }
+}
+
+inline size_t NextInContext(const WordView& w, size_t j) {
+  for (;;) {
+    if (j >= w.size) return kNoPosition;
+    const SymbolId s = w.symbols[j];
+    if (s == kOpenBracket) {  // a sibling branch the context does not name
+      const uint32_t m = w.bracketMatch[j];
+      if (m == kNoMatch) return kNoPosition;
+      j = size_t(m) + 1;
+      continue;
+    }
+    if (s == kCloseBracket) return kNoPosition;  // end of this branch
+    if (w.skip[s]) {
+      ++j;
+      continue;
+    }
+    return j;
+  }
+}
 
 }  // namespace sylva::lsys
