@@ -21,6 +21,10 @@ enum : uint64_t { kAxiomDraws = 0, kMainDraws = 1, kDecompositionDraws = 2, kInt
 
 constexpr uint32_t kIdentity = 0xFFFFFFFFu;
 constexpr uint32_t kDynamic = 0xFFFFFFFEu;
+// Per-module choices are stored in 16 bits (the parser allows at most
+// kMaxProductionsPerSection productions per section).
+constexpr uint16_t kIdentity16 = 0xFFFF;
+static_assert(kMaxProductionsPerSection < kIdentity16);
 constexpr size_t kMinChunk = 16384;
 // Successors of up to kOverCopy symbols are copied as one fixed-size block
 // (the table is padded, and the copy stays inside the chunk's own output).
@@ -103,7 +107,7 @@ struct Chunk {
 // Buffers reused from step to step, so a derivation allocates (and the
 // kernel zeroes) them once, not at every step.
 struct Scratch {
-  PodBuffer<uint32_t> choice;  // production chosen per module of the input
+  PodBuffer<uint16_t> choice;  // production chosen per module of the input (kIdentity16: none)
   PodBuffer<uint32_t> match;   // bracket partners
 };
 
@@ -165,6 +169,7 @@ class Pass {
 
  private:
   void SplitChunks(const Word& in);
+  void MatchBrackets(const Word& in);
   Status Allocate(Word& out, bool outHasParams);
   // General path.
   bool Choose(const WordView& w, size_t i, double* formals, uint32_t* choice, Chunk& c);
@@ -227,9 +232,56 @@ class Pass {
   }
   std::vector<uint32_t> succModules_, succParams_;  // per production
   std::vector<Chunk> chunks_;
-  PodBuffer<uint32_t>& choice_;
+  PodBuffer<uint16_t>& choice_;
   PodBuffer<uint32_t>& match_;
 };
+
+// Bracket partners in parallel: each chunk matches its own brackets and
+// keeps the ones it cannot close (']' first, then '['); a sequential merge
+// pairs those across chunks. The merge touches only brackets that span a
+// chunk boundary, about depth x chunks of them.
+void Pass::MatchBrackets(const Word& in) {
+  const SymbolId* sym = in.symbols.data();
+  uint32_t* match = match_.data();
+  if (chunks_.size() == 1) {
+    ComputeBracketMatch(sym, in.size(), match);
+    return;
+  }
+  struct Open {
+    std::vector<uint32_t> closes, opens;  // unmatched, in word order
+  };
+  std::vector<Open> open(chunks_.size());
+  pool_.ParallelFor(chunks_.size(), [&](size_t k) {
+    Open& o = open[k];
+    for (size_t i = chunks_[k].begin; i < chunks_[k].end; ++i) {
+      if (sym[i] == kOpenBracket) {
+        o.opens.push_back(uint32_t(i));
+        match[i] = kNoMatch;
+      } else if (sym[i] == kCloseBracket) {
+        if (o.opens.empty()) {
+          o.closes.push_back(uint32_t(i));
+          match[i] = kNoMatch;
+        } else {
+          const uint32_t a = o.opens.back();
+          o.opens.pop_back();
+          match[a] = uint32_t(i);
+          match[i] = a;
+        }
+      }
+    }
+  });
+  std::vector<uint32_t> stack;
+  for (const Open& o : open) {
+    for (uint32_t c : o.closes) {
+      if (stack.empty()) continue;  // unbalanced: stays kNoMatch
+      const uint32_t a = stack.back();
+      stack.pop_back();
+      match[a] = c;
+      match[c] = a;
+    }
+    stack.insert(stack.end(), o.opens.begin(), o.opens.end());
+  }
+}
 
 void Pass::SplitChunks(const Word& in) {
   const size_t n = in.size();
@@ -390,8 +442,8 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
   const auto& arities = g_.symbols.arities();
   for (size_t i = c.begin; i < c.end; ++i) {
     const SymbolId sym = w.symbols[i];
-    const uint32_t ch = choice_.empty() ? kIdentity : choice_[i];
-    if (ch == kIdentity) {
+    const uint16_t ch16 = choice_[i];
+    if (ch16 == kIdentity16) {
       osym[o] = sym;
       if (ostart) {
         ostart[o] = uint32_t(po);
@@ -405,7 +457,7 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
       ++o;
       continue;
     }
-    const Production& p = sec_.productions[ch];
+    const Production& p = sec_.productions[ch16];
     const Successor& s = p.successor;
     if (!ostart) {  // no parameters anywhere in the output: copy the symbols
       const size_t len = s.symbols.size();
@@ -504,7 +556,7 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
   w.skip = g_.contextSkip.data();
   if (needsMatch_) {
     match_.ResizeUninitialized(n);
-    ComputeBracketMatch(in.symbols.data(), n, match_.data());
+    MatchBrackets(in);
     w.bracketMatch = match_.data();
   }
   choice_.ResizeUninitialized(n);
@@ -537,7 +589,7 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
           return;
         }
       }
-      choice_[i] = ch;
+      choice_[i] = ch == kIdentity ? kIdentity16 : uint16_t(ch);
       if (ch == kIdentity) {
         modules += 1;
         params += arity[sym];

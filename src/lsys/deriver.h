@@ -25,6 +25,7 @@
 
 #include "core/status.h"
 #include "lsys/grammar.h"
+#include "lsys/parser.h"
 #include "lsys/word.h"
 
 namespace sylva::lsys {

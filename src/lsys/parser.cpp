@@ -880,6 +880,11 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   }
   p.loc = Loc(l, pf.column);
   p.sourceLine = l.original;
+  if (section_->productions.size() >= kMaxProductionsPerSection) {
+    Error(l, pf.column, "more than " + std::to_string(kMaxProductionsPerSection) +
+                            " productions in one section");
+    return;
+  }
   section_->productions.push_back(std::move(p));
 }
 

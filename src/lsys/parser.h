@@ -21,6 +21,7 @@ namespace sylva::lsys {
 inline constexpr int kMaxErrors = 50;
 inline constexpr int kMaxIncludeDepth = 16;
 inline constexpr int kMaxDerivationLength = 100000;
+inline constexpr size_t kMaxProductionsPerSection = 65000;
 
 struct ParseOptions {
   // -D NAME=VALUE: replaces the value of `#define NAME`.

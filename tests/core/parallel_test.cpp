@@ -35,3 +35,22 @@ TEST(PodBuffer, GrowsAndKeepsContents) {
 }
 
 }  // namespace sylva
+
+namespace sylva {
+
+TEST(PodBuffer, LargeBuffersGrowInPlaceAndKeepContents) {
+  PodBuffer<uint32_t> b;
+  b.ResizeUninitialized(3 << 20);  // 12 MiB: mapped
+  for (uint32_t i = 0; i < b.size(); ++i) b[i] = i * 7;
+  b.ResizeUninitialized(10 << 20);  // grows with mremap
+  for (uint32_t i = 0; i < (3u << 20); i += 4099) ASSERT_EQ(b[i], i * 7) << i;
+  PodBuffer<uint32_t> c = b;  // copy of a mapped buffer
+  b.ResizeUninitialized(5);
+  b.shrink_to_fit();  // back to malloc
+  EXPECT_EQ(b[4], 28u);
+  EXPECT_EQ(c[(3u << 20) - 1], ((3u << 20) - 1) * 7);
+  PodBuffer<uint32_t> d(std::move(c));
+  EXPECT_EQ(d[12345], 12345u * 7);
+}
+
+}  // namespace sylva

@@ -74,3 +74,29 @@ TEST(Context, SignalTravelsOneModulePerStepAcrossBranches) {
 
 }  // namespace
 }  // namespace sylva::lsys
+
+namespace sylva::lsys {
+namespace {
+
+TEST(BracketMatch, ParallelMatchEqualsSequentialOnDeepWords) {
+  // A word deep enough that brackets span many chunks: a context-sensitive
+  // grammar on it must give the same word with 1 and 4 threads.
+  Grammar g = testing::MustParse(R"(
+axiom: A
+A --> [BA]
+B < B --> C
+B > [C] --> E
+C --> B
+)");
+  DeriveOptions opt;
+  opt.steps = 12000;
+  opt.threads = 1;
+  auto a = testing::MustDerive(g, opt);
+  opt.threads = 4;
+  auto b = testing::MustDerive(g, opt);
+  EXPECT_EQ(a.word.size(), 3u * 12000 + 1);
+  EXPECT_EQ(HashWord(a.word), HashWord(b.word));
+}
+
+}  // namespace
+}  // namespace sylva::lsys

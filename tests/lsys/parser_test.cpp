@@ -212,3 +212,26 @@ TEST(Parser, CollectsSeveralErrorsInOneRun) {
 
 }  // namespace
 }  // namespace sylva::lsys
+
+namespace sylva::lsys {
+namespace {
+
+TEST(WordFormat, NumbersPrintAsPrintfG6) {
+  const double values[] = {0, -0.0, 1, -1, 0.5, 1.0 / 3, 2.0 / 3, 123456, 1234567, 1e-5, 1e-4,
+                           0.0001234567, 1e100, -2.5e-300, 7.07, 4.99849, 99999.95, 999999.5};
+  for (double v : values) {
+    std::string a;
+    AppendNumber(a, v);
+    char b[64];
+    std::snprintf(b, sizeof b, "%.6g", v == 0 ? 0.0 : v);
+    EXPECT_EQ(a, b) << v;
+  }
+}
+
+TEST(WordFormat, MultiCharacterNamesAndParameters) {
+  Grammar g = testing::MustParse("module: Fl\naxiom: Fl(1.5)[+F]~leaf(2,3)\n");
+  EXPECT_EQ(FormatWord(testing::MustDerive(g).word, g.symbols), "Fl(1.5)[+F]~leaf(2,3)");
+}
+
+}  // namespace
+}  // namespace sylva::lsys
