@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Runs the derivation benchmarks (3 repetitions, medians), the peak-memory
+# check and the lindenmayer.js comparison; writes bench/results/<date>-<host>.txt
+# and .json. Ratios, not bare times, are what compare across machines.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/deps.sh
+scripts/build.sh -DSYLVA_BUILD_BENCH=ON
+stamp="$(date +%Y-%m-%d)-$(hostname -s)"
+out="bench/results/$stamp"
+{
+  echo "# Sylva derivation benchmarks, $(date -u +%Y-%m-%dT%H:%MZ)"
+  echo "# machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p'), $(free -g | awk '/Mem:/{print $2}') GiB"
+  echo "# commit: $(git rev-parse --short HEAD)"
+  echo
+  build/bench/bench_derive --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+    --benchmark_out="$out.json" --benchmark_out_format=json 2>&1 | grep -E "^BM_.*_median" || true
+  echo
+  echo "# peak memory, sylva derive fig1_06 (Koch) -n 8 > /dev/null (124.6 M modules)"
+  /usr/bin/time -f "peak RSS %M KB, %e s" build/src/app/sylva derive grammars/abop/fig1_06_koch_island.lsys -n 8 \
+    2>&1 >/dev/null
+  echo
+  echo "# whole process against lindenmayer.js 1.5.4 (node $(node --version 2>/dev/null || echo missing))"
+  if command -v node >/dev/null && command -v npm >/dev/null; then
+    NS="6 7 8" bench/compare/run.sh 2>/dev/null
+  else
+    echo "node/npm not installed: skipped"
+  fi
+} | tee "$out.txt"
