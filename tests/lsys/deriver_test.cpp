@@ -148,3 +148,38 @@ TEST(Deriver, LongDerivationOfAFixedPointFinishes) {
 
 }  // namespace
 }  // namespace sylva::lsys
+
+namespace sylva::lsys {
+namespace {
+
+// Golden hashes: the same word in every run, build and thread count. The
+// parametric ones use only + - * / on doubles, which IEEE 754 makes exact
+// everywhere (the build uses -ffp-contract=off, so no fused multiply-adds).
+TEST(Determinism, GoldenHashesAcrossRunsAndThreadCounts) {
+  struct Golden {
+    const char* file;
+    int steps;
+    size_t size;
+    uint64_t hash;
+  } golden[] = {
+      {"grammars/abop/fig2_06a_monopodial.lsys", 14, 114682, 0x2230fa77d61d3ad4ULL},
+      {"grammars/abop/fig1_27_stochastic_plant.lsys", 8, 74656, 0x24dfd731230a49edULL},
+      {"grammars/abop/fig1_31a_hogeweg_hesper.lsys", 40, 75931, 0x059466fc578d792dULL},
+      {"grammars/abop/fig2_08c_ternary.lsys", 9, 177142, 0xb101ae8e86b34eb5ULL},
+  };
+  for (const Golden& g : golden) {
+    Grammar grammar = testing::MustParse(*ReadFile(testing::SourcePath(g.file)));
+    for (int threads : {1, 2, 4}) {
+      DeriveOptions opt;
+      opt.steps = g.steps;
+      opt.threads = threads;
+      auto r = testing::MustDerive(grammar, opt);
+      EXPECT_EQ(r.word.size(), g.size) << g.file << " threads " << threads;
+      EXPECT_EQ(HashWord(r.word), g.hash)
+          << g.file << " threads " << threads << ": hash 0x" << std::hex << HashWord(r.word);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sylva::lsys
