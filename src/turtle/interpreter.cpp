@@ -1,0 +1,319 @@
+#include "turtle/interpreter.h"
+
+#include <cmath>
+#include <cstring>
+
+#include "core/assert.h"
+
+namespace sylva::turtle {
+namespace {
+
+enum class Op : uint8_t {
+  kNone, kForwardDraw, kForwardMove, kForwardDrawNoVertex, kForwardMoveNoVertex,
+  kTurnLeft, kTurnRight, kPitchDown, kPitchUp, kRollLeft, kRollRight, kTurnAround, kLevel,
+  kPush, kPop, kWidth, kColor, kPolygonBegin, kVertex, kPolygonEnd, kSurface, kSphere,
+};
+
+Op OpFor(const std::string& name) {
+  if (name.size() == 1) {
+    switch (name[0]) {
+      case 'F': return Op::kForwardDraw;
+      case 'f': return Op::kForwardMove;
+      case 'G': return Op::kForwardDrawNoVertex;
+      case 'g': return Op::kForwardMoveNoVertex;
+      case '+': return Op::kTurnLeft;
+      case '-': return Op::kTurnRight;
+      case '&': return Op::kPitchDown;
+      case '^': return Op::kPitchUp;
+      case '/': return Op::kRollRight;
+      case '\\': return Op::kRollLeft;
+      case '|': return Op::kTurnAround;
+      case '$': return Op::kLevel;
+      case '[': return Op::kPush;
+      case ']': return Op::kPop;
+      case '!': return Op::kWidth;
+      case '\'': return Op::kColor;
+      case '{': return Op::kPolygonBegin;
+      case '.': return Op::kVertex;
+      case '}': return Op::kPolygonEnd;
+      default: return Op::kNone;
+    }
+  }
+  if (name[0] == '~') return Op::kSurface;
+  if (name == "@O") return Op::kSphere;
+  return Op::kNone;
+}
+
+struct State {
+  Vec3 pos{0, 0, 0};
+  Frame frame;
+  double width = 1;
+  uint32_t branch = 0;
+  uint16_t depth = 0;
+  uint16_t color = 0;
+};
+
+// X' = X cos a + Y sin a, Y' = Y cos a - X sin a: X turns toward Y.
+inline void Rotate(Vec3& x, Vec3& y, double c, double s) {
+  const Vec3 nx = x * c + y * s;
+  const Vec3 ny = y * c - x * s;
+  x = nx;
+  y = ny;
+}
+
+// sin and cos of an angle in degrees, with a small cache: parametric plants
+// reuse a handful of angles millions of times.
+class SinCos {
+ public:
+  void Get(double degrees, double* s, double* c) {
+    uint64_t bits;
+    std::memcpy(&bits, &degrees, 8);
+    Entry& e = cache_[(bits ^ (bits >> 29)) & 15];
+    if (!e.valid || e.degrees != degrees) {
+      e.valid = true;
+      e.degrees = degrees;
+      double r = degrees * kDegToRad;
+      e.s = std::sin(r);
+      e.c = std::cos(r);
+    }
+    *s = e.s;
+    *c = e.c;
+  }
+
+ private:
+  struct Entry {
+    double degrees = 0, s = 0, c = 1;
+    bool valid = false;
+  };
+  Entry cache_[16];
+};
+
+// Re-orthonormalises a frame that has drifted by rounding over many turns.
+inline void Orthonormalise(Frame& f) {
+  f.heading.normalize();
+  f.up = f.left.cross(f.heading);
+  f.up.normalize();
+  f.left = f.heading.cross(f.up);
+}
+
+}  // namespace
+
+TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
+  TurtleDef d;
+  d.angle = g.angle;
+  d.step = g.step;
+  d.width = g.width;
+  d.widthFactor = g.widthFactor;
+  if (g.tropism) {
+    d.tropism = Vec3(g.tropism->x, g.tropism->y, g.tropism->z);
+    d.susceptibility = g.tropism->susceptibility;
+  }
+  return d;
+}
+
+Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTable& symbols,
+                                  const TurtleDef& def, const DrawOptions& options) {
+  std::vector<Op> ops(symbols.size());
+  for (size_t s = 0; s < symbols.size(); ++s) ops[s] = OpFor(symbols.name(lsys::SymbolId(s)));
+
+  PlantGeometry g;
+  std::vector<uint32_t> branchParent{0};
+  std::vector<State> stack;
+  std::vector<Polygon> openPolygons;
+  State t;
+  t.width = def.width;
+  SinCos sincos;
+  double defSin, defCos;
+  sincos.Get(def.angle, &defSin, &defCos);
+  const bool tropism = def.susceptibility != 0;
+  Vec3 lo = t.pos, hi = t.pos;
+  bool planar = true;
+  const size_t n = word.size();
+  const bool hasParams = word.HasParams();
+  if (options.recordModules) {
+    g.modulePosition.resize(n);
+    g.moduleFrame.resize(n);
+  }
+  auto visit = [&](const Vec3& p) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+    planar &= p.z() == 0;
+  };
+  uint32_t turnsSinceOrtho = 0;
+
+  for (size_t i = 0; i < n; ++i) {
+    const lsys::SymbolId sym = word.symbols[i];
+    const Op op = ops[sym];
+    if (op == Op::kNone) {
+      if (options.recordModules) {
+        g.modulePosition[i] = t.pos;
+        g.moduleFrame[i] = t.frame;
+      }
+      continue;
+    }
+    const double* p = nullptr;
+    uint32_t np = 0;
+    if (hasParams) {
+      p = word.params.data() + word.paramStart[i];
+      np = word.paramStart[i + 1] - word.paramStart[i];
+    }
+    double s = defSin, c = defCos;
+    auto angle = [&] {
+      if (np) sincos.Get(p[0], &s, &c);
+      ++turnsSinceOrtho;
+    };
+    switch (op) {
+      case Op::kForwardDraw:
+      case Op::kForwardMove:
+      case Op::kForwardDrawNoVertex:
+      case Op::kForwardMoveNoVertex: {
+        const double len = np ? p[0] : def.step;
+        const Vec3 start = t.pos;
+        t.pos += t.frame.heading * len;
+        visit(t.pos);
+        const bool inPolygon = !openPolygons.empty();
+        if (inPolygon) {
+          if (op == Op::kForwardDraw || op == Op::kForwardMove)
+            openPolygons.back().vertices.push_back(t.pos);
+        } else if (op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex) {
+          Segment sg;
+          sg.start = start;
+          sg.end = t.pos;
+          sg.left = t.frame.left;
+          sg.radiusStart = sg.radiusEnd = float(t.width * 0.5);
+          sg.branch = t.branch;
+          sg.parent = branchParent[t.branch];
+          sg.depth = t.depth;
+          sg.color = t.color;
+          sg.module = uint32_t(i);
+          g.segments.push_back(sg);
+        }
+        if (tropism) {
+          // ABOP eq. 2.3: turn about H x T by e |H x T|.
+          const Vec3 axis = t.frame.heading.cross(def.tropism);
+          const double norm = axis.norm();
+          if (norm > 1e-12) {
+            const double a = def.susceptibility * norm;
+            const Eigen::AngleAxisd rot(a, axis / norm);
+            t.frame.heading = rot * t.frame.heading;
+            t.frame.left = rot * t.frame.left;
+            t.frame.up = rot * t.frame.up;
+            ++turnsSinceOrtho;
+          }
+        }
+        break;
+      }
+      case Op::kTurnLeft: angle(); Rotate(t.frame.heading, t.frame.left, c, s); break;
+      case Op::kTurnRight: angle(); Rotate(t.frame.heading, t.frame.left, c, -s); break;
+      case Op::kPitchDown: angle(); Rotate(t.frame.heading, t.frame.up, c, s); break;
+      case Op::kPitchUp: angle(); Rotate(t.frame.heading, t.frame.up, c, -s); break;
+      case Op::kRollRight: angle(); Rotate(t.frame.left, t.frame.up, c, s); break;
+      case Op::kRollLeft: angle(); Rotate(t.frame.left, t.frame.up, c, -s); break;
+      case Op::kTurnAround:
+        t.frame.heading = -t.frame.heading;
+        t.frame.left = -t.frame.left;
+        break;
+      case Op::kLevel: {
+        const Vec3 v = Vec3::UnitY().cross(t.frame.heading);
+        const double norm = v.norm();
+        if (norm > 1e-9) {
+          t.frame.left = v / norm;
+          t.frame.up = t.frame.left.cross(t.frame.heading);
+        }
+        break;
+      }
+      case Op::kPush:
+        stack.push_back(t);
+        branchParent.push_back(t.branch);
+        t.branch = uint32_t(branchParent.size() - 1);
+        t.depth = uint16_t(std::min<int>(t.depth + 1, 65535));
+        break;
+      case Op::kPop:
+        if (stack.empty()) {
+          return MakeError({}, "unmatched ']' at module " + std::to_string(i + 1) + " of the word");
+        }
+        t = stack.back();
+        stack.pop_back();
+        break;
+      case Op::kWidth:
+        t.width = np ? p[0] : t.width * def.widthFactor;
+        break;
+      case Op::kColor:
+        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : t.color + 1);
+        break;
+      case Op::kPolygonBegin: {
+        Polygon poly;
+        poly.color = t.color;
+        poly.module = uint32_t(i);
+        openPolygons.push_back(std::move(poly));
+        break;
+      }
+      case Op::kVertex:
+        if (!openPolygons.empty()) openPolygons.back().vertices.push_back(t.pos);
+        break;
+      case Op::kPolygonEnd: {
+        if (openPolygons.empty()) {
+          g.warnings.push_back("unmatched '}' at module " + std::to_string(i + 1) + " ignored");
+          break;
+        }
+        Polygon poly = std::move(openPolygons.back());
+        openPolygons.pop_back();
+        // Drop a closing vertex that repeats the first.
+        if (poly.vertices.size() > 1 &&
+            (poly.vertices.front() - poly.vertices.back()).norm() < 1e-9)
+          poly.vertices.pop_back();
+        if (poly.vertices.size() < 3) {
+          g.warnings.push_back("polygon at module " + std::to_string(poly.module + 1) + " has " +
+                               std::to_string(poly.vertices.size()) +
+                               " vertices; skipped");
+          break;
+        }
+        g.polygons.push_back(std::move(poly));
+        break;
+      }
+      case Op::kSurface: {
+        SurfaceInstance si;
+        si.name = symbols.name(sym).substr(1);
+        si.position = t.pos;
+        si.frame = t.frame;
+        si.scale = np ? p[0] : 1.0;
+        si.color = t.color;
+        si.module = uint32_t(i);
+        g.surfaces.push_back(std::move(si));
+        break;
+      }
+      case Op::kSphere: {
+        Sphere sp;
+        sp.center = t.pos;
+        sp.radius = (np ? p[0] : t.width) * 0.5;
+        sp.color = t.color;
+        sp.module = uint32_t(i);
+        g.spheres.push_back(sp);
+        break;
+      }
+      case Op::kNone: break;
+    }
+    if (turnsSinceOrtho >= 64) {
+      Orthonormalise(t.frame);
+      turnsSinceOrtho = 0;
+    }
+    if (options.recordModules) {
+      g.modulePosition[i] = t.pos;
+      g.moduleFrame[i] = t.frame;
+    }
+  }
+  for (const Polygon& poly : openPolygons) {
+    g.warnings.push_back("polygon opened at module " + std::to_string(poly.module + 1) +
+                         " is never closed; skipped");
+  }
+  if (!std::isfinite(lo.x() + lo.y() + lo.z() + hi.x() + hi.y() + hi.z())) {
+    return MakeError({}, "the turtle moved to a position that is not a finite number");
+  }
+  g.boundsMin = lo;
+  g.boundsMax = hi;
+  g.planar = planar;
+  g.branchCount = uint32_t(branchParent.size());
+  return g;
+}
+
+}  // namespace sylva::turtle

@@ -1,0 +1,53 @@
+// The 3D turtle (ABOP chapter 1.5, as cpfg implements it) reading a word.
+//
+// The turtle starts at the origin with heading H = (0,1,0), left
+// L = (-1,0,0) and up U = (0,0,-1). A rotation by angle a "toward" a vector
+// uses X' = X cos a + Y sin a, Y' = Y cos a - X sin a:
+//   +(a) H toward L    -(a) H toward -L
+//   &(a) H toward U    ^(a) H toward -U
+//   /(a) L toward U    \(a) L toward -U
+//   |    H and L reversed
+//   $    L = (Y x H)/|Y x H| with Y = (0,1,0), U = L x H (unchanged when H is vertical)
+// F(l) f(l) move by l (default: the grammar's step), F drawing a segment;
+// G g move without recording a polygon vertex. Inside a polygon `{ ... }`, F
+// and f add their end point as a vertex and draw no segment; `.` adds the
+// current position. `[` `]` push and pop the turtle state (not the polygon).
+// !(w) sets the width (a diameter), ! multiplies it by the width factor;
+// '(c) sets the colour index, ' adds 1; ~name(s) places a surface scaled by
+// s (default 1); @O(d) a sphere of diameter d (default: the width).
+// Tropism (ABOP eq. 2.3): after every F and f, the frame turns about H x T
+// by e |H x T|.
+#pragma once
+
+#include <optional>
+
+#include "core/status.h"
+#include "lsys/grammar.h"
+#include "lsys/word.h"
+#include "turtle/plant_geometry.h"
+
+namespace sylva::turtle {
+
+// What the turtle needs of a grammar; TurtleDefFrom fills it from the
+// grammar's header (angle:, step:, width:, width factor:, tropism:).
+struct TurtleDef {
+  double angle = 90;       // degrees, for rotations with no parameter
+  double step = 1;         // for F f G g with no parameter
+  double width = 1;        // initial width (diameter)
+  double widthFactor = 0.7;
+  Vec3 tropism{0, -1, 0};
+  double susceptibility = 0;  // 0: no tropism
+};
+
+TurtleDef TurtleDefFrom(const lsys::Grammar& g);
+
+struct DrawOptions {
+  bool recordModules = false;  // fill PlantGeometry::modulePosition / moduleFrame
+};
+
+// Interprets `word` (already through the interpretation rules). Errors: an
+// unmatched `]` or `}`, a polygon left open, a non-finite position.
+Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTable& symbols,
+                                  const TurtleDef& def, const DrawOptions& options = {});
+
+}  // namespace sylva::turtle

@@ -1,0 +1,78 @@
+// PlantGeometry: what the turtle draws, as parametric primitives. The turtle
+// never emits triangles; the mesh tessellator turns these into triangles at
+// the detail a camera or an export asks for.
+//
+// Units are the grammar's (a step of 1 is 1 unit); the world is Y-up and
+// right-handed. Frames are the turtle's (H heading, L left, U up), unit and
+// orthogonal, with U = L x H.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+
+namespace sylva::turtle {
+
+struct Frame {
+  Vec3 heading{0, 1, 0};
+  Vec3 left{-1, 0, 0};
+  Vec3 up{0, 0, -1};
+};
+
+// One drawn step (F or G) of a branch. 112 bytes.
+struct Segment {
+  Vec3 start, end;
+  Vec3 left;                 // turtle L at the start; H is (end - start) normalised
+  float radiusStart = 0.5f;  // half the turtle width at the start and the end
+  float radiusEnd = 0.5f;
+  uint32_t branch = 0;       // id of the branch (a `[`...`]` span) it belongs to
+  uint32_t parent = 0;       // branch that this branch grew from (itself for the trunk)
+  uint16_t depth = 0;        // bracket nesting depth
+  uint16_t color = 0;        // colour index
+  uint32_t module = 0;       // index of the module that drew it
+};
+
+struct Polygon {
+  std::vector<Vec3> vertices;  // in drawing order; not closed (first != last)
+  uint16_t color = 0;
+  uint32_t module = 0;         // the `{` that opened it
+};
+
+struct SurfaceInstance {
+  std::string name;  // without the `~`
+  Vec3 position;
+  Frame frame;
+  double scale = 1;
+  uint16_t color = 0;
+  uint32_t module = 0;
+};
+
+struct Sphere {
+  Vec3 center;
+  double radius = 0.5;
+  uint16_t color = 0;
+  uint32_t module = 0;
+};
+
+struct PlantGeometry {
+  std::vector<Segment> segments;
+  std::vector<Polygon> polygons;
+  std::vector<SurfaceInstance> surfaces;
+  std::vector<Sphere> spheres;
+  uint32_t branchCount = 0;
+  Vec3 boundsMin{0, 0, 0}, boundsMax{0, 0, 0};  // of every point drawn or visited
+  bool planar = true;  // every point lies in the z = 0 plane (ABOP's 2D figures)
+
+  // Problems that do not stop the drawing (an unmatched `}`, a polygon with
+  // fewer than 3 vertices), each naming the module.
+  std::vector<std::string> warnings;
+
+  // Optional per-module state (DrawOptions::recordModules): the turtle's
+  // position and frame after each module.
+  std::vector<Vec3> modulePosition;
+  std::vector<Frame> moduleFrame;
+};
+
+}  // namespace sylva::turtle

@@ -1,0 +1,226 @@
+#include "turtle/interpreter.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "core/atomic_file.h"
+#include "lsys/deriver.h"
+#include "lsys/parser.h"
+
+namespace sylva::turtle {
+namespace {
+
+std::string Str(const Vec3& v) {
+  char b[96];
+  std::snprintf(b, sizeof b, "(%.9g, %.9g, %.9g)", v.x(), v.y(), v.z());
+  return b;
+}
+
+#define EXPECT_VEC_NEAR(a, b, tol) \
+  EXPECT_LT(((a) - (b)).norm(), tol) << "got " << Str(a) << ", want " << Str(b)
+
+struct Drawn {
+  lsys::Grammar grammar;
+  PlantGeometry geometry;
+};
+
+// Parses, derives (interpretation rules applied) and draws.
+Drawn Draw(const std::string& text, int steps = -1, DrawOptions opt = {}) {
+  Drawn d;
+  auto r = lsys::ParseGrammarText(text, "t.lsys");
+  if (!r.grammar) {
+    ADD_FAILURE() << r.diagnostics.FormatAll();
+    return d;
+  }
+  d.grammar = std::move(*r.grammar);
+  lsys::DeriveOptions o;
+  o.steps = steps;
+  auto w = lsys::Derive(d.grammar, o);
+  if (!w) {
+    ADD_FAILURE() << w.error().Format();
+    return d;
+  }
+  auto iw = lsys::Interpret(d.grammar, w->word);
+  auto g = Interpret(*iw, d.grammar.symbols, TurtleDefFrom(d.grammar), opt);
+  if (!g) {
+    ADD_FAILURE() << g.error().Format();
+    return d;
+  }
+  d.geometry = std::move(*g);
+  return d;
+}
+
+Frame FinalFrame(const std::string& axiom) {
+  DrawOptions opt;
+  opt.recordModules = true;
+  Drawn d = Draw("axiom: " + axiom + "\n", 0, opt);
+  return d.geometry.moduleFrame.back();
+}
+
+TEST(Turtle, ForwardThenTurnLeftEndsAtMinusOneOne) {
+  Drawn d = Draw("axiom: F+F\n");
+  ASSERT_EQ(d.geometry.segments.size(), 2u);
+  EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.segments[1].end, Vec3(-1, 1, 0), 1e-12);
+}
+
+TEST(Turtle, EachRotationMovesTowardItsVector) {
+  // Initial frame: H = (0,1,0), L = (-1,0,0), U = (0,0,-1).
+  EXPECT_VEC_NEAR(FinalFrame("-").heading, Vec3(1, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(FinalFrame("&").heading, Vec3(0, 0, -1), 1e-12);
+  EXPECT_VEC_NEAR(FinalFrame("&").up, Vec3(0, -1, 0), 1e-12);
+  EXPECT_VEC_NEAR(FinalFrame("^").heading, Vec3(0, 0, 1), 1e-12);
+  EXPECT_VEC_NEAR(FinalFrame("/").left, Vec3(0, 0, -1), 1e-12);
+  EXPECT_VEC_NEAR(FinalFrame("/").up, Vec3(1, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(FinalFrame("\\").left, Vec3(0, 0, 1), 1e-12);
+  EXPECT_VEC_NEAR(FinalFrame("+(30)").heading, Vec3(-0.5, std::sqrt(3.0) / 2, 0), 1e-12);
+}
+
+TEST(Turtle, TurnAroundReversesHeadingAndLeft) {
+  Frame f = FinalFrame("&(20)/(30)|");
+  Frame g = FinalFrame("&(20)/(30)");
+  EXPECT_VEC_NEAR(f.heading, Vec3(-g.heading), 1e-12);
+  EXPECT_VEC_NEAR(f.left, Vec3(-g.left), 1e-12);
+  EXPECT_VEC_NEAR(f.up, g.up, 1e-12);
+}
+
+TEST(Turtle, DollarMakesLeftHorizontal) {
+  Frame before = FinalFrame("&(35)/(50)+(20)");
+  Frame f = FinalFrame("&(35)/(50)+(20)$");
+  EXPECT_VEC_NEAR(f.heading, before.heading, 1e-12);
+  EXPECT_NEAR(f.left.y(), 0, 1e-12) << Str(f.left);
+  EXPECT_NEAR(f.left.norm(), 1, 1e-12);
+  EXPECT_VEC_NEAR(f.up, Vec3(f.left.cross(f.heading)), 1e-12);
+  // Unchanged when H is vertical.
+  Frame v = FinalFrame("/(30)$");
+  EXPECT_VEC_NEAR(v.left, FinalFrame("/(30)").left, 1e-12);
+}
+
+TEST(Turtle, FrameStaysOrthonormalOverManyTurns) {
+  std::string axiom;
+  std::mt19937 rng(5);
+  const char* turns = "+-&^/\\";
+  for (int i = 0; i < 20000; ++i) {
+    axiom += turns[rng() % 6];
+    axiom += "(" + std::to_string(int(rng() % 170) + 3) + ".37)";
+  }
+  Frame f = FinalFrame(axiom);
+  EXPECT_NEAR(f.heading.norm(), 1, 1e-12);
+  EXPECT_NEAR(f.left.norm(), 1, 1e-12);
+  EXPECT_NEAR(f.heading.dot(f.left), 0, 1e-12);
+  EXPECT_VEC_NEAR(f.up, Vec3(f.left.cross(f.heading)), 1e-12);
+}
+
+TEST(Turtle, TropismBendsTowardTheVectorByTheAbopFormula) {
+  // Heading (-1,0,0), T = (0,-1,0): |H x T| = 1, so H turns by e = 0.2 rad toward T.
+  DrawOptions opt;
+  opt.recordModules = true;
+  Drawn d = Draw("tropism: 0 -1 0 0.2\naxiom: +F\n", 0, opt);
+  Vec3 h = d.geometry.moduleFrame.back().heading;
+  EXPECT_VEC_NEAR(h, Vec3(-std::cos(0.2), -std::sin(0.2), 0), 1e-12);
+  // Parallel to T: no bend.
+  Drawn up = Draw("tropism: 0 -1 0 0.2\naxiom: F\n", 0, opt);
+  EXPECT_VEC_NEAR(up.geometry.moduleFrame.back().heading, Vec3(0, 1, 0), 1e-12);
+}
+
+TEST(Turtle, KochIslandClosesOnItself) {
+  std::string text = *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig1_06_koch_island.lsys");
+  DrawOptions opt;
+  opt.recordModules = true;
+  Drawn d = Draw(text, 2, opt);
+  EXPECT_EQ(d.geometry.segments.size(), 4u * 64);
+  EXPECT_VEC_NEAR(d.geometry.modulePosition.back(), Vec3(0, 0, 0), 1e-9);
+  EXPECT_TRUE(d.geometry.planar);
+}
+
+TEST(Turtle, DragonCurveEndsAtDistanceTwoToTheHalfN) {
+  std::string text = *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig1_10a_dragon_curve.lsys");
+  DrawOptions opt;
+  opt.recordModules = true;
+  Drawn d = Draw(text, 10, opt);
+  ASSERT_EQ(d.geometry.segments.size(), 1024u);
+  // The end point is (1 + i)^10 = 32i times the first step, up to a reflection:
+  // 32 units away, on a coordinate axis.
+  Vec3 end = d.geometry.modulePosition.back();
+  EXPECT_NEAR(end.norm(), 32, 1e-9) << Str(end);
+  EXPECT_NEAR(std::min(std::abs(end.x()), std::abs(end.y())), 0, 1e-9) << Str(end);
+}
+
+TEST(Turtle, BranchesDepthsAndWidths) {
+  Drawn d = Draw("width factor: 0.5\naxiom: !(2)F[!F[F]]'F\n");
+  const auto& s = d.geometry.segments;
+  ASSERT_EQ(s.size(), 4u);
+  EXPECT_EQ(s[0].branch, 0u);
+  EXPECT_EQ(s[1].branch, 1u);
+  EXPECT_EQ(s[2].branch, 2u);
+  EXPECT_EQ(s[3].branch, 0u);
+  EXPECT_EQ(s[2].parent, 1u);
+  EXPECT_EQ(s[1].parent, 0u);
+  EXPECT_EQ(s[2].depth, 2);
+  EXPECT_EQ(s[0].radiusStart, 1.0f);
+  EXPECT_EQ(s[1].radiusStart, 0.5f);
+  EXPECT_EQ(s[2].radiusStart, 0.5f);
+  EXPECT_EQ(s[3].radiusStart, 1.0f);  // width restored by ]
+  EXPECT_EQ(s[3].color, 1);
+  EXPECT_VEC_NEAR(s[3].start, Vec3(0, 1, 0), 1e-12);
+  EXPECT_EQ(d.geometry.branchCount, 3u);
+}
+
+TEST(Turtle, PolygonsCollectVerticesAndDrawNoSegments) {
+  Drawn d = Draw("axiom: {.F+F+F+F}G\n");
+  ASSERT_EQ(d.geometry.polygons.size(), 1u);
+  const auto& v = d.geometry.polygons[0].vertices;
+  ASSERT_EQ(v.size(), 4u);  // the closing vertex repeats the first and is dropped
+  EXPECT_VEC_NEAR(v[1], Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(v[2], Vec3(-1, 1, 0), 1e-12);
+  EXPECT_EQ(d.geometry.segments.size(), 1u);  // only the G outside
+}
+
+TEST(Turtle, PolygonSpansBranchesAndGRecordsNoVertex) {
+  Drawn d = Draw("axiom: {.[+G.]G.-G.}\n");
+  ASSERT_EQ(d.geometry.polygons.size(), 1u);
+  EXPECT_EQ(d.geometry.polygons[0].vertices.size(), 4u);
+}
+
+TEST(Turtle, DegeneratePolygonsAndStrayBracesAreWarnings) {
+  Drawn d = Draw("axiom: {.F}}{F\n");
+  EXPECT_EQ(d.geometry.polygons.size(), 0u);
+  ASSERT_EQ(d.geometry.warnings.size(), 3u);
+  EXPECT_EQ(d.geometry.warnings[0], "polygon at module 1 has 2 vertices; skipped");
+  EXPECT_EQ(d.geometry.warnings[1], "unmatched '}' at module 5 ignored");
+  EXPECT_EQ(d.geometry.warnings[2], "polygon opened at module 6 is never closed; skipped");
+}
+
+TEST(Turtle, SurfacesAndSpheres) {
+  Drawn d = Draw("axiom: F~leaf(2)!(3)@O@O(1)\n");
+  ASSERT_EQ(d.geometry.surfaces.size(), 1u);
+  EXPECT_EQ(d.geometry.surfaces[0].name, "leaf");
+  EXPECT_EQ(d.geometry.surfaces[0].scale, 2);
+  EXPECT_VEC_NEAR(d.geometry.surfaces[0].position, Vec3(0, 1, 0), 1e-12);
+  ASSERT_EQ(d.geometry.spheres.size(), 2u);
+  EXPECT_EQ(d.geometry.spheres[0].radius, 1.5);
+  EXPECT_EQ(d.geometry.spheres[1].radius, 0.5);
+}
+
+TEST(Turtle, StepAngleAndBounds) {
+  Drawn d = Draw("step: 2\nangle: 45\naxiom: F-F&F\n");
+  EXPECT_VEC_NEAR(d.geometry.segments[1].end, Vec3(std::sqrt(2.0), 2 + std::sqrt(2.0), 0), 1e-12);
+  EXPECT_FALSE(d.geometry.planar);
+  EXPECT_NEAR(d.geometry.boundsMin.z(), -std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(d.geometry.boundsMax.y(), 2 + std::sqrt(2.0) + 1, 1e-12);
+}
+
+TEST(Turtle, MonopodialTreeIsThreeDimensionalAndBounded) {
+  std::string text = *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys");
+  Drawn d = Draw(text);
+  // 2^10 - 1 internodes of lengths r1^k..., all F's of the derived word.
+  EXPECT_EQ(d.geometry.segments.size(), 1023u);
+  EXPECT_FALSE(d.geometry.planar);
+  // The trunk: 1 + 0.9 + ... + 0.9^9 = (1 - 0.9^10)/0.1 = 6.5132, straight up.
+  double trunk = (1 - std::pow(0.9, 10)) / 0.1;
+  EXPECT_NEAR(d.geometry.boundsMax.y(), trunk, 1e-9);
+}
+
+}  // namespace
+}  // namespace sylva::turtle
