@@ -16,6 +16,10 @@ out="bench/results/$stamp"
   build/bench/bench_derive --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
     --benchmark_out="$out.json" --benchmark_out_format=json 2>&1 | grep -E "^BM_.*_median" || true
   echo
+  echo "# turtle interpretation (/0 fresh geometry, /1 reused), modules/s"
+  build/bench/bench_turtle --benchmark_repetitions=3 --benchmark_report_aggregates_only=true 2>&1 \
+    | grep -E "^BM_.*_median" || true
+  echo
   echo "# peak memory, sylva derive fig1_06 (Koch) -n 8 > /dev/null (124.6 M modules)"
   /usr/bin/time -f "peak RSS %M KB, %e s" build/src/app/sylva derive grammars/abop/fig1_06_koch_island.lsys -n 8 \
     2>&1 >/dev/null

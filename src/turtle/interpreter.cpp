@@ -1,9 +1,12 @@
 #include "turtle/interpreter.h"
 
+#include <math.h>
+
 #include <cmath>
 #include <cstring>
 
 #include "core/assert.h"
+#include "core/memory.h"
 
 namespace sylva::turtle {
 namespace {
@@ -54,11 +57,21 @@ struct State {
 };
 
 // X' = X cos a + Y sin a, Y' = Y cos a - X sin a: X turns toward Y.
-inline void Rotate(Vec3& x, Vec3& y, double c, double s) {
+[[gnu::always_inline]] inline void Rotate(Vec3& x, Vec3& y, double c, double s) {
   const Vec3 nx = x * c + y * s;
   const Vec3 ny = y * c - x * s;
   x = nx;
   y = ny;
+}
+
+// Both at once where the C library offers it (glibc's sincos).
+inline void SinCosRadians(double r, double* s, double* c) {
+#if defined(__GLIBC__)
+  ::sincos(r, s, c);
+#else
+  *s = std::sin(r);
+  *c = std::cos(r);
+#endif
 }
 
 // sin and cos of an angle in degrees, with a small cache: parametric plants
@@ -68,13 +81,11 @@ class SinCos {
   void Get(double degrees, double* s, double* c) {
     uint64_t bits;
     std::memcpy(&bits, &degrees, 8);
-    Entry& e = cache_[(bits ^ (bits >> 29)) & 15];
+    Entry& e = cache_[(bits * 0x9E3779B97F4A7C15ULL) >> 60];  // Fibonacci hashing
     if (!e.valid || e.degrees != degrees) {
       e.valid = true;
       e.degrees = degrees;
-      double r = degrees * kDegToRad;
-      e.s = std::sin(r);
-      e.c = std::cos(r);
+      SinCosRadians(degrees * kDegToRad, &e.s, &e.c);
     }
     *s = e.s;
     *c = e.c;
@@ -113,10 +124,40 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
 
 Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTable& symbols,
                                   const TurtleDef& def, const DrawOptions& options) {
+  PlantGeometry g;
+  if (Status s = InterpretInto(word, symbols, def, options, g); !s.ok()) return s.error();
+  return g;
+}
+
+Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
+                     const TurtleDef& def, const DrawOptions& options, PlantGeometry& g) {
   std::vector<Op> ops(symbols.size());
   for (size_t s = 0; s < symbols.size(); ++s) ops[s] = OpFor(symbols.name(lsys::SymbolId(s)));
 
-  PlantGeometry g;
+  g.segments.clear();
+  g.polygons.clear();
+  g.surfaces.clear();
+  g.spheres.clear();
+  g.warnings.clear();
+  g.modulePosition.clear();
+  g.moduleFrame.clear();
+  {
+    // Count what will be drawn, so the arrays are allocated once.
+    size_t draws = 0, spheres = 0, surfaces = 0;
+    for (size_t i = 0; i < word.size(); ++i) {
+      const Op op = ops[word.symbols[i]];
+      draws += op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex;
+      spheres += op == Op::kSphere;
+      surfaces += op == Op::kSurface;
+    }
+    if (g.segments.capacity() < draws) {
+      g.segments = std::vector<Segment>();
+      g.segments.reserve(draws);
+      AdviseHugePages(g.segments.data(), draws * sizeof(Segment));
+    }
+    g.spheres.reserve(spheres);
+    g.surfaces.reserve(surfaces);
+  }
   std::vector<uint32_t> branchParent{0};
   std::vector<State> stack;
   std::vector<Polygon> openPolygons;
@@ -193,11 +234,15 @@ Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTabl
           const Vec3 axis = t.frame.heading.cross(def.tropism);
           const double norm = axis.norm();
           if (norm > 1e-12) {
+            // Rodrigues: v' = v cos a + (k x v) sin a + k (k.v)(1 - cos a).
             const double a = def.susceptibility * norm;
-            const Eigen::AngleAxisd rot(a, axis / norm);
-            t.frame.heading = rot * t.frame.heading;
-            t.frame.left = rot * t.frame.left;
-            t.frame.up = rot * t.frame.up;
+            const Vec3 k = axis / norm;
+            double sa, ca;
+            SinCosRadians(a, &sa, &ca);
+            auto turn = [&](Vec3& v) { v = v * ca + k.cross(v) * sa + k * (k.dot(v) * (1 - ca)); };
+            turn(t.frame.heading);
+            turn(t.frame.left);
+            turn(t.frame.up);
             ++turnsSinceOrtho;
           }
         }
@@ -230,6 +275,7 @@ Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTabl
         break;
       case Op::kPop:
         if (stack.empty()) {
+          g = PlantGeometry();
           return MakeError({}, "unmatched ']' at module " + std::to_string(i + 1) + " of the word");
         }
         t = stack.back();
@@ -307,13 +353,14 @@ Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTabl
                          " is never closed; skipped");
   }
   if (!std::isfinite(lo.x() + lo.y() + lo.z() + hi.x() + hi.y() + hi.z())) {
+    g = PlantGeometry();
     return MakeError({}, "the turtle moved to a position that is not a finite number");
   }
   g.boundsMin = lo;
   g.boundsMax = hi;
   g.planar = planar;
   g.branchCount = uint32_t(branchParent.size());
-  return g;
+  return {};
 }
 
 }  // namespace sylva::turtle

@@ -50,4 +50,10 @@ struct DrawOptions {
 Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTable& symbols,
                                   const TurtleDef& def, const DrawOptions& options = {});
 
+// The same, drawing into `out` and reusing its arrays' memory: the viewer
+// redraws a plant many times, and fresh memory costs the kernel a page
+// clear per 4 KiB. On error `out` is left empty.
+Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
+                     const TurtleDef& def, const DrawOptions& options, PlantGeometry& out);
+
 }  // namespace sylva::turtle

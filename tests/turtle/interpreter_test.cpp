@@ -224,3 +224,26 @@ TEST(Turtle, MonopodialTreeIsThreeDimensionalAndBounded) {
 
 }  // namespace
 }  // namespace sylva::turtle
+
+namespace sylva::turtle {
+namespace {
+
+TEST(Turtle, RedrawingIntoAnExistingGeometryGivesTheSameResult) {
+  auto r = lsys::ParseGrammarText("axiom: F[+F{.F+F+F}]~a@O F\n", "t.lsys");
+  ASSERT_TRUE(r.grammar);
+  auto w = lsys::Derive(*r.grammar);
+  TurtleDef def = TurtleDefFrom(*r.grammar);
+  auto fresh = Interpret(w->word, r.grammar->symbols, def);
+  PlantGeometry kept;
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(InterpretInto(w->word, r.grammar->symbols, def, {}, kept).ok());
+    EXPECT_EQ(kept.segments.size(), fresh->segments.size());
+    EXPECT_EQ(kept.polygons.size(), 1u);
+    EXPECT_EQ(kept.surfaces.size(), 1u);
+    EXPECT_EQ(kept.spheres.size(), 1u);
+    EXPECT_EQ(kept.segments.back().end, fresh->segments.back().end);
+  }
+}
+
+}  // namespace
+}  // namespace sylva::turtle
