@@ -24,9 +24,16 @@
 #include "core/status.h"
 #include "lsys/grammar.h"
 #include "lsys/word.h"
-#include "turtle/plant_geometry.h"
+#include "mesh/plant_geometry.h"
 
 namespace sylva::turtle {
+
+using mesh::Frame;
+using mesh::PlantGeometry;
+using mesh::Polygon;
+using mesh::Segment;
+using mesh::Sphere;
+using mesh::SurfaceInstance;
 
 // What the turtle needs of a grammar; TurtleDefFrom fills it from the
 // grammar's header (angle:, step:, width:, width factor:, tropism:).

@@ -1,4 +1,4 @@
-// PlantGeometry: what the turtle draws, as parametric primitives. The turtle
+// PlantGeometry: parametric primitives, the tessellator's input. The turtle
 // never emits triangles; the mesh tessellator turns these into triangles at
 // the detail a camera or an export asks for.
 //
@@ -13,7 +13,7 @@
 
 #include "core/math.h"
 
-namespace sylva::turtle {
+namespace sylva::mesh {
 
 struct Frame {
   Vec3 heading{0, 1, 0};
@@ -75,4 +75,4 @@ struct PlantGeometry {
   std::vector<Frame> moduleFrame;
 };
 
-}  // namespace sylva::turtle
+}  // namespace sylva::mesh

@@ -1,0 +1,318 @@
+#include "mesh/tessellator.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sylva::mesh {
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925;
+
+Vec3f F(const Vec3& v) { return v.cast<float>(); }
+
+Vec3 AnyPerpendicular(const Vec3& t) {
+  Vec3 a = std::abs(t.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  return (a - t * t.dot(a)).normalized();
+}
+
+int ClampSides(int s) { return std::clamp(s, 3, 256); }
+
+// Builds chains: runs of segments of one branch where each starts where the
+// previous ended.
+std::vector<std::vector<uint32_t>> BuildChains(const PlantGeometry& g) {
+  std::vector<std::vector<uint32_t>> chains;
+  std::vector<int64_t> open(std::max<size_t>(g.branchCount, 1), -1);
+  for (uint32_t k = 0; k < g.segments.size(); ++k) {
+    const Segment& s = g.segments[k];
+    const double len = (s.end - s.start).norm();
+    if (!(len > 1e-12)) continue;
+    if (s.branch >= open.size()) open.resize(s.branch + 1, -1);
+    int64_t c = open[s.branch];
+    if (c >= 0) {
+      const Segment& last = g.segments[chains[size_t(c)].back()];
+      if ((last.end - s.start).norm() <= 1e-9 * (1 + last.end.norm())) {
+        chains[size_t(c)].push_back(k);
+        continue;
+      }
+    }
+    open[s.branch] = int64_t(chains.size());
+    chains.push_back({k});
+  }
+  return chains;
+}
+
+void TessellateChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, int sides,
+                     TriangleMesh& out) {
+  const size_t m = chain.size();
+  std::vector<Vec3> P(m + 1), T(m + 1), N(m + 1);
+  std::vector<double> R(m + 1), V(m + 1);
+  P[0] = g.segments[chain[0]].start;
+  for (size_t k = 0; k < m; ++k) P[k + 1] = g.segments[chain[k]].end;
+  auto dir = [&](size_t k) { return (P[k + 1] - P[k]).normalized(); };
+  T[0] = dir(0);
+  T[m] = dir(m - 1);
+  for (size_t k = 1; k < m; ++k) {
+    Vec3 t = dir(k - 1) + dir(k);
+    T[k] = t.norm() > 1e-9 ? t.normalized() : dir(k);
+  }
+  R[0] = g.segments[chain[0]].radiusStart;
+  for (size_t k = 1; k < m; ++k) R[k] = g.segments[chain[k]].radiusStart;
+  R[m] = g.segments[chain[m - 1]].radiusEnd;
+  double rmax = *std::max_element(R.begin(), R.end());
+  for (double& r : R) r = std::max(r, rmax * 1e-3);
+  V[0] = 0;
+  for (size_t k = 0; k < m; ++k) V[k + 1] = V[k] + (P[k + 1] - P[k]).norm();
+
+  // First normal: the turtle's L, made perpendicular to the tangent.
+  Vec3 n0 = g.segments[chain[0]].left;
+  n0 -= T[0] * T[0].dot(n0);
+  N[0] = n0.norm() > 1e-9 ? n0.normalized() : AnyPerpendicular(T[0]);
+  // Double reflection (Wang et al. 2008).
+  for (size_t k = 0; k < m; ++k) {
+    const Vec3 v1 = P[k + 1] - P[k];
+    const double c1 = v1.dot(v1);
+    const Vec3 rL = N[k] - (2 / c1) * v1.dot(N[k]) * v1;
+    const Vec3 tL = T[k] - (2 / c1) * v1.dot(T[k]) * v1;
+    const Vec3 v2 = T[k + 1] - tL;
+    const double c2 = v2.dot(v2);
+    Vec3 n = c2 > 1e-18 ? Vec3(rL - (2 / c2) * v2.dot(rL) * v2) : rL;
+    n -= T[k + 1] * T[k + 1].dot(n);
+    N[k + 1] = n.norm() > 1e-9 ? n.normalized() : AnyPerpendicular(T[k + 1]);
+  }
+
+  const int S = sides;
+  std::vector<double> cs(S + 1), sn(S + 1);
+  for (int j = 0; j < S; ++j) {
+    cs[j] = std::cos(kTwoPi * j / S);
+    sn[j] = std::sin(kTwoPi * j / S);
+  }
+  cs[S] = cs[0];  // the seam vertex repeats the first exactly (only u differs)
+  sn[S] = sn[0];
+  const uint32_t base = uint32_t(out.positions.size());
+  // Tube rings: S + 1 vertices each (the seam is duplicated for u = 1).
+  for (size_t k = 0; k <= m; ++k) {
+    const Vec3 B = T[k].cross(N[k]);
+    for (int j = 0; j <= S; ++j) {
+      const Vec3 radial = N[k] * cs[j] + B * sn[j];
+      out.positions.push_back(F(P[k] + radial * R[k]));
+      out.normals.push_back(F(radial.normalized()));
+      out.uvs.push_back(Vec2f(float(j) / float(S), float(V[k])));
+    }
+  }
+  const uint32_t ring = uint32_t(S + 1);
+  for (size_t k = 0; k < m; ++k) {
+    const uint16_t mat = g.segments[chain[k]].color;
+    for (int j = 0; j < S; ++j) {
+      const uint32_t a = base + uint32_t(k) * ring + uint32_t(j), b = a + 1, d = a + ring, c = d + 1;
+      out.indices.insert(out.indices.end(), {a, b, c, a, c, d});
+      out.material.push_back(mat);
+      out.material.push_back(mat);
+    }
+  }
+  // Caps: a centre and a ring of S vertices with the axis as normal.
+  auto cap = [&](size_t k, bool tip) {
+    const Vec3 B = T[k].cross(N[k]);
+    const Vec3 normal = tip ? T[k] : Vec3(-T[k]);
+    const uint32_t center = uint32_t(out.positions.size());
+    out.positions.push_back(F(P[k]));
+    out.normals.push_back(F(normal));
+    out.uvs.push_back(Vec2f(0.5f, 0.5f));
+    for (int j = 0; j < S; ++j) {
+      out.positions.push_back(F(P[k] + (N[k] * cs[j] + B * sn[j]) * R[k]));
+      out.normals.push_back(F(normal));
+      out.uvs.push_back(Vec2f(float(0.5 + 0.5 * cs[j]), float(0.5 + 0.5 * sn[j])));
+    }
+    const uint16_t mat = g.segments[chain[tip ? m - 1 : 0]].color;
+    for (int j = 0; j < S; ++j) {
+      const uint32_t p = center + 1 + uint32_t(j), q = center + 1 + uint32_t((j + 1) % S);
+      if (tip) {
+        out.indices.insert(out.indices.end(), {center, p, q});
+      } else {
+        out.indices.insert(out.indices.end(), {center, q, p});
+      }
+      out.material.push_back(mat);
+    }
+  };
+  cap(0, false);
+  cap(m, true);
+}
+
+void TessellateSphere(const Sphere& s, int sides, TriangleMesh& out) {
+  const int S = sides, Rn = std::max(2, S / 2);
+  const uint32_t base = uint32_t(out.positions.size());
+  for (int i = 0; i <= Rn; ++i) {
+    const double th = kTwoPi * 0.5 * i / Rn;
+    // Exact poles and seam, so coincident vertices are bit-identical.
+    const double st = (i == 0 || i == Rn) ? 0.0 : std::sin(th);
+    const double ct = i == 0 ? 1.0 : (i == Rn ? -1.0 : std::cos(th));
+    for (int j = 0; j <= S; ++j) {
+      const double ph = j == S ? 0.0 : kTwoPi * j / S;
+      const Vec3 n(st * std::cos(ph), ct, st * std::sin(ph));
+      out.positions.push_back(F(s.center + n * s.radius));
+      out.normals.push_back(F(n));
+      out.uvs.push_back(Vec2f(float(j) / float(S), float(i) / float(Rn)));
+    }
+  }
+  const uint32_t W = uint32_t(S + 1);
+  for (int i = 0; i < Rn; ++i) {
+    for (int j = 0; j < S; ++j) {
+      const uint32_t a = base + uint32_t(i) * W + uint32_t(j), b = a + 1, d = a + W, c = d + 1;
+      if (i != Rn - 1) {
+        out.indices.insert(out.indices.end(), {a, c, d});
+        out.material.push_back(s.color);
+      }
+      if (i != 0) {
+        out.indices.insert(out.indices.end(), {a, b, c});
+        out.material.push_back(s.color);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<uint32_t> TriangulatePolygon(const std::vector<Vec3>& in, Vec3* normalOut) {
+  std::vector<uint32_t> tris;
+  const size_t n = in.size();
+  if (n < 3) return tris;
+  // Newell's normal: robust for non-planar and concave outlines.
+  Vec3 normal = Vec3::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& a = in[i];
+    const Vec3& b = in[(i + 1) % n];
+    normal += Vec3((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()),
+                   (a.x() - b.x()) * (a.y() + b.y()));
+  }
+  const double area2 = normal.norm();
+  double scale = 0;
+  for (const Vec3& v : in) scale = std::max(scale, (v - in[0]).norm());
+  if (!(area2 > 1e-12 * scale * scale) || !std::isfinite(area2)) return tris;
+  normal /= area2;
+  if (normalOut) *normalOut = normal;
+  const Vec3 e1 = AnyPerpendicular(normal), e2 = normal.cross(e1);
+  std::vector<Vec2> p(n);
+  for (size_t i = 0; i < n; ++i) p[i] = Vec2((in[i] - in[0]).dot(e1), (in[i] - in[0]).dot(e2));
+  auto cross = [](const Vec2& a, const Vec2& b, const Vec2& c) {
+    return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+  };
+  const double eps = 1e-12 * scale * scale;
+  std::vector<uint32_t> idx(n);
+  for (size_t i = 0; i < n; ++i) idx[i] = uint32_t(i);
+  while (idx.size() > 3) {
+    bool clipped = false;
+    const size_t k = idx.size();
+    for (size_t i = 0; i < k; ++i) {
+      const uint32_t a = idx[(i + k - 1) % k], b = idx[i], c = idx[(i + 1) % k];
+      if (cross(p[a], p[b], p[c]) <= eps) continue;  // reflex or flat
+      bool inside = false;
+      for (uint32_t q : idx) {
+        if (q == a || q == b || q == c) continue;
+        if (cross(p[a], p[b], p[q]) >= 0 && cross(p[b], p[c], p[q]) >= 0 &&
+            cross(p[c], p[a], p[q]) >= 0) {
+          inside = true;
+          break;
+        }
+      }
+      if (inside) continue;
+      tris.insert(tris.end(), {a, b, c});
+      idx.erase(idx.begin() + long(i));
+      clipped = true;
+      break;
+    }
+    if (!clipped) {
+      // Collinear or self-intersecting remainder: drop a flat vertex, or stop.
+      bool dropped = false;
+      for (size_t i = 0; i < idx.size() && !dropped; ++i) {
+        const size_t kk = idx.size();
+        if (std::abs(cross(p[idx[(i + kk - 1) % kk]], p[idx[i]], p[idx[(i + 1) % kk]])) <= eps) {
+          idx.erase(idx.begin() + long(i));
+          dropped = true;
+        }
+      }
+      if (!dropped) break;
+    }
+  }
+  if (idx.size() == 3 && cross(p[idx[0]], p[idx[1]], p[idx[2]]) > eps)
+    tris.insert(tris.end(), {idx[0], idx[1], idx[2]});
+  return tris;
+}
+
+std::string Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
+                       TessellateStats* stats) {
+  auto detailFor = [&](const Vec3& c, double r) {
+    return ClampSides(options.detailFn ? options.detailFn(c, r).sides : options.detail.sides);
+  };
+  // Surfaces first: an unknown name fails before anything is appended.
+  for (const SurfaceInstance& si : g.surfaces) {
+    if (!options.surfaces || !options.surfaces->count(si.name)) return "unknown surface '" + si.name + "'";
+  }
+  const auto chains = BuildChains(g);
+  size_t tubeTris = 0;
+  for (const auto& c : chains) tubeTris += TubeTriangles(c.size(), ClampSides(options.detail.sides));
+  out.indices.reserve(out.indices.size() + 3 * tubeTris);
+  out.material.reserve(out.material.size() + tubeTris);
+  for (const auto& chain : chains) {
+    Vec3 lo = g.segments[chain[0]].start, hi = lo;
+    double rmax = 0;
+    for (uint32_t k : chain) {
+      lo = lo.cwiseMin(g.segments[k].end);
+      hi = hi.cwiseMax(g.segments[k].end);
+      rmax = std::max<double>(rmax, g.segments[k].radiusStart);
+    }
+    if (!(rmax > 0)) continue;  // zero width: nothing to draw
+    TessellateChain(g, chain, detailFor((lo + hi) / 2, (hi - lo).norm() / 2 + rmax), out);
+  }
+  for (const Sphere& s : g.spheres) {
+    if (s.radius > 0) TessellateSphere(s, detailFor(s.center, s.radius), out);
+  }
+  for (const Polygon& poly : g.polygons) {
+    Vec3 normal;
+    std::vector<uint32_t> tris = TriangulatePolygon(poly.vertices, &normal);
+    if (tris.empty()) {
+      if (stats) {
+        ++stats->polygonsSkipped;
+        stats->warnings.push_back("polygon at module " + std::to_string(poly.module + 1) +
+                                  " is degenerate; skipped");
+      }
+      continue;
+    }
+    const Vec3 e1 = AnyPerpendicular(normal), e2 = normal.cross(e1);
+    Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
+    for (const Vec3& v : poly.vertices) {
+      Vec2 q(v.dot(e1), v.dot(e2));
+      lo = lo.cwiseMin(q);
+      hi = hi.cwiseMax(q);
+    }
+    const Vec2 ext = (hi - lo).cwiseMax(Vec2(1e-12, 1e-12));
+    const uint32_t base = uint32_t(out.positions.size());
+    for (const Vec3& v : poly.vertices) {
+      out.positions.push_back(F(v));
+      out.normals.push_back(F(normal));
+      Vec2 q((v.dot(e1) - lo.x()) / ext.x(), (v.dot(e2) - lo.y()) / ext.y());
+      out.uvs.push_back(q.cast<float>());
+    }
+    for (size_t t = 0; t < tris.size(); t += 3) {
+      out.indices.insert(out.indices.end(), {base + tris[t], base + tris[t + 1], base + tris[t + 2]});
+      out.material.push_back(poly.color);
+    }
+  }
+  for (const SurfaceInstance& si : g.surfaces) {
+    const TriangleMesh& s = options.surfaces->at(si.name);
+    const uint32_t base = uint32_t(out.positions.size());
+    for (size_t i = 0; i < s.positions.size(); ++i) {
+      const Vec3 p = s.positions[i].cast<double>(), n = s.normals[i].cast<double>();
+      const Vec3 wp = si.position + si.scale * (p.x() * si.frame.left + p.y() * si.frame.heading +
+                                                p.z() * si.frame.up);
+      const Vec3 wn = n.x() * si.frame.left + n.y() * si.frame.heading + n.z() * si.frame.up;
+      out.positions.push_back(F(wp));
+      out.normals.push_back(F(wn.normalized()));
+      out.uvs.push_back(s.uvs[i]);
+    }
+    for (uint32_t i : s.indices) out.indices.push_back(base + i);
+    for (size_t t = 0; t < s.triangleCount(); ++t) out.material.push_back(si.color);
+  }
+  if (stats) stats->chains += chains.size();
+  return {};
+}
+
+}  // namespace sylva::mesh

@@ -1,0 +1,71 @@
+// Tessellation: PlantGeometry (segments, polygons, spheres, surfaces) to
+// triangles, at a detail chosen per primitive.
+//
+// Branches become generalized cylinders. Consecutive segments of one branch
+// (the end of one is the start of the next, same branch id) form one chain
+// with one ring of vertices per joint, shared by the segments on both sides
+// (no cracks, no overlaps). Ring frames are rotation-minimizing: the double
+// reflection method of Wang, Juttler, Zheng & Liu, "Computation of rotation
+// minimizing frames" (ACM TOG 27(1), 2008) carries the first ring's normal
+// (the turtle's L) along the chain, so tubes do not twist. The radius at a
+// joint is the next segment's start radius (the width set by `!` before its
+// F), so each internode tapers linearly to the next one. Every chain is
+// closed by a fan at its base and at its tip, so each tube is a closed
+// 2-manifold (after welding the UV seam). Lateral branches start on their
+// parent's axis, so their base lies inside the parent tube: no gap shows.
+//
+// UVs: u runs 0..1 around the tube (the seam vertex is duplicated), v is the
+// distance along the chain in world units, so a bark texture keeps its
+// scale. Polygons `{ . }` are triangulated by ear clipping in their best-fit
+// plane (Newell's normal), so concave outlines work; they are one-sided with
+// the Newell normal (renderers and glTF draw them double-sided). Spheres are
+// UV spheres. Counts, for a chain of m segments at S sides: S(m+1)+... see
+// TubeTriangles().
+#pragma once
+
+#include <functional>
+#include <string>
+#include <unordered_map>
+
+#include "mesh/plant_geometry.h"
+#include "mesh/triangle_mesh.h"
+
+namespace sylva::mesh {
+
+struct Detail {
+  int sides = 8;  // vertices around a tube ring and a sphere's equator, 3..256
+};
+
+// Chooses the detail per primitive; the screen-space level-of-detail code
+// passes one that looks at the camera. `center` and `radius` bound the
+// primitive (a whole chain, sphere or polygon).
+using DetailFn = std::function<Detail(const Vec3& center, double radius)>;
+
+// Triangles of a tube chain with `segments` segments and S sides, caps included.
+constexpr size_t TubeTriangles(size_t segments, int sides) {
+  return 2 * size_t(sides) * segments + 2 * size_t(sides);
+}
+
+struct TessellateOptions {
+  Detail detail;     // used when detailFn is empty
+  DetailFn detailFn;
+  // Surfaces by name (without `~`), already loaded; unknown names are an error.
+  const std::unordered_map<std::string, TriangleMesh>* surfaces = nullptr;
+};
+
+struct TessellateStats {
+  size_t chains = 0, polygonsSkipped = 0;
+  std::vector<std::string> warnings;
+};
+
+// Appends the triangles of `g` to `out`. Fails only on a surface name that
+// `options.surfaces` does not have (the message names it).
+std::string Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
+                       TessellateStats* stats = nullptr);
+
+// Ear clipping of a simple polygon (any orientation, concave allowed) in 3D.
+// Returns triangles as index triples into `vertices`; empty when the polygon
+// is degenerate (fewer than 3 distinct vertices or zero area).
+std::vector<uint32_t> TriangulatePolygon(const std::vector<Vec3>& vertices, Vec3* normalOut);
+
+}  // namespace sylva::mesh

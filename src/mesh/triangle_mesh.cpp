@@ -1,0 +1,58 @@
+#include "mesh/triangle_mesh.h"
+
+#include <cmath>
+
+namespace sylva::mesh {
+
+void TriangleMesh::Clear() {
+  positions.clear();
+  normals.clear();
+  uvs.clear();
+  indices.clear();
+  material.clear();
+}
+
+void TriangleMesh::Append(const TriangleMesh& o) {
+  const uint32_t base = uint32_t(positions.size());
+  positions.insert(positions.end(), o.positions.begin(), o.positions.end());
+  normals.insert(normals.end(), o.normals.begin(), o.normals.end());
+  uvs.insert(uvs.end(), o.uvs.begin(), o.uvs.end());
+  indices.reserve(indices.size() + o.indices.size());
+  for (uint32_t i : o.indices) indices.push_back(base + i);
+  material.insert(material.end(), o.material.begin(), o.material.end());
+}
+
+std::pair<uint16_t, uint16_t> TriangleMesh::MaterialRange() const {
+  if (material.empty()) return {0, 0};
+  uint16_t lo = material[0], hi = material[0];
+  for (uint16_t m : material) {
+    lo = std::min(lo, m);
+    hi = std::max(hi, m);
+  }
+  return {lo, hi};
+}
+
+std::string Validate(const TriangleMesh& m, float areaEpsilon) {
+  const size_t n = m.positions.size();
+  if (m.normals.size() != n || m.uvs.size() != n) return "attribute arrays differ in size";
+  if (m.indices.size() % 3) return "index count is not a multiple of 3";
+  if (m.material.size() != m.triangleCount()) return "one material per triangle expected";
+  for (size_t i = 0; i < n; ++i) {
+    if (!m.positions[i].allFinite() || !m.normals[i].allFinite() || !m.uvs[i].allFinite())
+      return "vertex " + std::to_string(i) + " is not finite";
+    if (std::abs(m.normals[i].norm() - 1) > 1e-4f)
+      return "normal " + std::to_string(i) + " has length " + std::to_string(m.normals[i].norm());
+  }
+  for (size_t t = 0; t < m.triangleCount(); ++t) {
+    const uint32_t a = m.indices[3 * t], b = m.indices[3 * t + 1], c = m.indices[3 * t + 2];
+    if (a >= n || b >= n || c >= n) return "triangle " + std::to_string(t) + " has an index out of range";
+    const Eigen::Vector3d pa = m.positions[a].cast<double>(), pb = m.positions[b].cast<double>(),
+                          pc = m.positions[c].cast<double>();
+    const double area = 0.5 * (pb - pa).cross(pc - pa).norm();
+    if (!(area > areaEpsilon))
+      return "triangle " + std::to_string(t) + " has zero area (" + std::to_string(area) + ")";
+  }
+  return {};
+}
+
+}  // namespace sylva::mesh

@@ -1,0 +1,38 @@
+// TriangleMesh: indexed triangles as structure of arrays, ready for the GPU
+// and the exporters. Positions, normals and UVs are 32-bit floats (what
+// glTF and OpenGL take); each triangle carries a material id (the turtle's
+// colour index).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+
+namespace sylva::mesh {
+
+using Vec3f = Eigen::Vector3f;
+using Vec2f = Eigen::Vector2f;
+
+struct TriangleMesh {
+  std::vector<Vec3f> positions;
+  std::vector<Vec3f> normals;          // unit, one per vertex
+  std::vector<Vec2f> uvs;              // one per vertex
+  std::vector<uint32_t> indices;       // 3 per triangle, counter-clockwise seen from outside
+  std::vector<uint16_t> material;      // one per triangle
+
+  size_t vertexCount() const { return positions.size(); }
+  size_t triangleCount() const { return indices.size() / 3; }
+  void Clear();
+  void Append(const TriangleMesh& other);
+  // Smallest and largest material id; {0, 0} when empty.
+  std::pair<uint16_t, uint16_t> MaterialRange() const;
+};
+
+// Checks the invariants every mesh Sylva makes must hold: indices in range,
+// finite values, unit normals, no zero-area triangle, array sizes agree.
+// Returns a description of the first violation, or an empty string.
+std::string Validate(const TriangleMesh& m, float areaEpsilon = 1e-12f);
+
+}  // namespace sylva::mesh

@@ -1,0 +1,262 @@
+#include "mesh/tessellator.h"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <map>
+#include <set>
+
+#include "core/atomic_file.h"
+#include "lsys/deriver.h"
+#include "lsys/parser.h"
+#include "turtle/interpreter.h"
+
+namespace sylva::mesh {
+namespace {
+
+PlantGeometry Draw(const std::string& text, int steps = -1) {
+  auto r = lsys::ParseGrammarText(text, "t.lsys");
+  if (!r.grammar) {
+    ADD_FAILURE() << r.diagnostics.FormatAll();
+    return {};
+  }
+  lsys::DeriveOptions o;
+  o.steps = steps;
+  auto w = lsys::Derive(*r.grammar, o);
+  auto iw = lsys::Interpret(*r.grammar, w->word);
+  auto g = turtle::Interpret(*iw, r.grammar->symbols, turtle::TurtleDefFrom(*r.grammar));
+  EXPECT_TRUE(g.ok());
+  return g.ok() ? std::move(*g) : PlantGeometry{};
+}
+
+PlantGeometry DrawFile(const std::string& name, int steps = -1) {
+  return Draw(*ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/" + name + ".lsys"), steps);
+}
+
+TriangleMesh Mesh(const PlantGeometry& g, int sides = 8) {
+  TriangleMesh m;
+  TessellateOptions opt;
+  opt.detail.sides = sides;
+  EXPECT_EQ(Tessellate(g, opt, m), "");
+  return m;
+}
+
+// Welds vertices at equal positions and checks that every edge is shared by
+// exactly two triangles with opposite directions (a closed, consistently
+// oriented 2-manifold). Returns V - E + F, or a large negative value on failure.
+long EulerCharacteristic(const TriangleMesh& m, std::string* why) {
+  std::map<std::tuple<float, float, float>, uint32_t> weld;
+  std::vector<uint32_t> id(m.positions.size());
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    auto key = std::make_tuple(m.positions[i].x(), m.positions[i].y(), m.positions[i].z());
+    id[i] = weld.emplace(key, uint32_t(weld.size())).first->second;
+  }
+  std::map<std::pair<uint32_t, uint32_t>, int> directed;
+  for (size_t t = 0; t < m.triangleCount(); ++t) {
+    for (int e = 0; e < 3; ++e) {
+      uint32_t a = id[m.indices[3 * t + e]], b = id[m.indices[3 * t + (e + 1) % 3]];
+      if (++directed[{a, b}] > 1) {
+        *why = "directed edge used twice (inconsistent orientation or non-manifold)";
+        return -1000000;
+      }
+    }
+  }
+  for (const auto& [e, n] : directed) {
+    if (!directed.count({e.second, e.first})) {
+      *why = "boundary edge: the surface is not closed";
+      return -1000000;
+    }
+  }
+  return long(weld.size()) - long(directed.size() / 2) + long(m.triangleCount());
+}
+
+TEST(Tessellator, TriangleCountsFollowTheDetailExactly) {
+  PlantGeometry g = Draw("axiom: FFF\n");
+  for (int sides : {3, 5, 8, 16, 64}) {
+    TriangleMesh m = Mesh(g, sides);
+    EXPECT_EQ(m.triangleCount(), TubeTriangles(3, sides)) << sides << " sides";
+    EXPECT_EQ(m.vertexCount(), size_t(4 * (sides + 1) + 2 * (sides + 1))) << sides << " sides";
+    EXPECT_EQ(Validate(m), "") << sides;
+  }
+}
+
+TEST(Tessellator, EachTubeIsAClosedTwoManifold) {
+  for (const char* text : {"axiom: FFF\n", "angle: 30\naxiom: F+F-F&F/F^F\n",
+                           "axiom: !(2)F!(1)F\n"}) {
+    TriangleMesh m = Mesh(Draw(text), 8);
+    std::string why;
+    EXPECT_EQ(EulerCharacteristic(m, &why), 2) << text << why;
+  }
+}
+
+TEST(Tessellator, BranchesShareRingsAlongTheirAxis) {
+  // F[+F]F: the trunk is one chain of 2 segments (the ring at the joint is
+  // shared), the branch another: 2 closed components.
+  PlantGeometry g = Draw("axiom: F[+F]F\n");
+  TriangleMesh m = Mesh(g, 6);
+  EXPECT_EQ(m.triangleCount(), TubeTriangles(2, 6) + TubeTriangles(1, 6));
+  std::string why;
+  EXPECT_EQ(EulerCharacteristic(m, &why), 4) << why;
+}
+
+TEST(Tessellator, CatalogueMeshesAreValid) {
+  for (const char* f : {"fig2_06a_monopodial", "fig2_07b_sympodial", "fig2_08a_ternary",
+                        "fig1_24d_bracketed_plant", "fig1_25_bush", "fig1_19_hilbert_3d"}) {
+    PlantGeometry g = DrawFile(f);
+    TriangleMesh m = Mesh(g, 8);
+    EXPECT_GT(m.triangleCount(), 100u) << f;
+    EXPECT_EQ(Validate(m, 1e-14f), "") << f;
+  }
+}
+
+// Splits the mesh into edge-connected components and returns the Euler
+// characteristic of each (a vertex shared by two tubes, as where sibling
+// branches start at one point, is counted in each).
+std::vector<long> ComponentEulerCharacteristics(const TriangleMesh& m) {
+  std::map<std::tuple<float, float, float>, uint32_t> weld;
+  std::vector<uint32_t> id(m.positions.size());
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    auto key = std::make_tuple(m.positions[i].x(), m.positions[i].y(), m.positions[i].z());
+    id[i] = weld.emplace(key, uint32_t(weld.size())).first->second;
+  }
+  const size_t nt = m.triangleCount();
+  std::vector<size_t> parent(nt);
+  for (size_t t = 0; t < nt; ++t) parent[t] = t;
+  std::function<size_t(size_t)> find = [&](size_t x) { return parent[x] == x ? x : parent[x] = find(parent[x]); };
+  std::map<std::pair<uint32_t, uint32_t>, size_t> edgeOwner;
+  for (size_t t = 0; t < nt; ++t) {
+    for (int e = 0; e < 3; ++e) {
+      uint32_t a = id[m.indices[3 * t + e]], b = id[m.indices[3 * t + (e + 1) % 3]];
+      auto key = std::minmax(a, b);
+      auto [it, fresh] = edgeOwner.emplace(key, t);
+      if (!fresh) parent[find(t)] = find(it->second);
+    }
+  }
+  std::map<size_t, std::set<uint32_t>> verts;
+  std::map<size_t, std::set<std::pair<uint32_t, uint32_t>>> edges;
+  std::map<size_t, long> faces;
+  for (size_t t = 0; t < nt; ++t) {
+    size_t c = find(t);
+    ++faces[c];
+    for (int e = 0; e < 3; ++e) {
+      uint32_t a = id[m.indices[3 * t + e]], b = id[m.indices[3 * t + (e + 1) % 3]];
+      verts[c].insert(a);
+      edges[c].insert(std::minmax(a, b));
+    }
+  }
+  std::vector<long> chi;
+  for (const auto& [c, f] : faces) chi.push_back(long(verts[c].size()) - long(edges[c].size()) + f);
+  return chi;
+}
+
+TEST(Tessellator, MonopodialTreeTubesAreClosed) {
+  PlantGeometry g = DrawFile("fig2_06a_monopodial", 6);
+  TriangleMesh m = Mesh(g, 6);
+  std::string why;
+  EulerCharacteristic(m, &why);
+  EXPECT_EQ(why, "") << "closed and consistently oriented";
+  auto chi = ComponentEulerCharacteristics(m);
+  EXPECT_GT(chi.size(), 10u);
+  for (size_t c = 0; c < chi.size(); ++c) EXPECT_EQ(chi[c], 2) << "component " << c;
+}
+
+TEST(Tessellator, PlanarChainsDoNotTwist) {
+  // A chain turning in the XY plane: the rotation-minimizing frame keeps the
+  // binormal on the plane's normal, so the vertex at a quarter turn of every
+  // ring sits straight above the axis point.
+  PlantGeometry g = Draw("angle: 25\naxiom: F+F+F-F+F\n");
+  const int S = 8;
+  TriangleMesh m = Mesh(g, S);
+  for (int k = 0; k <= 5; ++k) {
+    Vec3 axis = k == 0 ? g.segments[0].start : g.segments[size_t(k - 1)].end;
+    Vec3f q = m.positions[size_t(k * (S + 1) + S / 4)];
+    EXPECT_NEAR(q.x(), axis.x(), 1e-5) << "ring " << k;
+    EXPECT_NEAR(q.y(), axis.y(), 1e-5) << "ring " << k;
+    EXPECT_NEAR(q.z(), 0.5, 1e-5) << "ring " << k;
+  }
+}
+
+TEST(Tessellator, RadiusTapersToTheNextInternodeAndVIsWorldLength) {
+  PlantGeometry g = Draw("axiom: !(2)F(1)!(1)F(2)\n");
+  const int S = 4;
+  TriangleMesh m = Mesh(g, S);
+  auto ringRadius = [&](int k, const Vec3& axis) {
+    return (m.positions[size_t(k * (S + 1))].cast<double>() - axis).norm();
+  };
+  EXPECT_NEAR(ringRadius(0, Vec3(0, 0, 0)), 1.0, 1e-6);
+  EXPECT_NEAR(ringRadius(1, Vec3(0, 1, 0)), 0.5, 1e-6);
+  EXPECT_NEAR(ringRadius(2, Vec3(0, 3, 0)), 0.5, 1e-6);
+  EXPECT_FLOAT_EQ(m.uvs[size_t(2 * (S + 1))].y(), 3.0f);
+  EXPECT_FLOAT_EQ(m.uvs[size_t(S)].x(), 1.0f);  // seam vertex
+}
+
+TEST(Tessellator, DetailIsChosenPerPrimitive) {
+  PlantGeometry g = Draw("axiom: F[+(90)f(10)F]\n");
+  TessellateOptions opt;
+  opt.detailFn = [](const Vec3& c, double) { return Detail{c.norm() > 5 ? 4 : 12}; };
+  TriangleMesh m;
+  ASSERT_EQ(Tessellate(g, opt, m), "");
+  EXPECT_EQ(m.triangleCount(), TubeTriangles(1, 12) + TubeTriangles(1, 4));
+}
+
+TEST(Tessellator, ConcavePolygonsAreEarClipped) {
+  // An L-shaped hexagon (concave), area 3.
+  std::vector<Vec3> l = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {1, 1, 0}, {1, 2, 0}, {0, 2, 0}};
+  Vec3 n;
+  auto tris = TriangulatePolygon(l, &n);
+  ASSERT_EQ(tris.size(), 12u);
+  double area = 0;
+  for (size_t t = 0; t < tris.size(); t += 3) {
+    Vec3 e = (l[tris[t + 1]] - l[tris[t]]).cross(l[tris[t + 2]] - l[tris[t]]);
+    EXPECT_GT(e.dot(n), 0) << "triangle " << t / 3 << " faces the other way";
+    area += 0.5 * e.norm();
+  }
+  EXPECT_NEAR(area, 3.0, 1e-12);
+  EXPECT_NEAR(n.z(), 1.0, 1e-12);
+  // Clockwise input: same area, opposite normal.
+  std::reverse(l.begin(), l.end());
+  EXPECT_EQ(TriangulatePolygon(l, &n).size(), 12u);
+  EXPECT_NEAR(n.z(), -1.0, 1e-12);
+}
+
+TEST(Tessellator, DegeneratePolygonsAreSkippedWithAWarning) {
+  PlantGeometry g;
+  Polygon flat;
+  flat.vertices = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  flat.module = 4;
+  g.polygons.push_back(flat);
+  TriangleMesh m;
+  TessellateStats stats;
+  ASSERT_EQ(Tessellate(g, {}, m, &stats), "");
+  EXPECT_EQ(m.triangleCount(), 0u);
+  ASSERT_EQ(stats.warnings.size(), 1u);
+  EXPECT_EQ(stats.warnings[0], "polygon at module 5 is degenerate; skipped");
+}
+
+TEST(Tessellator, LeafPolygonsOfTheBush) {
+  PlantGeometry g = DrawFile("fig1_25_bush", 3);
+  ASSERT_GT(g.polygons.size(), 0u);
+  TriangleMesh m = Mesh(g, 6);
+  EXPECT_EQ(Validate(m), "");
+}
+
+TEST(Tessellator, SpheresAreClosedAndRound) {
+  PlantGeometry g = Draw("axiom: f(3)@O(4)\n");
+  const int S = 10;
+  TriangleMesh m = Mesh(g, S);
+  EXPECT_EQ(m.triangleCount(), size_t(2 * S * (S / 2 - 1)));
+  for (const Vec3f& p : m.positions) EXPECT_NEAR((p - Vec3f(0, 3, 0)).norm(), 2.0f, 1e-5f);
+  std::string why;
+  EXPECT_EQ(EulerCharacteristic(m, &why), 2) << why;
+  EXPECT_EQ(Validate(m), "");
+}
+
+TEST(Tessellator, UnknownSurfaceIsAnError) {
+  PlantGeometry g = Draw("axiom: F~nope\n");
+  TriangleMesh m;
+  EXPECT_EQ(Tessellate(g, {}, m), "unknown surface 'nope'");
+  EXPECT_EQ(m.triangleCount(), 0u);
+}
+
+}  // namespace
+}  // namespace sylva::mesh
