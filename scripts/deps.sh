@@ -2,7 +2,11 @@
 # Installs the Debian 12 packages Sylva needs, only those missing.
 # Usage: scripts/deps.sh [--fuzz]   (--fuzz adds clang and its libFuzzer runtime)
 set -euo pipefail
-packages=(cmake g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libbenchmark-dev python3)
+packages=(cmake g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libbenchmark-dev python3
+          libtinygltf-dev nlohmann-json3-dev libstb-dev assimp-utils)
+# node and npm run the Khronos glTF validator in the tests; any recent node will do.
+command -v node >/dev/null 2>&1 || packages+=(nodejs)
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 if [[ "${1:-}" == "--fuzz" ]]; then packages+=(clang libclang-rt-14-dev); fi
 missing=()
 for p in "${packages[@]}"; do

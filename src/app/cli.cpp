@@ -50,6 +50,14 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
               "apply the interpretation rules (the word the turtle reads)");
   d->add_option("-o,--output", derive.output, "write the word to this file");
 
+  MeshCommand mesh;
+  CLI::App* me = app.add_subcommand("mesh", "derive a grammar and write the plant mesh");
+  AddDeriveFlags(me, mesh.derive);
+  me->add_option("-o,--output", mesh.output, "mesh file: .obj (+ .mtl), .ply, .glb or .gltf")
+      ->required();
+  me->add_option("--sides", mesh.sides, "vertices around each branch tube (3-256, default 8)")
+      ->check(CLI::Range(3, 256));
+
   DeriveFlags check;
   CLI::App* c = app.add_subcommand("check", "parse and check a grammar; print diagnostics");
   c->add_option("file", check.file, "grammar file (.lsys)")->required();
@@ -72,6 +80,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   }
   if (d->parsed()) return RunDerive(derive, out, err);
   if (c->parsed()) return RunCheck(check, out, err);
+  if (me->parsed()) return RunMesh(mesh, out, err);
   return kExitBadInput;
 }
 

@@ -39,8 +39,7 @@ static bool ParseDefines(const std::vector<std::string>& defs, lsys::ParseOption
   return true;
 }
 
-// Parses the grammar, printing diagnostics. Returns the grammar or sets *exit.
-static std::optional<lsys::Grammar> Load(const DeriveFlags& f, std::ostream& err, int* exit) {
+std::optional<lsys::Grammar> LoadGrammar(const DeriveFlags& f, std::ostream& err, int* exit) {
   lsys::ParseOptions opt;
   if (!ParseDefines(f.defines, &opt, err)) {
     *exit = kExitBadInput;
@@ -55,9 +54,18 @@ static std::optional<lsys::Grammar> Load(const DeriveFlags& f, std::ostream& err
   return std::move(r.grammar);
 }
 
+lsys::DeriveOptions DeriveOptionsFrom(const DeriveFlags& f) {
+  lsys::DeriveOptions opt;
+  if (f.steps) opt.steps = *f.steps;
+  opt.seed = f.seed;
+  opt.threads = f.threads;
+  if (f.maxModules) opt.maxModules = f.maxModules;
+  return opt;
+}
+
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err) {
   int exit = kExitOk;
-  auto g = Load(flags, err, &exit);
+  auto g = LoadGrammar(flags, err, &exit);
   return g ? kExitOk : exit;
 }
 
@@ -100,14 +108,10 @@ static void PrintStats(const lsys::Grammar& g, const lsys::DeriveResult& r, int 
 
 int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err) {
   int exit = kExitOk;
-  auto g = Load(cmd.derive, err, &exit);
+  auto g = LoadGrammar(cmd.derive, err, &exit);
   if (!g) return exit;
 
-  lsys::DeriveOptions opt;
-  if (cmd.derive.steps) opt.steps = *cmd.derive.steps;
-  opt.seed = cmd.derive.seed;
-  opt.threads = cmd.derive.threads;
-  if (cmd.derive.maxModules) opt.maxModules = cmd.derive.maxModules;
+  lsys::DeriveOptions opt = DeriveOptionsFrom(cmd.derive);
   // Progress on a terminal, once a derivation has run for a second.
   const bool tty = &err == &std::cerr && isatty(2);
   const auto start = std::chrono::steady_clock::now();

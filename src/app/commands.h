@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "core/diagnostic.h"
+#include "lsys/deriver.h"
+#include "lsys/grammar.h"
 
 namespace sylva::app {
 
@@ -29,7 +31,19 @@ struct DeriveCommand {
   std::string output;  // empty: standard output
 };
 
+struct MeshCommand {
+  DeriveFlags derive;
+  std::string output;  // .obj .ply .glb .gltf
+  int sides = 8;
+};
+
 int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err);
+int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
+
+// Parses the grammar named by the flags (with -D), printing diagnostics.
+// Returns the grammar, or nullopt with the exit status in *exit.
+std::optional<lsys::Grammar> LoadGrammar(const DeriveFlags& f, std::ostream& err, int* exit);
+lsys::DeriveOptions DeriveOptionsFrom(const DeriveFlags& f);
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
 // Prints diagnostics; returns the exit status they call for (0 when there

@@ -83,6 +83,14 @@ struct Grammar {
   bool usesRandom = false;            // weights or random functions anywhere
 
   std::unordered_map<std::string, double> constants;  // after -D overrides
+
+  // Where each module name is first written (axiom or successor), so later
+  // stages can point into the grammar (an unknown surface `~name`).
+  struct Use {
+    SourceLoc loc;
+    std::string line;
+  };
+  std::unordered_map<std::string, Use> symbolLoc;
 };
 
 }  // namespace sylva::lsys

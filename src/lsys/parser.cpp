@@ -393,6 +393,7 @@ bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const
     if (!id) return false;
     out->symbols.push_back(*id);
     cols.push_back(col);
+    g_.symbolLoc.try_emplace(name, Grammar::Use{Loc(l, col), l.original});
   }
   return CheckBrackets(l, out->symbols, cols, "word");
 }

@@ -4,6 +4,7 @@
 
 #include "cli_test_util.h"
 #include "core/atomic_file.h"
+#include "core/status.h"
 
 namespace sylva::app {
 namespace {
@@ -111,6 +112,49 @@ TEST(Cli, HelpIsExitZero) {
   auto r = RunSylva({"--help"});
   EXPECT_EQ(r.code, 0);
   EXPECT_NE(r.out.find("derive"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sylva::app
+
+namespace sylva::app {
+namespace {
+
+using testing::RunSylva;
+using testing::Scratch;
+using testing::Source;
+using testing::WriteFile;
+
+TEST(CliMesh, WritesTheMeshAndASummary) {
+  std::string out = (Scratch() / "tree.ply").string();
+  auto r = RunSylva({"mesh", Source("grammars/abop/fig2_06a_monopodial.lsys"), "-n", "3", "--sides", "4", "-o", out});
+  EXPECT_EQ(r.code, 0) << r.err;
+  auto text = ReadFile(out);
+  ASSERT_TRUE(text.ok());
+  EXPECT_EQ(text->rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+  EXPECT_NE(r.err.find(" vertices, "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("time: derive"), std::string::npos) << r.err;
+}
+
+TEST(CliMesh, UnknownExtensionIsExitTwo) {
+  auto r = RunSylva({"mesh", Source("grammars/abop/fig1_25_bush.lsys"), "-o", (Scratch() / "x.stl").string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("unknown mesh format"), std::string::npos) << r.err;
+}
+
+TEST(CliMesh, UnwritableOutputIsExitOneWithNoPartialFile) {
+  auto r = RunSylva({"mesh", Source("grammars/abop/fig1_25_bush.lsys"), "-o", "/nonexistent-dir/bush.glb"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("/nonexistent-dir/bush.glb: error: cannot create output file"), std::string::npos) << r.err;
+}
+
+TEST(CliMesh, UnknownSurfacePointsAtTheTilde) {
+  std::string f = WriteFile("surf.lsys", "axiom: F\nF --> F[+~lef(2)]F\n");
+  std::string out = (Scratch() / "surf.obj").string();
+  auto r = RunSylva({"mesh", f, "-n", "1", "-o", out});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err.rfind(f + ":2:10: error: unknown surface 'lef'", 0), 0u) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 }  // namespace

@@ -1,0 +1,226 @@
+// Material grouping, palette and the OBJ and PLY writers. (glTF: export_gltf.cpp.)
+#include "mesh/export.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cstring>
+#include <filesystem>
+
+#include "core/atomic_file.h"
+
+namespace sylva::mesh {
+
+const Palette& DefaultPalette() {
+  static const Palette p = {
+      {0.42f, 0.30f, 0.19f}, {0.24f, 0.50f, 0.16f}, {0.52f, 0.74f, 0.30f}, {0.93f, 0.55f, 0.70f},
+      {0.98f, 0.84f, 0.25f}, {0.95f, 0.95f, 0.92f}, {0.26f, 0.18f, 0.11f}, {0.80f, 0.15f, 0.12f},
+  };
+  return p;
+}
+
+std::optional<MeshFormat> FormatFromPath(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".obj") return MeshFormat::kObj;
+  if (ext == ".ply") return MeshFormat::kPly;
+  if (ext == ".glb") return MeshFormat::kGlb;
+  if (ext == ".gltf") return MeshFormat::kGltf;
+  return std::nullopt;
+}
+
+MaterialGroups GroupByMaterial(const TriangleMesh& m) {
+  MaterialGroups g;
+  const size_t nt = m.triangleCount();
+  std::vector<uint32_t> count(65536, 0);
+  for (uint16_t mat : m.material) ++count[mat];
+  std::vector<uint32_t> offset(65536, 0);
+  uint32_t total = 0;
+  for (size_t k = 0; k < 65536; ++k) {
+    if (!count[k]) continue;
+    g.materials.push_back(uint16_t(k));
+    g.starts.push_back(total);
+    offset[k] = total;
+    total += count[k];
+  }
+  g.starts.push_back(total);
+  g.order.resize(nt);
+  for (uint32_t t = 0; t < nt; ++t) g.order[offset[m.material[t]]++] = t;
+  return g;
+}
+
+static Vec3f PaletteColor(const Palette& p, uint16_t index) {
+  return p.empty() ? Vec3f(0.8f, 0.8f, 0.8f) : p[index % p.size()];
+}
+
+// Appends a float the shortest way that reads back exactly.
+static inline void Num(std::string& out, float v) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, size_t(r.ptr - buf));
+}
+
+static inline void UInt(std::string& out, uint32_t v) {
+  char buf[16];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, size_t(r.ptr - buf));
+}
+
+Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string& path) {
+  const MaterialGroups groups = GroupByMaterial(m);
+  const std::filesystem::path p(path);
+  const std::string mtlName = p.stem().string() + ".mtl";
+  const std::string mtlPath = (p.parent_path() / mtlName).string();
+
+  AtomicFile mtl;
+  if (Status s = mtl.Open(mtlPath); !s.ok()) return s;
+  std::string text = "# Sylva materials\n";
+  for (uint16_t mat : groups.materials) {
+    Vec3f c = PaletteColor(palette, mat);
+    text += "newmtl color" + std::to_string(mat) + "\nKd ";
+    Num(text, c.x());
+    text += ' ';
+    Num(text, c.y());
+    text += ' ';
+    Num(text, c.z());
+    text += "\nKa 0 0 0\nKs 0 0 0\nd 1\nillum 1\n\n";
+  }
+  if (Status s = mtl.Write(text); !s.ok()) return s;
+
+  AtomicFile obj;
+  if (Status s = obj.Open(path); !s.ok()) return s;
+  static constexpr size_t kFlush = 1 << 20;
+  std::string out;
+  out.reserve(kFlush + 256);
+  out = "# Sylva mesh: " + std::to_string(m.vertexCount()) + " vertices, " +
+        std::to_string(m.triangleCount()) + " triangles\nmtllib " + mtlName + "\n";
+  auto flush = [&](bool force) -> Status {
+    if (out.size() < kFlush && !force) return {};
+    Status s = obj.Write(out);
+    out.clear();
+    return s;
+  };
+  for (const Vec3f& v : m.positions) {
+    out += "v ";
+    Num(out, v.x());
+    out += ' ';
+    Num(out, v.y());
+    out += ' ';
+    Num(out, v.z());
+    out += '\n';
+    if (Status s = flush(false); !s.ok()) return s;
+  }
+  for (const Vec3f& v : m.normals) {
+    out += "vn ";
+    Num(out, v.x());
+    out += ' ';
+    Num(out, v.y());
+    out += ' ';
+    Num(out, v.z());
+    out += '\n';
+    if (Status s = flush(false); !s.ok()) return s;
+  }
+  for (const Vec2f& v : m.uvs) {
+    out += "vt ";
+    Num(out, v.x());
+    out += ' ';
+    Num(out, v.y());
+    out += '\n';
+    if (Status s = flush(false); !s.ok()) return s;
+  }
+  for (size_t k = 0; k < groups.materials.size(); ++k) {
+    out += "usemtl color" + std::to_string(groups.materials[k]) + "\n";
+    for (uint32_t o = groups.starts[k]; o < groups.starts[k + 1]; ++o) {
+      const uint32_t t = groups.order[o];
+      out += 'f';
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t i = m.indices[3 * t + e] + 1;
+        out += ' ';
+        UInt(out, i);
+        out += '/';
+        UInt(out, i);
+        out += '/';
+        UInt(out, i);
+      }
+      out += '\n';
+      if (Status s = flush(false); !s.ok()) return s;
+    }
+  }
+  if (Status s = flush(true); !s.ok()) return s;
+  if (Status s = mtl.Commit(); !s.ok()) return s;
+  return obj.Commit();
+}
+
+Status WritePly(const TriangleMesh& m, const Palette& palette, const std::string& path) {
+  // Vertex colour: the material of the first triangle that uses the vertex.
+  std::vector<uint16_t> vmat(m.vertexCount(), 0);
+  std::vector<uint8_t> seen(m.vertexCount(), 0);
+  for (size_t t = 0; t < m.triangleCount(); ++t) {
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t i = m.indices[3 * t + e];
+      if (!seen[i]) {
+        seen[i] = 1;
+        vmat[i] = m.material[t];
+      }
+    }
+  }
+  AtomicFile f;
+  if (Status s = f.Open(path); !s.ok()) return s;
+  std::string header =
+      "ply\nformat binary_little_endian 1.0\ncomment Sylva mesh\nelement vertex " +
+      std::to_string(m.vertexCount()) +
+      "\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float nx\nproperty float ny\nproperty float nz\n"
+      "property float s\nproperty float t\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+      "element face " +
+      std::to_string(m.triangleCount()) + "\nproperty list uchar uint vertex_indices\nend_header\n";
+  if (Status s = f.Write(header); !s.ok()) return s;
+  static_assert(sizeof(float) == 4);
+  constexpr size_t kVertexBytes = 8 * 4 + 3;
+  std::string buf;
+  buf.reserve((1 << 20) + 64);
+  auto put = [&](const void* p, size_t n) { buf.append(static_cast<const char*>(p), n); };
+  for (size_t i = 0; i < m.vertexCount(); ++i) {
+    float v[8] = {m.positions[i].x(), m.positions[i].y(), m.positions[i].z(), m.normals[i].x(),
+                  m.normals[i].y(),   m.normals[i].z(),   m.uvs[i].x(),       m.uvs[i].y()};
+    put(v, sizeof v);
+    const Vec3f c = PaletteColor(palette, vmat[i]) * 255.0f + Vec3f::Constant(0.5f);
+    const uint8_t rgb[3] = {uint8_t(c.x()), uint8_t(c.y()), uint8_t(c.z())};
+    put(rgb, 3);
+    if (buf.size() >= (1 << 20)) {
+      if (Status s = f.Write(buf); !s.ok()) return s;
+      buf.clear();
+    }
+  }
+  (void)kVertexBytes;
+  for (size_t t = 0; t < m.triangleCount(); ++t) {
+    const uint8_t three = 3;
+    put(&three, 1);
+    put(&m.indices[3 * t], 12);
+    if (buf.size() >= (1 << 20)) {
+      if (Status s = f.Write(buf); !s.ok()) return s;
+      buf.clear();
+    }
+  }
+  if (Status s = f.Write(buf); !s.ok()) return s;
+  return f.Commit();
+}
+
+Status WriteMesh(const TriangleMesh& m, const Palette& palette, const std::string& path) {
+  auto format = FormatFromPath(path);
+  if (!format) {
+    Diagnostic d;
+    d.loc.file = path;
+    d.message = "unknown mesh format: use .obj, .ply, .glb or .gltf";
+    return d;
+  }
+  switch (*format) {
+    case MeshFormat::kObj: return WriteObj(m, palette, path);
+    case MeshFormat::kPly: return WritePly(m, palette, path);
+    case MeshFormat::kGlb: return WriteGltf(m, palette, path, true);
+    case MeshFormat::kGltf: return WriteGltf(m, palette, path, false);
+  }
+  return {};
+}
+
+}  // namespace sylva::mesh

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Writes meshes of catalogue plants in every format with `sylva mesh` and
+# checks them with the formats' own tools:
+#  - the Khronos glTF validator (npm gltf-validator, run with node): zero
+#    errors and zero warnings for every .glb and .gltf;
+#  - `assimp info -r` (raw import, Debian assimp-utils): the face count that
+#    sylva reported, and the vertex count the format implies (PLY and
+#    single-material glTF: exact; OBJ: 3 per face, as assimp expands corners).
+# Usage: validate_exports.sh SYLVA_BINARY SOURCE_DIR WORK_DIR
+set -euo pipefail
+sylva="$1"; src="$2"; work="$3"
+mkdir -p "$work"
+tools="$work/node_tools"
+if [[ ! -d "$tools/node_modules/gltf-validator" ]]; then
+  mkdir -p "$tools"
+  (cd "$tools" && npm init -y >/dev/null 2>&1 && npm install gltf-validator@2.0.0-dev.3.10 --no-audit --no-fund >/dev/null 2>&1)
+fi
+fail=0
+check() {  # what expected actual
+  if [[ "$2" != "$3" ]]; then echo "FAIL: $1: expected $2, got $3"; fail=1; else echo "ok: $1 = $3"; fi
+}
+gltfs=()
+for plant in fig2_06a_monopodial fig1_25_bush fig1_24c_bracketed_plant; do
+  for ext in obj ply glb gltf; do
+    out="$work/$plant.$ext"
+    rm -f "$out"
+    summary=$("$sylva" mesh "$src/grammars/abop/$plant.lsys" --sides 6 -o "$out" 2>&1 >/dev/null | head -1)
+    verts=$(sed -E 's/.*: ([0-9]+) vertices, ([0-9]+) triangles.*/\1/' <<<"$summary")
+    faces=$(sed -E 's/.*: ([0-9]+) vertices, ([0-9]+) triangles.*/\2/' <<<"$summary")
+    info=$(assimp info "$out" -r 2>&1)
+    av=$(awk '/^Vertices:/{print $2}' <<<"$info")
+    af=$(awk '/^Faces:/{print $2}' <<<"$info")
+    nm=$(awk '/^Meshes:/{print $2; exit}' <<<"$info")
+    check "$plant.$ext faces" "$faces" "$af"
+    case $ext in
+      obj) check "$plant.$ext vertices" "$((3 * faces))" "$av" ;;
+      ply) check "$plant.$ext vertices" "$verts" "$av" ;;
+      glb|gltf) check "$plant.$ext vertices" "$((verts * nm))" "$av"; gltfs+=("$out") ;;
+    esac
+  done
+done
+NODE_PATH="$tools/node_modules" node "$src/tests/tools/validate_gltf.js" "${gltfs[@]}" || fail=1
+exit $fail
