@@ -1,7 +1,10 @@
 #include "mesh/tessellator.h"
 
 #include <algorithm>
+#include <type_traits>
 #include <cmath>
+
+#include "core/memory.h"
 
 namespace sylva::mesh {
 namespace {
@@ -247,11 +250,11 @@ std::string Tessellate(const PlantGeometry& g, const TessellateOptions& options,
     if (!options.surfaces || !options.surfaces->count(si.name)) return "unknown surface '" + si.name + "'";
   }
   const auto chains = BuildChains(g);
-  size_t tubeTris = 0;
-  for (const auto& c : chains) tubeTris += TubeTriangles(c.size(), ClampSides(options.detail.sides));
-  out.indices.reserve(out.indices.size() + 3 * tubeTris);
-  out.material.reserve(out.material.size() + tubeTris);
-  for (const auto& chain : chains) {
+  // Choose every chain's detail first, so the arrays are sized exactly once.
+  std::vector<int> chainSides(chains.size(), 0);
+  size_t verts = 0, tris = 0;
+  for (size_t c = 0; c < chains.size(); ++c) {
+    const auto& chain = chains[c];
     Vec3 lo = g.segments[chain[0]].start, hi = lo;
     double rmax = 0;
     for (uint32_t k : chain) {
@@ -260,7 +263,28 @@ std::string Tessellate(const PlantGeometry& g, const TessellateOptions& options,
       rmax = std::max<double>(rmax, g.segments[k].radiusStart);
     }
     if (!(rmax > 0)) continue;  // zero width: nothing to draw
-    TessellateChain(g, chain, detailFor((lo + hi) / 2, (hi - lo).norm() / 2 + rmax), out);
+    const int S = detailFor((lo + hi) / 2, (hi - lo).norm() / 2 + rmax);
+    chainSides[c] = S;
+    verts += (chain.size() + 1) * size_t(S + 1) + 2 * size_t(S + 1);
+    tris += TubeTriangles(chain.size(), S);
+  }
+  auto grow = [](auto& v, size_t extra) {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    const size_t want = v.size() + extra;
+    if (v.capacity() >= want) return;
+    std::decay_t<decltype(v)> fresh;
+    fresh.reserve(want);
+    AdviseHugePages(fresh.data(), want * sizeof(T));
+    fresh.insert(fresh.end(), v.begin(), v.end());
+    v.swap(fresh);
+  };
+  grow(out.positions, verts);
+  grow(out.normals, verts);
+  grow(out.uvs, verts);
+  grow(out.indices, 3 * tris);
+  grow(out.material, tris);
+  for (size_t c = 0; c < chains.size(); ++c) {
+    if (chainSides[c]) TessellateChain(g, chains[c], chainSides[c], out);
   }
   for (const Sphere& s : g.spheres) {
     if (s.radius > 0) TessellateSphere(s, detailFor(s.center, s.radius), out);

@@ -1,0 +1,94 @@
+// Tessellation and export throughput (issue 3 targets, one core):
+//   tessellation >= 50 M triangles/s; .glb writing >= 500 MB/s; OBJ >= 100 MB/s;
+//   Fig. 2.6 grown to about a million segments, end to end (derive,
+//   interpret, tessellate at 8 sides, write .glb) in under 2 s.
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <string>
+
+#include "lsys/deriver.h"
+#include "lsys/parser.h"
+#include "mesh/export.h"
+#include "mesh/tessellator.h"
+#include "turtle/interpreter.h"
+
+namespace {
+
+using namespace sylva;
+
+std::string Grammar(const char* name) {
+  return std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/" + name + ".lsys";
+}
+
+mesh::PlantGeometry Geometry(const char* name, int steps) {
+  auto r = lsys::ParseGrammarFile(Grammar(name));
+  lsys::DeriveOptions opt;
+  opt.steps = steps;
+  opt.threads = 1;
+  auto d = lsys::Derive(*r.grammar, opt);
+  auto w = lsys::Interpret(*r.grammar, d->word, opt);
+  return std::move(*turtle::Interpret(*w, r.grammar->symbols, turtle::TurtleDefFrom(*r.grammar)));
+}
+
+void BM_Tessellate(benchmark::State& state, const char* name, int steps) {
+  mesh::PlantGeometry g = Geometry(name, steps);
+  mesh::TessellateOptions opt;
+  opt.detail.sides = int(state.range(0));
+  mesh::TriangleMesh m;
+  for (auto _ : state) {
+    m.Clear();
+    mesh::Tessellate(g, opt, m);
+    benchmark::DoNotOptimize(m.indices.data());
+  }
+  state.SetItemsProcessed(int64_t(m.triangleCount()) * state.iterations());
+  state.counters["triangles"] = double(m.triangleCount());
+}
+BENCHMARK_CAPTURE(BM_Tessellate, monopodial_2_6a_n16, "fig2_06a_monopodial", 16)
+    ->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Tessellate, bracketed_1_24c_n5, "fig1_24c_bracketed_plant", 5)
+    ->Arg(8)->Unit(benchmark::kMillisecond);
+
+void BM_Write(benchmark::State& state, const char* ext) {
+  mesh::PlantGeometry g = Geometry("fig2_06a_monopodial", 15);
+  mesh::TriangleMesh m;
+  mesh::TessellateOptions opt;
+  mesh::Tessellate(g, opt, m);
+  const std::string path = (std::filesystem::temp_directory_path() / (std::string("sylva_bench.") + ext)).string();
+  size_t bytes = 0;
+  for (auto _ : state) {
+    if (!mesh::WriteMesh(m, mesh::DefaultPalette(), path).ok()) state.SkipWithError("write failed");
+    bytes = std::filesystem::file_size(path);
+  }
+  state.SetBytesProcessed(int64_t(bytes) * state.iterations());
+  state.counters["MB"] = double(bytes) / 1e6;
+  std::filesystem::remove(path);
+}
+BENCHMARK_CAPTURE(BM_Write, glb, "glb")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Write, gltf, "gltf")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Write, obj, "obj")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Write, ply, "ply")->Unit(benchmark::kMillisecond);
+
+// End to end, as `sylva mesh fig2_06a -n 20 --sides 8 -o tree.glb` does on one core.
+void BM_EndToEndMillionSegments(benchmark::State& state) {
+  const std::string path = (std::filesystem::temp_directory_path() / "sylva_bench_e2e.glb").string();
+  size_t segments = 0, triangles = 0;
+  for (auto _ : state) {
+    mesh::PlantGeometry g = Geometry("fig2_06a_monopodial", 20);
+    mesh::TriangleMesh m;
+    mesh::TessellateOptions opt;
+    opt.detail.sides = 8;
+    mesh::Tessellate(g, opt, m);
+    if (!mesh::WriteMesh(m, mesh::DefaultPalette(), path).ok()) state.SkipWithError("write failed");
+    segments = g.segments.size();
+    triangles = m.triangleCount();
+  }
+  state.counters["segments"] = double(segments);
+  state.counters["triangles"] = double(triangles);
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_EndToEndMillionSegments)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+
+BENCHMARK_MAIN();
