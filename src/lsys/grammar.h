@@ -5,6 +5,7 @@
 // looks only at the productions of its own symbol, in file order.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -70,6 +71,9 @@ struct Grammar {
   double widthFactor = 0.7;
   std::optional<Tropism> tropism;
   uint64_t seed = 1;
+  // `palette: #rrggbb ...`: material colour of each colour index (sRGB as
+  // written, 0..1); empty: the exporters' default palette.
+  std::vector<std::array<float, 3>> palette;
 
   SymbolTable symbols;
   Successor axiom;  // parameters are evaluated when a derivation starts (seed)

@@ -520,7 +520,8 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
                                     "step",              "width",        "tropism",
                                     "seed",              "ignore",       "consider",
                                     "module",            "decomposition", "interpretation",
-                                    "homomorphism",      "endlsystem"};
+                                    "homomorphism",      "endlsystem",
+                                    "palette"};
   const std::string& t = l.text;
   std::string lower = Lower(t.substr(pos, 20));
   const char* kw = nullptr;
@@ -634,6 +635,28 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
       }
       (ignore ? ignoreNames_ : considerNames_).insert(name);
     }
+    return true;
+  }
+  if (k == "palette") {
+    size_t q = after;
+    g_.palette.clear();
+    while (q < end) {
+      while (q < end && (IsSpace(t[q]) || t[q] == ',')) ++q;
+      if (q >= end) break;
+      size_t s0 = q;
+      while (q < end && !IsSpace(t[q]) && t[q] != ',') ++q;
+      std::string tok = t.substr(s0, q - s0);
+      bool ok = tok.size() == 7 && tok[0] == '#';
+      for (size_t i = 1; ok && i < 7; ++i) ok = std::isxdigit(static_cast<unsigned char>(tok[i]));
+      if (!ok) {
+        Error(l, int(s0) + 1, "expected a colour as #rrggbb in 'palette:'", int(tok.size()));
+        return true;
+      }
+      std::array<float, 3> c;
+      for (int i = 0; i < 3; ++i) c[size_t(i)] = float(std::stoi(tok.substr(1 + 2 * size_t(i), 2), nullptr, 16)) / 255.0f;
+      g_.palette.push_back(c);
+    }
+    if (g_.palette.empty()) Error(l, col, "'palette:' needs at least one colour", 8);
     return true;
   }
   if (k == "tropism") {

@@ -235,3 +235,19 @@ TEST(WordFormat, MultiCharacterNamesAndParameters) {
 
 }  // namespace
 }  // namespace sylva::lsys
+
+namespace sylva::lsys {
+namespace {
+
+TEST(Parser, PaletteOfHexColours) {
+  Grammar g = testing::MustParse("palette: #ff0000, #00ff80 #000000\naxiom: F\n");
+  ASSERT_EQ(g.palette.size(), 3u);
+  EXPECT_EQ(g.palette[0][0], 1.0f);
+  EXPECT_NEAR(g.palette[1][2], 128 / 255.0f, 1e-6f);
+  ParseResult bad = ParseGrammarText("palette: #ff00\naxiom: F\n", "p.lsys");
+  ASSERT_FALSE(bad.grammar);
+  EXPECT_EQ(bad.diagnostics.items[0].loc.column, 10);
+}
+
+}  // namespace
+}  // namespace sylva::lsys

@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <unordered_map>
 
 #include "core/atomic_file.h"
 #include "lsys/deriver.h"
@@ -256,6 +257,78 @@ TEST(Tessellator, UnknownSurfaceIsAnError) {
   TriangleMesh m;
   EXPECT_EQ(Tessellate(g, {}, m), "unknown surface 'nope'");
   EXPECT_EQ(m.triangleCount(), 0u);
+}
+
+}  // namespace
+}  // namespace sylva::mesh
+
+#include "mesh/obj_reader.h"
+
+namespace sylva::mesh {
+namespace {
+
+TEST(ObjReader, ReadsPolygonsWithAllIndexForms) {
+  auto m = ParseObj(
+      "# a unit square and a triangle\n"
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+      "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+      "f 1/1/1 2/2/1 3/3/1 4/4/1\n"
+      "f -4//1 -3//1 -1//1\n",
+      "sq.obj");
+  ASSERT_TRUE(m.ok()) << m.error().Format();
+  EXPECT_EQ(m->triangleCount(), 3u);
+  EXPECT_EQ(Validate(*m), "");
+  EXPECT_EQ(m->uvs[2], Vec2f(1, 1));
+}
+
+TEST(ObjReader, ComputesMissingNormals) {
+  auto m = ParseObj("v 0 0 0\nv 0 0 1\nv 1 0 0\nf 1 2 3\n", "n.obj");
+  ASSERT_TRUE(m.ok());
+  EXPECT_NEAR(m->normals[0].y(), 1.0f, 1e-6f);
+}
+
+TEST(ObjReader, ErrorsNameLineAndColumn) {
+  auto bad = ParseObj("v 0 0 0\nv 1 x 0\n", "bad.obj");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().loc.line, 2);
+  EXPECT_EQ(bad.error().loc.column, 5);  // the x
+  auto range = ParseObj("v 0 0 0\nv 1 0 0\nf 1 2 7\n", "r.obj");
+  ASSERT_FALSE(range.ok());
+  EXPECT_EQ(range.error().message, "vertex index 7 out of range");
+  EXPECT_EQ(range.error().loc.column, 7);
+  EXPECT_FALSE(ParseObj("# nothing\n", "e.obj").ok());
+}
+
+TEST(ObjReader, BundledSurfacesAreValidMeshes) {
+  for (const char* name : {"leaf", "petal", "flower"}) {
+    auto m = ReadObj(std::string(SYLVA_SOURCE_DIR) + "/grammars/surfaces/" + name + ".obj");
+    ASSERT_TRUE(m.ok()) << name << ": " << m.error().Format();
+    EXPECT_EQ(Validate(*m), "") << name;
+    EXPECT_GT(m->triangleCount(), 4u) << name;
+  }
+}
+
+TEST(Tessellator, SurfacesArePlacedByTheTurtleFrameAndScaled) {
+  TriangleMesh tri;
+  tri.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  tri.normals = {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}};
+  tri.uvs = {{0, 0}, {1, 0}, {0, 1}};
+  tri.indices = {0, 1, 2};
+  tri.material = {0};
+  std::unordered_map<std::string, TriangleMesh> lib{{"t", tri}};
+  PlantGeometry g = Draw("axiom: F+'~t(2)\n");
+  TessellateOptions opt;
+  opt.surfaces = &lib;
+  TriangleMesh m;
+  ASSERT_EQ(Tessellate(g, opt, m), "");
+  // After F+ the turtle is at (0,1,0) with H = (-1,0,0), L = (0,-1,0), U = (0,0,-1):
+  // local x -> L, y -> H, z -> U, scaled by 2.
+  const size_t n = m.vertexCount();
+  EXPECT_LT((m.positions[n - 3] - Vec3f(0, 1, 0)).norm(), 1e-6f);
+  EXPECT_LT((m.positions[n - 2] - Vec3f(0, -1, 0)).norm(), 1e-6f);
+  EXPECT_LT((m.positions[n - 1] - Vec3f(-2, 1, 0)).norm(), 1e-6f);
+  EXPECT_LT((m.normals[n - 1] - Vec3f(0, 0, -1)).norm(), 1e-6f);
+  EXPECT_EQ(m.material.back(), 1);
 }
 
 }  // namespace

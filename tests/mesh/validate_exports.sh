@@ -20,22 +20,22 @@ check() {  # what expected actual
   if [[ "$2" != "$3" ]]; then echo "FAIL: $1: expected $2, got $3"; fail=1; else echo "ok: $1 = $3"; fi
 }
 gltfs=()
-for plant in fig2_06a_monopodial fig1_25_bush fig1_24c_bracketed_plant; do
+for plant in abop/fig2_06a_monopodial abop/fig1_25_bush abop/fig1_24c_bracketed_plant plants/leafy_stem; do
   for ext in obj ply glb gltf; do
-    out="$work/$plant.$ext"
+    out="$work/$(basename $plant).$ext"
     rm -f "$out"
-    summary=$("$sylva" mesh "$src/grammars/abop/$plant.lsys" --sides 6 -o "$out" 2>&1 >/dev/null | head -1)
+    summary=$("$sylva" mesh "$src/grammars/$plant.lsys" --sides 6 -o "$out" 2>&1 >/dev/null | head -1)
     verts=$(sed -E 's/.*: ([0-9]+) vertices, ([0-9]+) triangles.*/\1/' <<<"$summary")
     faces=$(sed -E 's/.*: ([0-9]+) vertices, ([0-9]+) triangles.*/\2/' <<<"$summary")
     info=$(assimp info "$out" -r 2>&1)
     av=$(awk '/^Vertices:/{print $2}' <<<"$info")
     af=$(awk '/^Faces:/{print $2}' <<<"$info")
     nm=$(awk '/^Meshes:/{print $2; exit}' <<<"$info")
-    check "$plant.$ext faces" "$faces" "$af"
+    check "$(basename $plant).$ext faces" "$faces" "$af"
     case $ext in
-      obj) check "$plant.$ext vertices" "$((3 * faces))" "$av" ;;
-      ply) check "$plant.$ext vertices" "$verts" "$av" ;;
-      glb|gltf) check "$plant.$ext vertices" "$((verts * nm))" "$av"; gltfs+=("$out") ;;
+      obj) check "$(basename $plant).$ext vertices" "$((3 * faces))" "$av" ;;
+      ply) check "$(basename $plant).$ext vertices" "$verts" "$av" ;;
+      glb|gltf) check "$(basename $plant).$ext vertices" "$((verts * nm))" "$av"; gltfs+=("$out") ;;
     esac
   done
 done
