@@ -91,49 +91,67 @@ void TessellateChain(const PlantGeometry& g, const std::vector<uint32_t>& chain,
   }
   cs[S] = cs[0];  // the seam vertex repeats the first exactly (only u differs)
   sn[S] = sn[0];
+  // Sizes are known: resize once and write through pointers.
   const uint32_t base = uint32_t(out.positions.size());
+  const size_t ring = size_t(S + 1);
+  const size_t nVerts = (m + 1) * ring + 2 * ring;
+  const size_t nTris = TubeTriangles(m, S);
+  const size_t triBase = out.material.size();
+  out.positions.resize(base + nVerts);
+  out.normals.resize(base + nVerts);
+  out.uvs.resize(base + nVerts);
+  out.indices.resize(3 * (triBase + nTris));
+  out.material.resize(triBase + nTris);
+  Vec3f* pos = out.positions.data() + base;
+  Vec3f* nor = out.normals.data() + base;
+  Vec2f* uv = out.uvs.data() + base;
+  uint32_t* idx = out.indices.data() + 3 * triBase;
+  uint16_t* mat = out.material.data() + triBase;
   // Tube rings: S + 1 vertices each (the seam is duplicated for u = 1).
+  // N and B are orthonormal, so the radial direction is already unit.
   for (size_t k = 0; k <= m; ++k) {
     const Vec3 B = T[k].cross(N[k]);
+    const float v = float(V[k]);
     for (int j = 0; j <= S; ++j) {
       const Vec3 radial = N[k] * cs[j] + B * sn[j];
-      out.positions.push_back(F(P[k] + radial * R[k]));
-      out.normals.push_back(F(radial.normalized()));
-      out.uvs.push_back(Vec2f(float(j) / float(S), float(V[k])));
+      *pos++ = F(P[k] + radial * R[k]);
+      *nor++ = F(radial);
+      *uv++ = Vec2f(float(j) / float(S), v);
     }
   }
-  const uint32_t ring = uint32_t(S + 1);
   for (size_t k = 0; k < m; ++k) {
-    const uint16_t mat = g.segments[chain[k]].color;
+    const uint16_t sm = g.segments[chain[k]].color;
     for (int j = 0; j < S; ++j) {
-      const uint32_t a = base + uint32_t(k) * ring + uint32_t(j), b = a + 1, d = a + ring, c = d + 1;
-      out.indices.insert(out.indices.end(), {a, b, c, a, c, d});
-      out.material.push_back(mat);
-      out.material.push_back(mat);
+      const uint32_t a = base + uint32_t(k * ring) + uint32_t(j), b = a + 1,
+                     d = a + uint32_t(ring), c = d + 1;
+      idx[0] = a; idx[1] = b; idx[2] = c;
+      idx[3] = a; idx[4] = c; idx[5] = d;
+      idx += 6;
+      *mat++ = sm;
+      *mat++ = sm;
     }
   }
   // Caps: a centre and a ring of S vertices with the axis as normal.
   auto cap = [&](size_t k, bool tip) {
     const Vec3 B = T[k].cross(N[k]);
-    const Vec3 normal = tip ? T[k] : Vec3(-T[k]);
-    const uint32_t center = uint32_t(out.positions.size());
-    out.positions.push_back(F(P[k]));
-    out.normals.push_back(F(normal));
-    out.uvs.push_back(Vec2f(0.5f, 0.5f));
+    const Vec3f normal = F(tip ? T[k] : Vec3(-T[k]));
+    const uint32_t center = uint32_t(pos - out.positions.data());
+    *pos++ = F(P[k]);
+    *nor++ = normal;
+    *uv++ = Vec2f(0.5f, 0.5f);
     for (int j = 0; j < S; ++j) {
-      out.positions.push_back(F(P[k] + (N[k] * cs[j] + B * sn[j]) * R[k]));
-      out.normals.push_back(F(normal));
-      out.uvs.push_back(Vec2f(float(0.5 + 0.5 * cs[j]), float(0.5 + 0.5 * sn[j])));
+      *pos++ = F(P[k] + (N[k] * cs[j] + B * sn[j]) * R[k]);
+      *nor++ = normal;
+      *uv++ = Vec2f(float(0.5 + 0.5 * cs[j]), float(0.5 + 0.5 * sn[j]));
     }
-    const uint16_t mat = g.segments[chain[tip ? m - 1 : 0]].color;
+    const uint16_t cm = g.segments[chain[tip ? m - 1 : 0]].color;
     for (int j = 0; j < S; ++j) {
       const uint32_t p = center + 1 + uint32_t(j), q = center + 1 + uint32_t((j + 1) % S);
-      if (tip) {
-        out.indices.insert(out.indices.end(), {center, p, q});
-      } else {
-        out.indices.insert(out.indices.end(), {center, q, p});
-      }
-      out.material.push_back(mat);
+      idx[0] = center;
+      idx[1] = tip ? p : q;
+      idx[2] = tip ? q : p;
+      idx += 3;
+      *mat++ = cm;
     }
   };
   cap(0, false);
