@@ -74,6 +74,37 @@ inline void SinCosRadians(double r, double* s, double* c) {
 #endif
 }
 
+// sin and cos of a small angle (|r| <= 0.5 rad) by their Taylor series to
+// degree 17 and 18: the first omitted terms are below 1e-22, so the result
+// is the correctly rounded double in practice, and it does not depend on the
+// C library. Tropism turns the frame by such angles after every step.
+inline void SinCosSmall(double r, double* s, double* c) {
+  if (std::abs(r) > 0.5) {
+    SinCosRadians(r, s, c);
+    return;
+  }
+  const double x2 = r * r;
+  double ps = 1.0 / 355687428096000.0;  // 1/17!
+  ps = 1.0 / 1307674368000.0 - x2 * ps;  // 1/15!
+  ps = 1.0 / 6227020800.0 - x2 * ps;     // 1/13!
+  ps = 1.0 / 39916800.0 - x2 * ps;       // 1/11!
+  ps = 1.0 / 362880.0 - x2 * ps;         // 1/9!
+  ps = 1.0 / 5040.0 - x2 * ps;
+  ps = 1.0 / 120.0 - x2 * ps;
+  ps = 1.0 / 6.0 - x2 * ps;
+  *s = r - r * x2 * ps;
+  double pc = 1.0 / 6402373705728000.0;  // 1/18!
+  pc = 1.0 / 20922789888000.0 - x2 * pc;  // 1/16!
+  pc = 1.0 / 87178291200.0 - x2 * pc;     // 1/14!
+  pc = 1.0 / 479001600.0 - x2 * pc;       // 1/12!
+  pc = 1.0 / 3628800.0 - x2 * pc;         // 1/10!
+  pc = 1.0 / 40320.0 - x2 * pc;
+  pc = 1.0 / 720.0 - x2 * pc;
+  pc = 1.0 / 24.0 - x2 * pc;
+  pc = 0.5 - x2 * pc;
+  *c = 1.0 - x2 * pc;
+}
+
 // sin and cos of an angle in degrees, with a small cache: parametric plants
 // reuse a handful of angles millions of times.
 class SinCos {
@@ -238,7 +269,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
             const double a = def.susceptibility * norm;
             const Vec3 k = axis / norm;
             double sa, ca;
-            SinCosRadians(a, &sa, &ca);
+            SinCosSmall(a, &sa, &ca);
             auto turn = [&](Vec3& v) { v = v * ca + k.cross(v) * sa + k * (k.dot(v) * (1 - ca)); };
             turn(t.frame.heading);
             turn(t.frame.left);

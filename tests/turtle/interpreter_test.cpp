@@ -247,3 +247,32 @@ TEST(Turtle, RedrawingIntoAnExistingGeometryGivesTheSameResult) {
 
 }  // namespace
 }  // namespace sylva::turtle
+
+namespace sylva::turtle {
+namespace {
+
+TEST(Turtle, TropismMatchesTheExactRotationOverManySteps) {
+  // 200 steps bending toward -Y: the heading approaches T; compare with a
+  // reference computed with libm's sin and cos through Eigen's AngleAxis.
+  DrawOptions opt;
+  opt.recordModules = true;
+  std::string axiom = "+(70)";
+  for (int i = 0; i < 200; ++i) axiom += "F";
+  auto r = lsys::ParseGrammarText("tropism: 0.3 -1 0.2 0.35\naxiom: " + axiom + "\n", "t.lsys");
+  ASSERT_TRUE(r.grammar);
+  auto w = lsys::Derive(*r.grammar);
+  auto g = Interpret(w->word, r.grammar->symbols, TurtleDefFrom(*r.grammar), opt);
+  ASSERT_TRUE(g.ok());
+  Vec3 h(-std::sin(70 * kDegToRad), std::cos(70 * kDegToRad), 0);
+  const Vec3 t(0.3, -1, 0.2);
+  for (int i = 0; i < 200; ++i) {
+    Vec3 axis = h.cross(t);
+    double n = axis.norm();
+    if (n > 1e-12) h = Eigen::AngleAxisd(0.35 * n, axis / n) * h;
+  }
+  EXPECT_LT((g->moduleFrame.back().heading - h).norm(), 1e-12)
+      << "got " << Str(g->moduleFrame.back().heading) << " want " << Str(h);
+}
+
+}  // namespace
+}  // namespace sylva::turtle
