@@ -58,6 +58,16 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   me->add_option("--sides", mesh.sides, "vertices around each branch tube (3-256, default 8)")
       ->check(CLI::Range(3, 256));
 
+  RenderCommand render;
+  CLI::App* re = app.add_subcommand("render", "derive a grammar and render it to a PNG, headless");
+  AddDeriveFlags(re, render.derive);
+  re->add_option("-o,--output", render.output, "image file (.png)")->required();
+  re->add_option("--size", render.size, "image size WxH (default 960x540)");
+  re->add_option("--camera", render.camera,
+                 "azimuth,elevation,distance in degrees and units (distance 0: frame the plant)");
+  re->add_option("--sides", render.sides, "vertices around each branch tube (3-256, default 12)")
+      ->check(CLI::Range(3, 256));
+
   DeriveFlags check;
   CLI::App* c = app.add_subcommand("check", "parse and check a grammar; print diagnostics");
   c->add_option("file", check.file, "grammar file (.lsys)")->required();
@@ -81,6 +91,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   if (d->parsed()) return RunDerive(derive, out, err);
   if (c->parsed()) return RunCheck(check, out, err);
   if (me->parsed()) return RunMesh(mesh, out, err);
+  if (re->parsed()) return RunRender(render, out, err);
   return kExitBadInput;
 }
 

@@ -16,6 +16,67 @@
 
 namespace sylva::app {
 
+mesh::Palette PaletteOf(const lsys::Grammar& g) {
+  if (g.palette.empty()) return mesh::DefaultPalette();
+  mesh::Palette p;
+  for (const auto& c : g.palette) p.push_back(mesh::Vec3f(c[0], c[1], c[2]));
+  return p;
+}
+
+bool BuildMesh(const lsys::Grammar& g, const mesh::PlantGeometry& geometry, int sides,
+               mesh::TriangleMesh* out, std::ostream& err, int* exit) {
+  // Predefined surfaces: NAME.obj beside the grammar, in its surfaces/
+  // folder, or in the project's grammars/surfaces/.
+  std::unordered_map<std::string, mesh::TriangleMesh> surfaces;
+  {
+    std::set<std::string> names;
+    for (const auto& si : geometry.surfaces) names.insert(si.name);
+    const std::filesystem::path dir = std::filesystem::path(g.path).parent_path();
+    const std::vector<std::filesystem::path> search = {
+        dir, dir / "surfaces", std::filesystem::path(SYLVA_DATA_DIR) / "grammars" / "surfaces"};
+    for (const std::string& name : names) {
+      std::string found;
+      for (const auto& d : search) {
+        if (std::filesystem::is_regular_file(d / (name + ".obj"))) {
+          found = (d / (name + ".obj")).string();
+          break;
+        }
+      }
+      if (found.empty()) {
+        // Point at the surface's first use in the grammar.
+        Diagnostic d;
+        d.loc.file = g.path;
+        d.message = "unknown surface '" + name + "': no " + name + ".obj beside the grammar, in " +
+                    (dir / "surfaces").string() + " or in the bundled grammars/surfaces";
+        if (auto it = g.symbolLoc.find("~" + name); it != g.symbolLoc.end()) {
+          d.loc = it->second.loc;
+          d.sourceLine = it->second.line;
+          d.length = int(name.size()) + 1;
+        }
+        *exit = Report(d, err);
+        return false;
+      }
+      auto surface = mesh::ReadObj(found);
+      if (!surface) {
+        *exit = Report(surface.error(), err);
+        return false;
+      }
+      surfaces.emplace(name, std::move(*surface));
+    }
+  }
+  mesh::TessellateOptions topt;
+  topt.detail.sides = sides;
+  topt.surfaces = &surfaces;
+  mesh::TessellateStats stats;
+  if (std::string problem = mesh::Tessellate(geometry, topt, *out, &stats); !problem.empty()) {
+    err << g.path << ": error: " << problem << "\n";
+    *exit = kExitBadInput;
+    return false;
+  }
+  for (const auto& w : stats.warnings) err << g.path << ": warning: " << w << "\n";
+  return true;
+}
+
 int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   using Clock = std::chrono::steady_clock;
   if (!mesh::FormatFromPath(cmd.output)) {
@@ -37,58 +98,10 @@ int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   if (!geometry) return Report(geometry.error(), err);
   for (const auto& w : geometry->warnings) err << g->path << ": warning: " << w << "\n";
   const auto t2 = Clock::now();
-  // Predefined surfaces: NAME.obj beside the grammar, in its surfaces/
-  // folder, or in the project's grammars/surfaces/.
-  std::unordered_map<std::string, mesh::TriangleMesh> surfaces;
-  {
-    std::set<std::string> names;
-    for (const auto& si : geometry->surfaces) names.insert(si.name);
-    const std::filesystem::path dir = std::filesystem::path(g->path).parent_path();
-    const std::vector<std::filesystem::path> search = {
-        dir, dir / "surfaces", std::filesystem::path(SYLVA_DATA_DIR) / "grammars" / "surfaces"};
-    for (const std::string& name : names) {
-      std::string found;
-      for (const auto& d : search) {
-        if (std::filesystem::is_regular_file(d / (name + ".obj"))) {
-          found = (d / (name + ".obj")).string();
-          break;
-        }
-      }
-      if (found.empty()) {
-        // Point at the surface's first use in the grammar.
-        Diagnostic d;
-        d.loc.file = g->path;
-        d.message = "unknown surface '" + name + "': no " + name + ".obj beside the grammar, in " +
-                    (dir / "surfaces").string() + " or in the bundled grammars/surfaces";
-        if (auto it = g->symbolLoc.find("~" + name); it != g->symbolLoc.end()) {
-          d.loc = it->second.loc;
-          d.sourceLine = it->second.line;
-          d.length = int(name.size()) + 1;
-        }
-        return Report(d, err);
-      }
-      auto surface = mesh::ReadObj(found);
-      if (!surface) return Report(surface.error(), err);
-      surfaces.emplace(name, std::move(*surface));
-    }
-  }
   mesh::TriangleMesh m;
-  mesh::TessellateOptions topt;
-  topt.detail.sides = cmd.sides;
-  topt.surfaces = &surfaces;
-  mesh::TessellateStats stats;
-  if (std::string problem = mesh::Tessellate(*geometry, topt, m, &stats); !problem.empty()) {
-    err << g->path << ": error: " << problem << "\n";
-    return kExitBadInput;
-  }
-  for (const auto& w : stats.warnings) err << g->path << ": warning: " << w << "\n";
+  if (!BuildMesh(*g, *geometry, cmd.sides, &m, err, &exit)) return exit;
   const auto t3 = Clock::now();
-  mesh::Palette palette = mesh::DefaultPalette();
-  if (!g->palette.empty()) {
-    palette.clear();
-    for (const auto& c : g->palette) palette.push_back(mesh::Vec3f(c[0], c[1], c[2]));
-  }
-  if (Status s = mesh::WriteMesh(m, palette, cmd.output); !s.ok()) {
+  if (Status s = mesh::WriteMesh(m, PaletteOf(*g), cmd.output); !s.ok()) {
     return Report(s.error(), err);
   }
   const auto t4 = Clock::now();

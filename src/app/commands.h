@@ -11,6 +11,9 @@
 #include "core/diagnostic.h"
 #include "lsys/deriver.h"
 #include "lsys/grammar.h"
+#include "mesh/export.h"
+#include "mesh/plant_geometry.h"
+#include "mesh/triangle_mesh.h"
 
 namespace sylva::app {
 
@@ -37,13 +40,29 @@ struct MeshCommand {
   int sides = 8;
 };
 
+struct RenderCommand {
+  DeriveFlags derive;
+  std::string output;          // .png
+  std::string size = "960x540";
+  std::string camera;          // "azimuth,elevation,distance"; empty or distance 0: framed
+  int sides = 12;
+};
+
 int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err);
+int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err);
 int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 
 // Parses the grammar named by the flags (with -D), printing diagnostics.
 // Returns the grammar, or nullopt with the exit status in *exit.
 std::optional<lsys::Grammar> LoadGrammar(const DeriveFlags& f, std::ostream& err, int* exit);
 lsys::DeriveOptions DeriveOptionsFrom(const DeriveFlags& f);
+
+// The grammar's palette, or the default one.
+mesh::Palette PaletteOf(const lsys::Grammar& g);
+// Loads the surfaces `geometry` places and tessellates it, printing
+// diagnostics and warnings; false with *exit set on failure.
+bool BuildMesh(const lsys::Grammar& g, const mesh::PlantGeometry& geometry, int sides,
+               mesh::TriangleMesh* out, std::ostream& err, int* exit);
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
 // Prints diagnostics; returns the exit status they call for (0 when there

@@ -515,7 +515,8 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
 
 // Header statements: "keyword:" at the start of a line, case-insensitive.
 bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
-  static const char* kKeywords[] = {"derivation length", "width factor", "maximum depth",
+  static const char* kKeywords[] = {"derivation length", "width factor", "width scale",
+                                    "maximum depth",
                                     "lsystem",           "axiom",        "angle",
                                     "step",              "width",        "tropism",
                                     "seed",              "ignore",       "consider",
@@ -708,6 +709,12 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
     g_.width = v;
   } else if (k == "width factor") {
     g_.widthFactor = v;
+  } else if (k == "width scale") {
+    if (!(v > 0)) {
+      Error(l, vcol, "width scale must be positive");
+      return true;
+    }
+    g_.widthScale = v;
   } else if (k == "seed") {
     if (v != std::floor(v) || v < 0 || v > 18446744073709549568.0) {
       Error(l, vcol, "seed must be a whole number >= 0");

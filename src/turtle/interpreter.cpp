@@ -146,6 +146,7 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   d.step = g.step;
   d.width = g.width;
   d.widthFactor = g.widthFactor;
+  d.widthScale = g.widthScale;
   if (g.tropism) {
     d.tropism = Vec3(g.tropism->x, g.tropism->y, g.tropism->z);
     d.susceptibility = g.tropism->susceptibility;
@@ -252,7 +253,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
           sg.start = start;
           sg.end = t.pos;
           sg.left = t.frame.left;
-          sg.radiusStart = sg.radiusEnd = float(t.width * 0.5);
+          sg.radiusStart = sg.radiusEnd = float(t.width * def.widthScale * 0.5);
           sg.branch = t.branch;
           sg.parent = branchParent[t.branch];
           sg.depth = t.depth;
@@ -362,7 +363,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
       case Op::kSphere: {
         Sphere sp;
         sp.center = t.pos;
-        sp.radius = (np ? p[0] : t.width) * 0.5;
+        sp.radius = (np ? p[0] : t.width * def.widthScale) * 0.5;
         sp.color = t.color;
         sp.module = uint32_t(i);
         g.spheres.push_back(sp);

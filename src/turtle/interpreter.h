@@ -42,6 +42,7 @@ struct TurtleDef {
   double step = 1;         // for F f G g with no parameter
   double width = 1;        // initial width (diameter)
   double widthFactor = 0.7;
+  double widthScale = 1;   // drawn diameter = width x widthScale
   Vec3 tropism{0, -1, 0};
   double susceptibility = 0;  // 0: no tropism
 };

@@ -1,0 +1,283 @@
+#include "render/renderer.h"
+
+#include <GL/glew.h>
+#include <stb_image_write.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdlib>
+#include <filesystem>
+
+#include "core/atomic_file.h"
+
+namespace sylva::render {
+
+namespace fs = std::filesystem;
+
+std::string FindShaderDir() {
+  if (const char* env = std::getenv("SYLVA_SHADER_DIR")) return env;
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (fs::path dir = exe.parent_path(); !dir.empty(); dir = dir.parent_path()) {
+      if (fs::is_regular_file(dir / "shaders" / "mesh.vert")) return (dir / "shaders").string();
+      if (fs::is_regular_file(dir / "share" / "sylva" / "shaders" / "mesh.vert"))
+        return (dir / "share" / "sylva" / "shaders").string();
+      if (dir == dir.root_path()) break;
+    }
+  }
+  return (fs::path(SYLVA_DATA_DIR) / "shaders").string();
+}
+
+struct Renderer::Gl {
+  GLuint meshProgram = 0, lineProgram = 0;
+  GLint meshViewProj = -1, meshEye = -1, lineViewProj = -1;
+  GLuint meshVao = 0, meshBuffers[3] = {0, 0, 0}, meshIndex = 0;
+  GLsizei meshIndexCount = 0;
+  GLuint lineVao = 0, lineBuffers[2] = {0, 0};
+  GLsizei lineVertexCount = 0;
+  GLuint msFbo = 0, msColor = 0, msDepth = 0, resolveFbo = 0, resolveColor = 0;
+};
+
+static Diagnostic ShaderError(const std::string& file, const std::string& message) {
+  Diagnostic d;
+  d.loc.file = file;
+  d.message = message;
+  return d;
+}
+
+static Expected<GLuint> CompileProgram(const std::string& dir, const std::string& name) {
+  GLuint shaders[2];
+  const char* exts[2] = {".vert", ".frag"};
+  const GLenum kinds[2] = {GL_VERTEX_SHADER, GL_FRAGMENT_SHADER};
+  for (int k = 0; k < 2; ++k) {
+    const std::string path = (fs::path(dir) / (name + exts[k])).string();
+    auto text = ReadFile(path);
+    if (!text) return ShaderError(path, "cannot read shader: " + text.error().message);
+    shaders[k] = glCreateShader(kinds[k]);
+    const char* src = text->c_str();
+    glShaderSource(shaders[k], 1, &src, nullptr);
+    glCompileShader(shaders[k]);
+    GLint ok = 0;
+    glGetShaderiv(shaders[k], GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+      char log[4096];
+      glGetShaderInfoLog(shaders[k], sizeof log, nullptr, log);
+      for (int j = 0; j <= k; ++j) glDeleteShader(shaders[j]);
+      return ShaderError(path, std::string("GLSL compilation failed: ") + log);
+    }
+  }
+  GLuint program = glCreateProgram();
+  glAttachShader(program, shaders[0]);
+  glAttachShader(program, shaders[1]);
+  glLinkProgram(program);
+  glDeleteShader(shaders[0]);
+  glDeleteShader(shaders[1]);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(program, sizeof log, nullptr, log);
+    glDeleteProgram(program);
+    return ShaderError((fs::path(dir) / name).string() + ".{vert,frag}",
+                       std::string("GLSL link failed: ") + log);
+  }
+  return program;
+}
+
+Expected<std::unique_ptr<Renderer>> Renderer::Create(const std::string& shaderDir) {
+  std::unique_ptr<Renderer> r(new Renderer());
+  r->gl_ = std::make_unique<Gl>();
+  Gl& g = *r->gl_;
+  auto mesh = CompileProgram(shaderDir, "mesh");
+  if (!mesh) return mesh.error();
+  g.meshProgram = *mesh;
+  auto line = CompileProgram(shaderDir, "line");
+  if (!line) return line.error();
+  g.lineProgram = *line;
+  g.meshViewProj = glGetUniformLocation(g.meshProgram, "uViewProj");
+  g.meshEye = glGetUniformLocation(g.meshProgram, "uEye");
+  g.lineViewProj = glGetUniformLocation(g.lineProgram, "uViewProj");
+  glGenVertexArrays(1, &g.meshVao);
+  glGenBuffers(3, g.meshBuffers);
+  glGenBuffers(1, &g.meshIndex);
+  glGenVertexArrays(1, &g.lineVao);
+  glGenBuffers(2, g.lineBuffers);
+  return r;
+}
+
+Renderer::~Renderer() {
+  if (!gl_) return;
+  Gl& g = *gl_;
+  glDeleteProgram(g.meshProgram);
+  glDeleteProgram(g.lineProgram);
+  glDeleteBuffers(3, g.meshBuffers);
+  glDeleteBuffers(1, &g.meshIndex);
+  glDeleteBuffers(2, g.lineBuffers);
+  glDeleteVertexArrays(1, &g.meshVao);
+  glDeleteVertexArrays(1, &g.lineVao);
+  glDeleteFramebuffers(1, &g.msFbo);
+  glDeleteFramebuffers(1, &g.resolveFbo);
+  glDeleteRenderbuffers(1, &g.msColor);
+  glDeleteRenderbuffers(1, &g.msDepth);
+  glDeleteRenderbuffers(1, &g.resolveColor);
+}
+
+Status Renderer::Resize(int width, int height, int samples) {
+  if (width < 1 || height < 1 || width > 8192 || height > 8192) {
+    Diagnostic d;
+    d.message = "image size " + std::to_string(width) + "x" + std::to_string(height) +
+                " is outside 1x1 .. 8192x8192";
+    return d;
+  }
+  Gl& g = *gl_;
+  width_ = width;
+  height_ = height;
+  glDeleteFramebuffers(1, &g.msFbo);
+  glDeleteFramebuffers(1, &g.resolveFbo);
+  glDeleteRenderbuffers(1, &g.msColor);
+  glDeleteRenderbuffers(1, &g.msDepth);
+  glDeleteRenderbuffers(1, &g.resolveColor);
+  GLint maxSamples = 1;
+  glGetIntegerv(GL_MAX_SAMPLES, &maxSamples);
+  samples = std::max(1, std::min(samples, int(maxSamples)));
+  glGenRenderbuffers(1, &g.msColor);
+  glBindRenderbuffer(GL_RENDERBUFFER, g.msColor);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, width, height);
+  glGenRenderbuffers(1, &g.msDepth);
+  glBindRenderbuffer(GL_RENDERBUFFER, g.msDepth);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT24, width, height);
+  glGenFramebuffers(1, &g.msFbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, g.msFbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, g.msColor);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g.msDepth);
+  const GLenum ms = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  glGenRenderbuffers(1, &g.resolveColor);
+  glBindRenderbuffer(GL_RENDERBUFFER, g.resolveColor);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+  glGenFramebuffers(1, &g.resolveFbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, g.resolveFbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, g.resolveColor);
+  const GLenum rs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (ms != GL_FRAMEBUFFER_COMPLETE || rs != GL_FRAMEBUFFER_COMPLETE) {
+    Diagnostic d;
+    d.kind = ErrorKind::kRuntime;
+    d.message = "the OpenGL framebuffer is incomplete";
+    return d;
+  }
+  return {};
+}
+
+void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette) {
+  Gl& g = *gl_;
+  // Per-vertex colour: the material of the first triangle using the vertex.
+  std::vector<mesh::Vec3f> color(m.vertexCount(), mesh::Vec3f(0.8f, 0.8f, 0.8f));
+  std::vector<uint8_t> seen(m.vertexCount(), 0);
+  for (size_t t = 0; t < m.triangleCount(); ++t) {
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t i = m.indices[3 * t + e];
+      if (!seen[i] && !palette.empty()) {
+        seen[i] = 1;
+        color[i] = palette[m.material[t] % palette.size()];
+      }
+    }
+  }
+  glBindVertexArray(g.meshVao);
+  const void* data[3] = {m.positions.data(), m.normals.data(), color.data()};
+  for (int k = 0; k < 3; ++k) {
+    glBindBuffer(GL_ARRAY_BUFFER, g.meshBuffers[k]);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertexCount() * 12), data[k], GL_STATIC_DRAW);
+    glEnableVertexAttribArray(GLuint(k));
+    glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
+  }
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.meshIndex);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(), GL_STATIC_DRAW);
+  g.meshIndexCount = GLsizei(m.indices.size());
+  glBindVertexArray(0);
+}
+
+void Renderer::SetLines(const LineBatch& lines) {
+  Gl& g = *gl_;
+  glBindVertexArray(g.lineVao);
+  const void* data[2] = {lines.points.data(), lines.colors.data()};
+  for (int k = 0; k < 2; ++k) {
+    glBindBuffer(GL_ARRAY_BUFFER, g.lineBuffers[k]);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(lines.points.size() * 12), data[k], GL_STATIC_DRAW);
+    glEnableVertexAttribArray(GLuint(k));
+    glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
+  }
+  g.lineVertexCount = GLsizei(lines.points.size());
+  glBindVertexArray(0);
+}
+
+void Renderer::Draw(const Camera& camera) {
+  Gl& g = *gl_;
+  glBindFramebuffer(GL_FRAMEBUFFER, g.msFbo);
+  glViewport(0, 0, width_, height_);
+  glClearColor(background_.x(), background_.y(), background_.z(), 1);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glEnable(GL_MULTISAMPLE);
+  const Eigen::Matrix4f vp = camera.ViewProjection(double(width_) / height_).cast<float>();
+  if (g.meshIndexCount) {
+    glUseProgram(g.meshProgram);
+    glUniformMatrix4fv(g.meshViewProj, 1, GL_FALSE, vp.data());
+    const Eigen::Vector3f eye = camera.Eye().cast<float>();
+    glUniform3fv(g.meshEye, 1, eye.data());
+    glBindVertexArray(g.meshVao);
+    glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
+  }
+  if (g.lineVertexCount) {
+    glUseProgram(g.lineProgram);
+    glUniformMatrix4fv(g.lineViewProj, 1, GL_FALSE, vp.data());
+    glBindVertexArray(g.lineVao);
+    glDrawArrays(GL_LINES, 0, g.lineVertexCount);
+  }
+  glBindVertexArray(0);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, g.msFbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.resolveFbo);
+  glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+}
+
+Image Renderer::ReadPixels() {
+  Image img;
+  img.width = width_;
+  img.height = height_;
+  img.rgba.resize(size_t(width_) * size_t(height_) * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolveFbo);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, img.rgba.data());
+  // OpenGL's rows run bottom to top.
+  const size_t row = size_t(width_) * 4;
+  std::vector<uint8_t> tmp(row);
+  for (int y = 0; y < height_ / 2; ++y) {
+    uint8_t* a = &img.rgba[size_t(y) * row];
+    uint8_t* b = &img.rgba[size_t(height_ - 1 - y) * row];
+    std::copy(a, a + row, tmp.begin());
+    std::copy(b, b + row, a);
+    std::copy(tmp.begin(), tmp.end(), b);
+  }
+  return img;
+}
+
+Status WritePng(const Image& image, const std::string& path) {
+  std::string png;
+  auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data), size_t(size));
+  };
+  if (!stbi_write_png_to_func(append, &png, image.width, image.height, 4, image.rgba.data(),
+                              image.width * 4)) {
+    Diagnostic d;
+    d.kind = ErrorKind::kRuntime;
+    d.loc.file = path;
+    d.message = "PNG encoding failed";
+    return d;
+  }
+  AtomicFile f;
+  Status s = f.Open(path);
+  if (s.ok()) s = f.Write(png);
+  if (s.ok()) s = f.Commit();
+  return s;
+}
+
+}  // namespace sylva::render

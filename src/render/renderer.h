@@ -1,0 +1,73 @@
+// The OpenGL renderer: a mesh pipeline (indexed triangles, per-vertex colour
+// from the palette, key and fill lights and a hemisphere ambient term) and
+// a line pipeline (2D ABOP curves, skeletons), drawn into a 4x multisampled
+// framebuffer and resolved for read-back. It takes meshes and plain line
+// batches, never particles, plants or scenes. Needs a current OpenGL 4.5
+// context (HeadlessContext, or the viewer's window). GL types stay inside.
+//
+// Shaders are GLSL files loaded at run time from a shader folder (see
+// FindShaderDir); a missing or broken shader is an error naming the file and
+// the compiler's message.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/status.h"
+#include "mesh/export.h"
+#include "mesh/triangle_mesh.h"
+#include "render/camera.h"
+
+namespace sylva::render {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgba;  // rows top to bottom, 4 bytes a pixel
+  const uint8_t* Pixel(int x, int y) const { return &rgba[4 * (size_t(y) * size_t(width) + size_t(x))]; }
+};
+
+struct LineBatch {
+  std::vector<mesh::Vec3f> points;  // pairs: one segment per two points
+  std::vector<mesh::Vec3f> colors;  // one per point
+};
+
+// The shader folder: $SYLVA_SHADER_DIR if set, else `shaders/` beside the
+// executable or one or two levels up, else the source tree's `shaders/`.
+std::string FindShaderDir();
+
+class Renderer {
+ public:
+  // Compiles the shaders in `shaderDir`; needs a current context.
+  static Expected<std::unique_ptr<Renderer>> Create(const std::string& shaderDir);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Size of the offscreen target in pixels (1..8192), with MSAA samples.
+  Status Resize(int width, int height, int samples = 4);
+  void SetBackground(const mesh::Vec3f& rgb) { background_ = rgb; }
+  mesh::Vec3f background() const { return background_; }
+
+  // Replaces the mesh (uploaded once; drawing it again uploads nothing).
+  void SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette);
+  void SetLines(const LineBatch& lines);
+  void Draw(const Camera& camera);
+  Image ReadPixels();
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+
+ private:
+  Renderer() = default;
+  struct Gl;
+  std::unique_ptr<Gl> gl_;
+  int width_ = 0, height_ = 0;
+  mesh::Vec3f background_{0.94f, 0.95f, 0.96f};
+};
+
+// Writes an RGBA image as PNG (stb_image_write), atomically.
+Status WritePng(const Image& image, const std::string& path);
+
+}  // namespace sylva::render
