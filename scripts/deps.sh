@@ -3,7 +3,8 @@
 # Usage: scripts/deps.sh [--fuzz]   (--fuzz adds clang and its libFuzzer runtime)
 set -euo pipefail
 packages=(cmake g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libbenchmark-dev python3
-          libtinygltf-dev nlohmann-json3-dev libstb-dev assimp-utils)
+          libtinygltf-dev nlohmann-json3-dev libstb-dev assimp-utils
+          libegl-dev libgl-dev libglew-dev libgl1-mesa-dri libegl-mesa0)
 # node and npm run the Khronos glTF validator in the tests; any recent node will do.
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)
