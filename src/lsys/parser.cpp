@@ -183,7 +183,10 @@ void GrammarParser::Preprocess(const std::string& text, const std::string& path,
         blockCol = int(i) + 1;
         t[i] = t[i + 1] = ' ';
         ++i;
-      } else if (t[i] == '/' && i + 1 < t.size() && t[i + 1] == '/') {
+      } else if (t[i] == '/' && i + 1 < t.size() && t[i + 1] == '/' &&
+                 (i == 0 || IsSpace(t[i - 1]))) {
+        // `//` opens a comment at the start of a line or after a space;
+        // elsewhere it is two roll modules, as ABOP writes them (`S/////F`).
         for (size_t k = i; k < t.size(); ++k) t[k] = ' ';
         break;
       }

@@ -251,3 +251,16 @@ TEST(Parser, PaletteOfHexColours) {
 
 }  // namespace
 }  // namespace sylva::lsys
+
+namespace sylva::lsys {
+namespace {
+
+TEST(Parser, DoubleSlashIsACommentOnlyAfterSpaceOrAtLineStart) {
+  // ABOP writes rolls as `/////`; a comment needs a space before `//`.
+  EXPECT_EQ(testing::DeriveText("// a comment line\naxiom: A\nA --> S/////F  // the stem\n", 1), "S/////F");
+  EXPECT_EQ(testing::DeriveText("axiom: F//F\n", 0), "F//F");
+  EXPECT_EQ(testing::DeriveText("axiom: F //F\n", 0), "F");
+}
+
+}  // namespace
+}  // namespace sylva::lsys

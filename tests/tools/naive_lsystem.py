@@ -28,7 +28,9 @@ def tokenize(s, modules):
 
 def parse(path):
     g = {'n': 0, 'axiom': [], 'rules': [], 'ignore': set(), 'modules': []}
-    lines = [re.sub(r'//.*', '', l).strip() for l in open(path)]
+    # `//` is a comment at the start of a line or after whitespace; elsewhere
+    # it is two roll modules (ABOP writes `S/////F`).
+    lines = [re.sub(r'(^|\s)//.*', '', l).strip() for l in open(path)]
     for l in lines:
         if l.startswith('module:'):
             g['modules'] = sorted(l[7:].split(), key=len, reverse=True)
