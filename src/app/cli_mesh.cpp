@@ -16,6 +16,35 @@
 
 namespace sylva::app {
 
+std::optional<DrawnPlant> DeriveAndDraw(const DeriveFlags& f, std::ostream& err, int* exit) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  auto g = LoadGrammar(f, err, exit);
+  if (!g) return std::nullopt;
+  const lsys::DeriveOptions opt = DeriveOptionsFrom(f);
+  auto derived = lsys::Derive(*g, opt);
+  if (!derived) {
+    *exit = Report(derived.error(), err);
+    return std::nullopt;
+  }
+  auto word = lsys::Interpret(*g, derived->word, opt);
+  if (!word) {
+    *exit = Report(word.error(), err);
+    return std::nullopt;
+  }
+  const auto t1 = Clock::now();
+  auto geometry = turtle::Interpret(*word, g->symbols, turtle::TurtleDefFrom(*g));
+  if (!geometry) {
+    *exit = Report(geometry.error(), err);
+    return std::nullopt;
+  }
+  for (const auto& w : geometry->warnings) err << g->path << ": warning: " << w << "\n";
+  const auto t2 = Clock::now();
+  auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+  DrawnPlant p{std::move(*g), word->size(), std::move(*geometry), ms(t0, t1), ms(t1, t2)};
+  return p;
+}
+
 mesh::Palette PaletteOf(const lsys::Grammar& g) {
   if (g.palette.empty()) return mesh::DefaultPalette();
   mesh::Palette p;
@@ -85,18 +114,10 @@ int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   int exit = kExitOk;
-  const auto t0 = Clock::now();
-  auto g = LoadGrammar(cmd.derive, err, &exit);
-  if (!g) return exit;
-  const lsys::DeriveOptions opt = DeriveOptionsFrom(cmd.derive);
-  auto derived = lsys::Derive(*g, opt);
-  if (!derived) return Report(derived.error(), err);
-  auto word = lsys::Interpret(*g, derived->word, opt);
-  if (!word) return Report(word.error(), err);
-  const auto t1 = Clock::now();
-  auto geometry = turtle::Interpret(*word, g->symbols, turtle::TurtleDefFrom(*g));
-  if (!geometry) return Report(geometry.error(), err);
-  for (const auto& w : geometry->warnings) err << g->path << ": warning: " << w << "\n";
+  auto plant = DeriveAndDraw(cmd.derive, err, &exit);
+  if (!plant) return exit;
+  const lsys::Grammar* g = &plant->grammar;
+  const mesh::PlantGeometry* geometry = &plant->geometry;
   const auto t2 = Clock::now();
   mesh::TriangleMesh m;
   if (!BuildMesh(*g, *geometry, cmd.sides, &m, err, &exit)) return exit;
@@ -111,8 +132,8 @@ int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
                 "%s: %zu vertices, %zu triangles, %zu segments, %zu polygons (%llu modules)\n"
                 "time: derive %.1f ms, turtle %.1f ms, tessellate %.1f ms, write %.1f ms\n",
                 cmd.output.c_str(), m.vertexCount(), m.triangleCount(), geometry->segments.size(),
-                geometry->polygons.size(), static_cast<unsigned long long>(word->size()),
-                ms(t0, t1), ms(t1, t2), ms(t2, t3), ms(t3, t4));
+                geometry->polygons.size(), static_cast<unsigned long long>(plant->modules),
+                plant->deriveMs, plant->turtleMs, ms(t2, t3), ms(t3, t4));
   err << line;
   (void)out;
   return kExitOk;

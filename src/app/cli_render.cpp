@@ -42,16 +42,10 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   int exit = kExitOk;
-  auto g = LoadGrammar(cmd.derive, err, &exit);
-  if (!g) return exit;
-  const lsys::DeriveOptions opt = DeriveOptionsFrom(cmd.derive);
-  auto derived = lsys::Derive(*g, opt);
-  if (!derived) return Report(derived.error(), err);
-  auto word = lsys::Interpret(*g, derived->word, opt);
-  if (!word) return Report(word.error(), err);
-  auto geometry = turtle::Interpret(*word, g->symbols, turtle::TurtleDefFrom(*g));
-  if (!geometry) return Report(geometry.error(), err);
-  for (const auto& w : geometry->warnings) err << g->path << ": warning: " << w << "\n";
+  auto plant = DeriveAndDraw(cmd.derive, err, &exit);
+  if (!plant) return exit;
+  const lsys::Grammar* g = &plant->grammar;
+  const mesh::PlantGeometry* geometry = &plant->geometry;
 
   const mesh::Palette palette = PaletteOf(*g);
   // 2D figures (all in the z = 0 plane, nothing but segments) draw as lines

@@ -57,6 +57,18 @@ int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 std::optional<lsys::Grammar> LoadGrammar(const DeriveFlags& f, std::ostream& err, int* exit);
 lsys::DeriveOptions DeriveOptionsFrom(const DeriveFlags& f);
 
+// Grammar -> derived word -> interpretation rules -> turtle, as `mesh` and
+// `render` need it, printing diagnostics and the turtle's warnings; nullopt
+// with *exit set on failure. Times in milliseconds: derive (with the
+// interpretation rules) and turtle.
+struct DrawnPlant {
+  lsys::Grammar grammar;
+  uint64_t modules = 0;  // of the word the turtle read
+  mesh::PlantGeometry geometry;
+  double deriveMs = 0, turtleMs = 0;
+};
+std::optional<DrawnPlant> DeriveAndDraw(const DeriveFlags& f, std::ostream& err, int* exit);
+
 // The grammar's palette, or the default one.
 mesh::Palette PaletteOf(const lsys::Grammar& g);
 // Loads the surfaces `geometry` places and tessellates it, printing
