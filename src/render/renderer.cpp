@@ -36,6 +36,9 @@ struct Renderer::Gl {
   GLsizei meshIndexCount = 0;
   GLuint lineVao = 0, lineBuffers[2] = {0, 0};
   GLsizei lineVertexCount = 0;
+  GLuint pointProgram = 0, pointVao = 0, pointBuffers[3] = {0, 0, 0};
+  GLint pointViewProj = -1, pointScale = -1, pointOrtho = -1;
+  GLsizei pointCount = 0;
   GLuint msFbo = 0, msColor = 0, msDepth = 0, resolveFbo = 0, resolveColor = 0;
 };
 
@@ -98,6 +101,14 @@ Expected<std::unique_ptr<Renderer>> Renderer::Create(const std::string& shaderDi
   g.meshViewProj = glGetUniformLocation(g.meshProgram, "uViewProj");
   g.meshEye = glGetUniformLocation(g.meshProgram, "uEye");
   g.lineViewProj = glGetUniformLocation(g.lineProgram, "uViewProj");
+  auto point = CompileProgram(shaderDir, "point");
+  if (!point) return point.error();
+  g.pointProgram = *point;
+  g.pointViewProj = glGetUniformLocation(g.pointProgram, "uViewProj");
+  g.pointScale = glGetUniformLocation(g.pointProgram, "uPixelsPerUnit");
+  g.pointOrtho = glGetUniformLocation(g.pointProgram, "uOrthographic");
+  glGenVertexArrays(1, &g.pointVao);
+  glGenBuffers(3, g.pointBuffers);
   glGenVertexArrays(1, &g.meshVao);
   glGenBuffers(3, g.meshBuffers);
   glGenBuffers(1, &g.meshIndex);
@@ -116,6 +127,9 @@ Renderer::~Renderer() {
   glDeleteBuffers(2, g.lineBuffers);
   glDeleteVertexArrays(1, &g.meshVao);
   glDeleteVertexArrays(1, &g.lineVao);
+  glDeleteProgram(g.pointProgram);
+  glDeleteBuffers(3, g.pointBuffers);
+  glDeleteVertexArrays(1, &g.pointVao);
   glDeleteFramebuffers(1, &g.msFbo);
   glDeleteFramebuffers(1, &g.resolveFbo);
   glDeleteRenderbuffers(1, &g.msColor);
@@ -210,6 +224,26 @@ void Renderer::SetLines(const LineBatch& lines) {
   glBindVertexArray(0);
 }
 
+void Renderer::SetPoints(const PointBatch& points) {
+  Gl& g = *gl_;
+  glBindVertexArray(g.pointVao);
+  const size_t n = points.positions.size();
+  glBindBuffer(GL_ARRAY_BUFFER, g.pointBuffers[0]);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(n * 12), points.positions.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 12, nullptr);
+  glBindBuffer(GL_ARRAY_BUFFER, g.pointBuffers[1]);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(n * 4), points.sizes.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 1, GL_FLOAT, GL_FALSE, 4, nullptr);
+  glBindBuffer(GL_ARRAY_BUFFER, g.pointBuffers[2]);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(n * 12), points.colors.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(2);
+  glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 12, nullptr);
+  g.pointCount = GLsizei(n);
+  glBindVertexArray(0);
+}
+
 void Renderer::Draw(const Camera& camera) {
   Gl& g = *gl_;
   glBindFramebuffer(GL_FRAMEBUFFER, g.msFbo);
@@ -227,6 +261,17 @@ void Renderer::Draw(const Camera& camera) {
     glBindVertexArray(g.meshVao);
     glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
   }
+  if (g.pointCount) {
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glUseProgram(g.pointProgram);
+    glUniformMatrix4fv(g.pointViewProj, 1, GL_FALSE, vp.data());
+    // Projection scale: a diameter d at clip w covers d * P11 * height / 2 / w pixels.
+    const Mat4 proj = camera.Projection(double(width_) / height_);
+    glUniform1f(g.pointScale, float(proj(1, 1) * height_ * 0.5));
+    glUniform1i(g.pointOrtho, camera.orthographic ? 1 : 0);
+    glBindVertexArray(g.pointVao);
+    glDrawArrays(GL_POINTS, 0, g.pointCount);
+  }
   if (g.lineVertexCount) {
     glUseProgram(g.lineProgram);
     glUniformMatrix4fv(g.lineViewProj, 1, GL_FALSE, vp.data());
@@ -238,6 +283,8 @@ void Renderer::Draw(const Camera& camera) {
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.resolveFbo);
   glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
 }
+
+void Renderer::Finish() { glFinish(); }
 
 Image Renderer::ReadPixels() {
   Image img;

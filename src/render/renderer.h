@@ -33,6 +33,16 @@ struct LineBatch {
   std::vector<mesh::Vec3f> colors;  // one per point
 };
 
+// Particles as the renderer sees them: plain arrays, one entry per point
+// (the particles library fills it; the renderer never includes it). Sizes
+// are diameters in world units; points are drawn as round sprites facing
+// the camera, sized by perspective.
+struct PointBatch {
+  std::vector<mesh::Vec3f> positions;
+  std::vector<float> sizes;
+  std::vector<mesh::Vec3f> colors;
+};
+
 // The shader folder: $SYLVA_SHADER_DIR if set, else `shaders/` beside the
 // executable or one or two levels up, else the source tree's `shaders/`.
 std::string FindShaderDir();
@@ -53,7 +63,11 @@ class Renderer {
   // Replaces the mesh (uploaded once; drawing it again uploads nothing).
   void SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette);
   void SetLines(const LineBatch& lines);
+  void SetPoints(const PointBatch& points);
+  // Draws the current mesh, points and lines: no allocation and no upload;
+  // one draw call for the mesh, one for the points, one for the lines.
   void Draw(const Camera& camera);
+  void Finish();  // waits for the GPU (for timing)
   Image ReadPixels();
 
   int width() const { return width_; }

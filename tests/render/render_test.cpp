@@ -229,3 +229,39 @@ TEST(RenderCli, BadInputIsExitTwoWithAClearMessage) {
 
 }  // namespace
 }  // namespace sylva::render
+
+namespace sylva::render {
+namespace {
+
+TEST_F(Render, PointBatchDrawsRoundSpritesOfTheirWorldSize) {
+  PointBatch pts;
+  pts.positions = {{-2, 0, 0}, {2, 0, 0}};
+  pts.sizes = {1.0f, 0.5f};
+  pts.colors = {{1, 0, 0}, {0, 0, 1}};
+  const int W = 200, H = 100;
+  Camera cam;
+  cam.orthographic = true;
+  cam.orthoHeight = 4;  // 25 pixels per unit
+  cam.azimuth = 0;
+  cam.elevation = 0;
+  cam.distance = 10;
+  ASSERT_TRUE(renderer_->Resize(W, H).ok());
+  renderer_->SetBackground(mesh::Vec3f(1, 1, 1));
+  renderer_->SetPoints(pts);
+  renderer_->Draw(cam);
+  Image img = renderer_->ReadPixels();
+  // Red sprite centred at x = 50: about 25 px across; blue at x = 150: about 12 px.
+  auto redWidth = 0, blueWidth = 0;
+  for (int x = 0; x < W; ++x) {
+    const uint8_t* p = img.Pixel(x, H / 2);
+    if (p[0] > 150 && p[2] < 80) ++redWidth;
+    if (p[2] > 150 && p[0] < 80) ++blueWidth;
+  }
+  EXPECT_NEAR(redWidth, 25, 2);
+  EXPECT_NEAR(blueWidth, 12.5, 2);
+  EXPECT_GT(img.Pixel(50, 50)[0], 150);
+  EXPECT_EQ(img.Pixel(100, 50)[0], 255);  // between them: background
+}
+
+}  // namespace
+}  // namespace sylva::render

@@ -1,0 +1,91 @@
+// Frame times at 1920x1080 (issue 4): a plant of about a million triangles
+// and a batch of a million points, drawn through the headless context
+// (Mesa llvmpipe on machines with no GPU). One iteration = Draw + Finish.
+#include <benchmark/benchmark.h>
+
+#include <random>
+#include <string>
+
+#include "lsys/deriver.h"
+#include "lsys/parser.h"
+#include "mesh/tessellator.h"
+#include "render/headless_context.h"
+#include "render/renderer.h"
+#include "turtle/interpreter.h"
+
+namespace {
+
+using namespace sylva;
+
+struct Gl {
+  std::unique_ptr<render::HeadlessContext> context;
+  std::unique_ptr<render::Renderer> renderer;
+};
+
+Gl& Context() {
+  static Gl gl = [] {
+    Gl g;
+    g.context = render::HeadlessContext::Create().value();
+    g.renderer = render::Renderer::Create(std::string(SYLVA_SOURCE_DIR) + "/shaders").value();
+    (void)g.renderer->Resize(1920, 1080);
+    return g;
+  }();
+  return gl;
+}
+
+void BM_FrameMillionTrianglePlant(benchmark::State& state) {
+  auto r = lsys::ParseGrammarFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_08b_ternary.lsys");
+  lsys::DeriveOptions opt;
+  opt.steps = 8;
+  auto d = lsys::Derive(*r.grammar, opt);
+  auto g = turtle::Interpret(d->word, r.grammar->symbols, turtle::TurtleDefFrom(*r.grammar));
+  mesh::TriangleMesh m;
+  mesh::TessellateOptions topt;
+  topt.detail.sides = 22;  // about 1.01 M triangles
+  mesh::Tessellate(*g, topt, m);
+  Vec3 lo = m.positions[0].cast<double>(), hi = lo;
+  for (const auto& p : m.positions) {
+    lo = lo.cwiseMin(p.cast<double>());
+    hi = hi.cwiseMax(p.cast<double>());
+  }
+  Gl& gl = Context();
+  gl.renderer->SetPoints({});
+  gl.renderer->SetLines({});
+  gl.renderer->SetMesh(m, mesh::DefaultPalette());
+  const render::Camera cam = render::Camera::Frame(lo, hi, 16.0 / 9, 30, 12, false);
+  for (auto _ : state) {
+    gl.renderer->Draw(cam);
+    gl.renderer->Finish();
+  }
+  gl.renderer->SetMesh({}, {});
+  state.counters["triangles"] = double(m.triangleCount());
+  state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_FrameMillionTrianglePlant)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+void BM_FrameMillionPoints(benchmark::State& state) {
+  render::PointBatch pts;
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-1, 1);
+  for (int i = 0; i < 1000000; ++i) {
+    pts.positions.push_back(mesh::Vec3f(u(rng), u(rng), u(rng)));
+    pts.sizes.push_back(0.004f);
+    pts.colors.push_back(mesh::Vec3f(0.9f, 0.6f + 0.3f * u(rng), 0.2f));
+  }
+  Gl& gl = Context();
+  gl.renderer->SetMesh({}, {});
+  gl.renderer->SetPoints(pts);
+  const render::Camera cam = render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 16.0 / 9, 30, 20, false);
+  for (auto _ : state) {
+    gl.renderer->Draw(cam);
+    gl.renderer->Finish();
+  }
+  gl.renderer->SetPoints({});
+  state.counters["points"] = 1e6;
+  state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_FrameMillionPoints)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+}  // namespace
+
+BENCHMARK_MAIN();
