@@ -4,7 +4,8 @@
 set -euo pipefail
 packages=(cmake g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libbenchmark-dev python3
           libtinygltf-dev nlohmann-json3-dev libstb-dev assimp-utils
-          libegl-dev libgl-dev libglew-dev libgl1-mesa-dri libegl-mesa0)
+          libegl-dev libgl-dev libglew-dev libgl1-mesa-dri libegl-mesa0
+          libglfw3-dev libimgui-dev xvfb)
 # node and npm run the Khronos glTF validator in the tests; any recent node will do.
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)

@@ -4,6 +4,7 @@
 #include <ostream>
 
 #include "app/commands.h"
+#include "app/viewer.h"
 #include "lsys/deriver.h"
 
 namespace sylva::app {
@@ -68,6 +69,13 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   re->add_option("--sides", render.sides, "vertices around each branch tube (3-256, default 12)")
       ->check(CLI::Range(3, 256));
 
+  ViewCommand view;
+  CLI::App* vi = app.add_subcommand("view", "open the interactive viewer (reloads the file when it changes)");
+  vi->add_option("file", view.file, "grammar file (.lsys); default: a bundled ABOP tree");
+  vi->add_option("--screenshot", view.screenshot, "save this PNG after --frames frames and quit");
+  vi->add_option("--frames", view.frames, "frames to draw before the screenshot")->check(CLI::Range(1, 1000000));
+  vi->add_option("--size", view.size, "window size WxH (default 1280x720)");
+
   DeriveFlags check;
   CLI::App* c = app.add_subcommand("check", "parse and check a grammar; print diagnostics");
   c->add_option("file", check.file, "grammar file (.lsys)")->required();
@@ -92,6 +100,10 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   if (c->parsed()) return RunCheck(check, out, err);
   if (me->parsed()) return RunMesh(mesh, out, err);
   if (re->parsed()) return RunRender(render, out, err);
+  if (vi->parsed()) {
+    if (!view.screenshot.empty() && view.frames == 0) view.frames = 3;
+    return RunView(view, out, err);
+  }
   return kExitBadInput;
 }
 

@@ -286,25 +286,43 @@ void Renderer::Draw(const Camera& camera) {
 
 void Renderer::Finish() { glFinish(); }
 
-Image Renderer::ReadPixels() {
-  Image img;
-  img.width = width_;
-  img.height = height_;
-  img.rgba.resize(size_t(width_) * size_t(height_) * 4);
+void Renderer::PresentToWindow(int width, int height) {
   glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolveFbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, width_, height_, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+// Reads the bound read framebuffer; OpenGL's rows run bottom to top.
+static Image ReadBound(int width, int height) {
+  Image img;
+  img.width = width;
+  img.height = height;
+  img.rgba.resize(size_t(width) * size_t(height) * 4);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, img.rgba.data());
-  // OpenGL's rows run bottom to top.
-  const size_t row = size_t(width_) * 4;
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, img.rgba.data());
+  const size_t row = size_t(width) * 4;
   std::vector<uint8_t> tmp(row);
-  for (int y = 0; y < height_ / 2; ++y) {
+  for (int y = 0; y < height / 2; ++y) {
     uint8_t* a = &img.rgba[size_t(y) * row];
-    uint8_t* b = &img.rgba[size_t(height_ - 1 - y) * row];
+    uint8_t* b = &img.rgba[size_t(height - 1 - y) * row];
     std::copy(a, a + row, tmp.begin());
     std::copy(b, b + row, a);
     std::copy(tmp.begin(), tmp.end(), b);
   }
+  for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;  // opaque
   return img;
+}
+
+Image Renderer::ReadPixels() {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolveFbo);
+  return ReadBound(width_, height_);
+}
+
+Image ReadWindowPixels(int width, int height) {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+  glReadBuffer(GL_BACK);
+  return ReadBound(width, height);
 }
 
 Status WritePng(const Image& image, const std::string& path) {

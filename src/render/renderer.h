@@ -68,6 +68,9 @@ class Renderer {
   // one draw call for the mesh, one for the points, one for the lines.
   void Draw(const Camera& camera);
   void Finish();  // waits for the GPU (for timing)
+  // Copies the last frame to the window's framebuffer (the viewer), scaled
+  // to width x height.
+  void PresentToWindow(int width, int height);
   Image ReadPixels();
 
   int width() const { return width_; }
@@ -80,6 +83,10 @@ class Renderer {
   int width_ = 0, height_ = 0;
   mesh::Vec3f background_{0.94f, 0.95f, 0.96f};
 };
+
+// Reads the current window's back buffer (after everything, UI included,
+// is drawn and before the swap): the viewer's screenshots.
+Image ReadWindowPixels(int width, int height);
 
 // Writes an RGBA image as PNG (stb_image_write), atomically.
 Status WritePng(const Image& image, const std::string& path);

@@ -1,0 +1,391 @@
+// The viewer. Threads: the UI thread owns the window, ImGui and every GL
+// call; one worker derives, draws and tessellates jobs posted by the UI and
+// hands back meshes. Only the newest job matters: a job that is overtaken
+// is dropped when it finishes.
+#include "app/viewer.h"
+
+#include <GL/glew.h>
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <ostream>
+#include <sstream>
+#include <thread>
+
+#include "app/cli.h"
+#include "app/commands.h"
+#include "lsys/parser.h"
+#include "mesh/tessellator.h"
+#include "render/renderer.h"
+#include "turtle/interpreter.h"
+
+namespace sylva::app {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct Job {
+  uint64_t id = 0;
+  std::string path;
+  std::map<std::string, double> overrides;
+  std::optional<uint64_t> seed;
+  int steps = -1;
+  int sides = 8;
+};
+
+struct Result {
+  uint64_t id = 0;
+  bool ok = false;
+  std::string diagnostics;   // errors and warnings, formatted
+  mesh::TriangleMesh mesh;
+  mesh::Palette palette;
+  Vec3 lo{0, 0, 0}, hi{1, 1, 1};
+  uint64_t modules = 0;
+  int derivationLength = 0;
+  std::vector<std::pair<std::string, double>> constants;  // file order not kept: sorted
+  double deriveMs = 0, turtleMs = 0, tessellateMs = 0;
+};
+
+Result RunJob(const Job& job) {
+  Result r;
+  r.id = job.id;
+  auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+  const auto t0 = Clock::now();
+  lsys::ParseOptions popt;
+  popt.overrides = job.overrides;
+  lsys::ParseResult parsed = lsys::ParseGrammarFile(job.path, popt);
+  r.diagnostics = parsed.diagnostics.FormatAll();
+  if (!parsed.grammar) return r;
+  const lsys::Grammar& g = *parsed.grammar;
+  r.derivationLength = g.derivationLength;
+  for (const auto& [k, v] : g.constants) r.constants.emplace_back(k, v);
+  std::sort(r.constants.begin(), r.constants.end());
+  lsys::DeriveOptions dopt;
+  dopt.steps = job.steps;
+  dopt.seed = job.seed;
+  auto derived = lsys::Derive(g, dopt);
+  if (!derived) {
+    r.diagnostics += derived.error().Format();
+    return r;
+  }
+  auto word = lsys::Interpret(g, derived->word, dopt);
+  if (!word) {
+    r.diagnostics += word.error().Format();
+    return r;
+  }
+  const auto t1 = Clock::now();
+  auto geometry = turtle::Interpret(*word, g.symbols, turtle::TurtleDefFrom(g));
+  if (!geometry) {
+    r.diagnostics += geometry.error().Format();
+    return r;
+  }
+  const auto t2 = Clock::now();
+  std::ostringstream err;
+  int exit = 0;
+  if (!BuildMesh(g, *geometry, job.sides, &r.mesh, err, &exit)) {
+    r.diagnostics += err.str();
+    return r;
+  }
+  r.diagnostics += err.str();
+  const auto t3 = Clock::now();
+  r.palette = PaletteOf(g);
+  r.modules = word->size();
+  if (r.mesh.vertexCount()) {
+    r.lo = r.hi = r.mesh.positions[0].cast<double>();
+    for (const auto& p : r.mesh.positions) {
+      r.lo = r.lo.cwiseMin(p.cast<double>());
+      r.hi = r.hi.cwiseMax(p.cast<double>());
+    }
+  }
+  r.deriveMs = ms(t0, t1);
+  r.turtleMs = ms(t1, t2);
+  r.tessellateMs = ms(t2, t3);
+  r.ok = true;
+  return r;
+}
+
+class Worker {
+ public:
+  Worker() : thread_([this] { Loop(); }) {}
+  ~Worker() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+  void Post(Job job) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      pending_ = std::move(job);
+    }
+    wake_.notify_all();
+  }
+  std::optional<Result> Take() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::optional<Result> r = std::move(done_);
+    done_.reset();
+    return r;
+  }
+  bool Busy() const { return busy_.load(); }
+
+ private:
+  void Loop() {
+    for (;;) {
+      Job job;
+      {
+        std::unique_lock<std::mutex> lock(mutex_);
+        wake_.wait(lock, [&] { return stop_ || pending_.has_value(); });
+        if (stop_) return;
+        job = std::move(*pending_);
+        pending_.reset();
+        busy_ = true;
+      }
+      Result r = RunJob(job);
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+      if (!pending_) done_ = std::move(r);  // overtaken results are dropped
+    }
+  }
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::optional<Job> pending_;
+  std::optional<Result> done_;
+  std::atomic<bool> busy_{false};
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+std::string DefaultGrammar() {
+  return (fs::path(SYLVA_DATA_DIR) / "grammars" / "abop" / "fig2_06a_monopodial.lsys").string();
+}
+
+}  // namespace
+
+int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
+  int width = 1280, height = 720;
+  {
+    int n = 0;
+    if (std::sscanf(cmd.size.c_str(), "%dx%d%n", &width, &height, &n) != 2 ||
+        size_t(n) != cmd.size.size() || width < 64 || height < 64 || width > 8192 || height > 8192) {
+      err << "sylva: error: --size '" << cmd.size << "': expected WxH from 64x64 to 8192x8192\n";
+      return kExitBadInput;
+    }
+  }
+  const std::string path = cmd.file.empty() ? DefaultGrammar() : cmd.file;
+  if (!fs::is_regular_file(path)) {
+    err << path << ": error: cannot read file\n";
+    return kExitBadInput;
+  }
+  if (!glfwInit()) {
+    err << "sylva: error: cannot open a window (no display? run under Xvfb, or use sylva render)\n";
+    return kExitRuntime;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  GLFWwindow* window = glfwCreateWindow(width, height, ("Sylva - " + path).c_str(), nullptr, nullptr);
+  if (!window) {
+    glfwTerminate();
+    err << "sylva: error: cannot create an OpenGL 4.5 window\n";
+    return kExitRuntime;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(cmd.frames > 0 ? 0 : 1);
+  glewExperimental = GL_TRUE;
+  if (glewInit() != GLEW_OK) {
+    glfwDestroyWindow(window);
+    glfwTerminate();
+    err << "sylva: error: cannot load OpenGL functions\n";
+    return kExitRuntime;
+  }
+  glGetError();
+  int exitCode = kExitOk;
+  {
+    auto renderer = render::Renderer::Create(render::FindShaderDir());
+    if (!renderer) {
+      glfwDestroyWindow(window);
+      glfwTerminate();
+      return Report(renderer.error(), err);
+    }
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;
+    ImGui::StyleColorsLight();
+    ImGui_ImplGlfw_InitForOpenGL(window, true);
+    ImGui_ImplOpenGL3_Init("#version 450 core");
+
+    Worker worker;
+    Job job;
+    job.path = path;
+    uint64_t nextId = 1;
+    auto post = [&] {
+      job.id = nextId++;
+      worker.Post(job);
+    };
+    post();
+    std::optional<Result> shown;  // last good plant
+    std::string diagnostics;
+    bool lastFailed = false;
+    std::vector<std::pair<std::string, double>> constants;
+    int derivationLength = 0;
+    render::Camera camera;
+    bool framed = false;
+    fs::file_time_type mtime = fs::last_write_time(path);
+    auto lastPoll = Clock::now();
+    double frameMs = 0;
+    int frame = 0;
+    int shots = 0;
+    double lastX = 0, lastY = 0;
+
+    while (!glfwWindowShouldClose(window)) {
+      const auto frameStart = Clock::now();
+      glfwPollEvents();
+      // Reload on change (polled four times a second).
+      if (Clock::now() - lastPoll > std::chrono::milliseconds(250)) {
+        lastPoll = Clock::now();
+        std::error_code ec;
+        auto t = fs::last_write_time(path, ec);
+        if (!ec && t != mtime) {
+          mtime = t;
+          post();
+        }
+      }
+      if (auto r = worker.Take()) {
+        diagnostics = r->diagnostics;
+        if (r->ok) {
+          constants = r->constants;
+          derivationLength = r->derivationLength;
+          (*renderer)->SetMesh(r->mesh, r->palette);
+          if (!framed) {
+            camera = render::Camera::Frame(r->lo, r->hi, double(width) / height, 30, 12, false);
+            framed = true;
+          }
+          shown = std::move(r);
+          lastFailed = false;
+        } else {
+          // Keep the last good plant; report what went wrong.
+          err << "sylva view: the grammar has errors; keeping the last good plant\n" << diagnostics;
+          lastFailed = true;
+        }
+      }
+      int fbw = 0, fbh = 0;
+      glfwGetFramebufferSize(window, &fbw, &fbh);
+      if (fbw > 0 && fbh > 0 && (fbw != (*renderer)->width() || fbh != (*renderer)->height())) {
+        (void)(*renderer)->Resize(fbw, fbh);
+      }
+      // Mouse: orbit, pan, zoom (when ImGui does not want the mouse).
+      ImGuiIO& io = ImGui::GetIO();
+      double mx, my;
+      glfwGetCursorPos(window, &mx, &my);
+      if (!io.WantCaptureMouse) {
+        if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
+          camera.azimuth -= (mx - lastX) * 0.4;
+          camera.elevation = std::clamp(camera.elevation + (my - lastY) * 0.4, -85.0, 85.0);
+        }
+        if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) {
+          const Mat4 v = camera.View();
+          const Vec3 right(v(0, 0), v(0, 1), v(0, 2)), up(v(1, 0), v(1, 1), v(1, 2));
+          const double k = camera.distance * 0.0015;
+          camera.target += (-right * (mx - lastX) + up * (my - lastY)) * k;
+        }
+        if (io.MouseWheel != 0) camera.distance *= std::pow(0.9, io.MouseWheel);
+      }
+      lastX = mx;
+      lastY = my;
+
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      ImGui::NewFrame();
+      ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+      ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
+      ImGui::Begin("Sylva", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+      ImGui::TextWrapped("%s", fs::path(path).filename().string().c_str());
+      bool changed = false;
+      int steps = job.steps < 0 ? derivationLength : job.steps;
+      if (ImGui::SliderInt("step", &steps, 0, std::max(derivationLength, 1))) {
+        job.steps = steps;
+        changed = true;
+      }
+      int seed = int(job.seed.value_or(1));
+      if (ImGui::InputInt("seed", &seed)) {
+        job.seed = uint64_t(std::max(seed, 0));
+        changed = true;
+      }
+      if (ImGui::SliderInt("sides", &job.sides, 3, 32)) changed = true;
+      if (!constants.empty() && ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
+        for (auto& [name, value] : constants) {
+          float v = float(job.overrides.count(name) ? job.overrides[name] : value);
+          const float lo = value > 0 ? 0.0f : float(value) - 10.0f;
+          const float hi = value > 0 ? float(value) * 2.0f : float(value) + 10.0f;
+          if (ImGui::SliderFloat(name.c_str(), &v, lo, hi)) {
+            job.overrides[name] = v;
+            changed = true;
+          }
+        }
+      }
+      if (changed) post();
+      if (worker.Busy()) ImGui::ProgressBar(-1.0f * float(ImGui::GetTime()), ImVec2(-1, 0), "deriving...");
+      ImGui::Separator();
+      if (shown) {
+        ImGui::Text("modules %llu, triangles %zu", static_cast<unsigned long long>(shown->modules),
+                    shown->mesh.triangleCount());
+        ImGui::Text("derive %.1f ms, turtle %.1f ms, mesh %.1f ms", shown->deriveMs, shown->turtleMs,
+                    shown->tessellateMs);
+      }
+      ImGui::Text("frame %.1f ms", frameMs);
+      if (!diagnostics.empty() && ImGui::CollapsingHeader("diagnostics", ImGuiTreeNodeFlags_DefaultOpen)) {
+        if (lastFailed) ImGui::TextColored(ImVec4(0.8f, 0.1f, 0.1f, 1), "errors: showing the last good plant");
+        ImGui::TextWrapped("%s", diagnostics.c_str());
+      }
+      ImGui::End();
+      ImGui::Render();
+
+      (*renderer)->Draw(camera);
+      (*renderer)->PresentToWindow(fbw, fbh);
+      glViewport(0, 0, fbw, fbh);
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+
+      ++frame;
+      const bool key = glfwGetKey(window, GLFW_KEY_P) == GLFW_PRESS && !io.WantCaptureKeyboard;
+      const bool done = cmd.frames > 0 && frame >= cmd.frames && shown.has_value();
+      if (key || done) {
+        std::string file = done ? cmd.screenshot : "sylva-screenshot-" + std::to_string(++shots) + ".png";
+        if (!file.empty()) {
+          if (Status s = render::WritePng(render::ReadWindowPixels(fbw, fbh), file); !s.ok()) {
+            exitCode = Report(s.error(), err);
+          } else {
+            out << "screenshot: " << file << "\n";
+          }
+        }
+      }
+      glfwSwapBuffers(window);
+      frameMs = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+      if (done) break;
+      // Wait for the first plant no longer than a minute when taking a screenshot.
+      if (cmd.frames > 0 && frame > cmd.frames + 6000) {
+        err << "sylva view: no plant to show after " << frame << " frames\n";
+        exitCode = kExitRuntime;
+        break;
+      }
+    }
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+  }
+  glfwDestroyWindow(window);
+  glfwTerminate();
+  return exitCode;
+}
+
+}  // namespace sylva::app

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The viewer in a real window under Xvfb:
+#  1. `sylva view FILE --screenshot` writes a picture that shows the plant;
+#  2. a running viewer, whose grammar is then rewritten with an error,
+#     reports the error (file:line:col) and keeps running.
+# Usage: viewer_test.sh SYLVA_BINARY SOURCE_DIR WORK_DIR
+set -euo pipefail
+sylva="$1"; src="$2"; work="$3"
+rm -rf "$work"; mkdir -p "$work"
+display=":$((200 + $$ % 500))"
+Xvfb "$display" -screen 0 1280x800x24 -nolisten tcp >"$work/xvfb.log" 2>&1 &
+xvfb=$!
+viewer=""
+cleanup() { [[ -n "$viewer" ]] && kill "$viewer" 2>/dev/null; kill "$xvfb" 2>/dev/null; true; }
+trap cleanup EXIT
+export DISPLAY="$display"
+for _ in $(seq 50); do [[ -e "/tmp/.X11-unix/X${display#:}" ]] && break; sleep 0.1; done
+
+cp "$src/grammars/abop/fig2_06a_monopodial.lsys" "$work/tree.lsys"
+"$sylva" view "$work/tree.lsys" --screenshot "$work/shot.png" --frames 5 --size 640x360
+python3 - "$work/shot.png" <<'PY'
+import struct, sys, zlib
+data = open(sys.argv[1], 'rb').read()
+assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+w, h = struct.unpack('>II', data[16:24])
+idat = b''; i = 8
+while i < len(data):
+    n, kind = struct.unpack('>I4s', data[i:i + 8]); body = data[i + 8:i + 8 + n]
+    if kind == b'IDAT': idat += body
+    i += 12 + n
+raw = zlib.decompress(idat); stride = 4 * w + 1
+assert w == 640 and h == 360, (w, h)
+# Count brownish bark pixels (the plant), undoing PNG row filters.
+prev = bytearray(4 * w); bark = 0
+for y in range(h):
+    f = raw[y * stride]; row = bytearray(raw[y * stride + 1:(y + 1) * stride])
+    for x in range(4 * w):
+        a = row[x - 4] if x >= 4 else 0; b = prev[x]; c = prev[x - 4] if x >= 4 else 0
+        if f == 1: row[x] = (row[x] + a) & 255
+        elif f == 2: row[x] = (row[x] + b) & 255
+        elif f == 3: row[x] = (row[x] + (a + b) // 2) & 255
+        elif f == 4:
+            p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+            row[x] = (row[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+    for x in range(w):
+        r, g, bl = row[4 * x:4 * x + 3]
+        if r > g > bl and r - bl > 25: bark += 1
+    prev = row
+print(f'screenshot {w}x{h}: {bark} bark-coloured pixels')
+assert bark > 300, 'the plant is not in the picture'
+PY
+
+# A running viewer, then a bad edit.
+"$sylva" view "$work/tree.lsys" --size 640x360 >"$work/view.out" 2>"$work/view.err" &
+viewer=$!
+sleep 2
+kill -0 "$viewer"
+printf 'axiom: A(1,10)\nA(l,w) --> F(l*nope)\n' > "$work/tree.lsys"
+for _ in $(seq 100); do grep -q "the grammar has errors" "$work/view.err" && break; sleep 0.1; done
+cat "$work/view.err"
+grep -q "tree.lsys:2:16: error: unknown name 'nope' in expression" "$work/view.err"
+kill -0 "$viewer"   # still running, with the last good plant
+echo "viewer reported the error and kept running"
