@@ -1,5 +1,5 @@
 #version 450 core
-// Key light (warm, from the upper left, behind the camera), fill light
+// Key light (warm, from the upper left, casting shadows), fill light
 // (cool, from the right) and a hemisphere ambient term (sky above, ground
 // below): enough shape to judge a plant. Two-sided: back faces flip their
 // normal. Output in sRGB (gamma 2.2).
@@ -7,15 +7,33 @@ in vec3 vPosition;
 in vec3 vNormal;
 in vec3 vColor;
 uniform vec3 uEye;
+uniform vec3 uKeyDir;             // toward the key light
+uniform mat4 uLightViewProj;
+uniform sampler2DShadow uShadow;  // depth from the key light
+uniform int uShadows;
 out vec4 fragColor;
+
+// 3x3 percentage-closer filtering of the key light's shadow map.
+float KeyVisibility(vec3 n) {
+  if (uShadows == 0) return 1.0;
+  vec4 q = uLightViewProj * vec4(vPosition + n * 0.002, 1.0);
+  vec3 c = q.xyz / q.w * 0.5 + 0.5;
+  if (c.x <= 0.0 || c.x >= 1.0 || c.y <= 0.0 || c.y >= 1.0 || c.z >= 1.0) return 1.0;
+  vec2 texel = 1.0 / vec2(textureSize(uShadow, 0));
+  float sum = 0.0;
+  for (int y = -1; y <= 1; ++y)
+    for (int x = -1; x <= 1; ++x)
+      sum += texture(uShadow, vec3(c.xy + vec2(x, y) * texel, c.z - 0.0015));
+  return sum / 9.0;
+}
 void main() {
   vec3 n = normalize(vNormal);
   vec3 toEye = normalize(uEye - vPosition);
   if (dot(n, toEye) < 0.0) n = -n;
   vec3 albedo = pow(vColor, vec3(2.2));
-  vec3 keyDir = normalize(vec3(-0.5, 0.8, 0.6));
+  vec3 keyDir = normalize(uKeyDir);
   vec3 fillDir = normalize(vec3(0.7, 0.2, -0.4));
-  float key = max(dot(n, keyDir), 0.0);
+  float key = max(dot(n, keyDir), 0.0) * KeyVisibility(n);
   float fill = max(dot(n, fillDir), 0.0);
   float hemi = 0.5 + 0.5 * n.y;
   vec3 ambient = mix(vec3(0.20, 0.17, 0.14), vec3(0.45, 0.50, 0.58), hemi);

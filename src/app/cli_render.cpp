@@ -87,6 +87,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
     (*renderer)->SetLines(batch);
   } else {
+    (*renderer)->SetGround(true);
     (*renderer)->SetMesh(m, palette);
   }
   (*renderer)->Draw(camera);

@@ -224,6 +224,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     ImGui::StyleColorsLight();
     ImGui_ImplGlfw_InitForOpenGL(window, true);
     ImGui_ImplOpenGL3_Init("#version 450 core");
+    (*renderer)->SetGround(true);
 
     Worker worker;
     Job job;

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdlib>
+#include <cmath>
 #include <filesystem>
 
 #include "core/atomic_file.h"
@@ -30,8 +31,18 @@ std::string FindShaderDir() {
 }
 
 struct Renderer::Gl {
-  GLuint meshProgram = 0, lineProgram = 0;
+  GLuint meshProgram = 0, lineProgram = 0, shadowProgram = 0;
   GLint meshViewProj = -1, meshEye = -1, lineViewProj = -1;
+  GLint meshKeyDir = -1, meshLightViewProj = -1, meshShadow = -1, meshShadows = -1;
+  GLint shadowLightViewProj = -1;
+  GLuint shadowFbo = 0, shadowDepth = 0;
+  static constexpr int kShadowSize = 2048;
+  Eigen::Matrix4f lightViewProj = Eigen::Matrix4f::Identity();
+  bool haveShadow = false;
+  // Ground disc: its own small vertex array, drawn with the mesh program.
+  GLuint groundVao = 0, groundBuffers[3] = {0, 0, 0};
+  GLsizei groundCount = 0;
+  Vec3 lo{0, 0, 0}, hi{0, 0, 0};  // mesh bounds
   GLuint meshVao = 0, meshBuffers[3] = {0, 0, 0}, meshIndex = 0;
   GLsizei meshIndexCount = 0;
   GLuint lineVao = 0, lineBuffers[2] = {0, 0};
@@ -100,6 +111,32 @@ Expected<std::unique_ptr<Renderer>> Renderer::Create(const std::string& shaderDi
   g.lineProgram = *line;
   g.meshViewProj = glGetUniformLocation(g.meshProgram, "uViewProj");
   g.meshEye = glGetUniformLocation(g.meshProgram, "uEye");
+  g.meshKeyDir = glGetUniformLocation(g.meshProgram, "uKeyDir");
+  g.meshLightViewProj = glGetUniformLocation(g.meshProgram, "uLightViewProj");
+  g.meshShadow = glGetUniformLocation(g.meshProgram, "uShadow");
+  g.meshShadows = glGetUniformLocation(g.meshProgram, "uShadows");
+  auto shadow = CompileProgram(shaderDir, "shadow");
+  if (!shadow) return shadow.error();
+  g.shadowProgram = *shadow;
+  g.shadowLightViewProj = glGetUniformLocation(g.shadowProgram, "uLightViewProj");
+  glGenTextures(1, &g.shadowDepth);
+  glBindTexture(GL_TEXTURE_2D, g.shadowDepth);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, Gl::kShadowSize, Gl::kShadowSize, 0,
+               GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+  glGenFramebuffers(1, &g.shadowFbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, g.shadowFbo);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, g.shadowDepth, 0);
+  glDrawBuffer(GL_NONE);
+  glReadBuffer(GL_NONE);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glGenVertexArrays(1, &g.groundVao);
+  glGenBuffers(3, g.groundBuffers);
   g.lineViewProj = glGetUniformLocation(g.lineProgram, "uViewProj");
   auto point = CompileProgram(shaderDir, "point");
   if (!point) return point.error();
@@ -121,6 +158,11 @@ Renderer::~Renderer() {
   if (!gl_) return;
   Gl& g = *gl_;
   glDeleteProgram(g.meshProgram);
+  glDeleteProgram(g.shadowProgram);
+  glDeleteFramebuffers(1, &g.shadowFbo);
+  glDeleteTextures(1, &g.shadowDepth);
+  glDeleteBuffers(3, g.groundBuffers);
+  glDeleteVertexArrays(1, &g.groundVao);
   glDeleteProgram(g.lineProgram);
   glDeleteBuffers(3, g.meshBuffers);
   glDeleteBuffers(1, &g.meshIndex);
@@ -208,6 +250,73 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(), GL_STATIC_DRAW);
   g.meshIndexCount = GLsizei(m.indices.size());
   glBindVertexArray(0);
+  g.lo = g.hi = Vec3::Zero();
+  if (m.vertexCount()) {
+    g.lo = g.hi = m.positions[0].cast<double>();
+    for (const auto& p : m.positions) {
+      g.lo = g.lo.cwiseMin(p.cast<double>());
+      g.hi = g.hi.cwiseMax(p.cast<double>());
+    }
+  }
+  // Ground: a disc of 48 sectors under the mesh, 1.1 times its radius.
+  {
+    const Vec3 c((g.lo.x() + g.hi.x()) / 2, g.lo.y(), (g.lo.z() + g.hi.z()) / 2);
+    const double r = std::max(0.55 * (g.hi - g.lo).norm(), 1e-3);
+    std::vector<mesh::Vec3f> pos, nor, col;
+    for (int k = 0; k < 48; ++k) {
+      const double a0 = 6.283185307 * k / 48, a1 = 6.283185307 * (k + 1) / 48;
+      for (const Vec3& p : {c, Vec3(c + r * Vec3(std::cos(a1), 0, std::sin(a1))),
+                            Vec3(c + r * Vec3(std::cos(a0), 0, std::sin(a0)))}) {
+        pos.push_back(p.cast<float>());
+        nor.push_back(mesh::Vec3f(0, 1, 0));
+        col.push_back(mesh::Vec3f(0.86f, 0.84f, 0.80f));
+      }
+    }
+    glBindVertexArray(g.groundVao);
+    const void* data[3] = {pos.data(), nor.data(), col.data()};
+    for (int k = 0; k < 3; ++k) {
+      glBindBuffer(GL_ARRAY_BUFFER, g.groundBuffers[k]);
+      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(pos.size() * 12), data[k], GL_STATIC_DRAW);
+      glEnableVertexAttribArray(GLuint(k));
+      glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
+    }
+    g.groundCount = GLsizei(pos.size());
+    glBindVertexArray(0);
+  }
+  RenderShadowMap();
+}
+
+// The key light is fixed in world space; its orthographic view covers the
+// mesh's bounding sphere, so the map is made once per mesh.
+static const Vec3 kKeyDir = Vec3(-0.5, 0.8, 0.6).normalized();
+
+void Renderer::RenderShadowMap() {
+  Gl& g = *gl_;
+  g.haveShadow = false;
+  if (!g.meshIndexCount) return;
+  Camera light;
+  light.orthographic = true;
+  light.target = (g.lo + g.hi) / 2;
+  const double r = std::max((g.hi - g.lo).norm() / 2, 1e-3) * 1.2;  // ground included
+  light.distance = 3 * r;
+  light.elevation = std::asin(kKeyDir.y()) * kRadToDeg;
+  light.azimuth = std::atan2(kKeyDir.x(), kKeyDir.z()) * kRadToDeg;
+  light.orthoHeight = 2 * r;
+  g.lightViewProj = light.ViewProjection(1.0).cast<float>();
+  glBindFramebuffer(GL_FRAMEBUFFER, g.shadowFbo);
+  glViewport(0, 0, Gl::kShadowSize, Gl::kShadowSize);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(2.0f, 4.0f);
+  glUseProgram(g.shadowProgram);
+  glUniformMatrix4fv(g.shadowLightViewProj, 1, GL_FALSE, g.lightViewProj.data());
+  glBindVertexArray(g.meshVao);
+  glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
+  glBindVertexArray(0);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  g.haveShadow = true;
 }
 
 void Renderer::SetLines(const LineBatch& lines) {
@@ -258,8 +367,19 @@ void Renderer::Draw(const Camera& camera) {
     glUniformMatrix4fv(g.meshViewProj, 1, GL_FALSE, vp.data());
     const Eigen::Vector3f eye = camera.Eye().cast<float>();
     glUniform3fv(g.meshEye, 1, eye.data());
+    const Eigen::Vector3f key = kKeyDir.cast<float>();
+    glUniform3fv(g.meshKeyDir, 1, key.data());
+    glUniformMatrix4fv(g.meshLightViewProj, 1, GL_FALSE, g.lightViewProj.data());
+    glUniform1i(g.meshShadows, shadows_ && g.haveShadow ? 1 : 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, g.shadowDepth);
+    glUniform1i(g.meshShadow, 0);
     glBindVertexArray(g.meshVao);
     glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
+    if (ground_) {
+      glBindVertexArray(g.groundVao);
+      glDrawArrays(GL_TRIANGLES, 0, g.groundCount);
+    }
   }
   if (g.pointCount) {
     glEnable(GL_PROGRAM_POINT_SIZE);

@@ -60,8 +60,12 @@ class Renderer {
   void SetBackground(const mesh::Vec3f& rgb) { background_ = rgb; }
   mesh::Vec3f background() const { return background_; }
 
-  // Replaces the mesh (uploaded once; drawing it again uploads nothing).
+  // Replaces the mesh (uploaded once; drawing it again uploads nothing) and
+  // renders its shadow map from the key light once.
   void SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette);
+  // A ground disc under the mesh that receives its shadow (off by default).
+  void SetGround(bool on) { ground_ = on; }
+  void SetShadows(bool on) { shadows_ = on; }
   void SetLines(const LineBatch& lines);
   void SetPoints(const PointBatch& points);
   // Draws the current mesh, points and lines: no allocation and no upload;
@@ -82,6 +86,8 @@ class Renderer {
   std::unique_ptr<Gl> gl_;
   int width_ = 0, height_ = 0;
   mesh::Vec3f background_{0.94f, 0.95f, 0.96f};
+  bool ground_ = false, shadows_ = true;
+  void RenderShadowMap();
 };
 
 // Reads the current window's back buffer (after everything, UI included,
