@@ -11,7 +11,7 @@ render abop/fig1_06_koch_island koch_island
 render abop/fig1_10a_dragon_curve dragon_curve -n 12
 render abop/fig1_24f_bracketed_plant bracketed_plant_f
 render abop/fig1_31a_hogeweg_hesper hogeweg_hesper_a
-render abop/fig2_06a_monopodial monopodial_a
+"$sylva" render grammars/abop/fig2_06a_monopodial.lsys --size 720x480 -o "$out/monopodial_a.png"
 render abop/fig2_07b_sympodial sympodial_b
 render abop/fig2_08b_ternary ternary_b
 render abop/fig1_25_bush bush --camera 30,25,0

@@ -71,6 +71,11 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
         lo = lo.cwiseMin(p.cast<double>());
         hi = hi.cwiseMax(p.cast<double>());
       }
+      // Frame the ground disc the renderer puts under the plant too.
+      const double r = 0.55 * (hi - lo).norm();
+      const Vec3 c((lo.x() + hi.x()) / 2, lo.y(), (lo.z() + hi.z()) / 2);
+      lo = lo.cwiseMin(c - Vec3(r, 0, r));
+      hi = hi.cwiseMax(c + Vec3(r, 0, r));
     }
   }
   const double aspect = double(width) / height;

@@ -72,10 +72,34 @@ Camera Camera::Frame(const Vec3& lo, const Vec3& hi, double aspect, double azimu
     if (c.orthoHeight <= 0) c.orthoHeight = 1;
     return c;
   }
-  // Perspective: the bounding sphere fits both the vertical and horizontal fov.
+  // Perspective: the smallest distance at which every corner of the box
+  // projects inside the frame (less the margin), found by bisection between
+  // "touching the box" and the distance that fits its bounding sphere.
   const double half = c.fovY * kDegToRad / 2;
   const double halfH = std::atan(std::tan(half) * aspect);
-  c.distance = margin * radius / std::sin(std::min(half, halfH));
+  const double limit = 1 / margin;
+  auto fits = [&](double d) {
+    Camera t = c;
+    t.distance = d;
+    const Mat4 vp = t.ViewProjection(aspect);
+    for (int k = 0; k < 8; ++k) {
+      Vec3 p((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
+      Vec4 q = vp * Vec4(p.x(), p.y(), p.z(), 1);
+      if (q.w() <= 1e-9 || std::abs(q.x() / q.w()) > limit || std::abs(q.y() / q.w()) > limit)
+        return false;
+    }
+    return true;
+  };
+  double far = margin * radius / std::sin(std::min(half, halfH)), near = radius * 1.001;
+  if (!fits(far)) {
+    c.distance = far;
+    return c;
+  }
+  for (int i = 0; i < 40 && near < far; ++i) {
+    const double mid = (near + far) / 2;
+    (fits(mid) ? far : near) = mid;
+  }
+  c.distance = far;
   return c;
 }
 
