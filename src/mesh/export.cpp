@@ -99,34 +99,23 @@ Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string
     out.clear();
     return s;
   };
-  for (const Vec3f& v : m.positions) {
-    out += "v ";
-    Num(out, v.x());
-    out += ' ';
-    Num(out, v.y());
-    out += ' ';
-    Num(out, v.z());
-    out += '\n';
-    if (Status s = flush(false); !s.ok()) return s;
-  }
-  for (const Vec3f& v : m.normals) {
-    out += "vn ";
-    Num(out, v.x());
-    out += ' ';
-    Num(out, v.y());
-    out += ' ';
-    Num(out, v.z());
-    out += '\n';
-    if (Status s = flush(false); !s.ok()) return s;
-  }
-  for (const Vec2f& v : m.uvs) {
-    out += "vt ";
-    Num(out, v.x());
-    out += ' ';
-    Num(out, v.y());
-    out += '\n';
-    if (Status s = flush(false); !s.ok()) return s;
-  }
+  // One "v", "vn" or "vt" line per element of an attribute array.
+  auto attribute = [&](const char* prefix, const float* data, size_t count, int n) -> Status {
+    for (size_t i = 0; i < count; ++i) {
+      out += prefix;
+      for (int k = 0; k < n; ++k) {
+        out += ' ';
+        Num(out, data[i * size_t(n) + size_t(k)]);
+      }
+      out += '\n';
+      if (Status s = flush(false); !s.ok()) return s;
+    }
+    return {};
+  };
+  static_assert(sizeof(Vec3f) == 3 * sizeof(float) && sizeof(Vec2f) == 2 * sizeof(float));
+  if (Status s = attribute("v", m.positions.data()->data(), m.vertexCount(), 3); !s.ok()) return s;
+  if (Status s = attribute("vn", m.normals.data()->data(), m.vertexCount(), 3); !s.ok()) return s;
+  if (Status s = attribute("vt", m.uvs.data()->data(), m.vertexCount(), 2); !s.ok()) return s;
   for (size_t k = 0; k < groups.materials.size(); ++k) {
     out += "usemtl color" + std::to_string(groups.materials[k]) + "\n";
     for (uint32_t o = groups.starts[k]; o < groups.starts[k + 1]; ++o) {
