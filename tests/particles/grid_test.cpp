@@ -1,0 +1,69 @@
+#include "particles/grid.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+namespace sylva::particles {
+namespace {
+
+TEST(NeighbourGrid, EqualsBruteForceOn10kRandomPoints) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-5, 5);
+  std::vector<Vec3> x(10000);
+  for (auto& p : x) p = Vec3(u(rng), u(rng), u(rng) * 0.2);  // dense in z
+  const double r = 0.3;
+  NeighbourGrid grid;
+  grid.Build(x.data(), x.size(), r);
+  size_t total = 0;
+  for (size_t i = 0; i < x.size(); i += 7) {
+    std::vector<size_t> fromGrid, brute;
+    grid.ForEachNeighbour(x.data(), i, r, [&](size_t j) { fromGrid.push_back(j); });
+    for (size_t j = 0; j < x.size(); ++j) {
+      if (j != i && (x[j] - x[i]).squaredNorm() <= r * r) brute.push_back(j);
+    }
+    std::sort(fromGrid.begin(), fromGrid.end());
+    ASSERT_EQ(fromGrid, brute) << "particle " << i << ": grid " << fromGrid.size() << ", brute force " << brute.size();
+    total += brute.size();
+  }
+  EXPECT_GT(total, 1000u) << "the test should see many neighbours";
+}
+
+TEST(InverseSquare, GridForcesEqualAllPairsWithinTheCutoff) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-2, 2);
+  ParticleState s;
+  for (int i = 0; i < 2000; ++i) s.Add(Vec3(u(rng), u(rng), u(rng)), Vec3::Zero(), 0.5 + 0.25 * (u(rng) + 2));
+  for (double strength : {1.0, -2.0}) {
+    InverseSquare force(strength, 0.5, 0.05);
+    std::vector<Vec3> a(s.size(), Vec3::Zero()), b(s.size(), Vec3::Zero());
+    force.Accumulate(s, s.position.data(), s.velocity.data(), a.data());
+    force.AccumulateAllPairs(s, s.position.data(), b.data());
+    double worst = 0, scale = 0;
+    for (size_t i = 0; i < s.size(); ++i) {
+      worst = std::max(worst, (a[i] - b[i]).norm());
+      scale = std::max(scale, b[i].norm());
+    }
+    EXPECT_LT(worst, 1e-5 * std::max(scale, 1.0)) << "strength " << strength << ": worst difference " << worst;
+  }
+}
+
+TEST(InverseSquare, PairForcesConserveMomentum) {
+  System sys;
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 300; ++i) sys.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)) * 0.1, 1 + 0.5 * u(rng));
+  sys.AddForce(std::make_shared<InverseSquare>(-0.01, 0.6, 0.05));
+  auto momentum = [&] {
+    Vec3 p = Vec3::Zero();
+    for (size_t i = 0; i < sys.state.size(); ++i) p += sys.state.mass[i] * sys.state.velocity[i];
+    return p;
+  };
+  const Vec3 p0 = momentum();
+  for (int i = 0; i < 200; ++i) sys.Step(1e-3, Integrator::kRK4);
+  EXPECT_LT((momentum() - p0).norm(), 1e-6) << "momentum drifted by " << (momentum() - p0).norm();
+}
+
+}  // namespace
+}  // namespace sylva::particles
