@@ -1,0 +1,44 @@
+#include "particles/flocking.h"
+
+namespace sylva::particles {
+
+void Flocking::Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const {
+  const size_t n = s.size();
+  grid_.Build(x, n, def_.radius);
+  const double sep2 = def_.separationRadius * def_.separationRadius;
+  for (size_t i = 0; i < n; ++i) {
+    if (s.invMass[i] == 0) continue;
+    Vec3 centre = Vec3::Zero(), velocity = Vec3::Zero(), away = Vec3::Zero();
+    int count = 0;
+    grid_.ForEachNeighbour(x, i, def_.radius, [&](size_t j) {
+      centre += x[j];
+      velocity += v[j];
+      ++count;
+      const Vec3 d = x[i] - x[j];
+      const double d2 = d.squaredNorm();
+      if (d2 < sep2 && d2 > 1e-24) away += d / d2;  // stronger the closer
+    });
+    Vec3 steer = def_.separation * away;
+    if (count) {
+      steer += def_.cohesion * (centre / count - x[i]);
+      steer += def_.alignment * (velocity / count - v[i]);
+    }
+    steer += def_.seek * (def_.target - x[i]);
+    f[i] += s.mass[i] * steer;
+  }
+}
+
+double OrderParameter(const ParticleState& s) {
+  Vec3 sum = Vec3::Zero();
+  size_t n = 0;
+  for (const Vec3& v : s.velocity) {
+    const double len = v.norm();
+    if (len > 0) {
+      sum += v / len;
+      ++n;
+    }
+  }
+  return n ? sum.norm() / double(n) : 0;
+}
+
+}  // namespace sylva::particles

@@ -1,0 +1,35 @@
+// Flocking (Reynolds 1987, "Flocks, herds and schools"; Angel & Shreiner
+// 9.4): each particle steers toward its neighbours' centre (cohesion), away
+// from the ones too close (separation), toward their mean velocity
+// (alignment), and optionally toward a target (seek). Neighbours are those
+// within `radius`, found on the uniform grid.
+#pragma once
+
+#include "particles/grid.h"
+
+namespace sylva::particles {
+
+struct FlockingDef {
+  double radius = 1;               // neighbourhood
+  double cohesion = 1;             // gain toward the neighbours' centre
+  double separation = 1;           // gain away from close neighbours
+  double separationRadius = 0.3;   // "too close"
+  double alignment = 1;            // gain toward the neighbours' mean velocity
+  double seek = 0;                 // gain toward `target`
+  Vec3 target{0, 0, 0};
+};
+
+class Flocking : public Force {
+ public:
+  explicit Flocking(const FlockingDef& def) : def_(def) {}
+  void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
+
+ private:
+  FlockingDef def_;
+  mutable NeighbourGrid grid_;
+};
+
+// Order parameter: |sum of unit velocities| / n, 1 when all move alike.
+double OrderParameter(const ParticleState& s);
+
+}  // namespace sylva::particles
