@@ -1,0 +1,67 @@
+// Cloth: a rectangular grid of particles held by structural, shear and bend
+// distance constraints, solved with XPBD (Macklin, Muller & Chentanez,
+// "XPBD: position-based simulation of compliant constrained dynamics",
+// MIG 2016) in substeps (Macklin et al., "Small steps in physics
+// simulation", SCA 2019).
+//
+// Design notes. Each substep predicts positions from velocities and external
+// accelerations, then projects every constraint `iterations` times with its
+// compliance alpha (inverse stiffness, m/N): the Lagrange multiplier update
+//   dl = (-C - alpha~ l) / (w_i + w_j + alpha~),  alpha~ = alpha / h^2
+// makes the stiffness independent of the iteration count and the step, so a
+// hanging mass settles at the extension m g alpha however many iterations
+// are used. Velocities are (x - x_prev) / h. Pinned particles have inverse
+// mass 0 and never move. Wind acts on each triangle by its area and the
+// normal component of the relative air speed (a drag/lift model).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/math.h"
+
+namespace sylva::particles {
+
+struct ClothDef {
+  int columns = 20, rows = 20;          // particles along u and v (>= 2)
+  Vec3 origin{0, 0, 0};                 // corner (0, 0)
+  Vec3 u{1, 0, 0}, v{0, -1, 0};         // edges of the whole cloth
+  double mass = 1;                      // total, kg
+  double stretchCompliance = 0;         // m/N: 0 = inextensible
+  double shearCompliance = 1e-4;
+  double bendCompliance = 1e-2;
+  int substeps = 10;
+  int iterations = 1;                   // per substep
+  double damping = 0;                   // fraction of velocity removed per second
+  double windDrag = 1.0;                // air force per (m^2 * m/s) of normal speed
+  std::vector<int> pinned;              // particle indices (row * columns + column)
+};
+
+class Cloth {
+ public:
+  explicit Cloth(const ClothDef& def);
+  void Step(double dt, const Vec3& gravity, const Vec3& wind = Vec3::Zero());
+
+  const std::vector<Vec3>& positions() const { return x_; }
+  std::vector<Vec3>& mutablePositions() { return x_; }
+  const std::vector<Vec3>& velocities() const { return v_; }
+  // Two triangles per grid cell, counter-clockwise seen from u x v.
+  const std::vector<std::array<uint32_t, 3>>& triangles() const { return tris_; }
+  struct Constraint {
+    uint32_t a, b;
+    double rest, compliance;
+  };
+  const std::vector<Constraint>& constraints() const { return constraints_; }
+  int Index(int column, int row) const { return row * def_.columns + column; }
+
+ private:
+  ClothDef def_;
+  std::vector<Vec3> x_, v_, prev_;
+  std::vector<double> w_;  // inverse masses
+  std::vector<Constraint> constraints_;
+  std::vector<double> lambda_;
+  std::vector<std::array<uint32_t, 3>> tris_;
+};
+
+}  // namespace sylva::particles

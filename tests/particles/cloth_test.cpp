@@ -1,0 +1,75 @@
+#include "particles/cloth.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace sylva::particles {
+namespace {
+
+// A 2x2 "cloth": the top row pinned, the bottom row hanging on structural
+// constraints only. With compliance alpha, the hanging particles settle at
+// the extension of a spring of stiffness 1/alpha under their weight.
+TEST(Cloth, HangingMassSettlesAtTheExtensionOfItsCompliance) {
+  const double alpha = 1e-3, g = 9.81;
+  for (int iterations : {1, 5, 50}) {
+    ClothDef def;
+    def.columns = 2;
+    def.rows = 2;
+    def.u = Vec3(1, 0, 0);
+    def.v = Vec3(0, -1, 0);
+    def.mass = 4;  // 1 kg a particle
+    def.stretchCompliance = alpha;
+    def.shearCompliance = 1e9;  // effectively absent
+    def.bendCompliance = 1e9;
+    def.windDrag = 0;
+    def.substeps = 20;
+    def.iterations = iterations;
+    def.damping = 2.0;
+    def.pinned = {0, 1};
+    Cloth cloth(def);
+    for (int i = 0; i < 2000; ++i) cloth.Step(1.0 / 60, Vec3(0, -g, 0));
+    // Each hanging particle carries its own weight on its vertical link; the
+    // horizontal link between them is slack-free and carries nothing.
+    const double extension = -cloth.positions()[2].y() - 1.0;
+    const double want = 1.0 * g * alpha;
+    EXPECT_NEAR(extension, want, 0.01 * want)
+        << iterations << " iterations: extension " << extension << ", want m g alpha = " << want;
+  }
+}
+
+TEST(Cloth, UnpinnedClothInFreeFallDoesNotDeform) {
+  ClothDef def;
+  def.columns = 12;
+  def.rows = 9;
+  def.windDrag = 0;
+  Cloth cloth(def);
+  const std::vector<Vec3> start = cloth.positions();
+  const double t = 1.0;
+  for (int i = 0; i < 60; ++i) cloth.Step(t / 60, Vec3(0, -9.81, 0));
+  double worst = 0;
+  for (const auto& c : cloth.constraints())
+    worst = std::max(worst, std::abs((cloth.positions()[c.a] - cloth.positions()[c.b]).norm() - c.rest));
+  EXPECT_LT(worst, 1e-9) << "largest change of a constraint length: " << worst;
+  // And it falls as a rigid body: 1/2 g t^2 (symplectic substeps: within h g t).
+  const double drop = start[0].y() - cloth.positions()[0].y();
+  EXPECT_NEAR(drop, 0.5 * 9.81 * t * t, 9.81 * t * (t / 600) + 1e-9) << "drop " << drop;
+}
+
+TEST(Cloth, PinsDoNotMoveUnderGravityAndWind) {
+  ClothDef def;
+  def.columns = 10;
+  def.rows = 8;
+  def.pinned = {0, 9};
+  Cloth cloth(def);
+  const Vec3 a = cloth.positions()[0], b = cloth.positions()[9];
+  for (int i = 0; i < 120; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 6));
+  EXPECT_EQ(cloth.positions()[0], a);
+  EXPECT_EQ(cloth.positions()[9], b);
+  // The wind pushed the free cloth along +z.
+  EXPECT_GT(cloth.positions()[cloth.Index(5, 7)].z(), 0.05) << cloth.positions()[cloth.Index(5, 7)].transpose();
+  EXPECT_EQ(cloth.triangles().size(), size_t(2 * 9 * 7));
+}
+
+}  // namespace
+}  // namespace sylva::particles
