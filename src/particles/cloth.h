@@ -31,6 +31,9 @@ struct ClothDef {
   double stretchCompliance = 0;         // m/N: 0 = inextensible
   double shearCompliance = 1e-4;
   double bendCompliance = 1e-2;
+  // Substeps x iterations decide how stiff "inextensible" really is: a flag
+  // in a strong wind (examples/particles/particles_flag) stretches 13% at
+  // 10 x 1, 1.3% at 20 x 4 and 0.5% at 40 x 4.
   int substeps = 10;
   int iterations = 1;                   // per substep
   double damping = 0;                   // fraction of velocity removed per second
