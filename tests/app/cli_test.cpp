@@ -120,11 +120,6 @@ TEST(Cli, HelpIsExitZero) {
 namespace sylva::app {
 namespace {
 
-using testing::RunSylva;
-using testing::Scratch;
-using testing::Source;
-using testing::WriteFile;
-
 TEST(CliMesh, WritesTheMeshAndASummary) {
   std::string out = (Scratch() / "tree.ply").string();
   auto r = RunSylva({"mesh", Source("grammars/abop/fig2_06a_monopodial.lsys"), "-n", "3", "--sides", "4", "-o", out});

@@ -16,6 +16,7 @@
 #include "mesh/tessellator.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
+#include "render/render_fixture.h"
 #include "turtle/interpreter.h"
 
 namespace sylva::render {
@@ -23,15 +24,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class Golden : public ::testing::Test {
+class Golden : public testing::RenderFixture {
  protected:
   void SetUp() override {
-    auto c = HeadlessContext::Create();
-    ASSERT_TRUE(c.ok()) << c.error().Format();
-    context_ = std::move(*c);
-    auto r = Renderer::Create(std::string(SYLVA_SOURCE_DIR) + "/shaders");
-    ASSERT_TRUE(r.ok()) << r.error().Format();
-    renderer_ = std::move(*r);
+    RenderFixture::SetUp();
+    if (HasFatalFailure()) return;
     ASSERT_TRUE(renderer_->Resize(kW, kH).ok());
   }
 
@@ -108,8 +105,6 @@ class Golden : public ::testing::Test {
   }
 
   static constexpr int kW = 240, kH = 180;
-  std::unique_ptr<HeadlessContext> context_;
-  std::unique_ptr<Renderer> renderer_;
 };
 
 TEST_F(Golden, MonopodialTreeMesh) {

@@ -16,6 +16,7 @@
 #include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
+#include "render/render_fixture.h"
 #include "turtle/interpreter.h"
 
 namespace sylva::render {
@@ -51,19 +52,7 @@ TEST(Camera, FramedBoxStaysInsideTheImage) {
   }
 }
 
-class Render : public ::testing::Test {
- protected:
-  void SetUp() override {
-    auto c = HeadlessContext::Create();
-    ASSERT_TRUE(c.ok()) << c.error().Format();
-    context_ = std::move(*c);
-    auto r = Renderer::Create(std::string(SYLVA_SOURCE_DIR) + "/shaders");
-    ASSERT_TRUE(r.ok()) << r.error().Format();
-    renderer_ = std::move(*r);
-  }
-  std::unique_ptr<HeadlessContext> context_;
-  std::unique_ptr<Renderer> renderer_;
-};
+class Render : public testing::RenderFixture {};
 
 bool IsBackground(const uint8_t* p, const uint8_t* bg) {
   return std::abs(p[0] - bg[0]) <= 2 && std::abs(p[1] - bg[1]) <= 2 && std::abs(p[2] - bg[2]) <= 2;
