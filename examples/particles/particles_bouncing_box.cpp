@@ -41,7 +41,12 @@ int main(int argc, char** argv) {
   const double h = 1.0 / 240;
   const double e0 = sys.KineticEnergy();
   int escaped = 0;
-  for (int step = 0; step * h < seconds; ++step) sys.Step(h, particles::Integrator::kSymplecticEuler);
+  for (int step = 0; step * h < seconds; ++step) {
+    if (Status st = sys.Step(h, particles::Integrator::kSymplecticEuler); !st.ok()) {
+      std::fputs(st.error().Format().c_str(), stderr);
+      return 1;
+    }
+  }
   double lowest = 1e9;
   for (const Vec3& p : sys.state.position) {
     escaped += p.cwiseAbs().maxCoeff() > 1 + 1e-9;

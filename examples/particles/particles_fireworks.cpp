@@ -73,7 +73,10 @@ int main(int argc, char** argv) {
       launcher.Emit(sys.state, h);
       for (uint32_t id = first; id < sys.state.nextId; ++id) kind[id] = kRocket;
     }
-    sys.Step(h, particles::Integrator::kSymplecticEuler);
+    if (Status st = sys.Step(h, particles::Integrator::kSymplecticEuler); !st.ok()) {
+      std::fputs(st.error().Format().c_str(), stderr);
+      return 1;
+    }
     // Colour over age; rockets and bursting sparks that die burst.
     for (size_t i = 0; i < sys.state.size(); ++i) {
       const uint32_t id = sys.state.id[i];

@@ -6,6 +6,7 @@
 // deriver writes each chunk to a position fixed in advance).
 #pragma once
 
+#include <algorithm>
 #include <condition_variable>
 #include <cstddef>
 #include <functional>
@@ -43,5 +44,17 @@ class ThreadPool {
   int active_ = 0;
   bool stop_ = false;
 };
+
+// Runs fn(begin, end) over [0, n) in ranges of `grain`, on the pool when
+// there is one and more than one range, else on the caller.
+template <typename Fn>
+void ForRanges(ThreadPool* pool, size_t n, size_t grain, Fn&& fn) {
+  const size_t ranges = (n + grain - 1) / grain;
+  if (!pool || ranges <= 1) {
+    if (n) fn(size_t(0), n);
+    return;
+  }
+  pool->ParallelFor(ranges, [&](size_t r) { fn(r * grain, std::min(n, (r + 1) * grain)); });
+}
 
 }  // namespace sylva

@@ -21,6 +21,7 @@ void Emitter::Spawn(ParticleState& s) {
   const double life = std::max(1e-9, def_.lifetime + def_.lifetimeJitter * (2 * r.Uniform() - 1));
   s.Add(p, v, def_.mass, life);
   s.color.back() = def_.colorStart;
+  s.radius.back() = def_.radiusStart;
 }
 
 int Emitter::Emit(ParticleState& s, double h) {
@@ -40,6 +41,18 @@ Vec3f Emitter::ColorAt(double age, double lifetime) const {
   return def_.colorStart * (1 - t) + def_.colorEnd * t;
 }
 
+float Emitter::RadiusAt(double age, double lifetime) const {
+  const float t = float(std::clamp(lifetime > 0 ? age / lifetime : 1.0, 0.0, 1.0));
+  return def_.radiusStart * (1 - t) + def_.radiusEnd * t;
+}
+
+void Emitter::Age(ParticleState& s, size_t begin, size_t end) const {
+  for (size_t i = begin; i < end && i < s.size(); ++i) {
+    s.color[i] = ColorAt(s.age[i], s.lifetime[i]);
+    s.radius[i] = RadiusAt(s.age[i], s.lifetime[i]);
+  }
+}
+
 size_t RemoveDead(ParticleState& s) {
   size_t w = 0;
   const size_t n = s.size();
@@ -53,6 +66,7 @@ size_t RemoveDead(ParticleState& s) {
       s.age[w] = s.age[i];
       s.lifetime[w] = s.lifetime[i];
       s.color[w] = s.color[i];
+      s.radius[w] = s.radius[i];
       s.id[w] = s.id[i];
     }
     ++w;
@@ -64,6 +78,7 @@ size_t RemoveDead(ParticleState& s) {
   s.age.resize(w);
   s.lifetime.resize(w);
   s.color.resize(w);
+  s.radius.resize(w);
   s.id.resize(w);
   return n - w;
 }

@@ -19,6 +19,7 @@ struct EmitterDef {
   double lifetimeJitter = 0;
   double mass = 1;
   Vec3f colorStart{1, 1, 1}, colorEnd{1, 1, 1};  // linear in age / lifetime
+  float radiusStart = 0.05f, radiusEnd = 0.05f;  // drawn size, linear in age / lifetime
   uint64_t seed = 1;
   uint32_t stream = 0;            // tells emitters with one seed apart
 };
@@ -34,6 +35,10 @@ class Emitter {
   void Burst(ParticleState& s, int n);
   // Colour of a particle of this emitter at the given age.
   Vec3f ColorAt(double age, double lifetime) const;
+  float RadiusAt(double age, double lifetime) const;
+  // Sets colour and radius over age for particles [begin, end) (this
+  // emitter's, as the caller knows them).
+  void Age(ParticleState& s, size_t begin, size_t end) const;
   const EmitterDef& def() const { return def_; }
 
  private:

@@ -6,7 +6,8 @@ void Flocking::Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, 
   const size_t n = s.size();
   grid_.Build(x, n, def_.radius);
   const double sep2 = def_.separationRadius * def_.separationRadius;
-  for (size_t i = 0; i < n; ++i) {
+  ForRanges(pool_, n, 1024, [&](size_t b, size_t e) {
+  for (size_t i = b; i < e; ++i) {
     if (s.invMass[i] == 0) continue;
     Vec3 centre = Vec3::Zero(), velocity = Vec3::Zero(), away = Vec3::Zero();
     int count = 0;
@@ -26,6 +27,7 @@ void Flocking::Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, 
     steer += def_.seek * (def_.target - x[i]);
     f[i] += s.mass[i] * steer;
   }
+  });
 }
 
 double OrderParameter(const ParticleState& s) {

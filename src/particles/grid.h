@@ -3,6 +3,13 @@
 // Rebuilt every step by counting sort: cell of each particle, prefix sums,
 // scatter; O(n) and allocation-free after the first build. Cells are hashed
 // into a table of a power-of-two size, so space need not be bounded.
+//
+// The hash is linear, slot = (cx + B cy + C cz) mod 2^k, so the three cells
+// of a row (dx = -1, 0, 1) are three consecutive slots and their particles
+// one contiguous range: a query reads 9 ranges, not 27 cells. Build checks
+// that the 9 rows of a neighbourhood never overlap modulo the table size
+// (it depends only on B, C and the size), picking other constants if they
+// would; so no slot is ever visited twice and no de-duplication is needed.
 #pragma once
 
 #include <cstdint>
@@ -25,6 +32,7 @@ class NeighbourGrid {
   uint32_t Slot(int64_t cx, int64_t cy, int64_t cz) const;
   double cell_ = 1;
   uint32_t mask_ = 0;
+  uint64_t B_ = 0, C_ = 0;
   std::vector<uint32_t> start_, count_, order_, slotOf_;
 };
 
@@ -49,9 +57,7 @@ class InverseSquare : public Force {
 // --- inline ---
 
 inline uint32_t NeighbourGrid::Slot(int64_t cx, int64_t cy, int64_t cz) const {
-  uint64_t h = uint64_t(cx) * 0x9E3779B185EBCA87ULL ^ uint64_t(cy) * 0xC2B2AE3D27D4EB4FULL ^
-               uint64_t(cz) * 0x165667B19E3779F9ULL;
-  return uint32_t((h ^ (h >> 29)) & mask_);
+  return uint32_t((uint64_t(cx) + uint64_t(cy) * B_ + uint64_t(cz) * C_) & mask_);
 }
 
 template <typename Fn>
@@ -59,20 +65,21 @@ void NeighbourGrid::ForEachNeighbour(const Vec3* x, size_t i, double radius, Fn&
   const double r2 = radius * radius;
   const int64_t cx = int64_t(std::floor(x[i].x() / cell_)), cy = int64_t(std::floor(x[i].y() / cell_)),
                 cz = int64_t(std::floor(x[i].z() / cell_));
-  // Hashing can map two of the 27 cells to one slot: visit each slot once.
-  uint32_t seen[27];
-  int nseen = 0;
+  auto visit = [&](uint32_t from, uint32_t to) {
+    for (uint32_t k = from; k < to; ++k) {
+      const uint32_t j = order_[k];
+      if (j != i && (x[j] - x[i]).squaredNorm() <= r2) fn(size_t(j));
+    }
+  };
   for (int64_t dz = -1; dz <= 1; ++dz) {
     for (int64_t dy = -1; dy <= 1; ++dy) {
-      for (int64_t dx = -1; dx <= 1; ++dx) {
-        const uint32_t slot = Slot(cx + dx, cy + dy, cz + dz);
-        bool dup = false;
-        for (int k = 0; k < nseen; ++k) dup |= seen[k] == slot;
-        if (dup) continue;
-        seen[nseen++] = slot;
-        for (uint32_t k = start_[slot]; k < start_[slot + 1]; ++k) {
-          const uint32_t j = order_[k];
-          if (j != i && (x[j] - x[i]).squaredNorm() <= r2) fn(size_t(j));
+      const uint32_t first = Slot(cx - 1, cy + dy, cz + dz);
+      if (first + 2 <= mask_) {  // the row's three slots are contiguous
+        visit(start_[first], start_[first + 3]);
+      } else {
+        for (uint32_t d = 0; d < 3; ++d) {
+          const uint32_t slot = (first + d) & mask_;
+          visit(start_[slot], start_[slot + 1]);
         }
       }
     }

@@ -1,29 +1,73 @@
 #include "particles/system.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstring>
+#include <sstream>
+
+#include "particles/grid.h"
 
 namespace sylva::particles {
+namespace {
+
+// Particles per chunk: the chunk's forces (96 KiB) stay in L2.
+constexpr size_t kChunk = 4096;
+
+Vec3 Friction(const Vec3& vt, double maxChange) {
+  const double len = vt.norm();
+  if (len <= maxChange) return Vec3::Zero();
+  return vt * (1 - maxChange / len);
+}
+
+std::string Format(const Vec3& v) {
+  std::ostringstream o;
+  o.precision(6);
+  o << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return o.str();
+}
+
+}  // namespace
 
 uint32_t ParticleState::Add(const Vec3& p, const Vec3& v, double m, double life) {
   position.push_back(p);
   velocity.push_back(v);
-  mass.push_back(m);
+  mass.push_back(m > 0 ? m : 0);
   invMass.push_back(m > 0 ? 1 / m : 0);
   age.push_back(0);
   lifetime.push_back(life);
   color.push_back(Vec3f(1, 1, 1));
+  radius.push_back(0.05f);
   id.push_back(nextId);
   return nextId++;
 }
 
-void Gravity::Accumulate(const ParticleState& s, const Vec3*, const Vec3*, Vec3* f) const {
-  for (size_t i = 0; i < s.size(); ++i) {
-    if (s.invMass[i] > 0) f[i] += s.mass[i] * g_;
+// --- forces ---
+
+void Gravity::AccumulateRange(const ParticleState& s, const Vec3*, const Vec3*, Vec3* f, size_t begin,
+                              size_t end) const {
+  const double* m = s.mass.data();
+  for (size_t i = begin; i < end; ++i) f[i - begin] += m[i] * g_;
+}
+
+void Drag::AccumulateRange(const ParticleState&, const Vec3*, const Vec3* v, Vec3* f, size_t begin,
+                           size_t end) const {
+  if (k2_ == 0) {
+    for (size_t i = begin; i < end; ++i) f[i - begin] -= k1_ * v[i];
+  } else {
+    for (size_t i = begin; i < end; ++i) f[i - begin] -= (k1_ + k2_ * v[i].norm()) * v[i];
   }
 }
 
-void Drag::Accumulate(const ParticleState& s, const Vec3*, const Vec3* v, Vec3* f) const {
-  for (size_t i = 0; i < s.size(); ++i) f[i] -= (k1_ + k2_ * v[i].norm()) * v[i];
+void Drag::AddJacobianProduct(const ParticleState& s, const Vec3*, const Vec3* v, double, double cv,
+                              const Vec3* p, Vec3* y) const {
+  if (cv == 0) return;
+  for (size_t i = 0; i < s.size(); ++i) {
+    const double speed = v[i].norm();
+    Vec3 j = -(k1_ + k2_ * speed) * p[i];
+    if (k2_ != 0 && speed > 0) j -= k2_ * v[i] * (v[i].dot(p[i]) / speed);
+    y[i] += cv * j;
+  }
 }
 
 void Springs::Accumulate(const ParticleState&, const Vec3* x, const Vec3* v, Vec3* f) const {
@@ -39,11 +83,87 @@ void Springs::Accumulate(const ParticleState&, const Vec3* x, const Vec3* v, Vec
   }
 }
 
-void System::Accelerations(const Vec3* x, const Vec3* v, Vec3* a) const {
+void Springs::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
+                                 const Vec3* p, Vec3* y) const {
+  for (const Spring& sp : springs_) {
+    const Vec3 d = x[sp.a] - x[sp.b];
+    const double len = d.norm();
+    if (!(len > 1e-300)) continue;
+    const Vec3 u = d / len;
+    const Vec3 dp = p[sp.a] - p[sp.b];
+    const double along = u.dot(dp);
+    const double transverse = std::max(0.0, 1 - sp.rest / len);
+    // df_a/dx_a = -ks [u u' + (1 - L/l)(I - u u')], df_a/dv_a = -kd u u'.
+    const Vec3 kdp = sp.ks * (along * u + transverse * (dp - along * u));
+    const Vec3 g = -cx * kdp - cv * sp.kd * along * u;
+    y[sp.a] += g;
+    y[sp.b] -= g;
+  }
+}
+
+// --- system ---
+
+System::System(int threads) { SetThreads(threads); }
+System::~System() = default;
+
+void System::SetThreads(int threads) {
+  threads_ = threads <= 0 ? ThreadPool::HardwareThreads() : threads;
+  pool_ = threads_ > 1 ? std::make_unique<ThreadPool>(threads_) : nullptr;
+  for (auto& f : forces_) f->set_pool(pool_.get());
+}
+
+int System::threads() const { return threads_; }
+
+void System::AddForce(std::shared_ptr<Force> f) {
+  f->set_pool(pool_.get());
+  hasNonLocal_ |= !f->local();
+  forces_.push_back(std::move(f));
+}
+
+void System::EnableParticleCollisions(double radius, double restitution) {
+  pairRadius_ = radius;
+  pairRestitution_ = restitution;
+  if (!pairGrid_) pairGrid_ = std::make_unique<NeighbourGrid>();
+}
+
+template <typename Fn>
+void System::ForChunks(size_t n, Fn&& fn) const {
+  const size_t chunks = (n + kChunk - 1) / kChunk;
+  if (!pool_ || chunks <= 1) {
+    for (size_t b = 0; b < n; b += kChunk) fn(b, std::min(n, b + kChunk));
+    return;
+  }
+  pool_->ParallelFor(chunks, [&](size_t c) { fn(c * kChunk, std::min(n, (c + 1) * kChunk)); });
+}
+
+void System::NonLocalForces(const Vec3* x, const Vec3* v) const {
+  if (!hasNonLocal_) return;
   const size_t n = state.size();
-  f_.assign(n, Vec3::Zero());
-  for (const auto& force : forces_) force->Accumulate(state, x, v, f_.data());
-  for (size_t i = 0; i < n; ++i) a[i] = f_[i] * state.invMass[i];
+  f_.resize(n);
+  ForChunks(n, [&](size_t b, size_t e) { std::fill(f_.begin() + b, f_.begin() + e, Vec3::Zero()); });
+  for (const auto& force : forces_) {
+    if (!force->local()) force->Accumulate(state, x, v, f_.data());
+  }
+}
+
+void System::LocalForcesInto(size_t b, size_t e, const Vec3* x, const Vec3* v, Vec3* fc) const {
+  if (hasNonLocal_) {
+    std::copy(f_.begin() + b, f_.begin() + e, fc);
+  } else {
+    std::fill(fc, fc + (e - b), Vec3::Zero());
+  }
+  for (const auto& force : forces_) {
+    if (force->local()) static_cast<const LocalForce&>(*force).AccumulateRange(state, x, v, fc, b, e);
+  }
+}
+
+void System::Accelerations(const Vec3* x, const Vec3* v, Vec3* a) const {
+  NonLocalForces(x, v);
+  ForChunks(state.size(), [&](size_t b, size_t e) {
+    LocalForcesInto(b, e, x, v, a + b);
+    const double* w = state.invMass.data();
+    for (size_t i = b; i < e; ++i) a[i] *= w[i];
+  });
 }
 
 double System::KineticEnergy() const {
@@ -54,113 +174,442 @@ double System::KineticEnergy() const {
   return e;
 }
 
-void System::Step(double h, Integrator integrator) {
+uint64_t System::Hash() const {
+  uint64_t h = 1469598103934665603ULL;
+  auto mix = [&](const std::vector<Vec3>& a) {
+    for (const Vec3& p : a) {
+      for (int k = 0; k < 3; ++k) {
+        uint64_t bits;
+        std::memcpy(&bits, &p[k], 8);
+        h = (h ^ bits) * 1099511628211ULL;
+        h ^= h >> 29;
+      }
+    }
+  };
+  mix(state.position);
+  mix(state.velocity);
+  return h;
+}
+
+// Contact response for particle i moving from a (velocity va) to x
+// (velocity v) over h seconds; see collider.h. Up to four contacts a step.
+[[gnu::noinline]] void System::Collide(size_t i, Vec3 a, Vec3 va, Vec3& x, Vec3& v, double h) {
+  Vec3 dv = v - va;  // velocity change from the forces over the segment
+  double rem = h;
+  int contacts = 0;
+  for (int iter = 0; iter < 4; ++iter) {
+    Contact best;
+    best.s = 2;
+    const Collider* hit = nullptr;
+    for (const Collider& c : colliders_) {
+      Contact ct;
+      if (c.Intersect(a, x, &ct) && ct.s < best.s) {
+        best = ct;
+        hit = &c;
+      }
+    }
+    if (!hit) break;
+    ++contacts;
+    const Vec3& n = best.normal;
+    const Vec3 vc = va + best.s * dv;  // velocity at contact
+    const double tRest = (1 - best.s) * rem;
+    const Vec3 restDv = (1 - best.s) * dv;
+    if (hit->response == Response::kKill) {
+      x = best.point;
+      v = vc;
+      state.lifetime[i] = std::min(state.lifetime[i], state.age[i]);
+      return;
+    }
+    if (hit->response == Response::kStick) {
+      x = best.point;
+      v = Vec3::Zero();
+      state.invMass[i] = 0;
+      return;
+    }
+    const double vn = vc.dot(n);
+    const double approach = -vn;
+    // Speed gained toward the surface over the rest of the segment: a
+    // slower approach is resting or sliding contact, not a bounce.
+    const double gained = std::max(0.0, -dv.dot(n));
+    Vec3 out;
+    if (approach > gained) {
+      // Bounce: reverse the normal speed times e; Coulomb friction takes at
+      // most mu times the normal impulse from the tangential speed.
+      const double jn = (1 + hit->restitution) * approach;
+      out = Friction(vc - vn * n, hit->friction * jn) + hit->restitution * approach * n;
+      x = best.point + tRest * (out + 0.5 * restDv);
+      v = out + restDv;
+      va = out;
+      dv = restDv;
+    } else {
+      // Resting or sliding: the surface removes the inward normal velocity
+      // the step would end with (its impulse is what gravity pressed in),
+      // and friction removes up to mu times that from the tangential one.
+      const Vec3 end = vc + restDv;
+      const double en = end.dot(n);
+      const double jn = std::max(0.0, -en);
+      out = Friction(end - en * n, hit->friction * jn) + std::max(en, 0.0) * n;
+      x = best.point + tRest * out;
+      v = out;
+      va = out;
+      dv = Vec3::Zero();
+    }
+    a = best.point;
+    rem = tRest;
+  }
+  // Never leave a particle inside a solid.
+  if (contacts == 0) return;
+  for (const Collider& c : colliders_) {
+    Vec3 sp, sn;
+    if (c.Project(x, &sp, &sn)) {
+      x = sp;
+      const double vn = v.dot(sn);
+      if (vn < 0) v -= vn * sn;
+    }
+  }
+}
+
+[[gnu::always_inline]] inline void System::Finish(size_t i, const Vec3& x0, const Vec3& v0, Vec3 x1, Vec3 v1, double h) {
+  if (state.invMass[i] == 0) {  // immovable
+    x1 = x0;
+    v1 = Vec3::Zero();
+  } else {
+    for (const Collider& c : colliders_) {
+      if (c.MayHit(x0, x1)) {
+        Collide(i, x0, v0, x1, v1, h);
+        break;
+      }
+    }
+  }
+  state.age[i] += h;
+  const double m = std::max(x1.cwiseAbs().maxCoeff(), v1.cwiseAbs().maxCoeff());
+  if (!(m <= maxMagnitude)) faulted_.store(true, std::memory_order_relaxed);  // NaN fails too
+  state.position[i] = x1;
+  state.velocity[i] = v1;
+}
+
+Status System::CheckFaults(const char* what) {
+  if (!faulted_.load()) return {};
+  for (size_t i = 0; i < state.size(); ++i) {
+    const Vec3 &x = state.position[i], &v = state.velocity[i];
+    const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
+    if (m <= maxMagnitude) continue;
+    std::ostringstream o;
+    o << "particles: " << what << " step " << state.step << " (from t = " << state.time << " s): particle id " << state.id[i]
+      << " has position " << Format(x) << " and velocity " << Format(v)
+      << (std::isfinite(m) ? " beyond the limit of " : " (not finite)");
+    if (std::isfinite(m)) o << maxMagnitude;
+    o << "; the state exploded: try a smaller step, a stabler integrator or softer forces";
+    Diagnostic d = MakeError({}, o.str());
+    d.kind = ErrorKind::kRuntime;
+    fault_ = d;
+    return d;
+  }
+  faulted_ = false;
+  return {};
+}
+
+Status System::Step(double h, Integrator integrator) {
+  if (fault_) return *fault_;
   const size_t n = state.size();
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
-  before_ = X;
-  vbefore_ = V;
-  for (auto& k : k_) k.resize(n);
-  x_.resize(n);
-  v_.resize(n);
-  Vec3* a = k_[0].data();
+  state.time = time;
+  state.step = steps;
+  faulted_ = false;
   switch (integrator) {
     case Integrator::kExplicitEuler:
-      Accelerations(X.data(), V.data(), a);
-      for (size_t i = 0; i < n; ++i) {
-        X[i] += h * V[i];
-        V[i] += h * a[i];
-      }
+    case Integrator::kSymplecticEuler: {
+      // One fused pass a chunk: forces, integration, collisions.
+      NonLocalForces(X.data(), V.data());
+      const bool symplectic = integrator == Integrator::kSymplecticEuler;
+      ForChunks(n, [&](size_t b, size_t e) {
+        thread_local std::vector<Vec3> fc;
+        fc.resize(kChunk);
+        LocalForcesInto(b, e, X.data(), V.data(), fc.data());
+        const double* w = state.invMass.data();
+        for (size_t i = b; i < e; ++i) {
+          const Vec3 x0 = X[i], v0 = V[i];
+          const Vec3 v1 = v0 + h * (fc[i - b] * w[i]);
+          Finish(i, x0, v0, x0 + h * (symplectic ? v1 : v0), v1, h);
+        }
+      });
       break;
-    case Integrator::kSymplecticEuler:
-      Accelerations(X.data(), V.data(), a);
-      for (size_t i = 0; i < n; ++i) {
-        V[i] += h * a[i];
-        X[i] += h * V[i];
-      }
-      break;
+    }
     case Integrator::kMidpoint: {
-      Accelerations(X.data(), V.data(), a);
-      for (size_t i = 0; i < n; ++i) {
-        x_[i] = X[i] + 0.5 * h * V[i];
-        v_[i] = V[i] + 0.5 * h * a[i];
-      }
-      Vec3* a2 = k_[1].data();
+      for (int k = 0; k < 2; ++k) k_[k].resize(n);
+      x_.resize(n);
+      v_.resize(n);
+      Vec3 *a1 = k_[0].data(), *a2 = k_[1].data();
+      Accelerations(X.data(), V.data(), a1);
+      ForChunks(n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) {
+          x_[i] = X[i] + 0.5 * h * V[i];
+          v_[i] = V[i] + 0.5 * h * a1[i];
+        }
+      });
+      state.time = time + 0.5 * h;
       Accelerations(x_.data(), v_.data(), a2);
-      for (size_t i = 0; i < n; ++i) {
-        X[i] += h * v_[i];
-        V[i] += h * a2[i];
-      }
+      ForChunks(n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) Finish(i, X[i], V[i], X[i] + h * v_[i], V[i] + h * a2[i], h);
+      });
       break;
     }
     case Integrator::kRK4: {
-      // k_x = v, k_v = a(x, v) at four stages.
+      for (int k = 0; k < 7; ++k) k_[k].resize(n);
+      x_.resize(n);
       Vec3 *a1 = k_[0].data(), *a2 = k_[1].data(), *a3 = k_[2].data(), *a4 = k_[3].data();
       Vec3 *v2 = k_[4].data(), *v3 = k_[5].data(), *v4 = k_[6].data();
       Accelerations(X.data(), V.data(), a1);
-      for (size_t i = 0; i < n; ++i) {
-        x_[i] = X[i] + 0.5 * h * V[i];
-        v2[i] = V[i] + 0.5 * h * a1[i];
-      }
+      ForChunks(n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) {
+          x_[i] = X[i] + 0.5 * h * V[i];
+          v2[i] = V[i] + 0.5 * h * a1[i];
+        }
+      });
+      state.time = time + 0.5 * h;
       Accelerations(x_.data(), v2, a2);
-      for (size_t i = 0; i < n; ++i) {
-        x_[i] = X[i] + 0.5 * h * v2[i];
-        v3[i] = V[i] + 0.5 * h * a2[i];
-      }
+      ForChunks(n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) {
+          x_[i] = X[i] + 0.5 * h * v2[i];
+          v3[i] = V[i] + 0.5 * h * a2[i];
+        }
+      });
       Accelerations(x_.data(), v3, a3);
-      for (size_t i = 0; i < n; ++i) {
-        x_[i] = X[i] + h * v3[i];
-        v4[i] = V[i] + h * a3[i];
-      }
+      ForChunks(n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) {
+          x_[i] = X[i] + h * v3[i];
+          v4[i] = V[i] + h * a3[i];
+        }
+      });
+      state.time = time + h;
       Accelerations(x_.data(), v4, a4);
-      for (size_t i = 0; i < n; ++i) {
-        X[i] += h / 6 * (V[i] + 2 * v2[i] + 2 * v3[i] + v4[i]);
-        V[i] += h / 6 * (a1[i] + 2 * a2[i] + 2 * a3[i] + a4[i]);
-      }
+      ForChunks(n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) {
+          Finish(i, X[i], V[i], X[i] + h / 6 * (V[i] + 2 * v2[i] + 2 * v3[i] + v4[i]),
+                 V[i] + h / 6 * (a1[i] + 2 * a2[i] + 2 * a3[i] + a4[i]), h);
+        }
+      });
       break;
     }
+    case Integrator::kImplicitEuler:
+      ImplicitEuler(h);
+      break;
   }
-  for (size_t i = 0; i < n; ++i) {
-    if (state.invMass[i] == 0) {  // immovable
-      X[i] = before_[i];
-      V[i] = Vec3::Zero();
-    }
-  }
-  Collide(before_, vbefore_, h);
-  for (size_t i = 0; i < n; ++i) state.age[i] += h;
+  if (pairRadius_ > 0) ParticleCollisions();
+  state.time = time;
+  Status status = CheckFaults("in");
   time += h;
+  ++steps;
+  return status;
 }
 
-void System::Collide(const std::vector<Vec3>& x0, const std::vector<Vec3>& v0, double h) {
+// Backward Euler linearised once about the current state (Baraff & Witkin
+// 1998, eq. 16):
+//   (M - h df/dv - h^2 df/dx) dv = h (f0 + h df/dx v0),
+// solved matrix-free by conjugate gradients; immovable particles are
+// filtered out of the residual and the search direction.
+void System::ImplicitEuler(double h) {
+  const size_t n = state.size();
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
-  for (const Plane& pl : planes_) {
-    for (size_t i = 0; i < X.size(); ++i) {
-      const double d1 = pl.normal.dot(X[i] - pl.point);
-      if (d1 >= 0) continue;
-      const double d0 = pl.normal.dot(x0[i] - pl.point);
-      // Time of contact by linear interpolation: the fraction s of the step
-      // at which the path meets the plane (0 for a particle already below).
-      const double s = d0 > 0 ? d0 / (d0 - d1) : 0.0;
-      const Vec3 dv = V[i] - v0[i];               // the step's velocity change
-      const Vec3 xc = x0[i] + s * (X[i] - x0[i]);  // on the plane
-      Vec3 vc = v0[i] + s * dv;                     // velocity at contact
-      const double vn = vc.dot(pl.normal);
-      if (vn < 0) vc = (vc - vn * pl.normal) * (1 - pl.friction) - pl.restitution * vn * pl.normal;
-      // The rest of the step from the contact, with the same acceleration.
-      const double rest = (1 - s) * h;
-      const Vec3 restDv = (1 - s) * dv;
-      X[i] = xc + rest * (vc + 0.5 * restDv);
-      V[i] = vc + restDv;
-      // Never leave a particle below the plane (resting contact at the end).
-      const double below = pl.normal.dot(X[i] - pl.point);
-      if (below < 0) {
-        X[i] -= below * pl.normal;
-        const double vn2 = V[i].dot(pl.normal);
-        if (vn2 < 0) V[i] -= vn2 * pl.normal;
+  for (auto& c : cg_) c.resize(n);
+  Vec3 *b = cg_[0].data(), *r = cg_[1].data(), *p = cg_[2].data(), *q = cg_[3].data(), *dv = cg_[4].data();
+  k_[0].resize(n);
+  Vec3* a0 = k_[0].data();
+  Accelerations(X.data(), V.data(), a0);
+  const double* m = state.mass.data();
+  const double* w = state.invMass.data();
+  for (size_t i = 0; i < n; ++i) b[i] = h * m[i] * a0[i];
+  for (const auto& f : forces_) f->AddJacobianProduct(state, X.data(), V.data(), h * h, 0, V.data(), b);
+  auto filter = [&](Vec3* y) {
+    for (size_t i = 0; i < n; ++i) {
+      if (w[i] == 0) y[i] = Vec3::Zero();
+    }
+  };
+  auto dot = [&](const Vec3* u, const Vec3* z) {
+    double s = 0;
+    for (size_t i = 0; i < n; ++i) s += u[i].dot(z[i]);
+    return s;
+  };
+  filter(b);
+  std::fill(dv, dv + n, Vec3::Zero());
+  std::copy(b, b + n, r);
+  for (size_t i = 0; i < n; ++i) p[i] = r[i] * w[i];  // mass preconditioner
+  double rz = 0;
+  for (size_t i = 0; i < n; ++i) rz += r[i].dot(p[i]) ;
+  const double bnorm = std::sqrt(dot(b, b));
+  solve_ = {0, 0};
+  if (bnorm > 0) {
+    double rnorm = bnorm;
+    int it = 0;
+    while (it < cgMaxIterations && rnorm > cgTolerance * bnorm) {
+      for (size_t i = 0; i < n; ++i) q[i] = m[i] * p[i];
+      for (const auto& f : forces_) f->AddJacobianProduct(state, X.data(), V.data(), -h * h, -h, p, q);
+      filter(q);
+      const double pq = dot(p, q);
+      if (!(pq > 0)) break;  // not positive definite along p (or NaN)
+      const double alpha = rz / pq;
+      for (size_t i = 0; i < n; ++i) {
+        dv[i] += alpha * p[i];
+        r[i] -= alpha * q[i];
+      }
+      double rzNew = 0;
+      for (size_t i = 0; i < n; ++i) rzNew += r[i].dot(r[i]) * w[i];
+      const double beta = rzNew / rz;
+      rz = rzNew;
+      for (size_t i = 0; i < n; ++i) p[i] = r[i] * w[i] + beta * p[i];
+      rnorm = std::sqrt(dot(r, r));
+      ++it;
+    }
+    solve_ = {it, rnorm / bnorm};
+  }
+  ForChunks(n, [&](size_t bb, size_t e) {
+    for (size_t i = bb; i < e; ++i) {
+      const Vec3 v1 = V[i] + dv[i];
+      Finish(i, X[i], V[i], X[i] + h * v1, v1, h);
+    }
+  });
+}
+
+void System::ParticleCollisions() {
+  const size_t n = state.size();
+  std::vector<Vec3>& X = state.position;
+  std::vector<Vec3>& V = state.velocity;
+  const double reach = 2 * pairRadius_;
+  pairGrid_->Build(X.data(), n, reach);
+  const double* w = state.invMass.data();
+  // Gauss-Seidel over the pairs in index order: serial, so deterministic.
+  for (size_t i = 0; i < n; ++i) {
+    pairGrid_->ForEachNeighbour(X.data(), i, reach, [&](size_t j) {
+      if (j < i) return;
+      const double ws = w[i] + w[j];
+      if (ws == 0) return;
+      const Vec3 d = X[i] - X[j];
+      const double dist = d.norm();
+      if (!(dist > 0) || dist >= reach) return;
+      const Vec3 nrm = d / dist;
+      const double rel = (V[i] - V[j]).dot(nrm);
+      if (rel < 0) {  // approaching: exchange a momentum-conserving impulse
+        const double J = -(1 + pairRestitution_) * rel / ws;
+        V[i] += J * w[i] * nrm;
+        V[j] -= J * w[j] * nrm;
+      }
+      const double overlap = reach - dist;  // separate, heavier moves less
+      X[i] += overlap * (w[i] / ws) * nrm;
+      X[j] -= overlap * (w[j] / ws) * nrm;
+    });
+  }
+}
+
+// Dormand & Prince (1980) RK5(4)7M.
+Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats* stats) {
+  if (fault_) return *fault_;
+  static constexpr double c[7] = {0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1, 1};
+  static constexpr double A[7][6] = {
+      {},
+      {1.0 / 5},
+      {3.0 / 40, 9.0 / 40},
+      {44.0 / 45, -56.0 / 15, 32.0 / 9},
+      {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
+      {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
+      {35.0 / 384, 0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
+  static constexpr double B5[7] = {35.0 / 384, 0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84, 0};
+  static constexpr double B4[7] = {5179.0 / 57600,    0, 7571.0 / 16695, 393.0 / 640,
+                                   -92097.0 / 339200, 187.0 / 2100,   1.0 / 40};
+  AdaptiveStats local;
+  AdaptiveStats& st = stats ? *stats : local;
+  const size_t n = state.size();
+  std::vector<Vec3>& X = state.position;
+  std::vector<Vec3>& V = state.velocity;
+  for (int k = 0; k < 14; ++k) k_[k].resize(n);
+  x_.resize(n);
+  v_.resize(n);
+  Vec3* KX[7];
+  Vec3* KV[7];
+  for (int k = 0; k < 7; ++k) {
+    KX[k] = k_[k].data();
+    KV[k] = k_[7 + k].data();
+  }
+  const double tEnd = time + dt;
+  double h = adaptiveStep_ > 0 ? std::min(adaptiveStep_, dt) : dt;
+  int calls = 0;
+  while (time < tEnd && tEnd - time > 1e-14 * std::max(1.0, std::abs(tEnd))) {
+    if (++calls > opt.maxSteps) {
+      Diagnostic d = MakeError({}, "particles: adaptive RK45 needed more than " + std::to_string(opt.maxSteps) +
+                                       " steps for " + std::to_string(dt) + " s");
+      d.kind = ErrorKind::kRuntime;
+      return d;
+    }
+    h = std::min(h, tEnd - time);
+    state.step = steps;
+    for (int s = 0; s < 7; ++s) {
+      const Vec3* xs = X.data();
+      const Vec3* vs = V.data();
+      if (s > 0) {
+        ForChunks(n, [&](size_t b, size_t e) {
+          for (size_t i = b; i < e; ++i) {
+            Vec3 dx = Vec3::Zero(), dvv = Vec3::Zero();
+            for (int l = 0; l < s; ++l) {
+              dx += A[s][l] * KX[l][i];
+              dvv += A[s][l] * KV[l][i];
+            }
+            x_[i] = X[i] + h * dx;
+            v_[i] = V[i] + h * dvv;
+          }
+        });
+        xs = x_.data();
+        vs = v_.data();
+      }
+      state.time = time + c[s] * h;
+      std::copy(vs, vs + n, KX[s]);
+      Accelerations(xs, vs, KV[s]);
+    }
+    // x_, v_ hold the 7th stage point, which is the fifth-order solution.
+    double err = 0;
+    for (size_t i = 0; i < n; ++i) {
+      Vec3 ex = Vec3::Zero(), ev = Vec3::Zero();
+      for (int l = 0; l < 7; ++l) {
+        ex += (B5[l] - B4[l]) * KX[l][i];
+        ev += (B5[l] - B4[l]) * KV[l][i];
+      }
+      for (int k = 0; k < 3; ++k) {
+        const double sx = opt.atol + opt.rtol * std::max(std::abs(X[i][k]), std::abs(x_[i][k]));
+        const double sv = opt.atol + opt.rtol * std::max(std::abs(V[i][k]), std::abs(v_[i][k]));
+        err = std::max({err, std::abs(h * ex[k]) / sx, std::abs(h * ev[k]) / sv});
       }
     }
+    if (err <= 1) {
+      faulted_ = false;
+      ForChunks(n, [&](size_t b, size_t e) {
+        for (size_t i = b; i < e; ++i) Finish(i, X[i], V[i], x_[i], v_[i], h);
+      });
+      if (pairRadius_ > 0) ParticleCollisions();
+      state.time = time;
+      Status s = CheckFaults("in adaptive");
+      time += h;
+      ++steps;
+      ++st.accepted;
+      st.maxError = std::max(st.maxError, err);
+      if (!s.ok()) return s;
+    } else {
+      ++st.rejected;
+    }
+    const double factor = err == 0 ? 5 : std::clamp(0.9 * std::pow(err, -0.2), 0.2, 5.0);
+    h *= factor;
+    if (!(h >= opt.minStep)) {
+      std::ostringstream o;
+      o << "particles: adaptive RK45 step fell below " << opt.minStep << " s at t = " << time
+        << " s (error norm " << err << "); the forces are too stiff or not finite";
+      Diagnostic d = MakeError({}, o.str());
+      d.kind = ErrorKind::kRuntime;
+      fault_ = d;
+      return d;
+    }
   }
+  adaptiveStep_ = h;
+  st.lastStep = h;
+  return {};
 }
 
 }  // namespace sylva::particles

@@ -3,22 +3,41 @@
 //
 // State is structure of arrays, hot fields apart from cold ones:
 //   hot   position, velocity            (48 bytes a particle)
-//   cold  mass, inverse mass, age, lifetime, colour, id
-// Each step computes every force first, for all particles (into an array of
-// accelerations), then advances the state with the chosen integrator, then
-// resolves collisions. Forces are evaluated on whatever positions and
-// velocities the integrator asks about (RK stages), never on the stored
-// state directly.
+//   cold  mass, inverse mass, age, lifetime, colour, radius, id
+// Each step computes every force first, for all particles, then advances the
+// state with the chosen integrator, then resolves collisions. Forces are
+// evaluated on whatever positions and velocities the integrator asks about
+// (RK stages), never on the stored state directly.
+//
+// Threads. Forces whose value on particle i depends only on particle i
+// (gravity, drag, wind, fields, anchors: `LocalForce`) are evaluated chunk by
+// chunk, fused with the integration and the collision response into one pass
+// over memory, on every thread of the system's pool. Pair forces (springs,
+// grids, flocking) are evaluated first, for all particles; those that loop
+// over particles gather per particle and may use the pool too. Every result
+// is written by exactly one thread in an order fixed by the particle index,
+// so a run is bit-identical whatever the thread count.
+//
+// Faults. A step that leaves a non-finite value or a coordinate or speed
+// beyond `System::maxMagnitude` returns an error naming the step and the
+// particle id; the system then refuses to step again.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/math.h"
+#include "core/parallel.h"
+#include "core/status.h"
+#include "particles/collider.h"
 
 namespace sylva::particles {
+
+class NeighbourGrid;
 
 struct ParticleState {
   // hot
@@ -26,8 +45,12 @@ struct ParticleState {
   // cold
   std::vector<double> mass, invMass, age, lifetime;
   std::vector<Vec3f> color;
+  std::vector<float> radius;  // drawn size, metres
   std::vector<uint32_t> id;
   uint32_t nextId = 0;
+  // The time and step number forces are evaluated at (set by the system).
+  double time = 0;
+  uint64_t step = 0;
 
   size_t size() const { return position.size(); }
   // Adds a particle; mass 0 or less means immovable (infinite mass).
@@ -40,23 +63,52 @@ class Force {
  public:
   virtual ~Force() = default;
   virtual void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const = 0;
+  // True for a LocalForce (f[i] depends on particle i alone).
+  virtual bool local() const { return false; }
+  // Matrix-free Jacobian product for the implicit solver:
+  //   y += cx (df/dx) p + cv (df/dv) p.
+  // Forces that do not override it are treated explicitly by that solver.
+  virtual void AddJacobianProduct(const ParticleState&, const Vec3* /*x*/, const Vec3* /*v*/, double /*cx*/,
+                                  double /*cv*/, const Vec3* /*p*/, Vec3* /*y*/) const {}
+  // The system hands its thread pool to every force it owns.
+  void set_pool(ThreadPool* pool) { pool_ = pool; }
+
+ protected:
+  ThreadPool* pool_ = nullptr;
+};
+
+// A force on each particle that depends on that particle alone. The system
+// calls AccumulateRange on chunks [begin, end), in parallel; f[k] is the
+// force on particle begin + k, while x and v are indexed by particle.
+class LocalForce : public Force {
+ public:
+  void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const final {
+    AccumulateRange(s, x, v, f, 0, s.size());
+  }
+  bool local() const final { return true; }
+  virtual void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
+                               size_t end) const = 0;
 };
 
 // Constant acceleration g for every movable particle (f = m g).
-class Gravity : public Force {
+class Gravity : public LocalForce {
  public:
   explicit Gravity(const Vec3& g) : g_(g) {}
-  void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
+  void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
+                       size_t end) const override;
 
  private:
   Vec3 g_;
 };
 
 // Drag: f = -k1 v - k2 |v| v (linear and quadratic).
-class Drag : public Force {
+class Drag : public LocalForce {
  public:
   Drag(double linear, double quadratic = 0) : k1_(linear), k2_(quadratic) {}
-  void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
+  void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
+                       size_t end) const override;
+  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
+                          const Vec3* p, Vec3* y) const override;
 
  private:
   double k1_, k2_;
@@ -72,13 +124,17 @@ class Springs : public Force {
   };
   void Add(uint32_t a, uint32_t b, double rest, double ks, double kd) { springs_.push_back({a, b, rest, ks, kd}); }
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
+  // Baraff & Witkin's spring Jacobian, with the transverse term clamped at
+  // zero for compressed springs so the system matrix stays positive definite.
+  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
+                          const Vec3* p, Vec3* y) const override;
   const std::vector<Spring>& springs() const { return springs_; }
 
  private:
   std::vector<Spring> springs_;
 };
 
-// A user force as a callable.
+// A user force as a callable (evaluated for all particles at once).
 class ForceFunction : public Force {
  public:
   using Fn = std::function<void(const ParticleState&, const Vec3*, const Vec3*, Vec3*)>;
@@ -96,41 +152,101 @@ enum class Integrator {
   kSymplecticEuler,  // v += h a(x, v), x += h v_new: first order, bounded energy error
   kMidpoint,         // RK2 (improved Euler): second order, two evaluations
   kRK4,              // classical Runge-Kutta: fourth order, four evaluations
+  kImplicitEuler,    // backward Euler linearised once (Baraff & Witkin 1998), CG solve
 };
 
-// A plane collider: the particle stays on the side the normal points to.
-// Crossings are exact: the time of contact is found by linear interpolation
-// between the step's start and end, the normal velocity is reversed and
-// scaled by the restitution, the tangential one scaled by (1 - friction),
-// and the particle is placed where its reflected path would be.
+// A plane collider in the shape the first examples use; see Collider for the
+// other shapes. `friction` is Coulomb's coefficient mu.
 struct Plane {
   Vec3 point{0, 0, 0};
   Vec3 normal{0, 1, 0};  // unit
   double restitution = 1;
-  double friction = 0;   // 0..1, fraction of tangential speed lost per contact
+  double friction = 0;
+};
+
+// Adaptive Dormand-Prince RK45: error per component against
+// atol + rtol * |value|, over positions and velocities.
+struct AdaptiveOptions {
+  double rtol = 1e-6, atol = 1e-9;
+  double minStep = 1e-12;
+  int maxSteps = 1000000;  // per call
+};
+struct AdaptiveStats {
+  int accepted = 0, rejected = 0;
+  double lastStep = 0;     // the step the controller would try next
+  double maxError = 0;     // largest accepted error norm (<= 1)
+};
+
+// Implicit Euler's conjugate-gradient solve.
+struct SolveStats {
+  int iterations = 0;
+  double residual = 0;     // |r| / |b| at the end
 };
 
 class System {
  public:
+  explicit System(int threads = 1);
+  ~System();
+  System(const System&) = delete;
+  System& operator=(const System&) = delete;
+
   ParticleState state;
   double time = 0;
+  uint64_t steps = 0;
+  double maxMagnitude = 1e12;  // a coordinate or speed beyond this is an explosion
+  // Implicit Euler's CG: stop at this relative residual or iteration count.
+  double cgTolerance = 1e-10;
+  int cgMaxIterations = 200;
 
-  void AddForce(std::shared_ptr<Force> f) { forces_.push_back(std::move(f)); }
-  void AddPlane(const Plane& p) { planes_.push_back(p); }
+  // 0 = every hardware thread.
+  void SetThreads(int threads);
+  int threads() const;
+  void AddForce(std::shared_ptr<Force> f);
+  void AddCollider(Collider c) { colliders_.push_back(std::move(c)); }
+  void AddPlane(const Plane& p) {
+    AddCollider(Collider::Plane(p.point, p.normal).Restitution(p.restitution).Friction(p.friction));
+  }
+  // Particles as spheres of this radius that collide with each other (found
+  // on a grid), with the given restitution; resolved after every step.
+  void EnableParticleCollisions(double radius, double restitution);
 
   // Accelerations for positions x and velocities v (all particles).
   void Accelerations(const Vec3* x, const Vec3* v, Vec3* a) const;
   // One step of length h: forces, integration, collisions, ageing.
-  void Step(double h, Integrator integrator);
+  [[nodiscard]] Status Step(double h, Integrator integrator);
+  // Advances by dt with adaptive Dormand-Prince RK45 substeps.
+  [[nodiscard]] Status StepAdaptive(double dt, const AdaptiveOptions& options, AdaptiveStats* stats = nullptr);
+  const SolveStats& lastSolve() const { return solve_; }
   // Kinetic energy, sum of m |v|^2 / 2 over movable particles.
   double KineticEnergy() const;
+  // Fingerprint of positions and velocities (bit patterns).
+  uint64_t Hash() const;
 
  private:
-  void Collide(const std::vector<Vec3>& x0, const std::vector<Vec3>& v0, double h);
+  template <typename Fn>
+  void ForChunks(size_t n, Fn&& fn) const;
+  void NonLocalForces(const Vec3* x, const Vec3* v) const;
+  void LocalForcesInto(size_t begin, size_t end, const Vec3* x, const Vec3* v, Vec3* fc) const;
+  // Collisions, ageing and the fault check for particle i, then stores it.
+  void Finish(size_t i, const Vec3& x0, const Vec3& v0, Vec3 x1, Vec3 v1, double h);
+  void Collide(size_t i, Vec3 a, Vec3 va, Vec3& x, Vec3& v, double h);
+  void ImplicitEuler(double h);
+  void ParticleCollisions();
+  Status CheckFaults(const char* what);
+
   std::vector<std::shared_ptr<Force>> forces_;
-  std::vector<Plane> planes_;
-  // Scratch for the integrators (sized once per particle count).
-  mutable std::vector<Vec3> f_, k_[8], x_, v_, before_, vbefore_;
+  std::vector<Collider> colliders_;
+  std::unique_ptr<ThreadPool> pool_;
+  int threads_ = 1;
+  bool hasNonLocal_ = false;
+  double pairRadius_ = 0, pairRestitution_ = 1;
+  std::unique_ptr<NeighbourGrid> pairGrid_;
+  std::optional<Diagnostic> fault_;
+  SolveStats solve_;
+  double adaptiveStep_ = 0;
+  // Scratch (sized once per particle count).
+  mutable std::vector<Vec3> f_, k_[14], x_, v_, cg_[5];
+  std::atomic<bool> faulted_{false};  // set by Finish, read by CheckFaults
 };
 
 }  // namespace sylva::particles

@@ -32,7 +32,7 @@ TEST(Emitter, EveryAgeStaysWithinItsLifetime) {
   size_t removed = 0;
   for (int i = 0; i < 240; ++i) {
     e.Emit(sys.state, 1.0 / 120);
-    sys.Step(1.0 / 120, Integrator::kSymplecticEuler);
+    ASSERT_TRUE(sys.Step(1.0 / 120, Integrator::kSymplecticEuler).ok());
     removed += RemoveDead(sys.state);
     for (size_t k = 0; k < sys.state.size(); ++k) {
       ASSERT_LT(sys.state.age[k], sys.state.lifetime[k]) << "particle " << sys.state.id[k];

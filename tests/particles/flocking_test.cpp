@@ -7,19 +7,20 @@
 namespace sylva::particles {
 namespace {
 
-System RandomFlock(int n, double spread, double speed, uint32_t seed) {
-  System s;
+ParticleState RandomFlock(int n, double spread, double speed, uint32_t seed) {
+  ParticleState s;
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
   for (int i = 0; i < n; ++i) {
     Vec3 v(u(rng), u(rng), u(rng));
-    s.state.Add(Vec3(u(rng), u(rng), u(rng)) * spread, v.normalized() * speed, 1);
+    s.Add(Vec3(u(rng), u(rng), u(rng)) * spread, v.normalized() * speed, 1);
   }
   return s;
 }
 
 TEST(Flocking, AlignmentAloneOrdersTheFlock) {
-  System s = RandomFlock(400, 1.0, 1.0, 3);
+  System s;
+  s.state = RandomFlock(400, 1.0, 1.0, 3);
   const double before = OrderParameter(s.state);
   FlockingDef def;
   def.radius = 1.0;
@@ -27,7 +28,7 @@ TEST(Flocking, AlignmentAloneOrdersTheFlock) {
   def.separation = 0;
   def.alignment = 3;
   s.AddForce(std::make_shared<Flocking>(def));
-  for (int i = 0; i < 600; ++i) s.Step(1.0 / 120, Integrator::kSymplecticEuler);
+  for (int i = 0; i < 600; ++i) ASSERT_TRUE(s.Step(1.0 / 120, Integrator::kSymplecticEuler).ok());
   const double after = OrderParameter(s.state);
   EXPECT_LT(before, 0.2) << "random start";
   EXPECT_GT(after, 0.9) << "order parameter " << before << " -> " << after;
@@ -43,7 +44,8 @@ double MinDistance(const ParticleState& s) {
 // Particles packed in a small ball with cohesion pulling them together:
 // with separation they keep their distance, without it they collapse.
 double MinDistanceAfter(bool separation) {
-  System s = RandomFlock(150, 0.6, 0.2, 5);
+  System s;
+  s.state = RandomFlock(150, 0.6, 0.2, 5);
   FlockingDef def;
   def.radius = 2.0;
   def.cohesion = 4;
@@ -54,7 +56,10 @@ double MinDistanceAfter(bool separation) {
   s.AddForce(std::make_shared<Drag>(2.0));
   double worst = 1e300;
   for (int i = 0; i < 600; ++i) {
-    s.Step(1.0 / 240, Integrator::kSymplecticEuler);
+    if (Status st = s.Step(1.0 / 240, Integrator::kSymplecticEuler); !st.ok()) {
+      ADD_FAILURE() << st.error().message;
+      return 0;
+    }
     if (i > 300) worst = std::min(worst, MinDistance(s.state));
   }
   return worst;
@@ -69,14 +74,15 @@ TEST(Flocking, SeparationAloneKeepsTheMinimumDistance) {
 }
 
 TEST(Flocking, SeekGoesToTheTarget) {
-  System s = RandomFlock(50, 0.5, 0.0, 9);
+  System s;
+  s.state = RandomFlock(50, 0.5, 0.0, 9);
   FlockingDef def;
   def.cohesion = def.separation = def.alignment = 0;
   def.seek = 4;
   def.target = Vec3(3, 1, 0);
   s.AddForce(std::make_shared<Flocking>(def));
   s.AddForce(std::make_shared<Drag>(4.0));  // critically damped: no overshoot
-  for (int i = 0; i < 2400; ++i) s.Step(1.0 / 240, Integrator::kSymplecticEuler);
+  for (int i = 0; i < 2400; ++i) ASSERT_TRUE(s.Step(1.0 / 240, Integrator::kSymplecticEuler).ok());
   for (const Vec3& p : s.state.position) EXPECT_LT((p - def.target).norm(), 1e-3) << p.transpose();
 }
 

@@ -1,0 +1,386 @@
+#include "particles/collider.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/assert.h"
+
+namespace sylva::particles {
+namespace {
+
+// Offset of a contact on a thin surface toward the particle's side.
+Vec3 Skin(const Vec3& p, const Vec3& n) { return p + n * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff())); }
+
+// Crossing of the segment a -> b with the plane through p with normal n (not
+// necessarily unit), from either side. Returns the fraction and the signed
+// distances' sign of the side the path came from (+1 or -1).
+bool CrossPlane(const Vec3& a, const Vec3& b, const Vec3& p, const Vec3& n, double* s, double* side) {
+  const double d0 = n.dot(a - p), d1 = n.dot(b - p);
+  if (d0 > 0 && d1 < 0) {
+    *side = 1;
+  } else if (d0 < 0 && d1 > 0) {
+    *side = -1;
+  } else if (d0 == 0 && d1 != 0) {
+    *side = d1 < 0 ? 1 : -1;
+  } else {
+    return false;
+  }
+  *s = d0 / (d0 - d1);
+  return true;
+}
+
+// Both roots of A s^2 + B s + C = 0 in ascending order (false if none).
+bool Roots(double A, double B, double C, double* r0, double* r1) {
+  const double disc = B * B - 4 * A * C;
+  if (!(A > 0) || disc < 0) return false;
+  const double q = -0.5 * (B + std::copysign(std::sqrt(disc), B));
+  double x0 = q / A, x1 = q != 0 ? C / q : 0;
+  if (x0 > x1) std::swap(x0, x1);
+  *r0 = x0;
+  *r1 = x1;
+  return true;
+}
+
+Vec3 UnitOr(const Vec3& d, const Vec3& fallback) {
+  const double len = d.norm();
+  return len > 0 ? Vec3(d / len) : fallback;
+}
+
+bool SegmentBox(const Vec3& a, const Vec3& d, const Vec3& lo, const Vec3& hi, double tmax) {
+  double t0 = 0, t1 = tmax;
+  for (int k = 0; k < 3; ++k) {
+    if (d[k] == 0) {
+      if (a[k] < lo[k] || a[k] > hi[k]) return false;
+      continue;
+    }
+    const double inv = 1 / d[k];
+    double ta = (lo[k] - a[k]) * inv, tb = (hi[k] - a[k]) * inv;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+// --- TriangleBvh ---
+
+TriangleBvh::TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint32_t, 3>> triangles)
+    : v_(std::move(vertices)), tris_(std::move(triangles)) {
+  for (const auto& t : tris_) {
+    for (uint32_t k : t) SYLVA_ASSERT(k < v_.size());
+  }
+  if (!tris_.empty()) Build(0, uint32_t(tris_.size()), 1);
+}
+
+uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
+  depth_ = std::max(depth_, depth);
+  Node node;
+  node.lo = Vec3::Constant(HUGE_VAL);
+  node.hi = Vec3::Constant(-HUGE_VAL);
+  Vec3 clo = node.lo, chi = node.hi;
+  for (uint32_t i = first; i < first + count; ++i) {
+    Vec3 c = Vec3::Zero();
+    for (uint32_t k : tris_[i]) {
+      node.lo = node.lo.cwiseMin(v_[k]);
+      node.hi = node.hi.cwiseMax(v_[k]);
+      c += v_[k];
+    }
+    clo = clo.cwiseMin(c);
+    chi = chi.cwiseMax(c);
+  }
+  const uint32_t index = uint32_t(nodes_.size());
+  nodes_.push_back(node);
+  if (count <= 4) {
+    nodes_[index].first = first;
+    nodes_[index].count = count;
+    return index;
+  }
+  int axis;
+  (chi - clo).maxCoeff(&axis);
+  const uint32_t mid = first + count / 2;
+  auto key = [&](const std::array<uint32_t, 3>& t) { return v_[t[0]][axis] + v_[t[1]][axis] + v_[t[2]][axis]; };
+  std::nth_element(tris_.begin() + first, tris_.begin() + mid, tris_.begin() + first + count,
+                   [&](const auto& x, const auto& y) { return key(x) < key(y); });
+  const uint32_t left = Build(first, mid - first, depth + 1);
+  const uint32_t right = Build(mid, first + count - mid, depth + 1);
+  nodes_[index].first = 0;
+  nodes_[index].count = 0;
+  nodes_[index].left = left;
+  nodes_[index].right = right;
+  return index;
+}
+
+bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
+  if (nodes_.empty()) return false;
+  const Vec3 d = b - a;
+  double best = 2;
+  Vec3 bestNormal = Vec3::Zero();
+  uint32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!SegmentBox(a, d, node.lo, node.hi, std::min(best, 1.0))) continue;
+    if (node.count == 0) {
+      if (top + 2 > 128) continue;  // cannot happen for depth < 64
+      stack[top++] = node.left;
+      stack[top++] = node.right;
+      continue;
+    }
+    for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+      const Vec3 &v0 = v_[tris_[i][0]], &v1 = v_[tris_[i][1]], &v2 = v_[tris_[i][2]];
+      const Vec3 n = (v1 - v0).cross(v2 - v0);
+      const double nn = n.squaredNorm();
+      if (!(nn > 0)) continue;  // degenerate
+      double s, side;
+      if (!CrossPlane(a, b, v0, n, &s, &side) || s >= best) continue;
+      const Vec3 q = a + s * d;
+      const double tol = -1e-12 * nn;
+      if ((v1 - v0).cross(q - v0).dot(n) < tol || (v2 - v1).cross(q - v1).dot(n) < tol ||
+          (v0 - v2).cross(q - v2).dot(n) < tol) {
+        continue;
+      }
+      best = s;
+      bestNormal = side * n / std::sqrt(nn);
+    }
+  }
+  if (best > 1) return false;
+  c->s = best;
+  c->normal = bestNormal;
+  c->point = Skin(a + best * d, bestNormal);
+  return true;
+}
+
+// --- Collider ---
+
+Collider Collider::Plane(const Vec3& point, const Vec3& normal) {
+  Collider c;
+  c.kind = Kind::kPlane;
+  c.point = point;
+  c.normal = normal.normalized();
+  return c;
+}
+
+Collider Collider::Sphere(const Vec3& centre, double radius, bool inside) {
+  Collider c;
+  c.kind = Kind::kSphere;
+  c.point = centre;
+  c.radius = radius;
+  c.inside = inside;
+  return c;
+}
+
+Collider Collider::Box(const Vec3& lo, const Vec3& hi, bool inside) {
+  Collider c;
+  c.kind = Kind::kBox;
+  c.lo = lo.cwiseMin(hi);
+  c.hi = lo.cwiseMax(hi);
+  c.inside = inside;
+  return c;
+}
+
+Collider Collider::Polygon(std::vector<Vec3> vertices) {
+  SYLVA_ASSERT(vertices.size() >= 3);
+  Collider c;
+  c.kind = Kind::kPolygon;
+  Vec3 n = Vec3::Zero();  // Newell's normal
+  for (size_t i = 0; i < vertices.size(); ++i) n += vertices[i].cross(vertices[(i + 1) % vertices.size()]);
+  c.normal = n.normalized();
+  c.point = vertices[0];
+  c.polygon = std::move(vertices);
+  return c;
+}
+
+Collider Collider::Mesh(std::shared_ptr<const TriangleBvh> bvh) {
+  Collider c;
+  c.kind = Kind::kMesh;
+  c.mesh = std::move(bvh);
+  return c;
+}
+
+bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
+  const Vec3 d = b - a;
+  switch (kind) {
+    case Kind::kPlane: {
+      const double d1 = normal.dot(b - point);
+      if (d1 >= 0) return false;
+      const double d0 = normal.dot(a - point);
+      c->normal = normal;
+      if (d0 <= 0) {  // starts on or below the surface
+        c->s = 0;
+        c->point = a - d0 * normal;
+      } else {
+        c->s = d0 / (d0 - d1);
+        c->point = a + c->s * d;
+        c->point -= normal.dot(c->point - point) * normal;  // exactly on the plane
+      }
+      return true;
+    }
+    case Kind::kSphere: {
+      const Vec3 ac = a - point;
+      const double C = ac.squaredNorm() - radius * radius;
+      if (!inside) {
+        if (C < 0) {  // starts inside the ball
+          c->s = 0;
+          c->normal = UnitOr(ac, Vec3(0, 1, 0));
+          c->point = point + radius * c->normal;
+          return true;
+        }
+        double s0, s1;
+        if (!Roots(d.squaredNorm(), 2 * d.dot(ac), C, &s0, &s1) || s0 < 0 || s0 > 1) return false;
+        c->s = s0;
+      } else {
+        if (C > 0) {  // starts outside the bowl
+          c->s = 0;
+          const Vec3 u = UnitOr(ac, Vec3(0, 1, 0));
+          c->point = point + radius * u;
+          c->normal = -u;
+          return true;
+        }
+        if ((b - point).squaredNorm() <= radius * radius) return false;
+        double s0, s1;
+        if (!Roots(d.squaredNorm(), 2 * d.dot(ac), C, &s0, &s1)) return false;
+        c->s = std::clamp(s1, 0.0, 1.0);
+      }
+      const Vec3 u = UnitOr(a + c->s * d - point, Vec3(0, 1, 0));
+      c->point = point + radius * u;
+      c->normal = inside ? Vec3(-u) : u;
+      return true;
+    }
+    case Kind::kBox: {
+      if (!inside) {
+        if ((a.array() > lo.array()).all() && (a.array() < hi.array()).all()) {
+          c->s = 0;
+          return Project(a, &c->point, &c->normal);
+        }
+        double t0 = -HUGE_VAL, t1 = HUGE_VAL;
+        int axis = -1;
+        for (int k = 0; k < 3; ++k) {
+          if (d[k] == 0) {
+            if (a[k] < lo[k] || a[k] > hi[k]) return false;
+            continue;
+          }
+          double ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
+          if (ta > tb) std::swap(ta, tb);
+          if (ta > t0) {
+            t0 = ta;
+            axis = k;
+          }
+          t1 = std::min(t1, tb);
+        }
+        if (axis < 0 || t0 > t1 || t0 < 0 || t0 > 1) return false;
+        if (t0 == t1) return false;  // grazes an edge or a corner
+        c->s = t0;
+        c->point = a + t0 * d;
+        c->normal = Vec3::Zero();
+        c->normal[axis] = d[axis] > 0 ? -1 : 1;
+        c->point[axis] = d[axis] > 0 ? lo[axis] : hi[axis];
+        return true;
+      }
+      if ((a.array() < lo.array()).any() || (a.array() > hi.array()).any()) {
+        c->s = 0;
+        return Project(a, &c->point, &c->normal);
+      }
+      double best = 2;
+      int axis = -1;
+      for (int k = 0; k < 3; ++k) {
+        double s = 2;
+        if (b[k] < lo[k]) s = (a[k] - lo[k]) / (a[k] - b[k]);
+        if (b[k] > hi[k]) s = (hi[k] - a[k]) / (b[k] - a[k]);
+        if (s < best) {
+          best = s;
+          axis = k;
+        }
+      }
+      if (axis < 0) return false;
+      c->s = best;
+      c->point = (a + best * d).cwiseMax(lo).cwiseMin(hi);
+      c->normal = Vec3::Zero();
+      c->normal[axis] = b[axis] < lo[axis] ? 1 : -1;
+      c->point[axis] = b[axis] < lo[axis] ? lo[axis] : hi[axis];
+      return true;
+    }
+    case Kind::kPolygon: {
+      double s, side;
+      if (!CrossPlane(a, b, point, normal, &s, &side)) return false;
+      const Vec3 q = a + s * d;
+      for (size_t i = 0; i < polygon.size(); ++i) {
+        const Vec3& p0 = polygon[i];
+        const Vec3& p1 = polygon[(i + 1) % polygon.size()];
+        if ((p1 - p0).cross(q - p0).dot(normal) < -1e-12 * (p1 - p0).squaredNorm()) return false;
+      }
+      c->s = s;
+      c->normal = side * normal;
+      c->point = Skin(q, c->normal);
+      return true;
+    }
+    case Kind::kMesh:
+      return mesh && mesh->Intersect(a, b, c);
+  }
+  return false;
+}
+
+bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n) const {
+  switch (kind) {
+    case Kind::kPlane: {
+      const double d = normal.dot(x - point);
+      if (d >= 0) return false;
+      *surface = x - d * normal;
+      *n = normal;
+      return true;
+    }
+    case Kind::kSphere: {
+      const Vec3 r = x - point;
+      const double r2 = r.squaredNorm();
+      if (inside ? r2 <= radius * radius : r2 >= radius * radius) return false;
+      const Vec3 u = UnitOr(r, Vec3(0, 1, 0));
+      *surface = point + radius * u;
+      *n = inside ? Vec3(-u) : u;
+      return true;
+    }
+    case Kind::kBox: {
+      if (!inside) {
+        if (!((x.array() > lo.array()).all() && (x.array() < hi.array()).all())) return false;
+        // Out through the nearest face.
+        double best = HUGE_VAL;
+        int axis = 0;
+        double sign = 1;
+        for (int k = 0; k < 3; ++k) {
+          if (x[k] - lo[k] < best) {
+            best = x[k] - lo[k];
+            axis = k;
+            sign = -1;
+          }
+          if (hi[k] - x[k] < best) {
+            best = hi[k] - x[k];
+            axis = k;
+            sign = 1;
+          }
+        }
+        *surface = x;
+        (*surface)[axis] = sign < 0 ? lo[axis] : hi[axis];
+        *n = Vec3::Zero();
+        (*n)[axis] = sign;
+        return true;
+      }
+      const Vec3 clamped = x.cwiseMax(lo).cwiseMin(hi);
+      if (clamped == x) return false;
+      int axis;
+      (clamped - x).cwiseAbs().maxCoeff(&axis);
+      *surface = clamped;
+      *n = Vec3::Zero();
+      (*n)[axis] = x[axis] < lo[axis] ? 1 : -1;
+      return true;
+    }
+    case Kind::kPolygon:
+    case Kind::kMesh:
+      return false;
+  }
+  return false;
+}
+
+}  // namespace sylva::particles

@@ -1,0 +1,131 @@
+// Hard constraints: colliders a particle cannot pass (Angel & Shreiner 9.6;
+// Baraff & Witkin, "Physically Based Modeling", collision and contact).
+//
+// Every collider answers one question: where does the straight path a -> b
+// (a particle's motion over one step) first enter the solid? The answer is
+// exact for that path: a fraction s of the step found in closed form (plane,
+// sphere, box slabs, polygon and triangle crossings), the point on the
+// surface and its outward unit normal. The system then turns the contact
+// into a response (see System::Collide): bounce with restitution and Coulomb
+// friction, resting or sliding contact, stick, or kill.
+//
+// Kinds:
+//   plane    half-space; the particle stays on the side the normal points to
+//   sphere   outside (a ball to bounce off) or inside (a bowl that holds)
+//   box      axis-aligned; outside (an obstacle) or inside (a container)
+//   polygon  convex and planar, two-sided (a thin panel)
+//   mesh     triangles with a bounding-volume hierarchy, two-sided
+//
+// Thin two-sided surfaces (polygon, mesh) leave a contact point a small skin
+// (1e-9 relative) on the particle's side, so rounding can never put it on
+// the far side where the next step would not see a crossing.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/math.h"
+
+namespace sylva::particles {
+
+// What happens to a particle that hits a collider.
+enum class Response {
+  kBounce,  // restitution and Coulomb friction; resting contact when slow
+  kStick,   // stays at the contact point, immovable from then on
+  kKill,    // dies at the contact point (lifetime set to its age)
+};
+
+struct Contact {
+  double s = 0;       // fraction of the path a -> b, in [0, 1]
+  Vec3 point;         // on the surface (plus the skin for thin surfaces)
+  Vec3 normal;        // unit, pointing to the side the particle came from
+};
+
+// Triangles with an axis-aligned bounding-volume hierarchy (median split on
+// the longest axis of the centroids' box, at most 4 triangles a leaf).
+class TriangleBvh {
+ public:
+  TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint32_t, 3>> triangles);
+  // First crossing of the segment a -> b with any triangle, either side.
+  bool Intersect(const Vec3& a, const Vec3& b, Contact* c) const;
+  size_t triangleCount() const { return tris_.size(); }
+  size_t nodeCount() const { return nodes_.size(); }
+  int depth() const { return depth_; }
+
+ private:
+  struct Node {
+    Vec3 lo, hi;
+    uint32_t first = 0, count = 0;  // leaf: triangles [first, first + count); inner: count = 0
+    uint32_t left = 0, right = 0;
+  };
+  uint32_t Build(uint32_t first, uint32_t count, int depth);
+  std::vector<Vec3> v_;
+  std::vector<std::array<uint32_t, 3>> tris_;
+  std::vector<Node> nodes_;
+  int depth_ = 0;
+};
+
+struct Collider {
+  enum class Kind { kPlane, kSphere, kBox, kPolygon, kMesh };
+  Kind kind = Kind::kPlane;
+  // plane / polygon: point and unit normal; sphere: centre = point, radius;
+  // box: lo, hi.
+  Vec3 point{0, 0, 0}, normal{0, 1, 0};
+  double radius = 1;
+  Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+  bool inside = false;                     // sphere and box: keep particles inside
+  std::vector<Vec3> polygon;               // convex, counter-clockwise about normal
+  std::shared_ptr<const TriangleBvh> mesh;
+  // Material.
+  double restitution = 1;                  // e: normal speed out / in
+  double friction = 0;                     // Coulomb mu: tangential impulse <= mu * normal impulse
+  Response response = Response::kBounce;
+
+  static Collider Plane(const Vec3& point, const Vec3& normal);
+  static Collider Sphere(const Vec3& centre, double radius, bool inside = false);
+  static Collider Box(const Vec3& lo, const Vec3& hi, bool inside = false);
+  static Collider Polygon(std::vector<Vec3> convexVertices);  // normal from the winding
+  static Collider Mesh(std::shared_ptr<const TriangleBvh> bvh);
+  Collider& Restitution(double e) { restitution = e; return *this; }
+  Collider& Friction(double mu) { friction = mu; return *this; }
+  Collider& Respond(Response r) { response = r; return *this; }
+
+  // First entry of the path a -> b into the solid. A path that starts inside
+  // (a half-space kind only) reports s = 0 at the nearest surface point.
+  bool Intersect(const Vec3& a, const Vec3& b, Contact* c) const;
+  // A cheap test that is false only when the path a -> b certainly does not
+  // touch the collider (the per-particle fast path).
+  bool MayHit(const Vec3& a, const Vec3& b) const;
+  // Half-space kinds (plane, sphere, box): if x is inside the solid, the
+  // nearest surface point and its outward normal. Thin kinds return false.
+  bool Project(const Vec3& x, Vec3* surface, Vec3* normal) const;
+};
+
+// --- inline ---
+
+inline bool Collider::MayHit(const Vec3& a, const Vec3& b) const {
+  switch (kind) {
+    case Kind::kPlane:
+      return normal.dot(b - point) < 0;
+    case Kind::kSphere:
+      if (inside) return (b - point).squaredNorm() > radius * radius || (a - point).squaredNorm() > radius * radius;
+      return ((a.cwiseMin(b) - point).array() <= radius).all() && ((a.cwiseMax(b) - point).array() >= -radius).all();
+    case Kind::kBox:
+      if (inside) {
+        return (b.array() < lo.array()).any() || (b.array() > hi.array()).any() || (a.array() < lo.array()).any() ||
+               (a.array() > hi.array()).any();
+      }
+      return (a.cwiseMin(b).array() <= hi.array()).all() && (a.cwiseMax(b).array() >= lo.array()).all();
+    case Kind::kPolygon: {
+      const double d0 = normal.dot(a - point), d1 = normal.dot(b - point);
+      return (d0 <= 0 && d1 >= 0) || (d0 >= 0 && d1 <= 0);
+    }
+    case Kind::kMesh:
+      return true;
+  }
+  return true;
+}
+
+}  // namespace sylva::particles

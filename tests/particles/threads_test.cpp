@@ -1,0 +1,103 @@
+// Determinism across thread counts, and faults reported rather than
+// propagated.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "particles/flocking.h"
+#include "particles/grid.h"
+#include "particles/system.h"
+
+namespace sylva::particles {
+namespace {
+
+// 9000 particles (three chunks) in a box with a sphere inside, under local
+// forces, springs, a grid force and particle-particle collisions.
+uint64_t Simulate(int threads, Integrator in, int steps) {
+  System s(threads);
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 9000; ++i) s.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), 1 + 0.1 * u(rng));
+  s.AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
+  s.AddForce(std::make_shared<Drag>(0.1, 0.02));
+  auto springs = std::make_shared<Springs>();
+  for (uint32_t i = 0; i + 1 < 2000; i += 2) springs->Add(i, i + 1, 0.05, 50, 0.5);
+  s.AddForce(springs);
+  s.AddForce(std::make_shared<InverseSquare>(0.001, 0.1, 0.01));
+  FlockingDef flock;
+  flock.radius = 0.1;
+  flock.separationRadius = 0.03;
+  flock.cohesion = 0;  // no clumping: keeps neighbour counts small
+  s.AddForce(std::make_shared<Flocking>(flock));
+  s.AddCollider(Collider::Box(Vec3(-1.2, -1.2, -1.2), Vec3(1.2, 1.2, 1.2), true).Restitution(0.7).Friction(0.3));
+  s.AddCollider(Collider::Sphere(Vec3(0, -0.8, 0), 0.4).Restitution(0.5).Friction(0.2));
+  s.EnableParticleCollisions(0.01, 0.8);
+  for (int i = 0; i < steps; ++i) {
+    if (Status st = s.Step(1.0 / 240, in); !st.ok()) {
+      ADD_FAILURE() << st.error().message;
+      return 0;
+    }
+  }
+  return s.Hash();
+}
+
+TEST(Determinism, OneAndTwoThreadsAreBitIdentical) {
+  for (Integrator in : {Integrator::kSymplecticEuler, Integrator::kRK4, Integrator::kImplicitEuler}) {
+    const uint64_t one = Simulate(1, in, 24), two = Simulate(2, in, 24), three = Simulate(3, in, 24);
+    EXPECT_EQ(one, two) << "integrator " << int(in) << ": 1 thread " << std::hex << one << ", 2 threads " << two;
+    EXPECT_EQ(one, three) << "integrator " << int(in) << ": 1 thread " << std::hex << one << ", 3 threads " << three;
+    EXPECT_NE(one, Simulate(1, in, 25)) << "the hash must see one more step";
+  }
+}
+
+TEST(Faults, NonFiniteForceIsReportedWithStepAndId) {
+  System s;
+  for (int i = 0; i < 10; ++i) s.state.Add(Vec3(i, 0, 0), Vec3::Zero());
+  s.AddForce(std::make_shared<ForceFunction>([](const ParticleState& st, const Vec3*, const Vec3*, Vec3* f) {
+    if (st.step == 3) f[7] = Vec3(std::nan(""), 0, 0);
+  }));
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(s.Step(0.01, Integrator::kSymplecticEuler).ok()) << "step " << i;
+  Status st = s.Step(0.01, Integrator::kSymplecticEuler);
+  ASSERT_FALSE(st.ok()) << "a NaN force must not pass silently";
+  const std::string& m = st.error().message;
+  EXPECT_NE(m.find("step 3"), std::string::npos) << m;
+  EXPECT_NE(m.find("particle id 7"), std::string::npos) << m;
+  EXPECT_NE(m.find("not finite"), std::string::npos) << m;
+  EXPECT_EQ(st.error().kind, ErrorKind::kRuntime);
+  Status again = s.Step(0.01, Integrator::kSymplecticEuler);
+  EXPECT_FALSE(again.ok()) << "a faulted system must refuse to step";
+  EXPECT_EQ(s.steps, 4u) << "no step after the fault";
+}
+
+TEST(Faults, ExplodingStiffSpringIsReported) {
+  // Explicit Euler on a stiff spring gains energy every step until it blows up.
+  System s;
+  s.state.Add(Vec3::Zero(), Vec3::Zero(), 0);
+  s.state.Add(Vec3(1.5, 0, 0), Vec3::Zero(), 1);
+  auto springs = std::make_shared<Springs>();
+  springs->Add(0, 1, 1, 1e4, 0);
+  s.AddForce(springs);
+  Status st;
+  int i = 0;
+  for (; i < 100000 && st.ok(); ++i) st = s.Step(0.05, Integrator::kExplicitEuler);
+  ASSERT_FALSE(st.ok()) << "no explosion reported after " << i << " steps, x = " << s.state.position[1].x();
+  EXPECT_NE(st.error().message.find("particle id 1"), std::string::npos) << st.error().message;
+  EXPECT_NE(st.error().message.find("exploded"), std::string::npos) << st.error().message;
+}
+
+TEST(Faults, ImplicitEulerIsStableWhereExplicitExplodes) {
+  System s;
+  s.state.Add(Vec3::Zero(), Vec3::Zero(), 0);
+  s.state.Add(Vec3(1.5, 0, 0), Vec3::Zero(), 1);
+  auto springs = std::make_shared<Springs>();
+  springs->Add(0, 1, 1, 1e4, 0);
+  s.AddForce(springs);
+  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(s.Step(0.05, Integrator::kImplicitEuler).ok()) << "step " << i;
+  // Backward Euler damps: the spring settles at its rest length.
+  EXPECT_NEAR(s.state.position[1].x(), 1.0, 1e-6) << "x " << s.state.position[1].x();
+  EXPECT_LT(s.lastSolve().residual, 1e-9) << "CG residual " << s.lastSolve().residual;
+}
+
+}  // namespace
+}  // namespace sylva::particles
