@@ -1,5 +1,8 @@
 #include "particles/flocking.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace sylva::particles {
 
 void Flocking::Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const {
@@ -25,6 +28,17 @@ void Flocking::Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, 
       steer += def_.alignment * (velocity / count - v[i]);
     }
     steer += def_.seek * (def_.target - x[i]);
+    for (const auto& [obstacle, radius] : def_.obstacles) {
+      const Vec3 r = x[i] - obstacle;
+      const double len = r.norm();
+      const double dist = len - radius;
+      if (!(len > 0) || dist >= def_.avoidDistance) continue;
+      const Vec3 out = r / len;
+      const double closeness = (def_.avoidDistance - dist) / def_.avoidDistance;  // 0 .. 1 (more inside)
+      steer += def_.avoid * closeness / std::max(dist, 0.01 * def_.avoidDistance) * out;
+      const double vn = v[i].dot(out);
+      if (vn < 0) steer -= def_.avoid * closeness * vn * out;
+    }
     f[i] += s.mass[i] * steer;
   }
   });

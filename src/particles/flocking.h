@@ -1,9 +1,13 @@
 // Flocking (Reynolds 1987, "Flocks, herds and schools"; Angel & Shreiner
 // 9.4): each particle steers toward its neighbours' centre (cohesion), away
 // from the ones too close (separation), toward their mean velocity
-// (alignment), and optionally toward a target (seek). Neighbours are those
+// (alignment), and optionally toward a target (seek) and away from
+// obstacles (avoid). Neighbours are those
 // within `radius`, found on the uniform grid.
 #pragma once
+
+#include <utility>
+#include <vector>
 
 #include "particles/grid.h"
 
@@ -17,6 +21,12 @@ struct FlockingDef {
   double alignment = 1;            // gain toward the neighbours' mean velocity
   double seek = 0;                 // gain toward `target`
   Vec3 target{0, 0, 0};
+  // Avoid: spherical obstacles (centre, radius). Within `avoidDistance` of
+  // an obstacle's surface a boid is pushed out along the normal, harder the
+  // closer it is, and its speed toward the obstacle is damped.
+  double avoid = 0;
+  double avoidDistance = 1;
+  std::vector<std::pair<Vec3, double>> obstacles;
 };
 
 class Flocking : public Force {
