@@ -41,29 +41,76 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
     }
   }
   lambda_.assign(constraints_.size(), 0);
+  if (def_.solver == ClothSolver::kImplicit) {
+    implicit_ = std::make_unique<System>(1);
+    implicit_->cgMaxIterations = std::max(1, def_.cgIterations);
+    implicit_->cgTolerance = 1e-12;
+    for (size_t i = 0; i < n; ++i) implicit_->state.Add(x_[i], Vec3::Zero(), w_[i] > 0 ? 1 / w_[i] : 0);
+    auto springs = std::make_shared<Springs>();
+    for (const Constraint& c : constraints_) {
+      springs->Add(c.a, c.b, c.rest,
+                   c.compliance > 0 ? std::min(1 / c.compliance, def_.implicitStiffness) : def_.implicitStiffness,
+                   def_.implicitDamping);
+    }
+    implicit_->AddForce(springs);
+    // Gravity, wind and damping read the current frame's values.
+    implicit_->AddForce(std::make_shared<ForceFunction>(
+        [this](const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) {
+          for (size_t i = 0; i < s.size(); ++i) f[i] += s.mass[i] * (gravity_ - def_.damping * v[i]);
+          AddWind(x, v, wind_, f);
+        }));
+  }
+}
+
+void Cloth::AddWind(const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f) const {
+  if (def_.windDrag == 0) return;
+  for (const auto& t : tris_) {
+    const Vec3 e1 = x[t[1]] - x[t[0]], e2 = x[t[2]] - x[t[0]];
+    const Vec3 cr = e1.cross(e2);
+    const double area2 = cr.norm();
+    if (!(area2 > 0)) continue;
+    const Vec3 nrm = cr / area2;
+    const Vec3 rel = wind - (v[t[0]] + v[t[1]] + v[t[2]]) / 3;
+    const Vec3 fw = def_.windDrag * 0.5 * area2 * rel.dot(nrm) * nrm / 3;
+    for (uint32_t k : t) f[k] += fw;
+  }
+}
+
+double Cloth::MaxStretch() const {
+  double worst = 0;
+  for (const Constraint& c : constraints_) {
+    if (c.compliance != def_.stretchCompliance) continue;
+    worst = std::max(worst, ((x_[c.a] - x_[c.b]).norm() - c.rest) / c.rest);
+  }
+  return worst;
+}
+
+void Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
+  gravity_ = gravity;
+  wind_ = wind;
+  implicit_->state.position = x_;  // the caller may have moved particles
+  implicit_->state.velocity = v_;
+  const int subs = std::max(def_.implicitSubsteps, 1);
+  for (int s = 0; s < subs; ++s) {
+    // Cloth is well-behaved input; a fault here is a bug in the set-up.
+    if (!implicit_->Step(dt / subs, Integrator::kImplicitEuler).ok()) break;
+  }
+  x_ = implicit_->state.position;
+  v_ = implicit_->state.velocity;
 }
 
 void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
+  if (implicit_) return StepImplicit(dt, gravity, wind);
   const int subs = std::max(def_.substeps, 1);
   const double h = dt / subs;
   const size_t n = x_.size();
-  std::vector<Vec3> fext(n);
+  std::vector<Vec3>& fext = fext_;
+  fext.resize(n);
   for (int s = 0; s < subs; ++s) {
     // External forces: gravity, and wind on each triangle by its area and
     // the normal component of the air speed relative to it.
     std::fill(fext.begin(), fext.end(), Vec3::Zero());
-    if (def_.windDrag != 0) {
-      for (const auto& t : tris_) {
-        const Vec3 e1 = x_[t[1]] - x_[t[0]], e2 = x_[t[2]] - x_[t[0]];
-        const Vec3 cr = e1.cross(e2);
-        const double area2 = cr.norm();
-        if (!(area2 > 0)) continue;
-        const Vec3 nrm = cr / area2;
-        const Vec3 rel = wind - (v_[t[0]] + v_[t[1]] + v_[t[2]]) / 3;
-        const Vec3 f = def_.windDrag * 0.5 * area2 * rel.dot(nrm) * nrm / 3;
-        for (uint32_t k : t) fext[k] += f;
-      }
-    }
+    AddWind(x_.data(), v_.data(), wind, fext.data());
     prev_ = x_;
     const double keep = std::max(0.0, 1 - def_.damping * h);
     for (size_t i = 0; i < n; ++i) {

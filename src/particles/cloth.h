@@ -12,16 +12,27 @@
 // hanging mass settles at the extension m g alpha however many iterations
 // are used. Velocities are (x - x_prev) / h. Pinned particles have inverse
 // mass 0 and never move. Wind acts on each triangle by its area and the
-// normal component of the relative air speed (a drag/lift model).
+// normal component of the relative air speed (a drag/lift model: the force
+// is along the normal, so a cloth at an angle to the wind is both pushed
+// downwind and lifted across it).
+//
+// The implicit solver (ClothDef::solver = kImplicit) turns every constraint
+// into a damped spring of stiffness 1/compliance, at most `implicitStiffness` and takes backward-Euler steps (Baraff & Witkin 1998) with
+// `cgIterations` of matrix-free conjugate gradients: larger steps, softer
+// cloth, more numerical damping.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/math.h"
+#include "particles/system.h"
 
 namespace sylva::particles {
+
+enum class ClothSolver { kXPBD, kImplicit };
 
 struct ClothDef {
   int columns = 20, rows = 20;          // particles along u and v (>= 2)
@@ -39,6 +50,12 @@ struct ClothDef {
   double damping = 0;                   // fraction of velocity removed per second
   double windDrag = 1.0;                // air force per (m^2 * m/s) of normal speed
   std::vector<int> pinned;              // particle indices (row * columns + column)
+  ClothSolver solver = ClothSolver::kXPBD;
+  // Implicit solver only.
+  double implicitStiffness = 2000;      // N/m for constraints of compliance 0
+  double implicitDamping = 0.02;        // N s/m along each spring
+  int implicitSubsteps = 1;             // backward-Euler steps per Step
+  int cgIterations = 20;
 };
 
 class Cloth {
@@ -57,10 +74,18 @@ class Cloth {
   };
   const std::vector<Constraint>& constraints() const { return constraints_; }
   int Index(int column, int row) const { return row * def_.columns + column; }
+  // The implicit solver's last CG solve (zero for XPBD).
+  SolveStats lastSolve() const { return implicit_ ? implicit_->lastSolve() : SolveStats{}; }
+  // Largest relative stretch of a structural constraint, (len - rest) / rest.
+  double MaxStretch() const;
 
  private:
+  void StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
+  void AddWind(const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f) const;
   ClothDef def_;
-  std::vector<Vec3> x_, v_, prev_;
+  std::vector<Vec3> x_, v_, prev_, fext_;
+  std::unique_ptr<System> implicit_;
+  Vec3 gravity_, wind_;
   std::vector<double> w_;  // inverse masses
   std::vector<Constraint> constraints_;
   std::vector<double> lambda_;

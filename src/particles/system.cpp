@@ -101,6 +101,21 @@ void Springs::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3
   }
 }
 
+void Springs::AddJacobianDiagonal(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
+                                  Vec3* diag) const {
+  for (const Spring& sp : springs_) {
+    const Vec3 d = x[sp.a] - x[sp.b];
+    const double len = d.norm();
+    if (!(len > 1e-300)) continue;
+    const Vec3 u2 = (d / len).cwiseAbs2();
+    const double transverse = std::max(0.0, 1 - sp.rest / len);
+    const Vec3 k = sp.ks * (u2 + transverse * (Vec3::Ones() - u2));
+    const Vec3 g = -cx * k - cv * sp.kd * u2;
+    diag[sp.a] += g;
+    diag[sp.b] += g;
+  }
+}
+
 // --- system ---
 
 System::System(int threads) { SetThreads(threads); }
@@ -415,6 +430,7 @@ void System::ImplicitEuler(double h) {
   std::vector<Vec3>& V = state.velocity;
   for (auto& c : cg_) c.resize(n);
   Vec3 *b = cg_[0].data(), *r = cg_[1].data(), *p = cg_[2].data(), *q = cg_[3].data(), *dv = cg_[4].data();
+  Vec3* inv = cg_[5].data();
   k_[0].resize(n);
   Vec3* a0 = k_[0].data();
   Accelerations(X.data(), V.data(), a0);
@@ -433,9 +449,15 @@ void System::ImplicitEuler(double h) {
     return s;
   };
   filter(b);
+  // Jacobi preconditioner: the inverse of the operator's diagonal.
+  for (size_t i = 0; i < n; ++i) inv[i] = Vec3::Constant(m[i]);
+  for (const auto& f : forces_) f->AddJacobianDiagonal(state, X.data(), V.data(), -h * h, -h, inv);
+  for (size_t i = 0; i < n; ++i) {
+    for (int k = 0; k < 3; ++k) inv[i][k] = w[i] > 0 && inv[i][k] > 0 ? 1 / inv[i][k] : 0;
+  }
   std::fill(dv, dv + n, Vec3::Zero());
   std::copy(b, b + n, r);
-  for (size_t i = 0; i < n; ++i) p[i] = r[i] * w[i];  // mass preconditioner
+  for (size_t i = 0; i < n; ++i) p[i] = r[i].cwiseProduct(inv[i]);
   double rz = 0;
   for (size_t i = 0; i < n; ++i) rz += r[i].dot(p[i]) ;
   const double bnorm = std::sqrt(dot(b, b));
@@ -455,10 +477,10 @@ void System::ImplicitEuler(double h) {
         r[i] -= alpha * q[i];
       }
       double rzNew = 0;
-      for (size_t i = 0; i < n; ++i) rzNew += r[i].dot(r[i]) * w[i];
+      for (size_t i = 0; i < n; ++i) rzNew += r[i].dot(r[i].cwiseProduct(inv[i]));
       const double beta = rzNew / rz;
       rz = rzNew;
-      for (size_t i = 0; i < n; ++i) p[i] = r[i] * w[i] + beta * p[i];
+      for (size_t i = 0; i < n; ++i) p[i] = r[i].cwiseProduct(inv[i]) + beta * p[i];
       rnorm = std::sqrt(dot(r, r));
       ++it;
     }

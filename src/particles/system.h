@@ -70,6 +70,9 @@ class Force {
   // Forces that do not override it are treated explicitly by that solver.
   virtual void AddJacobianProduct(const ParticleState&, const Vec3* /*x*/, const Vec3* /*v*/, double /*cx*/,
                                   double /*cv*/, const Vec3* /*p*/, Vec3* /*y*/) const {}
+  // The diagonal of the same operator, per axis (the CG preconditioner).
+  virtual void AddJacobianDiagonal(const ParticleState&, const Vec3* /*x*/, const Vec3* /*v*/, double /*cx*/,
+                                   double /*cv*/, Vec3* /*diag*/) const {}
   // The system hands its thread pool to every force it owns.
   void set_pool(ThreadPool* pool) { pool_ = pool; }
 
@@ -128,6 +131,8 @@ class Springs : public Force {
   // zero for compressed springs so the system matrix stays positive definite.
   void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
                           const Vec3* p, Vec3* y) const override;
+  void AddJacobianDiagonal(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
+                           Vec3* diag) const override;
   const std::vector<Spring>& springs() const { return springs_; }
 
  private:
@@ -245,7 +250,7 @@ class System {
   SolveStats solve_;
   double adaptiveStep_ = 0;
   // Scratch (sized once per particle count).
-  mutable std::vector<Vec3> f_, k_[14], x_, v_, cg_[5];
+  mutable std::vector<Vec3> f_, k_[14], x_, v_, cg_[6];
   std::atomic<bool> faulted_{false};  // set by Finish, read by CheckFaults
 };
 

@@ -71,5 +71,59 @@ TEST(Cloth, PinsDoNotMoveUnderGravityAndWind) {
   EXPECT_EQ(cloth.triangles().size(), size_t(2 * 9 * 7));
 }
 
+TEST(ClothImplicit, HangingMassSettlesAtTheExtensionOfItsCompliance) {
+  // Backward Euler's rest state is the exact static equilibrium f = 0.
+  const double alpha = 1e-3, g = 9.81;
+  ClothDef def;
+  def.columns = 2;
+  def.rows = 2;
+  def.mass = 4;
+  def.stretchCompliance = alpha;
+  def.shearCompliance = 1e9;
+  def.bendCompliance = 1e9;
+  def.windDrag = 0;
+  def.solver = ClothSolver::kImplicit;
+  def.cgIterations = 50;
+  def.pinned = {0, 1};
+  Cloth cloth(def);
+  for (int i = 0; i < 600; ++i) cloth.Step(1.0 / 60, Vec3(0, -g, 0));
+  const double extension = -cloth.positions()[2].y() - 1.0;
+  EXPECT_NEAR(extension, g * alpha, 0.001 * g * alpha) << "extension " << extension;
+}
+
+TEST(ClothImplicit, LargeStepsStayStableWithPinsFixed) {
+  ClothDef def;
+  def.columns = 40;
+  def.rows = 40;
+  def.solver = ClothSolver::kImplicit;
+  def.pinned = {0, 39};
+  Cloth cloth(def);
+  const Vec3 pin0 = cloth.positions()[0], pin1 = cloth.positions()[39];
+  for (int i = 0; i < 120; ++i) {
+    cloth.Step(1.0 / 30, Vec3(0, -9.81, 0), Vec3(0, 0, 1));
+    for (const Vec3& p : cloth.positions()) ASSERT_TRUE(p.allFinite()) << "frame " << i;
+  }
+  EXPECT_EQ(cloth.positions()[0], pin0);
+  EXPECT_EQ(cloth.positions()[39], pin1);
+  EXPECT_LT(cloth.MaxStretch(), 0.2) << "stretch " << cloth.MaxStretch();
+  EXPECT_EQ(cloth.lastSolve().iterations, 20) << "the default CG budget";
+  double lowest = 0;
+  for (const Vec3& p : cloth.positions()) lowest = std::min(lowest, p.y());
+  EXPECT_LT(lowest, -0.95) << "the cloth hangs";
+}
+
+TEST(ClothImplicit, ConjugateGradientsConvergeWhenGivenTheIterations) {
+  ClothDef def;
+  def.columns = 30;
+  def.rows = 30;
+  def.solver = ClothSolver::kImplicit;
+  def.pinned = {0, 29};
+  def.cgIterations = 1000;
+  Cloth cloth(def);
+  cloth.Step(1.0 / 30, Vec3(0, -9.81, 0));  // the first frame has the largest right-hand side
+  EXPECT_LT(cloth.lastSolve().residual, 1e-9) << "after " << cloth.lastSolve().iterations << " iterations";
+  EXPECT_LT(cloth.lastSolve().iterations, 1000);
+}
+
 }  // namespace
 }  // namespace sylva::particles
