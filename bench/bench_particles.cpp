@@ -4,6 +4,10 @@
 
 #include <random>
 
+#include "core/parallel.h"
+#include "particles/cloth.h"
+#include "particles/flocking.h"
+#include "particles/grid.h"
 #include "particles/system.h"
 
 namespace {
@@ -36,6 +40,70 @@ BENCHMARK_CAPTURE(BM_Step, symplectic_euler, particles::Integrator::kSymplecticE
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Step, rk4, particles::Integrator::kRK4)
     ->ArgsProduct({{1000000}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Counting-sort grid over n random points in a cube (density ~8 a cell).
+void BM_GridBuild(benchmark::State& state) {
+  const int n = int(state.range(0));
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Vec3> x(n);
+  for (auto& p : x) p = Vec3(u(rng), u(rng), u(rng));
+  const double cell = std::cbrt(8.0 / n);
+  particles::NeighbourGrid grid;
+  for (auto _ : state) {
+    grid.Build(x.data(), x.size(), cell);
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(int64_t(n) * state.iterations());
+}
+BENCHMARK(BM_GridBuild)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Flocking: n boids, about 20 neighbours each, symplectic Euler steps.
+void BM_Flocking(benchmark::State& state) {
+  const int n = int(state.range(0));
+  particles::System sys(int(state.range(1)));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double side = std::cbrt(n / 20.0);  // ~20 boids per unit cube
+  for (int i = 0; i < n; ++i) sys.state.Add(Vec3(u(rng), u(rng), u(rng)) * side, Vec3(u(rng), u(rng), u(rng)));
+  particles::FlockingDef def;
+  def.radius = 0.6;
+  def.separationRadius = 0.2;
+  sys.AddForce(std::make_shared<particles::Flocking>(def));
+  sys.AddForce(std::make_shared<particles::Drag>(0.1));
+  for (auto _ : state) {
+    if (!sys.Step(1.0 / 60, particles::Integrator::kSymplecticEuler).ok()) state.SkipWithError("step failed");
+  }
+  state.SetItemsProcessed(int64_t(n) * state.iterations());
+}
+BENCHMARK(BM_Flocking)->ArgsProduct({{100000}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Cloth: one 1/60 s frame of a k x k cloth pinned at two corners, in wind.
+void BM_Cloth(benchmark::State& state, particles::ClothSolver solver) {
+  const int k = int(state.range(0));
+  particles::ClothDef def;
+  def.columns = k;
+  def.rows = k;
+  def.solver = solver;
+  def.substeps = 20;
+  def.iterations = 1;
+  def.cgIterations = 20;
+  def.pinned = {0, k - 1};
+  def.threads = int(state.range(1));
+  particles::Cloth cloth(def);
+  for (int i = 0; i < 30; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2));  // settle a little
+  for (auto _ : state) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2));
+  state.counters["stretch"] = cloth.MaxStretch();
+  state.SetItemsProcessed(int64_t(k) * k * state.iterations());
+}
+BENCHMARK_CAPTURE(BM_Cloth, xpbd_20_substeps, particles::ClothSolver::kXPBD)
+    ->ArgsProduct({{100, 256}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Cloth, implicit_20_cg, particles::ClothSolver::kImplicit)
+    ->ArgsProduct({{100}, {1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace sylva::particles {
 
@@ -40,7 +41,55 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
       }
     }
   }
+  // Greedy colouring in creation order, then a stable sort by colour.
+  {
+    std::vector<uint64_t> used(n, 0);
+    std::vector<int> color(constraints_.size());
+    int colors = 0;
+    for (size_t k = 0; k < constraints_.size(); ++k) {
+      const uint64_t taken = used[constraints_[k].a] | used[constraints_[k].b];
+      int c = 0;
+      while (c < 63 && (taken >> c & 1)) ++c;
+      color[k] = c;
+      used[constraints_[k].a] |= 1ULL << c;
+      used[constraints_[k].b] |= 1ULL << c;
+      colors = std::max(colors, c + 1);
+    }
+    std::vector<Constraint> sorted;
+    sorted.reserve(constraints_.size());
+    colorStart_.clear();
+    for (int c = 0; c < colors; ++c) {
+      colorStart_.push_back(sorted.size());
+      for (size_t k = 0; k < constraints_.size(); ++k) {
+        if (color[k] == c) sorted.push_back(constraints_[k]);
+      }
+    }
+    colorStart_.push_back(sorted.size());
+    constraints_ = std::move(sorted);
+  }
   lambda_.assign(constraints_.size(), 0);
+  // Tethers to the nearest pins in rest space.
+  std::vector<uint32_t> pins;
+  for (size_t i = 0; i < n; ++i) {
+    if (w_[i] == 0) pins.push_back(uint32_t(i));
+  }
+  if (def_.longRangeAttachments && !pins.empty()) {
+    tethers_.assign(n * kTethers, Tether{UINT32_MAX, 0});
+    for (size_t i = 0; i < n; ++i) {
+      if (w_[i] == 0) continue;
+      Tether* t = &tethers_[i * kTethers];
+      for (uint32_t p : pins) {
+        Tether cand{p, (x_[i] - x_[p]).norm()};
+        for (int k = 0; k < kTethers; ++k) {
+          if (t[k].pin == UINT32_MAX || cand.rest < t[k].rest) std::swap(cand, t[k]);
+        }
+      }
+    }
+  }
+  if (def_.threads != 1) {
+    const int threads = def_.threads <= 0 ? ThreadPool::HardwareThreads() : def_.threads;
+    if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
+  }
   if (def_.solver == ClothSolver::kImplicit) {
     implicit_ = std::make_unique<System>(1);
     implicit_->cgMaxIterations = std::max(1, def_.cgIterations);
@@ -104,38 +153,81 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
   const int subs = std::max(def_.substeps, 1);
   const double h = dt / subs;
   const size_t n = x_.size();
-  std::vector<Vec3>& fext = fext_;
-  fext.resize(n);
+  ThreadPool* pool = pool_.get();
+  // Wind once a frame (it changes slowly next to the substeps).
+  fext_.assign(n, Vec3::Zero());
+  AddWind(x_.data(), v_.data(), wind, fext_.data());
+  prev_.resize(n);
+  const size_t m = constraints_.size();
+  scale_.resize(m);
+  alphaT_.resize(m);
+  for (size_t k = 0; k < m; ++k) {
+    const Constraint& c = constraints_[k];
+    alphaT_[k] = c.compliance / (h * h);
+    const double denom = w_[c.a] + w_[c.b] + alphaT_[k];
+    scale_[k] = denom > 0 ? 1 / denom : 0;  // 0: both ends pinned, nothing moves
+  }
+  const double keep = std::max(0.0, 1 - def_.damping * h);
   for (int s = 0; s < subs; ++s) {
-    // External forces: gravity, and wind on each triangle by its area and
-    // the normal component of the air speed relative to it.
-    std::fill(fext.begin(), fext.end(), Vec3::Zero());
-    AddWind(x_.data(), v_.data(), wind, fext.data());
-    prev_ = x_;
-    const double keep = std::max(0.0, 1 - def_.damping * h);
-    for (size_t i = 0; i < n; ++i) {
-      if (w_[i] == 0) continue;
-      v_[i] = (v_[i] + h * (gravity + fext[i] * w_[i])) * keep;
-      x_[i] += h * v_[i];
-    }
+    ForRanges(pool, n, 4096, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        prev_[i] = x_[i];
+        if (w_[i] == 0) continue;
+        v_[i] = (v_[i] + h * (gravity + fext_[i] * w_[i])) * keep;
+        x_[i] += h * v_[i];
+      }
+    });
     std::fill(lambda_.begin(), lambda_.end(), 0.0);
     for (int it = 0; it < def_.iterations; ++it) {
-      for (size_t k = 0; k < constraints_.size(); ++k) {
-        const Constraint& c = constraints_[k];
-        const double wsum = w_[c.a] + w_[c.b];
-        if (wsum == 0) continue;
-        const Vec3 d = x_[c.a] - x_[c.b];
-        const double len = d.norm();
-        if (!(len > 1e-12)) continue;
-        const Vec3 dir = d / len;
-        const double alpha = c.compliance / (h * h);
-        const double dl = (-(len - c.rest) - alpha * lambda_[k]) / (wsum + alpha);
-        lambda_[k] += dl;
-        x_[c.a] += w_[c.a] * dl * dir;
-        x_[c.b] -= w_[c.b] * dl * dir;
+      // Colour by colour: no two constraints of a colour share a particle,
+      // so a colour's projections are independent (and run in parallel)
+      // and the result does not depend on the thread count.
+      for (size_t c = 0; c + 1 < colorStart_.size(); ++c) {
+        const size_t first = colorStart_[c], count = colorStart_[c + 1] - first;
+        ForRanges(pool, count, 2048, [&](size_t b, size_t e) { ProjectRange(first + b, first + e); });
       }
     }
-    for (size_t i = 0; i < n; ++i) v_[i] = (x_[i] - prev_[i]) / h;
+    // Long-range attachments (Kim, Chentanez & Muller 2012): no particle may
+    // be farther from a pin than its rest distance, which keeps a hanging
+    // cloth from stretching at few iterations. Then velocities.
+    const bool tethered = !tethers_.empty();
+    ForRanges(pool, n, 4096, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        if (tethered && w_[i] != 0) {
+          for (int t = 0; t < kTethers; ++t) {
+            const Tether& th = tethers_[i * kTethers + t];
+            if (th.pin == UINT32_MAX) continue;
+            const Vec3 d = x_[i] - x_[th.pin];
+            const double len2 = d.squaredNorm();
+            if (len2 > th.rest * th.rest) x_[i] = x_[th.pin] + d * (th.rest / std::sqrt(len2));
+          }
+        }
+        v_[i] = (x_[i] - prev_[i]) / h;
+      }
+    });
+  }
+}
+
+// Projects constraints [first, last) of one colour. scale_[k] = 1 / (w_a +
+// w_b + alpha~_k) and alphaT_[k] = alpha~_k are set once a frame.
+void Cloth::ProjectRange(size_t first, size_t last) {
+  const Constraint* __restrict cs = constraints_.data();
+  const double* __restrict w = w_.data();
+  const double* __restrict scale = scale_.data();
+  const double* __restrict alphaT = alphaT_.data();
+  double* __restrict lambda = lambda_.data();
+  Vec3* __restrict x = x_.data();
+  for (size_t k = first; k < last; ++k) {
+    const Constraint& c = cs[k];
+    const Vec3 d = x[c.a] - x[c.b];
+    const double len2 = d.squaredNorm();
+    if (!(len2 > 1e-24)) continue;
+    const double len = std::sqrt(len2);
+    const double dl = (c.rest - len - alphaT[k] * lambda[k]) * scale[k];
+    lambda[k] += dl;
+    const Vec3 corr = (dl / len) * d;
+    x[c.a] += w[c.a] * corr;
+    x[c.b] -= w[c.b] * corr;
   }
 }
 

@@ -5,7 +5,10 @@
 // simulation", SCA 2019).
 //
 // Design notes. Each substep predicts positions from velocities and external
-// accelerations, then projects every constraint `iterations` times with its
+// accelerations (wind is evaluated once a frame), then projects every
+// constraint `iterations` times, colour by colour (a greedy colouring makes
+// the constraints of one colour independent, so they run in parallel and
+// the result is the same for any thread count), with its
 // compliance alpha (inverse stiffness, m/N): the Lagrange multiplier update
 //   dl = (-C - alpha~ l) / (w_i + w_j + alpha~),  alpha~ = alpha / h^2
 // makes the stiffness independent of the iteration count and the step, so a
@@ -28,6 +31,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "core/parallel.h"
 #include "particles/system.h"
 
 namespace sylva::particles {
@@ -50,6 +54,10 @@ struct ClothDef {
   double damping = 0;                   // fraction of velocity removed per second
   double windDrag = 1.0;                // air force per (m^2 * m/s) of normal speed
   std::vector<int> pinned;              // particle indices (row * columns + column)
+  // Long-range attachments: tethers from every particle to its two nearest
+  // pins, at their rest distance (XPBD only).
+  bool longRangeAttachments = true;
+  int threads = 1;                      // 0 = every hardware thread
   ClothSolver solver = ClothSolver::kXPBD;
   // Implicit solver only.
   double implicitStiffness = 2000;      // N/m for constraints of compliance 0
@@ -81,6 +89,15 @@ class Cloth {
 
  private:
   void StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
+  void ProjectRange(size_t first, size_t last);
+  struct Tether {
+    uint32_t pin;
+    double rest;
+  };
+  static constexpr int kTethers = 2;
+  std::vector<Tether> tethers_;         // kTethers a particle
+  std::vector<size_t> colorStart_;      // constraints_ sorted by colour
+  std::unique_ptr<ThreadPool> pool_;
   void AddWind(const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f) const;
   ClothDef def_;
   std::vector<Vec3> x_, v_, prev_, fext_;
@@ -88,7 +105,7 @@ class Cloth {
   Vec3 gravity_, wind_;
   std::vector<double> w_;  // inverse masses
   std::vector<Constraint> constraints_;
-  std::vector<double> lambda_;
+  std::vector<double> lambda_, scale_, alphaT_;
   std::vector<std::array<uint32_t, 3>> tris_;
 };
 

@@ -26,6 +26,7 @@ TEST(Cloth, HangingMassSettlesAtTheExtensionOfItsCompliance) {
     def.substeps = 20;
     def.iterations = iterations;
     def.damping = 2.0;
+    def.longRangeAttachments = false;  // tethers would cap the extension at rest
     def.pinned = {0, 1};
     Cloth cloth(def);
     for (int i = 0; i < 2000; ++i) cloth.Step(1.0 / 60, Vec3(0, -g, 0));
@@ -123,6 +124,41 @@ TEST(ClothImplicit, ConjugateGradientsConvergeWhenGivenTheIterations) {
   cloth.Step(1.0 / 30, Vec3(0, -9.81, 0));  // the first frame has the largest right-hand side
   EXPECT_LT(cloth.lastSolve().residual, 1e-9) << "after " << cloth.lastSolve().iterations << " iterations";
   EXPECT_LT(cloth.lastSolve().iterations, 1000);
+}
+
+TEST(Cloth, OneAndTwoThreadsAreBitIdentical) {
+  auto run = [](int threads) {
+    ClothDef def;
+    def.columns = 64;
+    def.rows = 64;
+    def.substeps = 8;
+    def.threads = threads;
+    def.pinned = {0, 63};
+    Cloth cloth(def);
+    for (int i = 0; i < 20; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(1, 0, 3));
+    return cloth.positions();
+  };
+  const auto one = run(1), two = run(2);
+  size_t differ = 0;
+  for (size_t i = 0; i < one.size(); ++i) differ += one[i] != two[i];
+  EXPECT_EQ(differ, 0u) << "particles that differ between 1 and 2 threads";
+}
+
+TEST(Cloth, TethersKeepAHangingClothFromStretching) {
+  double stretch[2];
+  for (bool tethers : {false, true}) {
+    ClothDef def;
+    def.columns = 60;
+    def.rows = 60;
+    def.substeps = 10;
+    def.longRangeAttachments = tethers;
+    def.pinned = {0, 59};
+    Cloth cloth(def);
+    for (int i = 0; i < 60; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0));
+    stretch[tethers] = cloth.MaxStretch();
+  }
+  EXPECT_LT(stretch[1], 0.05) << "with tethers";
+  EXPECT_GT(stretch[0], 4 * stretch[1]) << "without tethers " << stretch[0] << ", with " << stretch[1];
 }
 
 }  // namespace
