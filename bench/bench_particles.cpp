@@ -52,13 +52,15 @@ void BM_GridBuild(benchmark::State& state) {
   for (auto& p : x) p = Vec3(u(rng), u(rng), u(rng));
   const double cell = std::cbrt(8.0 / n);
   particles::NeighbourGrid grid;
+  std::unique_ptr<ThreadPool> pool;
+  if (state.range(1) > 1) pool = std::make_unique<ThreadPool>(int(state.range(1)));
   for (auto _ : state) {
-    grid.Build(x.data(), x.size(), cell);
+    grid.Build(x.data(), x.size(), cell, pool.get());
     benchmark::ClobberMemory();
   }
   state.SetItemsProcessed(int64_t(n) * state.iterations());
 }
-BENCHMARK(BM_GridBuild)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_GridBuild)->ArgsProduct({{1000000}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Flocking: n boids, about 20 neighbours each, symplectic Euler steps.
 void BM_Flocking(benchmark::State& state) {

@@ -19,3 +19,4 @@ render plants/leafy_stem leafy_stem --camera 20,20,0
 build/examples/particles_bouncing_box 2000 3 "$out/particles_bouncing_box.png"
 build/examples/particles_fireworks 2.6 "$out/particles_fireworks.png"
 build/examples/particles_flag 3 "$out/particles_flag.png"
+build/examples/particles_flock 3000 8 "$out/particles_flock.png"

@@ -7,7 +7,7 @@ namespace sylva::particles {
 
 void Flocking::Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const {
   const size_t n = s.size();
-  grid_.Build(x, n, def_.radius);
+  grid_.Build(x, n, def_.radius, pool_);
   const double sep2 = def_.separationRadius * def_.separationRadius;
   ForRanges(pool_, n, 1024, [&](size_t b, size_t e) {
   for (size_t i = b; i < e; ++i) {

@@ -32,6 +32,8 @@ struct FlockingDef {
 class Flocking : public Force {
  public:
   explicit Flocking(const FlockingDef& def) : def_(def) {}
+  // Gains and the target may change between steps (a moving target).
+  FlockingDef& def() { return def_; }
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
 
  private:

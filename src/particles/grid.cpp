@@ -4,7 +4,7 @@
 
 namespace sylva::particles {
 
-void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize) {
+void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool) {
   cell_ = cellSize > 0 ? cellSize : 1;
   uint32_t slots = 1;
   while ((slots < 2 * n || slots < 64) && slots < (1u << 30)) slots <<= 1;
@@ -34,12 +34,13 @@ void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize) {
   }
   count_.assign(slots, 0);
   slotOf_.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    const uint32_t s = Slot(int64_t(std::floor(x[i].x() / cell_)), int64_t(std::floor(x[i].y() / cell_)),
-                            int64_t(std::floor(x[i].z() / cell_)));
-    slotOf_[i] = s;
-    ++count_[s];
-  }
+  ForRanges(pool, n, 65536, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      slotOf_[i] = Slot(int64_t(std::floor(x[i].x() / cell_)), int64_t(std::floor(x[i].y() / cell_)),
+                        int64_t(std::floor(x[i].z() / cell_)));
+    }
+  });
+  for (size_t i = 0; i < n; ++i) ++count_[slotOf_[i]];
   start_.resize(size_t(slots) + 1);
   uint32_t sum = 0;
   for (uint32_t s = 0; s < slots; ++s) {
@@ -58,7 +59,7 @@ Vec3 InverseSquare::Pair(const ParticleState& s, const Vec3* x, size_t i, size_t
 }
 
 void InverseSquare::Accumulate(const ParticleState& s, const Vec3* x, const Vec3*, Vec3* f) const {
-  grid_.Build(x, s.size(), cutoff_);
+  grid_.Build(x, s.size(), cutoff_, pool_);
   // Each particle gathers its own sum: ranges of particles are independent.
   ForRanges(pool_, s.size(), 1024, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {

@@ -23,7 +23,8 @@ namespace sylva::particles {
 class NeighbourGrid {
  public:
   // cellSize should be at least the query radius.
-  void Build(const Vec3* x, size_t n, double cellSize);
+  // The pool, if any, computes the particles' cells in parallel.
+  void Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool = nullptr);
   // Calls fn(j) for every particle j != i within `radius` of x[i].
   template <typename Fn>
   void ForEachNeighbour(const Vec3* x, size_t i, double radius, Fn&& fn) const;

@@ -499,7 +499,7 @@ void System::ParticleCollisions() {
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
   const double reach = 2 * pairRadius_;
-  pairGrid_->Build(X.data(), n, reach);
+  pairGrid_->Build(X.data(), n, reach, pool_.get());
   const double* w = state.invMass.data();
   // Gauss-Seidel over the pairs in index order: serial, so deterministic.
   for (size_t i = 0; i < n; ++i) {
