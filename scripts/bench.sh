@@ -31,3 +31,12 @@ out="bench/results/$stamp"
     echo "node/npm not installed: skipped"
   fi
 } | tee "$out.txt"
+{
+  echo "# Sylva particle benchmarks, $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD)"
+  echo "# machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p')"
+  echo "# BM_Step: gravity + linear/quadratic drag + one plane collider; args: particles/threads; items = particle steps"
+  echo "# BM_GridBuild: counting-sort grid, args: points/threads; BM_Flocking: boids/threads, ~20 neighbours"
+  echo "# BM_Cloth: one 1/60 s frame, args: k (k x k particles)/threads; stretch = largest structural strain"
+  build/bench/bench_particles --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+    --benchmark_min_time=0.3 2>&1 | grep -E "^BM_.*_median" || true
+} | tee "$out-particles.txt"
