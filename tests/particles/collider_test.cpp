@@ -7,6 +7,8 @@
 #include <cmath>
 #include <random>
 
+#include "particles/step_ok.h"
+
 #include "particles/emitter.h"
 #include "particles/system.h"
 
@@ -15,12 +17,6 @@ namespace {
 
 constexpr double kG = 9.81;
 constexpr double kPi = 3.14159265358979323846;
-
-#define STEP_OK(sys, h, in)                                           \
-  do {                                                                \
-    Status st_ = (sys).Step((h), (in));                               \
-    ASSERT_TRUE(st_.ok()) << st_.error().message;                     \
-  } while (0)
 
 TEST(Contact, SlidingDistanceIsV0SquaredOver2MuG) {
   for (double mu : {0.2, 0.5, 1.0}) {

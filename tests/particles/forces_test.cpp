@@ -6,16 +6,12 @@
 #include <cmath>
 #include <random>
 
+#include "particles/step_ok.h"
+
 #include "particles/flocking.h"
 
 namespace sylva::particles {
 namespace {
-
-#define STEP_OK(sys, h, in)                                           \
-  do {                                                                \
-    Status st_ = (sys).Step((h), (in));                               \
-    ASSERT_TRUE(st_.ok()) << st_.error().message;                     \
-  } while (0)
 
 TEST(NoiseWind, IsDivergenceFreeSmoothAndHasItsSpeed) {
   NoiseWindDef def;
