@@ -324,6 +324,18 @@ Status System::CheckFaults(const char* what) {
   return {};
 }
 
+// x_ = X + c dx, out = V + c dv, for all particles: an RK stage's point.
+void System::StagePoint(double c, const Vec3* dx, const Vec3* dv, Vec3* out) const {
+  const Vec3* X = state.position.data();
+  const Vec3* V = state.velocity.data();
+  ForChunks(state.size(), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      x_[i] = X[i] + c * dx[i];
+      out[i] = V[i] + c * dv[i];
+    }
+  });
+}
+
 Status System::Step(double h, Integrator integrator) {
   if (fault_) return *fault_;
   const size_t n = state.size();
@@ -357,12 +369,7 @@ Status System::Step(double h, Integrator integrator) {
       v_.resize(n);
       Vec3 *a1 = k_[0].data(), *a2 = k_[1].data();
       Accelerations(X.data(), V.data(), a1);
-      ForChunks(n, [&](size_t b, size_t e) {
-        for (size_t i = b; i < e; ++i) {
-          x_[i] = X[i] + 0.5 * h * V[i];
-          v_[i] = V[i] + 0.5 * h * a1[i];
-        }
-      });
+      StagePoint(0.5 * h, V.data(), a1, v_.data());
       state.time = time + 0.5 * h;
       Accelerations(x_.data(), v_.data(), a2);
       ForChunks(n, [&](size_t b, size_t e) {
@@ -376,27 +383,12 @@ Status System::Step(double h, Integrator integrator) {
       Vec3 *a1 = k_[0].data(), *a2 = k_[1].data(), *a3 = k_[2].data(), *a4 = k_[3].data();
       Vec3 *v2 = k_[4].data(), *v3 = k_[5].data(), *v4 = k_[6].data();
       Accelerations(X.data(), V.data(), a1);
-      ForChunks(n, [&](size_t b, size_t e) {
-        for (size_t i = b; i < e; ++i) {
-          x_[i] = X[i] + 0.5 * h * V[i];
-          v2[i] = V[i] + 0.5 * h * a1[i];
-        }
-      });
+      StagePoint(0.5 * h, V.data(), a1, v2);
       state.time = time + 0.5 * h;
       Accelerations(x_.data(), v2, a2);
-      ForChunks(n, [&](size_t b, size_t e) {
-        for (size_t i = b; i < e; ++i) {
-          x_[i] = X[i] + 0.5 * h * v2[i];
-          v3[i] = V[i] + 0.5 * h * a2[i];
-        }
-      });
+      StagePoint(0.5 * h, v2, a2, v3);
       Accelerations(x_.data(), v3, a3);
-      ForChunks(n, [&](size_t b, size_t e) {
-        for (size_t i = b; i < e; ++i) {
-          x_[i] = X[i] + h * v3[i];
-          v4[i] = V[i] + h * a3[i];
-        }
-      });
+      StagePoint(h, v3, a3, v4);
       state.time = time + h;
       Accelerations(x_.data(), v4, a4);
       ForChunks(n, [&](size_t b, size_t e) {

@@ -231,6 +231,7 @@ class System {
   template <typename Fn>
   void ForChunks(size_t n, Fn&& fn) const;
   void NonLocalForces(const Vec3* x, const Vec3* v) const;
+  void StagePoint(double c, const Vec3* dx, const Vec3* dv, Vec3* out) const;
   void LocalForcesInto(size_t begin, size_t end, const Vec3* x, const Vec3* v, Vec3* fc) const;
   // Collisions, ageing and the fault check for particle i, then stores it.
   void Finish(size_t i, const Vec3& x0, const Vec3& v0, Vec3 x1, Vec3 v1, double h);

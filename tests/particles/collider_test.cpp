@@ -7,7 +7,7 @@
 #include <cmath>
 #include <random>
 
-#include "particles/step_ok.h"
+#include "particles/helpers.h"
 
 #include "particles/emitter.h"
 #include "particles/system.h"
@@ -269,11 +269,7 @@ TEST(ParticleCollisions, GasConservesMomentumAndElasticEnergy) {
 // x'' = -x from x = 1: error at T against cos T, steps taken.
 std::pair<double, int> AdaptiveOscillator(double tol) {
   System s;
-  s.state.Add(Vec3::Zero(), Vec3::Zero(), 0);
-  s.state.Add(Vec3(1, 0, 0), Vec3::Zero(), 1);
-  auto springs = std::make_shared<Springs>();
-  springs->Add(1, 0, 0.0, 1.0, 0.0);
-  s.AddForce(springs);
+  testing::AddAnchoredSpring(s, 1, 0, 1);
   AdaptiveOptions opt;
   opt.rtol = tol;
   opt.atol = tol;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "particles/step_ok.h"
+#include "particles/helpers.h"
 
 #include "particles/flocking.h"
 

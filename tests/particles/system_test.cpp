@@ -7,6 +7,8 @@
 #include <cmath>
 #include <random>
 
+#include "particles/helpers.h"
+
 namespace sylva::particles {
 namespace {
 
@@ -14,11 +16,7 @@ namespace {
 // x(t) = cos t. Returns |x(T) - cos T| after integrating with step h.
 double OscillatorError(Integrator in, double h, double T = 2.0) {
   System s;
-  s.state.Add(Vec3(0, 0, 0), Vec3::Zero(), 0);  // anchor
-  s.state.Add(Vec3(1, 0, 0), Vec3::Zero(), 1);
-  auto springs = std::make_shared<Springs>();
-  springs->Add(1, 0, 0.0, 1.0, 0.0);
-  s.AddForce(springs);
+  testing::AddAnchoredSpring(s, 1, 0, 1);
   const int steps = int(std::lround(T / h));
   for (int i = 0; i < steps; ++i) {
     if (Status st = s.Step(h, in); !st.ok()) {

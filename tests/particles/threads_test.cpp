@@ -7,6 +7,7 @@
 
 #include "particles/flocking.h"
 #include "particles/grid.h"
+#include "particles/helpers.h"
 #include "particles/system.h"
 
 namespace sylva::particles {
@@ -73,11 +74,7 @@ TEST(Faults, NonFiniteForceIsReportedWithStepAndId) {
 TEST(Faults, ExplodingStiffSpringIsReported) {
   // Explicit Euler on a stiff spring gains energy every step until it blows up.
   System s;
-  s.state.Add(Vec3::Zero(), Vec3::Zero(), 0);
-  s.state.Add(Vec3(1.5, 0, 0), Vec3::Zero(), 1);
-  auto springs = std::make_shared<Springs>();
-  springs->Add(0, 1, 1, 1e4, 0);
-  s.AddForce(springs);
+  testing::AddAnchoredSpring(s, 1.5, 1, 1e4);
   Status st;
   int i = 0;
   for (; i < 100000 && st.ok(); ++i) st = s.Step(0.05, Integrator::kExplicitEuler);
@@ -88,11 +85,7 @@ TEST(Faults, ExplodingStiffSpringIsReported) {
 
 TEST(Faults, ImplicitEulerIsStableWhereExplicitExplodes) {
   System s;
-  s.state.Add(Vec3::Zero(), Vec3::Zero(), 0);
-  s.state.Add(Vec3(1.5, 0, 0), Vec3::Zero(), 1);
-  auto springs = std::make_shared<Springs>();
-  springs->Add(0, 1, 1, 1e4, 0);
-  s.AddForce(springs);
+  testing::AddAnchoredSpring(s, 1.5, 1, 1e4);
   for (int i = 0; i < 1000; ++i) ASSERT_TRUE(s.Step(0.05, Integrator::kImplicitEuler).ok()) << "step " << i;
   // Backward Euler damps: the spring settles at its rest length.
   EXPECT_NEAR(s.state.position[1].x(), 1.0, 1e-6) << "x " << s.state.position[1].x();
