@@ -40,3 +40,16 @@ out="bench/results/$stamp"
   build/bench/bench_particles --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
     --benchmark_min_time=0.3 2>&1 | grep -E "^BM_.*_median" || true
 } | tee "$out-particles.txt"
+if [[ -x build/bench/bench_bullet_cloth ]]; then
+  {
+    echo "# Sylva cloth against Bullet $(pkg-config --modversion bullet) btSoftBody, $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD)"
+    echo "# machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p')"
+    echo "# one 1/60 s frame (20 substeps) of a k x k, 1 kg, 1 m cloth pinned at two corners, after 3 s of fall;"
+    echo "# Sylva args: k/threads; Bullet args: k/position iterations a substep (1 = Sylva's work)"
+    echo "# sag: free corners below the pins at 3 s (m); stretch: largest structural strain at 3 s; peak: over the 3 s"
+    build/bench/bench_bullet_cloth --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+      --benchmark_min_time=0.3 2>&1 | grep -E "^BM_.*_median" || true
+  } | tee "$out-bullet.txt"
+else
+  echo "bench_bullet_cloth not built (apt-get install libbullet-dev): no Bullet comparison"
+fi
