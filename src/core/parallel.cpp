@@ -1,8 +1,27 @@
 #include "core/parallel.h"
 
 #include <algorithm>
+#include <chrono>
+#include <limits>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define SYLVA_PAUSE() _mm_pause()
+#else
+#define SYLVA_PAUSE() ((void)0)
+#endif
 
 namespace sylva {
+namespace {
+
+// How long an idle worker spins before it sleeps, and how long the caller
+// spins on the join before it yields its core.
+constexpr auto kSpin = std::chrono::microseconds(50);
+
+constexpr uint32_t Gen(uint64_t word) { return uint32_t(word >> 32); }
+constexpr uint32_t Index(uint64_t word) { return uint32_t(word); }
+
+}  // namespace
 
 int ThreadPool::HardwareThreads() {
   unsigned n = std::thread::hardware_concurrency();
@@ -18,44 +37,50 @@ ThreadPool::ThreadPool(int threads) {
 ThreadPool::~ThreadPool() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    stop_ = true;
+    stop_.store(true);
   }
   wake_.notify_all();
   for (auto& t : workers_) t.join();
 }
 
-// Claims indices until none are left. Called with mutex_ unlocked.
-void ThreadPool::RunTasks() {
+void ThreadPool::RunTasks(uint32_t gen) {
+  uint64_t word = claim_.load(std::memory_order_acquire);
   for (;;) {
-    size_t i;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (next_ >= count_) return;
-      i = next_++;
+    if (Gen(word) != gen) return;
+    // fn_ and count_ were written before the word that published `gen` and
+    // after the word that closed the call before; a value of a later call
+    // makes the claim below fail, since its word was closed first.
+    const size_t count = count_.load(std::memory_order_acquire);
+    const std::function<void(size_t)>* fn = fn_.load(std::memory_order_acquire);
+    if (Index(word) >= count) return;
+    if (!claim_.compare_exchange_weak(word, word + 1, std::memory_order_acq_rel, std::memory_order_acquire)) {
+      continue;  // word now holds the current value
     }
-    (*fn_)(i);
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (++finished_ == count_) done_.notify_all();
-    }
+    (*fn)(Index(word));
+    finished_.fetch_add(1, std::memory_order_acq_rel);
+    word = claim_.load(std::memory_order_acquire);
   }
 }
 
 void ThreadPool::WorkerLoop() {
-  uint64_t seen = 0;
+  uint32_t seen = 0;
   for (;;) {
-    {
-      std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait(lock, [&] { return stop_ || generation_ != seen; });
-      if (stop_) return;
-      seen = generation_;
-      ++active_;
+    // Spin a little for the next call, then sleep.
+    const auto until = std::chrono::steady_clock::now() + kSpin;
+    uint32_t gen = Gen(claim_.load(std::memory_order_acquire));
+    for (int spins = 0; gen == seen && !stop_.load(std::memory_order_relaxed); ++spins) {
+      SYLVA_PAUSE();
+      if ((spins & 63) == 63 && std::chrono::steady_clock::now() > until) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        sleepers_.fetch_add(1);
+        wake_.wait(lock, [&] { return stop_.load() || Gen(claim_.load()) != seen; });
+        sleepers_.fetch_sub(1);
+      }
+      gen = Gen(claim_.load(std::memory_order_acquire));
     }
-    RunTasks();
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (--active_ == 0) done_.notify_all();
-    }
+    if (stop_.load()) return;
+    seen = gen;
+    RunTasks(gen);
   }
 }
 
@@ -65,20 +90,32 @@ void ThreadPool::ParallelFor(size_t n, const std::function<void(size_t)>& fn) {
     for (size_t i = 0; i < n; ++i) fn(i);
     return;
   }
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    fn_ = &fn;
-    count_ = n;
-    next_ = 0;
-    finished_ = 0;
-    ++generation_;
+  if (n >= std::numeric_limits<uint32_t>::max()) {  // the claim word holds 32-bit indices
+    const size_t half = n / 2;
+    ParallelFor(half, fn);
+    ParallelFor(n - half, [&](size_t i) { fn(half + i); });
+    return;
   }
-  wake_.notify_all();
-  RunTasks();
-  std::unique_lock<std::mutex> lock(mutex_);
-  // Wait until every index ran and no worker still holds a reference to fn.
-  done_.wait(lock, [&] { return finished_ == count_ && active_ == 0; });
-  fn_ = nullptr;
+  fn_.store(&fn, std::memory_order_release);
+  count_.store(n, std::memory_order_release);
+  finished_.store(0, std::memory_order_relaxed);
+  ++generation_;
+  claim_.store(uint64_t(generation_) << 32);  // seq_cst: ordered against sleepers_
+  if (sleepers_.load() > 0) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    wake_.notify_all();
+  }
+  RunTasks(generation_);
+  // Join: every index claimed has finished (no worker holds fn after that).
+  const auto until = std::chrono::steady_clock::now() + kSpin;
+  for (int spins = 0; finished_.load(std::memory_order_acquire) != n; ++spins) {
+    SYLVA_PAUSE();
+    if ((spins & 63) == 63 && std::chrono::steady_clock::now() > until) std::this_thread::yield();
+  }
+  // Close the call: no claim on this generation can succeed any more, even
+  // by a worker that read the next call's count.
+  claim_.store(uint64_t(generation_) << 32 | 0xffffffffu);
+  fn_.store(nullptr, std::memory_order_release);
 }
 
 }  // namespace sylva

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <thread>
 #include <vector>
 
 #include "core/pod_buffer.h"
@@ -19,6 +21,27 @@ TEST(ThreadPool, ParallelForRunsEveryIndexOnce) {
     for (size_t i = 0; i < hits.size(); ++i) {
       ASSERT_EQ(hits[i].load(), 20) << "index " << i << " threads " << threads;
     }
+  }
+}
+
+// Many short calls back to back (workers still spinning from the last one)
+// and calls after a pause (workers asleep): every index runs exactly once.
+TEST(ThreadPool, BackToBackAndAfterSleepCallsRunEveryIndexOnce) {
+  ThreadPool pool(3);
+  std::vector<std::atomic<int>> hits(64);
+  for (int round = 0; round < 20000; ++round) {
+    const size_t n = 1 + size_t(round % 64);
+    pool.ParallelFor(n, [&](size_t i) { hits[i].fetch_add(1, std::memory_order_relaxed); });
+  }
+  for (int round = 0; round < 5; ++round) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    pool.ParallelFor(64, [&](size_t i) { hits[i].fetch_add(1, std::memory_order_relaxed); });
+  }
+  // Index i ran in every round with n > i: rounds r with (r % 64) >= i.
+  for (size_t i = 0; i < hits.size(); ++i) {
+    int want = 5;
+    for (int round = 0; round < 20000; ++round) want += (round % 64) >= int(i) ? 1 : 0;
+    ASSERT_EQ(hits[i].load(), want) << "index " << i;
   }
 }
 
