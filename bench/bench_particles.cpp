@@ -105,7 +105,7 @@ BENCHMARK_CAPTURE(BM_Cloth, xpbd_20_substeps, particles::ClothSolver::kXPBD)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Cloth, implicit_20_cg, particles::ClothSolver::kImplicit)
-    ->ArgsProduct({{100}, {1}})
+    ->ArgsProduct({{100}, {1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -91,7 +91,7 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
     if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
   }
   if (def_.solver == ClothSolver::kImplicit) {
-    implicit_ = std::make_unique<System>(1);
+    implicit_ = std::make_unique<System>(def_.threads);
     implicit_->cgMaxIterations = std::max(1, def_.cgIterations);
     implicit_->cgTolerance = 1e-12;
     for (size_t i = 0; i < n; ++i) implicit_->state.Add(x_[i], Vec3::Zero(), w_[i] > 0 ? 1 / w_[i] : 0);
@@ -169,7 +169,7 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
   }
   const double keep = std::max(0.0, 1 - def_.damping * h);
   for (int s = 0; s < subs; ++s) {
-    ForRanges(pool, n, 4096, [&](size_t b, size_t e) {
+    ForRanges(pool, n, BalancedGrain(pool, n, 512, 4096), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
         prev_[i] = x_[i];
         if (w_[i] == 0) continue;
@@ -184,14 +184,14 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
       // and the result does not depend on the thread count.
       for (size_t c = 0; c + 1 < colorStart_.size(); ++c) {
         const size_t first = colorStart_[c], count = colorStart_[c + 1] - first;
-        ForRanges(pool, count, 2048, [&](size_t b, size_t e) { ProjectRange(first + b, first + e); });
+        ForRanges(pool, count, BalancedGrain(pool, count, 256, 4096), [&](size_t b, size_t e) { ProjectRange(first + b, first + e); });
       }
     }
     // Long-range attachments (Kim, Chentanez & Muller 2012): no particle may
     // be farther from a pin than its rest distance, which keeps a hanging
     // cloth from stretching at few iterations. Then velocities.
     const bool tethered = !tethers_.empty();
-    ForRanges(pool, n, 4096, [&](size_t b, size_t e) {
+    ForRanges(pool, n, BalancedGrain(pool, n, 512, 4096), [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
         if (tethered && w_[i] != 0) {
           for (int t = 0; t < kTethers; ++t) {

@@ -1,6 +1,7 @@
 #include "particles/system.h"
 
 #include <algorithm>
+#include <bit>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -70,50 +71,141 @@ void Drag::AddJacobianProduct(const ParticleState& s, const Vec3*, const Vec3* v
   }
 }
 
+void Springs::Colour() const {
+  if (colouredSprings_ == springs_.size()) return;
+  size_t n = 0;
+  for (const Spring& sp : springs_) n = std::max<size_t>(n, std::max(sp.a, sp.b) + size_t(1));
+  std::vector<uint64_t> used(n, 0);
+  std::vector<int8_t> colour(springs_.size());
+  int colours = 0;
+  for (size_t k = 0; k < springs_.size(); ++k) {
+    const Spring& sp = springs_[k];
+    const uint64_t free = ~(used[sp.a] | used[sp.b]);
+    if (free == 0) {
+      colour[k] = -1;  // the serial group
+      continue;
+    }
+    const int c = std::countr_zero(free);
+    colour[k] = int8_t(c);
+    used[sp.a] |= 1ULL << c;
+    used[sp.b] |= 1ULL << c;
+    colours = std::max(colours, c + 1);
+  }
+  std::vector<size_t> count(size_t(colours) + 2, 0);
+  for (int8_t c : colour) ++count[c < 0 ? size_t(colours) + 1 : size_t(c) + 1];
+  serialGroup_ = count[size_t(colours) + 1] > 0;
+  colourStart_.assign(size_t(colours) + (serialGroup_ ? 2 : 1), 0);
+  for (size_t c = 1; c < colourStart_.size(); ++c) colourStart_[c] = colourStart_[c - 1] + count[c];
+  std::vector<size_t> fill(colourStart_.begin(), colourStart_.end() - 1);
+  order_.resize(springs_.size());
+  for (size_t k = 0; k < springs_.size(); ++k) {
+    order_[fill[colour[k] < 0 ? size_t(colours) : size_t(colour[k])]++] = uint32_t(k);
+  }
+  colouredSprings_ = springs_.size();
+}
+
+template <typename Fn>
+void Springs::ForColours(Fn&& fn) const {
+  Colour();
+  for (size_t c = 0; c + 1 < colourStart_.size(); ++c) {
+    const size_t first = colourStart_[c], count = colourStart_[c + 1] - first;
+    auto range = [&](size_t b, size_t e) {
+      for (size_t j = first + b; j < first + e; ++j) fn(j, springs_[order_[j]]);
+    };
+    if (serialGroup_ && c + 2 == colourStart_.size()) {
+      range(0, count);
+    } else {
+      ForRanges(pool_, count, BalancedGrain(pool_, count, 256, 4096), range);
+    }
+  }
+}
+
 void Springs::Accumulate(const ParticleState&, const Vec3* x, const Vec3* v, Vec3* f) const {
-  for (const Spring& sp : springs_) {
+  ForColours([&](size_t, const Spring& sp) {
     const Vec3 d = x[sp.a] - x[sp.b];
     const double len = d.norm();
-    if (!(len > 1e-300)) continue;
+    if (!(len > 1e-300)) return;
     const Vec3 dir = d / len;
     const double rate = (v[sp.a] - v[sp.b]).dot(dir);
     const Vec3 fa = -(sp.ks * (len - sp.rest) + sp.kd * rate) * dir;
     f[sp.a] += fa;
     f[sp.b] -= fa;
+  });
+}
+
+Springs::Linear Springs::Linearise(const Spring& sp, const Vec3* x) {
+  const Vec3 d = x[sp.a] - x[sp.b];
+  const double len = d.norm();
+  if (!(len > 1e-300)) return {sp.a, sp.b, Vec3::Zero(), 0, 0, sp.kd};
+  const double kt = sp.ks * std::max(0.0, 1 - sp.rest / len);
+  return {sp.a, sp.b, d / len, kt, sp.ks - kt, sp.kd};
+}
+
+void Springs::PrepareJacobian(const ParticleState&, const Vec3* x, const Vec3*) {
+  Colour();
+  preparedX_ = x;
+  linear_.resize(springs_.size());
+  ForColours([&](size_t j, const Spring& sp) { linear_[j] = Linearise(sp, x); });
+}
+
+namespace {
+
+// The product's kernel over springs [first, last) of one colour:
+// y_a += g, y_b -= g with g = -(cx kt) dp - (cx kl + cv kd) (u . dp) u.
+template <typename Lin>
+void ProductRange(const Lin* __restrict lin, size_t first, size_t last, double cx, double cv,
+                  const double* __restrict p, double* __restrict y) {
+  for (size_t j = first; j < last; ++j) {
+    const Lin& l = lin[j];
+    const size_t a = size_t(l.a) * 3, b = size_t(l.b) * 3;
+    const double d0 = p[a] - p[b], d1 = p[a + 1] - p[b + 1], d2 = p[a + 2] - p[b + 2];
+    const double ux = l.u[0], uy = l.u[1], uz = l.u[2];
+    const double t = -cx * l.kt;
+    const double s = -(cx * l.kl + cv * l.kd) * (ux * d0 + uy * d1 + uz * d2);
+    const double g0 = t * d0 + s * ux, g1 = t * d1 + s * uy, g2 = t * d2 + s * uz;
+    y[a] += g0;
+    y[a + 1] += g1;
+    y[a + 2] += g2;
+    y[b] -= g0;
+    y[b + 1] -= g1;
+    y[b + 2] -= g2;
   }
 }
 
+}  // namespace
+
 void Springs::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
                                  const Vec3* p, Vec3* y) const {
-  for (const Spring& sp : springs_) {
-    const Vec3 d = x[sp.a] - x[sp.b];
-    const double len = d.norm();
-    if (!(len > 1e-300)) continue;
-    const Vec3 u = d / len;
-    const Vec3 dp = p[sp.a] - p[sp.b];
-    const double along = u.dot(dp);
-    const double transverse = std::max(0.0, 1 - sp.rest / len);
-    // df_a/dx_a = -ks [u u' + (1 - L/l)(I - u u')], df_a/dv_a = -kd u u'.
-    const Vec3 kdp = sp.ks * (along * u + transverse * (dp - along * u));
-    const Vec3 g = -cx * kdp - cv * sp.kd * along * u;
-    y[sp.a] += g;
-    y[sp.b] -= g;
+  if (!(x == preparedX_ && linear_.size() == springs_.size())) {
+    ForColours([&](size_t, const Spring& sp) {
+      const Linear l = Linearise(sp, x);
+      ProductRange(&l, 0, 1, cx, cv, p[0].data(), y[0].data());
+    });
+    return;
+  }
+  const Linear* lin = linear_.data();
+  for (size_t c = 0; c + 1 < colourStart_.size(); ++c) {
+    const size_t first = colourStart_[c], last = colourStart_[c + 1];
+    if (serialGroup_ && c + 2 == colourStart_.size()) {
+      ProductRange(lin, first, last, cx, cv, p[0].data(), y[0].data());
+    } else {
+      ForRanges(pool_, last - first, BalancedGrain(pool_, last - first, 256, 4096), [&](size_t b, size_t e) {
+        ProductRange(lin, first + b, first + e, cx, cv, p[0].data(), y[0].data());
+      });
+    }
   }
 }
 
 void Springs::AddJacobianDiagonal(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
                                   Vec3* diag) const {
-  for (const Spring& sp : springs_) {
-    const Vec3 d = x[sp.a] - x[sp.b];
-    const double len = d.norm();
-    if (!(len > 1e-300)) continue;
-    const Vec3 u2 = (d / len).cwiseAbs2();
-    const double transverse = std::max(0.0, 1 - sp.rest / len);
-    const Vec3 k = sp.ks * (u2 + transverse * (Vec3::Ones() - u2));
-    const Vec3 g = -cx * k - cv * sp.kd * u2;
-    diag[sp.a] += g;
-    diag[sp.b] += g;
-  }
+  const bool cached = x == preparedX_ && linear_.size() == springs_.size();
+  ForColours([&](size_t j, const Spring& sp) {
+    const Linear l = cached ? linear_[j] : Linearise(sp, x);
+    const Vec3 u2 = l.u.cwiseAbs2();
+    const Vec3 g = -cx * (Vec3::Constant(l.kt) + l.kl * u2) - cv * l.kd * u2;
+    diag[l.a] += g;
+    diag[l.b] += g;
+  });
 }
 
 // --- system ---
@@ -143,12 +235,12 @@ void System::EnableParticleCollisions(double radius, double restitution) {
 
 template <typename Fn>
 void System::ForChunks(size_t n, Fn&& fn) const {
-  const size_t chunks = (n + kChunk - 1) / kChunk;
-  if (!pool_ || chunks <= 1) {
+  // At most kChunk a range (the fused step's force buffer), balanced.
+  if (!pool_) {
     for (size_t b = 0; b < n; b += kChunk) fn(b, std::min(n, b + kChunk));
     return;
   }
-  pool_->ParallelFor(chunks, [&](size_t c) { fn(c * kChunk, std::min(n, (c + 1) * kChunk)); });
+  ForRanges(pool_.get(), n, BalancedGrain(pool_.get(), n, 256, kChunk), fn);
 }
 
 void System::NonLocalForces(const Vec3* x, const Vec3* v) const {
@@ -411,11 +503,31 @@ Status System::Step(double h, Integrator integrator) {
   return status;
 }
 
+template <int K, typename Fn>
+std::array<double, K> System::SumChunks(size_t n, Fn&& fn) const {
+  // Fixed chunks whatever the thread count: the partial sums, and so their
+  // total, do not depend on it.
+  constexpr size_t kSumChunk = 1024;
+  const size_t chunks = (n + kSumChunk - 1) / kSumChunk;
+  thread_local std::vector<std::array<double, K>> partial;
+  std::vector<std::array<double, K>>& part = partial;  // the caller's, shared with the pool
+  part.assign(chunks, std::array<double, K>{});
+  ForRanges(pool_.get(), chunks, BalancedGrain(pool_.get(), chunks, 1), [&](size_t cb, size_t ce) {
+    for (size_t c = cb; c < ce; ++c) part[c] = fn(c * kSumChunk, std::min(n, (c + 1) * kSumChunk));
+  });
+  std::array<double, K> sum{};
+  for (const auto& p : part) {
+    for (int k = 0; k < K; ++k) sum[size_t(k)] += p[size_t(k)];
+  }
+  return sum;
+}
+
 // Backward Euler linearised once about the current state (Baraff & Witkin
 // 1998, eq. 16):
 //   (M - h df/dv - h^2 df/dx) dv = h (f0 + h df/dx v0),
-// solved matrix-free by conjugate gradients; immovable particles are
-// filtered out of the residual and the search direction.
+// solved matrix-free by Jacobi-preconditioned conjugate gradients;
+// immovable particles are filtered out of the residual and the search
+// direction. Vector passes run on the pool, fused, with sums in chunk order.
 void System::ImplicitEuler(double h) {
   const size_t n = state.size();
   std::vector<Vec3>& X = state.position;
@@ -426,55 +538,73 @@ void System::ImplicitEuler(double h) {
   k_[0].resize(n);
   Vec3* a0 = k_[0].data();
   Accelerations(X.data(), V.data(), a0);
+  for (const auto& f : forces_) f->PrepareJacobian(state, X.data(), V.data());
   const double* m = state.mass.data();
   const double* w = state.invMass.data();
-  for (size_t i = 0; i < n; ++i) b[i] = h * m[i] * a0[i];
-  for (const auto& f : forces_) f->AddJacobianProduct(state, X.data(), V.data(), h * h, 0, V.data(), b);
-  auto filter = [&](Vec3* y) {
-    for (size_t i = 0; i < n; ++i) {
-      if (w[i] == 0) y[i] = Vec3::Zero();
+  ForChunks(n, [&](size_t bb, size_t e) {
+    for (size_t i = bb; i < e; ++i) {
+      b[i] = h * m[i] * a0[i];
+      inv[i] = Vec3::Constant(m[i]);
     }
-  };
-  auto dot = [&](const Vec3* u, const Vec3* z) {
-    double s = 0;
-    for (size_t i = 0; i < n; ++i) s += u[i].dot(z[i]);
-    return s;
-  };
-  filter(b);
+  });
+  for (const auto& f : forces_) f->AddJacobianProduct(state, X.data(), V.data(), h * h, 0, V.data(), b);
   // Jacobi preconditioner: the inverse of the operator's diagonal.
-  for (size_t i = 0; i < n; ++i) inv[i] = Vec3::Constant(m[i]);
   for (const auto& f : forces_) f->AddJacobianDiagonal(state, X.data(), V.data(), -h * h, -h, inv);
-  for (size_t i = 0; i < n; ++i) {
-    for (int k = 0; k < 3; ++k) inv[i][k] = w[i] > 0 && inv[i][k] > 0 ? 1 / inv[i][k] : 0;
-  }
-  std::fill(dv, dv + n, Vec3::Zero());
-  std::copy(b, b + n, r);
-  for (size_t i = 0; i < n; ++i) p[i] = r[i].cwiseProduct(inv[i]);
-  double rz = 0;
-  for (size_t i = 0; i < n; ++i) rz += r[i].dot(p[i]) ;
-  const double bnorm = std::sqrt(dot(b, b));
+  // dv = 0, r = b (filtered), p = M^-1 r, q = A p's mass term.
+  const auto start = SumChunks<2>(n, [&](size_t bb, size_t e) {
+    std::array<double, 2> s{};
+    for (size_t i = bb; i < e; ++i) {
+      for (int k = 0; k < 3; ++k) inv[i][k] = w[i] > 0 && inv[i][k] > 0 ? 1 / inv[i][k] : 0;
+      if (w[i] == 0) b[i] = Vec3::Zero();
+      dv[i] = Vec3::Zero();
+      r[i] = b[i];
+      p[i] = r[i].cwiseProduct(inv[i]);
+      q[i] = m[i] * p[i];
+      s[0] += r[i].dot(p[i]);
+      s[1] += b[i].squaredNorm();
+    }
+    return s;
+  });
+  double rz = start[0];
+  const double bnorm = std::sqrt(start[1]);
   solve_ = {0, 0};
   if (bnorm > 0) {
     double rnorm = bnorm;
     int it = 0;
     while (it < cgMaxIterations && rnorm > cgTolerance * bnorm) {
-      for (size_t i = 0; i < n; ++i) q[i] = m[i] * p[i];
       for (const auto& f : forces_) f->AddJacobianProduct(state, X.data(), V.data(), -h * h, -h, p, q);
-      filter(q);
-      const double pq = dot(p, q);
+      const double pq = SumChunks<1>(n, [&](size_t bb, size_t e) {
+        std::array<double, 1> s{};
+        for (size_t i = bb; i < e; ++i) {
+          if (w[i] == 0) q[i] = Vec3::Zero();
+          s[0] += p[i].dot(q[i]);
+        }
+        return s;
+      })[0];
       if (!(pq > 0)) break;  // not positive definite along p (or NaN)
       const double alpha = rz / pq;
-      for (size_t i = 0; i < n; ++i) {
-        dv[i] += alpha * p[i];
-        r[i] -= alpha * q[i];
-      }
-      double rzNew = 0;
-      for (size_t i = 0; i < n; ++i) rzNew += r[i].dot(r[i].cwiseProduct(inv[i]));
-      const double beta = rzNew / rz;
-      rz = rzNew;
-      for (size_t i = 0; i < n; ++i) p[i] = r[i].cwiseProduct(inv[i]) + beta * p[i];
-      rnorm = std::sqrt(dot(r, r));
+      const auto sums = SumChunks<2>(n, [&](size_t bb, size_t e) {
+        std::array<double, 2> s{};
+        for (size_t i = bb; i < e; ++i) {
+          dv[i] += alpha * p[i];
+          r[i] -= alpha * q[i];
+          s[0] += r[i].dot(r[i].cwiseProduct(inv[i]));
+          s[1] += r[i].squaredNorm();
+        }
+        return s;
+      });
+      const double beta = sums[0] / rz;
+      rz = sums[0];
+      rnorm = std::sqrt(sums[1]);
       ++it;
+      if (it < cgMaxIterations && rnorm > cgTolerance * bnorm) {
+        ForChunks(n, [&](size_t bb, size_t e) {
+          for (size_t i = bb; i < e; ++i) {
+            p[i] = r[i].cwiseProduct(inv[i]) + beta * p[i];
+            q[i] = m[i] * p[i];
+          }
+        });
+      }
     }
     solve_ = {it, rnorm / bnorm};
   }

@@ -23,6 +23,7 @@
 // particle id; the system then refuses to step again.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -65,6 +66,10 @@ class Force {
   virtual void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const = 0;
   // True for a LocalForce (f[i] depends on particle i alone).
   virtual bool local() const { return false; }
+  // The implicit solver linearises about (x, v) once a step: it calls
+  // PrepareJacobian(x, v) first, then the products and the diagonal at the
+  // same x and v. A force may cache what does not depend on p here.
+  virtual void PrepareJacobian(const ParticleState&, const Vec3* /*x*/, const Vec3* /*v*/) {}
   // Matrix-free Jacobian product for the implicit solver:
   //   y += cx (df/dx) p + cv (df/dv) p.
   // Forces that do not override it are treated explicitly by that solver.
@@ -119,6 +124,12 @@ class Drag : public LocalForce {
 
 // Damped Hooke springs between particle pairs (Angel & Shreiner 9.3):
 // with d = p_a - p_b, f_a = -[ks(|d| - rest) + kd (d'.d)/|d|] d/|d|, f_b = -f_a.
+//
+// Threads. The springs are coloured greedily (no two springs of a colour
+// share a particle; springs of a particle with more than 64 colours in use
+// go to a last, serial group), and every pass runs colour by colour, each
+// colour in parallel: the sums on a particle are made in the same order
+// whatever the thread count.
 class Springs : public Force {
  public:
   struct Spring {
@@ -128,15 +139,43 @@ class Springs : public Force {
   void Add(uint32_t a, uint32_t b, double rest, double ks, double kd) { springs_.push_back({a, b, rest, ks, kd}); }
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
   // Baraff & Witkin's spring Jacobian, with the transverse term clamped at
-  // zero for compressed springs so the system matrix stays positive definite.
+  // zero for compressed springs so the system matrix stays positive definite:
+  //   df_a/dx_a = -[kl u u' + kt I],  kt = ks max(0, 1 - rest/|d|), kl = ks - kt
+  //   df_a/dv_a = -kd u u'
+  // PrepareJacobian caches u, kt and kl a spring; products at the same
+  // positions array use the cache until the next PrepareJacobian (at any
+  // other array they linearise themselves).
+  void PrepareJacobian(const ParticleState& s, const Vec3* x, const Vec3* v) override;
   void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
                           const Vec3* p, Vec3* y) const override;
   void AddJacobianDiagonal(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
                            Vec3* diag) const override;
   const std::vector<Spring>& springs() const { return springs_; }
+  // Colour groups of the last pass (the serial group counts as one).
+  size_t colourCount() const { return colourStart_.empty() ? 0 : colourStart_.size() - 1; }
 
  private:
+  // A spring in colour order with its linearisation.
+  struct Linear {
+    uint32_t a, b;
+    Vec3 u;
+    double kt, kl, kd;
+  };
+  void Colour() const;
+  // fn(spring index in colour order j, spring) for every spring, colour by
+  // colour.
+  template <typename Fn>
+  void ForColours(Fn&& fn) const;
+  static Linear Linearise(const Spring& sp, const Vec3* x);
   std::vector<Spring> springs_;
+  std::vector<Linear> linear_;           // from PrepareJacobian at preparedX_, colour order
+  const Vec3* preparedX_ = nullptr;
+  // Colour order: springs order_[colourStart_[c] .. colourStart_[c + 1]);
+  // the last group is serial when serialGroup_.
+  mutable std::vector<uint32_t> order_;
+  mutable std::vector<size_t> colourStart_;
+  mutable bool serialGroup_ = false;
+  mutable size_t colouredSprings_ = SIZE_MAX;
 };
 
 // A user force as a callable (evaluated for all particles at once).
@@ -237,6 +276,10 @@ class System {
   void Finish(size_t i, const Vec3& x0, const Vec3& v0, Vec3 x1, Vec3 v1, double h);
   void Collide(size_t i, Vec3 a, Vec3 va, Vec3& x, Vec3& v, double h);
   void ImplicitEuler(double h);
+  // Sum of fn(begin, end) over the fixed chunks of [0, n), added in chunk
+  // order: the same bits for any thread count.
+  template <int K, typename Fn>
+  std::array<double, K> SumChunks(size_t n, Fn&& fn) const;
   void ParticleCollisions();
   Status CheckFaults(const char* what);
 
