@@ -1,11 +1,14 @@
 #include "particles/grid.h"
 
+#include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace sylva::particles {
 
 void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool) {
   cell_ = cellSize > 0 ? cellSize : 1;
+  invCell_ = 1 / cell_;
   uint32_t slots = 1;
   while ((slots < 2 * n || slots < 64) && slots < (1u << 30)) slots <<= 1;
   // Row offsets B dy + C dz (dy, dz in -1..1) must be 3 or more slots apart
@@ -32,24 +35,75 @@ void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* 
     }
     if (found) break;
   }
-  count_.assign(slots, 0);
-  slotOf_.resize(n);
-  ForRanges(pool, n, 65536, [&](size_t b, size_t e) {
+  keys_.resize(n);
+  tmp_.resize(n);
+  order_.resize(n);
+  start_.resize(size_t(slots) + 1);
+  // Ranges of particles: a fixed split (a stable sort's result does not
+  // depend on it), about four a thread.
+  const size_t grain = BalancedGrain(pool, n, 16384);
+  const size_t ranges = std::max<size_t>(1, (n + grain - 1) / grain);
+  constexpr int kBits = 8;
+  constexpr size_t kBuckets = size_t(1) << kBits;
+  hist_.resize(ranges * kBuckets);
+  auto range = [&](size_t r) { return std::pair(r * grain, std::min(n, (r + 1) * grain)); };
+  auto forRanges = [&](auto&& fn) {
+    if (pool && ranges > 1) {
+      pool->ParallelFor(ranges, fn);
+    } else {
+      for (size_t r = 0; r < ranges; ++r) fn(r);
+    }
+  };
+  forRanges([&](size_t r) {
+    const auto [b, e] = range(r);
     for (size_t i = b; i < e; ++i) {
-      slotOf_[i] = Slot(int64_t(std::floor(x[i].x() / cell_)), int64_t(std::floor(x[i].y() / cell_)),
-                        int64_t(std::floor(x[i].z() / cell_)));
+      const uint32_t slot = Slot(CellOf(x[i].x()), CellOf(x[i].y()), CellOf(x[i].z()));
+      keys_[i] = uint64_t(slot) << 32 | i;
     }
   });
-  for (size_t i = 0; i < n; ++i) ++count_[slotOf_[i]];
-  start_.resize(size_t(slots) + 1);
-  uint32_t sum = 0;
-  for (uint32_t s = 0; s < slots; ++s) {
-    start_[s] = sum;
-    sum += count_[s];
+  int bits = 0;
+  while ((uint64_t(1) << bits) < slots) ++bits;
+  constexpr uint64_t kDigit = kBuckets - 1;
+  for (int shift = 32; shift < 32 + bits; shift += kBits) {
+    const uint64_t* src = keys_.data();
+    uint64_t* dst = tmp_.data();
+    forRanges([&](size_t r) {
+      uint32_t* h = hist_.data() + r * kBuckets;
+      std::fill(h, h + kBuckets, 0u);
+      const auto [b, e] = range(r);
+      for (size_t i = b; i < e; ++i) ++h[(src[i] >> shift) & kDigit];
+    });
+    // Offsets bucket-major, range-minor: the sort stays stable.
+    uint32_t sum = 0;
+    for (size_t d = 0; d < kBuckets; ++d) {
+      for (size_t r = 0; r < ranges; ++r) {
+        const uint32_t c = hist_[r * kBuckets + d];
+        hist_[r * kBuckets + d] = sum;
+        sum += c;
+      }
+    }
+    forRanges([&](size_t r) {
+      uint32_t* off = hist_.data() + r * kBuckets;
+      const auto [b, e] = range(r);
+      for (size_t i = b; i < e; ++i) dst[off[(src[i] >> shift) & kDigit]++] = src[i];
+    });
+    keys_.swap(tmp_);
   }
-  start_[slots] = sum;
-  order_.resize(n);
-  for (size_t i = 0; i < n; ++i) order_[start_[slotOf_[i]] + --count_[slotOf_[i]]] = uint32_t(i);
+  // Slot starts and the particle order, a range of sorted keys each: start_
+  // of the slots from just after the previous key's slot to this key's.
+  const uint64_t* keys = keys_.data();
+  forRanges([&](size_t r) {
+    const auto [b, e] = range(r);
+    uint32_t prev = b == 0 ? 0 : uint32_t(keys[b - 1] >> 32) + 1;
+    for (size_t k = b; k < e; ++k) {
+      const uint32_t slot = uint32_t(keys[k] >> 32);
+      for (uint32_t s = prev; s <= slot; ++s) start_[s] = uint32_t(k);
+      prev = slot + 1;
+      order_[k] = uint32_t(keys[k]);
+    }
+  });
+  const uint32_t last = n == 0 ? 0 : uint32_t(keys[n - 1] >> 32) + 1;
+  std::fill(start_.begin() + last, start_.end(), uint32_t(n));
 }
 
 Vec3 InverseSquare::Pair(const ParticleState& s, const Vec3* x, size_t i, size_t j) const {
