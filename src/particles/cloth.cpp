@@ -159,14 +159,15 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
   AddWind(x_.data(), v_.data(), wind, fext_.data());
   prev_.resize(n);
   const size_t m = constraints_.size();
-  scale_.resize(m);
-  alphaT_.resize(m);
+  proj_.resize(m);
   for (size_t k = 0; k < m; ++k) {
     const Constraint& c = constraints_[k];
-    alphaT_[k] = c.compliance / (h * h);
-    const double denom = w_[c.a] + w_[c.b] + alphaT_[k];
-    scale_[k] = denom > 0 ? 1 / denom : 0;  // 0: both ends pinned, nothing moves
+    const double alphaT = c.compliance / (h * h);
+    const double denom = w_[c.a] + w_[c.b] + alphaT;
+    const double scale = denom > 0 ? 1 / denom : 0;  // 0: both ends pinned, nothing moves
+    proj_[k] = {c.a, c.b, c.rest, scale, w_[c.a] * scale, w_[c.b] * scale, alphaT};
   }
+  const double invH = 1 / h;
   const double keep = std::max(0.0, 1 - def_.damping * h);
   for (int s = 0; s < subs; ++s) {
     ForRanges(pool, n, BalancedGrain(pool, n, 512, 4096), [&](size_t b, size_t e) {
@@ -177,14 +178,19 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
         x_[i] += h * v_[i];
       }
     });
-    std::fill(lambda_.begin(), lambda_.end(), 0.0);
     for (int it = 0; it < def_.iterations; ++it) {
       // Colour by colour: no two constraints of a colour share a particle,
       // so a colour's projections are independent (and run in parallel)
       // and the result does not depend on the thread count.
       for (size_t c = 0; c + 1 < colorStart_.size(); ++c) {
         const size_t first = colorStart_[c], count = colorStart_[c + 1] - first;
-        ForRanges(pool, count, BalancedGrain(pool, count, 256, 4096), [&](size_t b, size_t e) { ProjectRange(first + b, first + e); });
+        ForRanges(pool, count, BalancedGrain(pool, count, 256, 4096), [&](size_t b, size_t e) {
+          if (it == 0) {
+            ProjectRange<true>(first + b, first + e);
+          } else {
+            ProjectRange<false>(first + b, first + e);
+          }
+        });
       }
     }
     // Long-range attachments (Kim, Chentanez & Muller 2012): no particle may
@@ -202,32 +208,37 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
             if (len2 > th.rest * th.rest) x_[i] = x_[th.pin] + d * (th.rest / std::sqrt(len2));
           }
         }
-        v_[i] = (x_[i] - prev_[i]) / h;
+        v_[i] = (x_[i] - prev_[i]) * invH;
       }
     });
   }
 }
 
-// Projects constraints [first, last) of one colour. scale_[k] = 1 / (w_a +
-// w_b + alpha~_k) and alphaT_[k] = alpha~_k are set once a frame.
+// Projects constraints [first, last) of one colour:
+//   dl = (rest - len - alpha~ l) / (w_a + w_b + alpha~),  l += dl,
+//   x_a += w_a dl d/len,  x_b -= w_b dl d/len.
+// The first iteration of a substep starts from l = 0, so it neither reads
+// the multipliers nor (when it is the only one) needs them afterwards.
+template <bool kFirstIteration>
 void Cloth::ProjectRange(size_t first, size_t last) {
-  const Constraint* __restrict cs = constraints_.data();
-  const double* __restrict w = w_.data();
-  const double* __restrict scale = scale_.data();
-  const double* __restrict alphaT = alphaT_.data();
+  const Projection* __restrict ps = proj_.data();
   double* __restrict lambda = lambda_.data();
   Vec3* __restrict x = x_.data();
+  const bool keep = def_.iterations > 1;
   for (size_t k = first; k < last; ++k) {
-    const Constraint& c = cs[k];
+    const Projection& c = ps[k];
     const Vec3 d = x[c.a] - x[c.b];
     const double len2 = d.squaredNorm();
-    if (!(len2 > 1e-24)) continue;
+    if (!(len2 > 1e-24)) {
+      if (kFirstIteration && keep) lambda[k] = 0;
+      continue;
+    }
     const double len = std::sqrt(len2);
-    const double dl = (c.rest - len - alphaT[k] * lambda[k]) * scale[k];
-    lambda[k] += dl;
-    const Vec3 corr = (dl / len) * d;
-    x[c.a] += w[c.a] * corr;
-    x[c.b] -= w[c.b] * corr;
+    const double err = kFirstIteration ? c.rest - len : c.rest - len - c.alphaT * lambda[k];
+    if (keep) lambda[k] = (kFirstIteration ? 0 : lambda[k]) + err * c.scale;
+    const Vec3 dn = d * (err / len);
+    x[c.a] += c.ca * dn;
+    x[c.b] -= c.cb * dn;
   }
 }
 

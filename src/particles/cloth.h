@@ -89,6 +89,7 @@ class Cloth {
 
  private:
   void StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
+  template <bool kFirstIteration>
   void ProjectRange(size_t first, size_t last);
   struct Tether {
     uint32_t pin;
@@ -105,7 +106,14 @@ class Cloth {
   Vec3 gravity_, wind_;
   std::vector<double> w_;  // inverse masses
   std::vector<Constraint> constraints_;
-  std::vector<double> lambda_, scale_, alphaT_;
+  // Per constraint, set once a frame: the ends, the rest length, scale =
+  // 1 / (w_a + w_b + alpha~), each end's share w scale, alpha~ = alpha/h^2.
+  struct Projection {
+    uint32_t a, b;
+    double rest, scale, ca, cb, alphaT;
+  };
+  std::vector<Projection> proj_;
+  std::vector<double> lambda_;
   std::vector<std::array<uint32_t, 3>> tris_;
 };
 
