@@ -94,3 +94,74 @@ TEST(Faults, ImplicitEulerIsStableWhereExplicitExplodes) {
 
 }  // namespace
 }  // namespace sylva::particles
+
+namespace sylva::particles {
+namespace {
+
+// A hub tied to 100 rim particles (more springs on one particle than the 64
+// colours, so the serial group is used) and a ring around the rim.
+struct HubNetwork {
+  ParticleState state;
+  std::shared_ptr<Springs> springs = std::make_shared<Springs>();
+  HubNetwork() {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    state.Add(Vec3::Zero(), Vec3::Zero());
+    for (int i = 0; i < 100; ++i) state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)));
+    for (uint32_t i = 1; i <= 100; ++i) {
+      springs->Add(0, i, 0.5, 10 + i, 0.1 * i);
+      springs->Add(i, i % 100 + 1, 0.2, 30, 0.3);
+    }
+  }
+  std::vector<Vec3> Forces(ThreadPool* pool) {
+    springs->set_pool(pool);
+    std::vector<Vec3> f(state.size(), Vec3::Zero());
+    springs->Accumulate(state, state.position.data(), state.velocity.data(), f.data());
+    return f;
+  }
+};
+
+TEST(Springs, ColouredPassesEqualTheSerialSumAndIgnoreTheThreadCount) {
+  HubNetwork net;
+  ThreadPool pool(2);
+  const std::vector<Vec3> one = net.Forces(nullptr), two = net.Forces(&pool);
+  EXPECT_GT(net.springs->colourCount(), 2u);
+  const Vec3* x = net.state.position.data();
+  const Vec3* v = net.state.velocity.data();
+  std::vector<Vec3> ref(net.state.size(), Vec3::Zero());
+  for (const auto& sp : net.springs->springs()) {
+    const Vec3 d = x[sp.a] - x[sp.b];
+    const double len = d.norm();
+    const Vec3 fa = -(sp.ks * (len - sp.rest) + sp.kd * (v[sp.a] - v[sp.b]).dot(d / len)) * d / len;
+    ref[sp.a] += fa;
+    ref[sp.b] -= fa;
+  }
+  for (size_t i = 0; i < ref.size(); ++i) {
+    ASSERT_EQ(one[i], two[i]) << "particle " << i << ": 1 thread " << one[i].transpose() << ", 2 threads "
+                              << two[i].transpose();
+    ASSERT_LT((one[i] - ref[i]).norm(), 1e-12 * (1 + ref[i].norm()))
+        << "particle " << i << ": coloured " << one[i].transpose() << ", serial " << ref[i].transpose();
+  }
+}
+
+TEST(Springs, CachedJacobianProductEqualsTheDirectOne) {
+  HubNetwork net;
+  ThreadPool pool(2);
+  net.springs->set_pool(&pool);
+  const Vec3* x = net.state.position.data();
+  const Vec3* v = net.state.velocity.data();
+  std::vector<Vec3> p(net.state.size()), direct(net.state.size(), Vec3::Zero()), cached = direct;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (Vec3& q : p) q = Vec3(u(rng), u(rng), u(rng));
+  net.springs->AddJacobianProduct(net.state, x, v, -0.01, -0.1, p.data(), direct.data());
+  net.springs->PrepareJacobian(net.state, x, v);
+  net.springs->AddJacobianProduct(net.state, x, v, -0.01, -0.1, p.data(), cached.data());
+  for (size_t i = 0; i < p.size(); ++i) {
+    ASSERT_LT((cached[i] - direct[i]).norm(), 1e-12 * (1 + direct[i].norm()))
+        << "particle " << i << ": cached " << cached[i].transpose() << ", direct " << direct[i].transpose();
+  }
+}
+
+}  // namespace
+}  // namespace sylva::particles
