@@ -569,7 +569,7 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
     const uint32_t* succModules = succModules_.data();
     const uint32_t* succParams = succParams_.data();
     const uint8_t* arity = arities.data();
-    bool changed = false;
+    bool rewrote = false;
     for (size_t i = c.begin; i < c.end; ++i) {
       const SymbolId sym = w.symbols[i];
       uint32_t ch = symChoice[sym];
@@ -596,10 +596,10 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
       } else {
         modules += succModules[ch];
         params += succParams[ch];
-        changed = true;
+        rewrote = true;
       }
     }
-    c.changed = changed;
+    c.changed = rewrote;
     c.outModules = modules;
     c.outParams = params;
   });
