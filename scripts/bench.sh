@@ -31,24 +31,30 @@ out="bench/results/$stamp"
     echo "node/npm not installed: skipped"
   fi
 } | tee "$out.txt"
-{
-  echo "# Sylva particle benchmarks, $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD)"
-  echo "# machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p')"
-  echo "# BM_Step: gravity + linear/quadratic drag + one plane collider; args: particles/threads; items = particle steps"
-  echo "# BM_GridBuild: counting-sort grid, args: points/threads; BM_Flocking: boids/threads, ~20 neighbours"
-  echo "# BM_Cloth: one 1/60 s frame, args: k (k x k particles)/threads; stretch = largest structural strain"
-  build/bench/bench_particles --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
+# Median of 3 repetitions of each benchmark in program $1.
+medians() {
+  "$1" --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
     --benchmark_min_time=0.3 2>&1 | grep -E "^BM_.*_median" || true
+}
+# When, at which commit, on what.
+provenance() {
+  echo "# $1, $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD)"
+  echo "# machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p')"
+}
+{
+  provenance "Sylva particle benchmarks"
+  echo "# BM_Step: gravity + linear/quadratic drag + one plane collider; args: particles/threads; items = particle steps"
+  echo "# BM_GridBuild: radix-sorted grid, args: points/threads; BM_Flocking: boids/threads, ~20 neighbours"
+  echo "# BM_Cloth: one 1/60 s frame, args: k (k x k particles)/threads; stretch = largest structural strain"
+  medians build/bench/bench_particles
 } | tee "$out-particles.txt"
 if [[ -x build/bench/bench_bullet_cloth ]]; then
   {
-    echo "# Sylva cloth against Bullet $(pkg-config --modversion bullet) btSoftBody, $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD)"
-    echo "# machine: $(nproc) cores, $(lscpu | sed -n 's/^Model name: *//p')"
+    provenance "Sylva cloth against Bullet $(pkg-config --modversion bullet) btSoftBody"
     echo "# one 1/60 s frame (20 substeps) of a k x k, 1 kg, 1 m cloth pinned at two corners, after 3 s of fall;"
     echo "# Sylva args: k/threads; Bullet args: k/position iterations a substep (1 = Sylva's work)"
     echo "# sag: free corners below the pins at 3 s (m); stretch: largest structural strain at 3 s; peak: over the 3 s"
-    build/bench/bench_bullet_cloth --benchmark_repetitions=3 --benchmark_report_aggregates_only=true \
-      --benchmark_min_time=0.3 2>&1 | grep -E "^BM_.*_median" || true
+    medians build/bench/bench_bullet_cloth
   } | tee "$out-bullet.txt"
 else
   echo "bench_bullet_cloth not built (apt-get install libbullet-dev): no Bullet comparison"
