@@ -31,7 +31,9 @@ int main(int argc, char** argv) {
   def.stretchCompliance = 1e-6;
   def.shearCompliance = 1e-4;
   def.bendCompliance = 5e-2;
-  def.windDrag = 2.0;
+  def.windDrag = 2.0;  // with equal lift: the pressure on a flat plate
+  def.windLift = 2.0;
+  def.windFriction = 0.05;
   def.damping = 0.2;
   def.substeps = 40;
   def.iterations = 4;

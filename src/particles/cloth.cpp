@@ -6,6 +6,25 @@
 
 namespace sylva::particles {
 
+// Gravity, damping and wind at the current frame's values, on the implicit
+// solver's threads.
+class Cloth::ExternalForce : public Force {
+ public:
+  explicit ExternalForce(Cloth* cloth) : cloth_(cloth) {}
+  void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override {
+    const size_t n = s.size();
+    const Vec3 g = cloth_->gravity_;
+    const double damping = cloth_->def_.damping;
+    ForRanges(pool_, n, BalancedGrain(pool_, n, 512, 4096), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) f[i] += s.mass[i] * (g - damping * v[i]);
+    });
+    cloth_->AddWind(pool_, x, v, cloth_->wind_, f);
+  }
+
+ private:
+  Cloth* cloth_;
+};
+
 Cloth::Cloth(const ClothDef& def) : def_(def) {
   def_.columns = std::max(def_.columns, 2);
   def_.rows = std::max(def_.rows, 2);
@@ -86,7 +105,7 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
       }
     }
   }
-  if (def_.threads != 1) {
+  if (def_.threads != 1 && def_.solver == ClothSolver::kXPBD) {  // the implicit solver has its own
     const int threads = def_.threads <= 0 ? ThreadPool::HardwareThreads() : def_.threads;
     if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
   }
@@ -102,27 +121,60 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
                    def_.implicitDamping);
     }
     implicit_->AddForce(springs);
-    // Gravity, wind and damping read the current frame's values.
-    implicit_->AddForce(std::make_shared<ForceFunction>(
-        [this](const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) {
-          for (size_t i = 0; i < s.size(); ++i) f[i] += s.mass[i] * (gravity_ - def_.damping * v[i]);
-          AddWind(x, v, wind_, f);
-        }));
+    implicit_->AddForce(std::make_shared<ExternalForce>(this));
   }
 }
 
-void Cloth::AddWind(const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f) const {
-  if (def_.windDrag == 0) return;
-  for (const auto& t : tris_) {
-    const Vec3 e1 = x[t[1]] - x[t[0]], e2 = x[t[2]] - x[t[0]];
-    const Vec3 cr = e1.cross(e2);
-    const double area2 = cr.norm();
-    if (!(area2 > 0)) continue;
-    const Vec3 nrm = cr / area2;
-    const Vec3 rel = wind - (v[t[0]] + v[t[1]] + v[t[2]]) / 3;
-    const Vec3 fw = def_.windDrag * 0.5 * area2 * rel.dot(nrm) * nrm / 3;
-    for (uint32_t k : t) f[k] += fw;
-  }
+void Cloth::AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f) {
+  const double cd = def_.windDrag, cl = def_.windLift, cf = def_.windFriction;
+  if (cd == 0 && cl == 0 && cf == 0) return;
+  // Each triangle's force, then each particle gathers from the (up to six)
+  // triangles around it in a fixed order: parallel, and the same sums for
+  // any thread count.
+  const size_t nt = tris_.size();
+  triForce_.resize(nt);
+  ForRanges(pool, nt, BalancedGrain(pool, nt, 512, 4096), [&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) {
+      const auto& t = tris_[k];
+      const Vec3 cr = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+      const double area2 = cr.norm();
+      const Vec3 u = wind - (v[t[0]] + v[t[1]] + v[t[2]]) / 3;
+      const double uu = u.squaredNorm();
+      if (!(area2 > 0) || !(uu > 0)) {
+        triForce_[k] = Vec3::Zero();
+        continue;
+      }
+      const Vec3 n = cr / area2;
+      const double un = u.dot(n);
+      // A (n.u) [c_l n + (c_d - c_l) (n.u) u / |u|^2]: drag along u is
+      // c_d A |u| cos^2, and what is left of c_l A (n.u) n is the lift.
+      Vec3 fw = un * (cl * n + ((cd - cl) * un / uu) * u);
+      if (cf != 0) fw += cf * (u - un * n);
+      triForce_[k] = (0.5 * area2 / 3) * fw;  // a third to each corner
+    }
+  });
+  // Cell (c, r) holds triangles 2 cell = (a, d, b) and 2 cell + 1 = (b, d, e)
+  // with a = (c, r), b = (c+1, r), d = (c, r+1), e = (c+1, r+1).
+  const int nc = def_.columns, nr = def_.rows;
+  const size_t n = x_.size();
+  ForRanges(pool, n, BalancedGrain(pool, n, 512, 4096), [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const int c = int(i % size_t(nc)), r = int(i / size_t(nc));
+      auto cell = [&](int cc, int rr) { return 2 * (size_t(rr) * size_t(nc - 1) + size_t(cc)); };
+      Vec3 sum = Vec3::Zero();
+      if (c + 1 < nc && r + 1 < nr) sum += triForce_[cell(c, r)];  // as a
+      if (c > 0 && r + 1 < nr) {                                     // as b
+        const size_t k = cell(c - 1, r);
+        sum += triForce_[k] + triForce_[k + 1];
+      }
+      if (c + 1 < nc && r > 0) {  // as d
+        const size_t k = cell(c, r - 1);
+        sum += triForce_[k] + triForce_[k + 1];
+      }
+      if (c > 0 && r > 0) sum += triForce_[cell(c - 1, r - 1) + 1];  // as e
+      f[i] += sum;
+    }
+  });
 }
 
 double Cloth::MaxStretch() const {
@@ -156,7 +208,7 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
   ThreadPool* pool = pool_.get();
   // Wind once a frame (it changes slowly next to the substeps).
   fext_.assign(n, Vec3::Zero());
-  AddWind(x_.data(), v_.data(), wind, fext_.data());
+  AddWind(pool, x_.data(), v_.data(), wind, fext_.data());
   prev_.resize(n);
   const size_t m = constraints_.size();
   proj_.resize(m);

@@ -14,10 +14,17 @@
 // makes the stiffness independent of the iteration count and the step, so a
 // hanging mass settles at the extension m g alpha however many iterations
 // are used. Velocities are (x - x_prev) / h. Pinned particles have inverse
-// mass 0 and never move. Wind acts on each triangle by its area and the
-// normal component of the relative air speed (a drag/lift model: the force
-// is along the normal, so a cloth at an angle to the wind is both pushed
-// downwind and lifted across it).
+// mass 0 and never move.
+//
+// Wind acts on each triangle (area A, unit normal n) through the air's
+// speed relative to it, u = wind - mean corner velocity, with th the angle
+// between n and u. Drag pulls along u, lift pushes across it (in the plane
+// of n and u), skin friction pulls along the triangle:
+//   drag     c_d A |u| cos^2 th
+//   lift     c_l A |u| cos th sin th
+//   friction c_f A (u - (n.u) n)
+// All three are linear in |u|. With c_d = c_l drag and lift add up to
+// A (n.u) n, the pressure on a flat plate, which is the default.
 //
 // The implicit solver (ClothDef::solver = kImplicit) turns every constraint
 // into a damped spring of stiffness 1/compliance, at most `implicitStiffness` and takes backward-Euler steps (Baraff & Witkin 1998) with
@@ -52,7 +59,10 @@ struct ClothDef {
   int substeps = 10;
   int iterations = 1;                   // per substep
   double damping = 0;                   // fraction of velocity removed per second
-  double windDrag = 1.0;                // air force per (m^2 * m/s) of normal speed
+  // Air force coefficients, N per (m^2 * m/s); see the notes above.
+  double windDrag = 1.0;                // c_d, along the relative air speed
+  double windLift = 1.0;                // c_l, across it
+  double windFriction = 0;              // c_f, along the triangle
   std::vector<int> pinned;              // particle indices (row * columns + column)
   // Long-range attachments: tethers from every particle to its two nearest
   // pins, at their rest distance (XPBD only).
@@ -99,7 +109,9 @@ class Cloth {
   std::vector<Tether> tethers_;         // kTethers a particle
   std::vector<size_t> colorStart_;      // constraints_ sorted by colour
   std::unique_ptr<ThreadPool> pool_;
-  void AddWind(const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f) const;
+  void AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f);
+  class ExternalForce;                  // gravity, damping and wind for the implicit solver
+  std::vector<Vec3> triForce_;          // AddWind's per-triangle forces
   ClothDef def_;
   std::vector<Vec3> x_, v_, prev_, fext_;
   std::unique_ptr<System> implicit_;

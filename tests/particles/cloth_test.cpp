@@ -127,21 +127,79 @@ TEST(ClothImplicit, ConjugateGradientsConvergeWhenGivenTheIterations) {
 }
 
 TEST(Cloth, OneAndTwoThreadsAreBitIdentical) {
-  auto run = [](int threads) {
-    ClothDef def;
-    def.columns = 64;
-    def.rows = 64;
-    def.substeps = 8;
-    def.threads = threads;
-    def.pinned = {0, 63};
-    Cloth cloth(def);
-    for (int i = 0; i < 20; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(1, 0, 3));
-    return cloth.positions();
-  };
-  const auto one = run(1), two = run(2);
-  size_t differ = 0;
-  for (size_t i = 0; i < one.size(); ++i) differ += one[i] != two[i];
-  EXPECT_EQ(differ, 0u) << "particles that differ between 1 and 2 threads";
+  for (ClothSolver solver : {ClothSolver::kXPBD, ClothSolver::kImplicit}) {
+    auto run = [solver](int threads) {
+      ClothDef def;
+      def.columns = 64;
+      def.rows = 64;
+      def.substeps = 8;
+      def.threads = threads;
+      def.pinned = {0, 63};
+      def.windLift = 0.6;
+      def.windFriction = 0.1;
+      def.solver = solver;
+      Cloth cloth(def);
+      for (int i = 0; i < 20; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(1, 0, 3));
+      return cloth.positions();
+    };
+    const auto one = run(1), two = run(2);
+    size_t differ = 0;
+    for (size_t i = 0; i < one.size(); ++i) differ += one[i] != two[i];
+    EXPECT_EQ(differ, 0u) << "particles that differ between 1 and 2 threads, solver "
+                          << (solver == ClothSolver::kXPBD ? "XPBD" : "implicit");
+  }
+}
+
+// A flat 1 m^2 square (two triangles) at rest in the xy plane, its normal
+// along z, in a wind of speed U at angle th to the normal. Internal
+// constraints conserve momentum, so after one frame of length dt the
+// cloth's momentum is dt times the air force, which has closed forms:
+// drag c_d A U cos^2 th along the wind, lift c_l A U cos th sin th across it
+// (toward the normal), friction c_f A U sin th along the cloth.
+TEST(Cloth, WindDragLiftAndFrictionMatchTheirClosedForms) {
+  const double U = 5, dt = 1.0 / 60;
+  for (ClothSolver solver : {ClothSolver::kXPBD, ClothSolver::kImplicit}) {
+    for (double deg : {0.0, 30.0, 60.0, 85.0}) {
+      const double th = deg * M_PI / 180, c = std::cos(th), s = std::sin(th);
+      const Vec3 along(s, 0, c);            // the wind's direction
+      const Vec3 across(c, 0, -s);          // perpendicular to it, in the plane of n and the wind
+      const Vec3 n(0, 0, 1), t(1, 0, 0);    // normal and the tangential direction of the wind
+      struct Case {
+        double cd, cl, cf;
+        Vec3 want;
+      };
+      // Lift points toward the normal side: -across has a positive z.
+      const Case cases[] = {
+          {1, 0, 0, U * c * c * along},
+          {0, 1, 0, -U * c * s * across},
+          {0, 0, 1, U * s * t},
+          {2, 2, 0, 2 * U * c * n},  // equal drag and lift: the flat-plate pressure
+          {1.5, 0.4, 0.3, 1.5 * U * c * c * along - 0.4 * U * c * s * across + 0.3 * U * s * t},
+      };
+      for (const Case& k : cases) {
+        ClothDef def;
+        def.columns = 2;
+        def.rows = 2;
+        def.u = Vec3(1, 0, 0);
+        def.v = Vec3(0, 1, 0);
+        def.mass = 0.4;
+        def.windDrag = k.cd;
+        def.windLift = k.cl;
+        def.windFriction = k.cf;
+        def.solver = solver;
+        def.substeps = 5;
+        Cloth cloth(def);
+        cloth.Step(dt, Vec3::Zero(), U * along);
+        Vec3 momentum = Vec3::Zero();
+        for (const Vec3& v : cloth.velocities()) momentum += (def.mass / 4) * v;
+        const Vec3 force = momentum / dt;
+        EXPECT_LT((force - k.want).norm(), 1e-9 * (1 + k.want.norm()))
+            << (solver == ClothSolver::kXPBD ? "XPBD" : "implicit") << ", th = " << deg << " deg, c_d " << k.cd
+            << " c_l " << k.cl << " c_f " << k.cf << ": force " << force.transpose() << ", want "
+            << k.want.transpose();
+      }
+    }
+  }
 }
 
 TEST(Cloth, TethersKeepAHangingClothFromStretching) {
