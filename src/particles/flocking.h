@@ -39,6 +39,7 @@ class Flocking : public Force {
  private:
   FlockingDef def_;
   mutable NeighbourGrid grid_;
+  mutable std::vector<Vec3> sortedV_, steer_;  // in the grid's slot order
 };
 
 // Order parameter: |sum of unit velocities| / n, 1 when all move alike.

@@ -6,7 +6,7 @@
 
 namespace sylva::particles {
 
-void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool) {
+void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool, bool copyPositions) {
   cell_ = cellSize > 0 ? cellSize : 1;
   invCell_ = 1 / cell_;
   uint32_t slots = 1;
@@ -92,6 +92,8 @@ void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* 
   // Slot starts and the particle order, a range of sorted keys each: start_
   // of the slots from just after the previous key's slot to this key's.
   const uint64_t* keys = keys_.data();
+  copied_ = copyPositions;
+  if (copied_) sorted_.resize(n);
   forRanges([&](size_t r) {
     const auto [b, e] = range(r);
     uint32_t prev = b == 0 ? 0 : uint32_t(keys[b - 1] >> 32) + 1;
@@ -100,6 +102,7 @@ void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* 
       for (uint32_t s = prev; s <= slot; ++s) start_[s] = uint32_t(k);
       prev = slot + 1;
       order_[k] = uint32_t(keys[k]);
+      if (copyPositions) sorted_[k] = x[order_[k]];
     }
   });
   const uint32_t last = n == 0 ? 0 : uint32_t(keys[n - 1] >> 32) + 1;
@@ -113,7 +116,7 @@ Vec3 InverseSquare::Pair(const ParticleState& s, const Vec3* x, size_t i, size_t
 }
 
 void InverseSquare::Accumulate(const ParticleState& s, const Vec3* x, const Vec3*, Vec3* f) const {
-  grid_.Build(x, s.size(), cutoff_, pool_);
+  grid_.Build(x, s.size(), cutoff_, pool_, /*copyPositions=*/true);
   // Each particle gathers its own sum: ranges of particles are independent.
   ForRanges(pool_, s.size(), 1024, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {

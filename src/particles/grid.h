@@ -29,20 +29,39 @@ namespace sylva::particles {
 class NeighbourGrid {
  public:
   // cellSize should be at least the query radius.
-  // The pool, if any, runs every pass in parallel.
-  void Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool = nullptr);
-  // Calls fn(j) for every particle j != i within `radius` of x[i].
+  // The pool, if any, runs every pass in parallel. With copyPositions the
+  // grid keeps a copy of the positions in slot order, so queries read the
+  // candidates contiguously instead of through the index (about one more
+  // pass over x; worth it when every particle queries, and valid only
+  // while x does not change).
+  void Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool = nullptr, bool copyPositions = false);
+  // Calls fn(j) for every particle j != i within `radius` of x[i], in the
+  // same order whatever the thread count.
   template <typename Fn>
   void ForEachNeighbour(const Vec3* x, size_t i, double radius, Fn&& fn) const;
+  // After a Build with copyPositions: calls fn(k) for every neighbour of
+  // the point p (closer than `radius`), where k is the neighbour's place in
+  // slot order: it is particle order()[k], at sortedPositions()[k]. The
+  // point itself, if it is a particle, is included (its distance is 0).
+  template <typename Fn>
+  void ForEachInSlotOrder(const Vec3& p, double radius, Fn&& fn) const;
+  // The particles in slot order: neighbours are near each other in it, so
+  // a loop over all particles in this order reuses the cache.
+  const std::vector<uint32_t>& order() const { return order_; }
+  const std::vector<Vec3>& sortedPositions() const { return sorted_; }
 
  private:
   uint32_t Slot(int64_t cx, int64_t cy, int64_t cz) const;
+  template <typename Fn>
+  void ForEachCandidateRange(const Vec3& p, Fn&& visit) const;
   // The cell coordinate of c (Build and queries must agree exactly).
   int64_t CellOf(double c) const;
   double cell_ = 1, invCell_ = 1;
   uint32_t mask_ = 0;
   uint64_t B_ = 0, C_ = 0;
   std::vector<uint32_t> start_, order_;
+  std::vector<Vec3> sorted_;           // x in slot order (copyPositions)
+  bool copied_ = false;
   std::vector<uint64_t> keys_, tmp_;   // slot << 32 | index
   std::vector<uint32_t> hist_;         // per range, per digit value
 };
@@ -80,16 +99,11 @@ inline uint32_t NeighbourGrid::Slot(int64_t cx, int64_t cy, int64_t cz) const {
   return uint32_t((uint64_t(cx) + uint64_t(cy) * B_ + uint64_t(cz) * C_) & mask_);
 }
 
+// Calls visit(from, to) for the 9 contiguous ranges of slot order that
+// hold the 27 cells around p.
 template <typename Fn>
-void NeighbourGrid::ForEachNeighbour(const Vec3* x, size_t i, double radius, Fn&& fn) const {
-  const double r2 = radius * radius;
-  const int64_t cx = CellOf(x[i].x()), cy = CellOf(x[i].y()), cz = CellOf(x[i].z());
-  auto visit = [&](uint32_t from, uint32_t to) {
-    for (uint32_t k = from; k < to; ++k) {
-      const uint32_t j = order_[k];
-      if (j != i && (x[j] - x[i]).squaredNorm() <= r2) fn(size_t(j));
-    }
-  };
+void NeighbourGrid::ForEachCandidateRange(const Vec3& p, Fn&& visit) const {
+  const int64_t cx = CellOf(p.x()), cy = CellOf(p.y()), cz = CellOf(p.z());
   for (int64_t dz = -1; dz <= 1; ++dz) {
     for (int64_t dy = -1; dy <= 1; ++dy) {
       const uint32_t first = Slot(cx - 1, cy + dy, cz + dz);
@@ -103,6 +117,36 @@ void NeighbourGrid::ForEachNeighbour(const Vec3* x, size_t i, double radius, Fn&
       }
     }
   }
+}
+
+template <typename Fn>
+void NeighbourGrid::ForEachNeighbour(const Vec3* x, size_t i, double radius, Fn&& fn) const {
+  const double r2 = radius * radius;
+  const Vec3 xi = x[i];
+  const Vec3* sx = sorted_.data();
+  ForEachCandidateRange(xi, [&](uint32_t from, uint32_t to) {
+    if (copied_) {
+      for (uint32_t k = from; k < to; ++k) {
+        if ((sx[k] - xi).squaredNorm() <= r2 && order_[k] != i) fn(size_t(order_[k]));
+      }
+      return;
+    }
+    for (uint32_t k = from; k < to; ++k) {
+      const uint32_t j = order_[k];
+      if (j != i && (x[j] - xi).squaredNorm() <= r2) fn(size_t(j));
+    }
+  });
+}
+
+template <typename Fn>
+void NeighbourGrid::ForEachInSlotOrder(const Vec3& p, double radius, Fn&& fn) const {
+  const double r2 = radius * radius;
+  const Vec3* sx = sorted_.data();
+  ForEachCandidateRange(p, [&](uint32_t from, uint32_t to) {
+    for (uint32_t k = from; k < to; ++k) {
+      if ((sx[k] - p).squaredNorm() <= r2) fn(size_t(k));
+    }
+  });
 }
 
 }  // namespace sylva::particles

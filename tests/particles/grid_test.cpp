@@ -14,20 +14,31 @@ TEST(NeighbourGrid, EqualsBruteForceOn10kRandomPoints) {
   std::vector<Vec3> x(10000);
   for (auto& p : x) p = Vec3(u(rng), u(rng), u(rng) * 0.2);  // dense in z
   const double r = 0.3;
-  NeighbourGrid grid;
-  grid.Build(x.data(), x.size(), r);
-  size_t total = 0;
-  for (size_t i = 0; i < x.size(); i += 7) {
-    std::vector<size_t> fromGrid, brute;
-    grid.ForEachNeighbour(x.data(), i, r, [&](size_t j) { fromGrid.push_back(j); });
-    for (size_t j = 0; j < x.size(); ++j) {
-      if (j != i && (x[j] - x[i]).squaredNorm() <= r * r) brute.push_back(j);
+  for (bool copy : {false, true}) {
+    NeighbourGrid grid;
+    grid.Build(x.data(), x.size(), r, nullptr, copy);
+    size_t total = 0;
+    for (size_t i = 0; i < x.size(); i += 7) {
+      std::vector<size_t> fromGrid, inSlotOrder, brute;
+      grid.ForEachNeighbour(x.data(), i, r, [&](size_t j) { fromGrid.push_back(j); });
+      if (copy) {
+        grid.ForEachInSlotOrder(x[i], r, [&](size_t k) {
+          EXPECT_EQ(grid.sortedPositions()[k], x[grid.order()[k]]) << "slot-order copy, place " << k;
+          if (grid.order()[k] != i) inSlotOrder.push_back(grid.order()[k]);
+        });
+        // Both queries visit in the same order.
+        EXPECT_EQ(inSlotOrder, fromGrid) << "particle " << i;
+      }
+      for (size_t j = 0; j < x.size(); ++j) {
+        if (j != i && (x[j] - x[i]).squaredNorm() <= r * r) brute.push_back(j);
+      }
+      std::sort(fromGrid.begin(), fromGrid.end());
+      ASSERT_EQ(fromGrid, brute) << (copy ? "with" : "without") << " copied positions, particle " << i << ": grid "
+                                 << fromGrid.size() << ", brute force " << brute.size();
+      total += brute.size();
     }
-    std::sort(fromGrid.begin(), fromGrid.end());
-    ASSERT_EQ(fromGrid, brute) << "particle " << i << ": grid " << fromGrid.size() << ", brute force " << brute.size();
-    total += brute.size();
+    EXPECT_GT(total, 1000u) << "the test should see many neighbours";
   }
-  EXPECT_GT(total, 1000u) << "the test should see many neighbours";
 }
 
 TEST(InverseSquare, GridForcesEqualAllPairsWithinTheCutoff) {
