@@ -39,13 +39,23 @@ void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* 
   tmp_.resize(n);
   order_.resize(n);
   start_.resize(size_t(slots) + 1);
+  copied_ = copyPositions;
+  if (copied_) sorted_.resize(n);
+  // Two passes of a stable sort by slot. First a counting sort by the top
+  // 8 bits of the slot into 256 buckets, in parallel over fixed ranges of
+  // particles; then each bucket, small enough for the cache, is counting-
+  // sorted by the remaining bits, which gives the slot starts directly.
+  int bits = 0;
+  while ((uint64_t(1) << bits) < slots) ++bits;
+  const int topBits = std::min(bits, 8), lowBits = bits - topBits;
+  const size_t buckets = size_t(1) << topBits, lowSlots = size_t(1) << lowBits;
+  const uint32_t lowMask = uint32_t(lowSlots - 1);
   // Ranges of particles: a fixed split (a stable sort's result does not
   // depend on it), about four a thread.
   const size_t grain = BalancedGrain(pool, n, 16384);
   const size_t ranges = std::max<size_t>(1, (n + grain - 1) / grain);
-  constexpr int kBits = 8;
-  constexpr size_t kBuckets = size_t(1) << kBits;
-  hist_.resize(ranges * kBuckets);
+  hist_.resize(ranges * buckets);
+  bucketStart_.resize(buckets + 1);
   auto range = [&](size_t r) { return std::pair(r * grain, std::min(n, (r + 1) * grain)); };
   auto forRanges = [&](auto&& fn) {
     if (pool && ranges > 1) {
@@ -54,59 +64,65 @@ void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* 
       for (size_t r = 0; r < ranges; ++r) fn(r);
     }
   };
+  // The keys (slot << 32 | index) and each range's histogram of top digits.
   forRanges([&](size_t r) {
+    uint32_t* h = hist_.data() + r * buckets;
+    std::fill(h, h + buckets, 0u);
     const auto [b, e] = range(r);
     for (size_t i = b; i < e; ++i) {
       const uint32_t slot = Slot(CellOf(x[i].x()), CellOf(x[i].y()), CellOf(x[i].z()));
       keys_[i] = uint64_t(slot) << 32 | i;
+      ++h[slot >> lowBits];
     }
   });
-  int bits = 0;
-  while ((uint64_t(1) << bits) < slots) ++bits;
-  constexpr uint64_t kDigit = kBuckets - 1;
-  for (int shift = 32; shift < 32 + bits; shift += kBits) {
-    const uint64_t* src = keys_.data();
-    uint64_t* dst = tmp_.data();
-    forRanges([&](size_t r) {
-      uint32_t* h = hist_.data() + r * kBuckets;
-      std::fill(h, h + kBuckets, 0u);
-      const auto [b, e] = range(r);
-      for (size_t i = b; i < e; ++i) ++h[(src[i] >> shift) & kDigit];
-    });
-    // Offsets bucket-major, range-minor: the sort stays stable.
-    uint32_t sum = 0;
-    for (size_t d = 0; d < kBuckets; ++d) {
-      for (size_t r = 0; r < ranges; ++r) {
-        const uint32_t c = hist_[r * kBuckets + d];
-        hist_[r * kBuckets + d] = sum;
-        sum += c;
+  // Offsets bucket-major, range-minor: the sort stays stable.
+  uint32_t sum = 0;
+  for (size_t d = 0; d < buckets; ++d) {
+    bucketStart_[d] = sum;
+    for (size_t r = 0; r < ranges; ++r) {
+      const uint32_t c = hist_[r * buckets + d];
+      hist_[r * buckets + d] = sum;
+      sum += c;
+    }
+  }
+  bucketStart_[buckets] = sum;
+  forRanges([&](size_t r) {
+    uint32_t* off = hist_.data() + r * buckets;
+    const uint64_t* __restrict src = keys_.data();
+    uint64_t* __restrict dst = tmp_.data();
+    const auto [b, e] = range(r);
+    for (size_t i = b; i < e; ++i) dst[off[uint32_t(src[i] >> 32) >> lowBits]++] = src[i];
+  });
+  // Each bucket: count its slots, write their starts, place its particles.
+  auto sortBuckets = [&](size_t first, size_t last) {
+    thread_local std::vector<uint32_t> cursor;
+    cursor.resize(lowSlots);
+    const uint64_t* __restrict keys = tmp_.data();
+    for (size_t d = first; d < last; ++d) {
+      const uint32_t b = bucketStart_[d], e = bucketStart_[d + 1];
+      std::fill(cursor.begin(), cursor.end(), 0u);
+      for (uint32_t k = b; k < e; ++k) ++cursor[uint32_t(keys[k] >> 32) & lowMask];
+      uint32_t* start = start_.data() + (d << lowBits);
+      uint32_t pos = b;
+      for (size_t q = 0; q < lowSlots; ++q) {
+        const uint32_t c = cursor[q];
+        start[q] = pos;
+        cursor[q] = pos;
+        pos += c;
+      }
+      for (uint32_t k = b; k < e; ++k) {
+        const uint32_t at = cursor[uint32_t(keys[k] >> 32) & lowMask]++;
+        order_[at] = uint32_t(keys[k]);
+        if (copyPositions) sorted_[at] = x[uint32_t(keys[k])];
       }
     }
-    forRanges([&](size_t r) {
-      uint32_t* off = hist_.data() + r * kBuckets;
-      const auto [b, e] = range(r);
-      for (size_t i = b; i < e; ++i) dst[off[(src[i] >> shift) & kDigit]++] = src[i];
-    });
-    keys_.swap(tmp_);
+  };
+  if (pool && buckets > 1) {
+    ForRanges(pool, buckets, BalancedGrain(pool, buckets, 1), sortBuckets);
+  } else {
+    sortBuckets(0, buckets);
   }
-  // Slot starts and the particle order, a range of sorted keys each: start_
-  // of the slots from just after the previous key's slot to this key's.
-  const uint64_t* keys = keys_.data();
-  copied_ = copyPositions;
-  if (copied_) sorted_.resize(n);
-  forRanges([&](size_t r) {
-    const auto [b, e] = range(r);
-    uint32_t prev = b == 0 ? 0 : uint32_t(keys[b - 1] >> 32) + 1;
-    for (size_t k = b; k < e; ++k) {
-      const uint32_t slot = uint32_t(keys[k] >> 32);
-      for (uint32_t s = prev; s <= slot; ++s) start_[s] = uint32_t(k);
-      prev = slot + 1;
-      order_[k] = uint32_t(keys[k]);
-      if (copyPositions) sorted_[k] = x[order_[k]];
-    }
-  });
-  const uint32_t last = n == 0 ? 0 : uint32_t(keys[n - 1] >> 32) + 1;
-  std::fill(start_.begin() + last, start_.end(), uint32_t(n));
+  start_[slots] = uint32_t(n);
 }
 
 Vec3 InverseSquare::Pair(const ParticleState& s, const Vec3* x, size_t i, size_t j) const {

@@ -41,6 +41,34 @@ TEST(NeighbourGrid, EqualsBruteForceOn10kRandomPoints) {
   }
 }
 
+// The sort is stable and its passes split the work by fixed ranges, so the
+// slot order is the same for any thread count, and within a cell the
+// particles are in index order; also when most points share a few cells.
+TEST(NeighbourGrid, SlotOrderIsTheSameForOneAndTwoThreads) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-3, 3);
+  for (bool clustered : {false, true}) {
+    std::vector<Vec3> x(200000);
+    for (size_t i = 0; i < x.size(); ++i) {
+      x[i] = clustered && i % 4 != 0 ? Vec3(0.01 * (i % 3), 0.5, -0.2) : Vec3(u(rng), u(rng), u(rng));
+    }
+    NeighbourGrid one, two;
+    ThreadPool pool(2);
+    one.Build(x.data(), x.size(), 0.1, nullptr, true);
+    two.Build(x.data(), x.size(), 0.1, &pool, true);
+    ASSERT_EQ(one.order(), two.order()) << (clustered ? "clustered" : "uniform");
+    ASSERT_EQ(one.sortedPositions(), two.sortedPositions());
+    // Index order within a cell: the neighbours of a clustered point come
+    // out in increasing index order.
+    std::vector<size_t> near;
+    two.ForEachNeighbour(x.data(), 1, 0.001, [&](size_t j) { near.push_back(j); });
+    EXPECT_TRUE(std::is_sorted(near.begin(), near.end())) << near.size() << " neighbours";
+    if (clustered) {
+      EXPECT_GT(near.size(), 40000u);
+    }
+  }
+}
+
 TEST(InverseSquare, GridForcesEqualAllPairsWithinTheCutoff) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-2, 2);
