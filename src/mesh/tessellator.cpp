@@ -309,8 +309,8 @@ std::string Tessellate(const PlantGeometry& g, const TessellateOptions& options,
   }
   for (const Polygon& poly : g.polygons) {
     Vec3 normal;
-    std::vector<uint32_t> tris = TriangulatePolygon(poly.vertices, &normal);
-    if (tris.empty()) {
+    std::vector<uint32_t> polyTris = TriangulatePolygon(poly.vertices, &normal);
+    if (polyTris.empty()) {
       if (stats) {
         ++stats->polygonsSkipped;
         stats->warnings.push_back("polygon at module " + std::to_string(poly.module + 1) +
@@ -333,8 +333,8 @@ std::string Tessellate(const PlantGeometry& g, const TessellateOptions& options,
       Vec2 q((v.dot(e1) - lo.x()) / ext.x(), (v.dot(e2) - lo.y()) / ext.y());
       out.uvs.push_back(q.cast<float>());
     }
-    for (size_t t = 0; t < tris.size(); t += 3) {
-      out.indices.insert(out.indices.end(), {base + tris[t], base + tris[t + 1], base + tris[t + 2]});
+    for (size_t t = 0; t < polyTris.size(); t += 3) {
+      out.indices.insert(out.indices.end(), {base + polyTris[t], base + polyTris[t + 1], base + polyTris[t + 2]});
       out.material.push_back(poly.color);
     }
   }

@@ -273,10 +273,10 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
       }
     }
     glBindVertexArray(g.groundVao);
-    const void* data[3] = {pos.data(), nor.data(), col.data()};
+    const void* ground[3] = {pos.data(), nor.data(), col.data()};
     for (int k = 0; k < 3; ++k) {
       glBindBuffer(GL_ARRAY_BUFFER, g.groundBuffers[k]);
-      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(pos.size() * 12), data[k], GL_STATIC_DRAW);
+      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(pos.size() * 12), ground[k], GL_STATIC_DRAW);
       glEnableVertexAttribArray(GLuint(k));
       glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
     }
