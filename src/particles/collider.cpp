@@ -202,7 +202,7 @@ Collider Collider::Mesh(std::shared_ptr<const TriangleBvh> bvh) {
   return c;
 }
 
-bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
+bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
   const Vec3 d = b - a;
   switch (kind) {
     case Kind::kPlane: {
@@ -324,7 +324,7 @@ bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
   return false;
 }
 
-bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n) const {
+bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n) const {
   switch (kind) {
     case Kind::kPlane: {
       const double d = normal.dot(x - point);

@@ -101,9 +101,41 @@ struct Collider {
   // Half-space kinds (plane, sphere, box): if x is inside the solid, the
   // nearest surface point and its outward normal. Thin kinds return false.
   bool Project(const Vec3& x, Vec3* surface, Vec3* normal) const;
+
+ private:
+  // Every kind, out of line; Intersect and Project inline the plane, the
+  // kind of most resting contacts.
+  bool IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const;
+  bool ProjectAny(const Vec3& x, Vec3* surface, Vec3* normal) const;
 };
 
 // --- inline ---
+
+inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
+  if (kind != Kind::kPlane) return IntersectAny(a, b, c);
+  const double d1 = normal.dot(b - point);
+  if (d1 >= 0) return false;
+  const double d0 = normal.dot(a - point);
+  c->normal = normal;
+  if (d0 <= 0) {  // starts on or below the surface
+    c->s = 0;
+    c->point = a - d0 * normal;
+  } else {
+    c->s = d0 / (d0 - d1);
+    c->point = a + c->s * (b - a);
+    c->point -= normal.dot(c->point - point) * normal;  // exactly on the plane
+  }
+  return true;
+}
+
+inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n) const {
+  if (kind != Kind::kPlane) return ProjectAny(x, surface, n);
+  const double d = normal.dot(x - point);
+  if (d >= 0) return false;
+  *surface = x - d * normal;
+  *n = normal;
+  return true;
+}
 
 inline bool Collider::MayHit(const Vec3& a, const Vec3& b) const {
   switch (kind) {
