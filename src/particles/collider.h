@@ -97,7 +97,7 @@ struct Collider {
   bool Intersect(const Vec3& a, const Vec3& b, Contact* c) const;
   // A cheap test that is false only when the path a -> b certainly does not
   // touch the collider (the per-particle fast path).
-  bool MayHit(const Vec3& a, const Vec3& b) const;
+  [[gnu::always_inline]] bool MayHit(const Vec3& a, const Vec3& b) const;
   // Half-space kinds (plane, sphere, box): if x is inside the solid, the
   // nearest surface point and its outward normal. Thin kinds return false.
   bool Project(const Vec3& x, Vec3* surface, Vec3* normal) const;
@@ -137,7 +137,7 @@ inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n) const {
   return true;
 }
 
-inline bool Collider::MayHit(const Vec3& a, const Vec3& b) const {
+[[gnu::always_inline]] inline bool Collider::MayHit(const Vec3& a, const Vec3& b) const {
   switch (kind) {
     case Kind::kPlane:
       return normal.dot(b - point) < 0;
