@@ -205,21 +205,8 @@ Collider Collider::Mesh(std::shared_ptr<const TriangleBvh> bvh) {
 bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
   const Vec3 d = b - a;
   switch (kind) {
-    case Kind::kPlane: {
-      const double d1 = normal.dot(b - point);
-      if (d1 >= 0) return false;
-      const double d0 = normal.dot(a - point);
-      c->normal = normal;
-      if (d0 <= 0) {  // starts on or below the surface
-        c->s = 0;
-        c->point = a - d0 * normal;
-      } else {
-        c->s = d0 / (d0 - d1);
-        c->point = a + c->s * d;
-        c->point -= normal.dot(c->point - point) * normal;  // exactly on the plane
-      }
-      return true;
-    }
+    case Kind::kPlane:
+      return Intersect(a, b, c);  // inline in the header
     case Kind::kSphere: {
       const Vec3 ac = a - point;
       const double C = ac.squaredNorm() - radius * radius;
@@ -326,13 +313,8 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
 
 bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n) const {
   switch (kind) {
-    case Kind::kPlane: {
-      const double d = normal.dot(x - point);
-      if (d >= 0) return false;
-      *surface = x - d * normal;
-      *n = normal;
-      return true;
-    }
+    case Kind::kPlane:
+      return Project(x, surface, n);  // inline in the header
     case Kind::kSphere: {
       const Vec3 r = x - point;
       const double r2 = r.squaredNorm();
