@@ -74,6 +74,7 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
       used[constraints_[k].b] |= 1ULL << c;
       colors = std::max(colors, c + 1);
     }
+    lastColourShared_ = colors == 64;
     std::vector<Constraint> sorted;
     sorted.reserve(constraints_.size());
     colorStart_.clear();
@@ -211,8 +212,10 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
   AddWind(pool, x_.data(), v_.data(), wind, fext_.data());
   prev_.resize(n);
   const size_t m = constraints_.size();
+  const bool reuse = projH_ == h && proj_.size() == m;  // the masses never change; the substep may
+  projH_ = h;
   proj_.resize(m);
-  for (size_t k = 0; k < m; ++k) {
+  for (size_t k = 0; k < m && !reuse; ++k) {
     const Constraint& c = constraints_[k];
     const double alphaT = c.compliance / (h * h);
     const double denom = w_[c.a] + w_[c.b] + alphaT;
@@ -220,77 +223,88 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
     proj_[k] = {c.a, c.b, c.rest, scale, w_[c.a] * scale, w_[c.b] * scale, alphaT};
   }
   const double invH = 1 / h;
+  const bool keepLambda = def_.iterations > 1;
   const double keep = std::max(0.0, 1 - def_.damping * h);
-  for (int s = 0; s < subs; ++s) {
-    ForRanges(pool, n, BalancedGrain(pool, n, 512, 4096), [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) {
-        prev_[i] = x_[i];
-        if (w_[i] == 0) continue;
-        v_[i] = (v_[i] + h * (gravity + fext_[i] * w_[i])) * keep;
-        x_[i] += h * v_[i];
+  // The substeps run on padded positions (see xpbd.h), loaded from x_ here
+  // (the caller may have moved particles) and stored back at the end.
+  x4_.resize(n);
+  xpbd::Point4* __restrict x = x4_.data();
+  Vec3* __restrict v = v_.data();
+  Vec3* __restrict prev = prev_.data();
+  const double* __restrict w = w_.data();
+  const Vec3* __restrict fe = fext_.data();
+  const Tether* tethers = tethers_.empty() ? nullptr : tethers_.data();
+  // Prediction: x += h v after gravity, wind and damping.
+  const Vec3 g = gravity;
+  auto predict = [=](size_t i) {
+    double* p = x[i].p;
+    prev[i] = Vec3(p[0], p[1], p[2]);
+    if (w[i] == 0) return;
+    for (int k = 0; k < 3; ++k) {
+      v[i][k] = (v[i][k] + h * (g[k] + fe[i][k] * w[i])) * keep;
+      p[k] += h * v[i][k];
+    }
+  };
+  // Long-range attachments (Kim, Chentanez & Muller 2012): no particle may
+  // be farther from a pin than its rest distance, which keeps a hanging
+  // cloth from stretching at few iterations. Then the velocity. Pins never
+  // move, so this may run beside another particle's prediction. Whether a
+  // tether is taut is data, so the clamp is a select, not a branch.
+  auto finish = [=](size_t i) {
+    double* p = x[i].p;
+    if (tethers && w[i] != 0) {
+      for (int t = 0; t < kTethers; ++t) {
+        const Tether& th = tethers[i * kTethers + t];
+        if (th.pin == UINT32_MAX) continue;
+        const double* q = x[th.pin].p;
+        const double d0 = p[0] - q[0], d1 = p[1] - q[1], d2 = p[2] - q[2];
+        const double len2 = (d0 * d0 + d1 * d1) + d2 * d2;
+        const bool taut = len2 > th.rest * th.rest;
+        const double s = th.rest / std::sqrt(taut ? len2 : 1.0);
+        p[0] = taut ? q[0] + d0 * s : p[0];
+        p[1] = taut ? q[1] + d1 * s : p[1];
+        p[2] = taut ? q[2] + d2 * s : p[2];
       }
-    });
+    }
+    for (int k = 0; k < 3; ++k) v[i][k] = (p[k] - prev[i][k]) * invH;
+  };
+  const size_t grain = BalancedGrain(pool, n, 512, 4096);
+  ForRanges(pool, n, grain, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      x[i] = {{x_[i].x(), x_[i].y(), x_[i].z(), 0}};
+      predict(i);
+    }
+  });
+  for (int s = 0; s < subs; ++s) {
     for (int it = 0; it < def_.iterations; ++it) {
       // Colour by colour: no two constraints of a colour share a particle,
       // so a colour's projections are independent (and run in parallel)
       // and the result does not depend on the thread count.
       for (size_t c = 0; c + 1 < colorStart_.size(); ++c) {
         const size_t first = colorStart_[c], count = colorStart_[c + 1] - first;
+        if (lastColourShared_ && c + 2 == colorStart_.size()) {
+          xpbd::ProjectRange(xpbd::Kernel::kScalar, it == 0, keepLambda, proj_.data(), lambda_.data(), x, first,
+                             first + count);
+          continue;
+        }
         ForRanges(pool, count, BalancedGrain(pool, count, 256, 4096), [&](size_t b, size_t e) {
-          if (it == 0) {
-            ProjectRange<true>(first + b, first + e);
-          } else {
-            ProjectRange<false>(first + b, first + e);
-          }
+          xpbd::ProjectRange(kernel_, it == 0, keepLambda, proj_.data(), lambda_.data(), x, first + b, first + e);
         });
       }
     }
-    // Long-range attachments (Kim, Chentanez & Muller 2012): no particle may
-    // be farther from a pin than its rest distance, which keeps a hanging
-    // cloth from stretching at few iterations. Then velocities.
-    const bool tethered = !tethers_.empty();
-    ForRanges(pool, n, BalancedGrain(pool, n, 512, 4096), [&](size_t b, size_t e) {
+    // This substep's attachments and velocities, fused with the next one's
+    // prediction (or the store back).
+    const bool last = s + 1 == subs;
+    ForRanges(pool, n, grain, [&](size_t b, size_t e) {
       for (size_t i = b; i < e; ++i) {
-        if (tethered && w_[i] != 0) {
-          for (int t = 0; t < kTethers; ++t) {
-            const Tether& th = tethers_[i * kTethers + t];
-            if (th.pin == UINT32_MAX) continue;
-            const Vec3 d = x_[i] - x_[th.pin];
-            const double len2 = d.squaredNorm();
-            if (len2 > th.rest * th.rest) x_[i] = x_[th.pin] + d * (th.rest / std::sqrt(len2));
-          }
+        finish(i);
+        if (!last) {
+          predict(i);
+        } else {
+          x_[i] = Vec3(x[i].p[0], x[i].p[1], x[i].p[2]);
         }
-        v_[i] = (x_[i] - prev_[i]) * invH;
       }
     });
-  }
-}
-
-// Projects constraints [first, last) of one colour:
-//   dl = (rest - len - alpha~ l) / (w_a + w_b + alpha~),  l += dl,
-//   x_a += w_a dl d/len,  x_b -= w_b dl d/len.
-// The first iteration of a substep starts from l = 0, so it neither reads
-// the multipliers nor (when it is the only one) needs them afterwards.
-template <bool kFirstIteration>
-void Cloth::ProjectRange(size_t first, size_t last) {
-  const Projection* __restrict ps = proj_.data();
-  double* __restrict lambda = lambda_.data();
-  Vec3* __restrict x = x_.data();
-  const bool keep = def_.iterations > 1;
-  for (size_t k = first; k < last; ++k) {
-    const Projection& c = ps[k];
-    const Vec3 d = x[c.a] - x[c.b];
-    const double len2 = d.squaredNorm();
-    if (!(len2 > 1e-24)) {
-      if (kFirstIteration && keep) lambda[k] = 0;
-      continue;
-    }
-    const double len = std::sqrt(len2);
-    const double err = kFirstIteration ? c.rest - len : c.rest - len - c.alphaT * lambda[k];
-    if (keep) lambda[k] = (kFirstIteration ? 0 : lambda[k]) + err * c.scale;
-    const Vec3 dn = d * (err / len);
-    x[c.a] += c.ca * dn;
-    x[c.b] -= c.cb * dn;
   }
 }
 

@@ -40,6 +40,7 @@
 #include "core/math.h"
 #include "core/parallel.h"
 #include "particles/system.h"
+#include "particles/xpbd.h"
 
 namespace sylva::particles {
 
@@ -99,8 +100,6 @@ class Cloth {
 
  private:
   void StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
-  template <bool kFirstIteration>
-  void ProjectRange(size_t first, size_t last);
   struct Tether {
     uint32_t pin;
     double rest;
@@ -114,17 +113,15 @@ class Cloth {
   std::vector<Vec3> triForce_;          // AddWind's per-triangle forces
   ClothDef def_;
   std::vector<Vec3> x_, v_, prev_, fext_;
+  std::vector<xpbd::Point4> x4_;        // the XPBD substeps' positions
   std::unique_ptr<System> implicit_;
   Vec3 gravity_, wind_;
   std::vector<double> w_;  // inverse masses
   std::vector<Constraint> constraints_;
-  // Per constraint, set once a frame: the ends, the rest length, scale =
-  // 1 / (w_a + w_b + alpha~), each end's share w scale, alpha~ = alpha/h^2.
-  struct Projection {
-    uint32_t a, b;
-    double rest, scale, ca, cb, alphaT;
-  };
-  std::vector<Projection> proj_;
+  std::vector<xpbd::Projection> proj_;  // constraints_ as set for substeps of projH_ seconds
+  double projH_ = 0;
+  xpbd::Kernel kernel_ = xpbd::Best();
+  bool lastColourShared_ = false;       // the colouring ran out: its last colour may share particles
   std::vector<double> lambda_;
   std::vector<std::array<uint32_t, 3>> tris_;
 };

@@ -1,0 +1,47 @@
+// XPBD distance-constraint projection kernels (Macklin, Muller & Chentanez,
+// "XPBD: Position-based simulation of compliant constrained dynamics",
+// MIG 2016), internal to the particles library.
+//
+// A projection does little arithmetic on a lot of memory operations, plus a
+// square root and a division. The solver therefore keeps positions padded to
+// four doubles (`Point4`, 32-byte aligned, the fourth always 0), so the AVX
+// kernel moves a particle with one load and one store, and it projects four
+// constraints of a colour (which share no particle) at a time: their square
+// roots and quotients take one vector instruction each. Every lane does the
+// scalar kernel's operations in the same order, and IEEE square root and
+// division are exactly rounded, so both kernels give bit-identical results.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace sylva::particles::xpbd {
+
+// One constraint, set once a frame: the ends, the rest length,
+// scale = 1 / (w_a + w_b + alpha~), each end's share w scale, and
+// alpha~ = alpha / h^2.
+struct Projection {
+  uint32_t a, b;
+  double rest, scale, ca, cb, alphaT;
+};
+
+// A position padded to 32 bytes; p[3] is 0.
+struct alignas(32) Point4 {
+  double p[4];
+};
+
+enum class Kernel { kScalar, kAvx };
+
+// The widest kernel this processor runs.
+Kernel Best();
+
+// Projects constraints [first, last), which must share no particle:
+//   dl = (rest - len - alpha~ l) / (w_a + w_b + alpha~),  l += dl,
+//   x_a += w_a dl d/len,  x_b -= w_b dl d/len,
+// on positions x. The first iteration of a substep
+// starts from l = 0 and does not read the multipliers; keepLambda false
+// (one iteration a substep) skips storing them.
+void ProjectRange(Kernel kernel, bool firstIteration, bool keepLambda, const Projection* ps, double* lambda,
+                  Point4* x, size_t first, size_t last);
+
+}  // namespace sylva::particles::xpbd
