@@ -94,13 +94,13 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
     if (w_[i] == 0) pins.push_back(uint32_t(i));
   }
   if (def_.longRangeAttachments && !pins.empty()) {
-    tethers_.assign(n * kTethers, Tether{UINT32_MAX, 0});
+    tethers_.assign(n * xpbd::kTethers, xpbd::Tether{UINT32_MAX, 0});
     for (size_t i = 0; i < n; ++i) {
       if (w_[i] == 0) continue;
-      Tether* t = &tethers_[i * kTethers];
+      xpbd::Tether* t = &tethers_[i * xpbd::kTethers];
       for (uint32_t p : pins) {
-        Tether cand{p, (x_[i] - x_[p]).norm()};
-        for (int k = 0; k < kTethers; ++k) {
+        xpbd::Tether cand{p, (x_[i] - x_[p]).norm()};
+        for (int k = 0; k < xpbd::kTethers; ++k) {
           if (t[k].pin == UINT32_MAX || cand.rest < t[k].rest) std::swap(cand, t[k]);
         }
       }
@@ -210,7 +210,6 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
   // Wind once a frame (it changes slowly next to the substeps).
   fext_.assign(n, Vec3::Zero());
   AddWind(pool, x_.data(), v_.data(), wind, fext_.data());
-  prev_.resize(n);
   const size_t m = constraints_.size();
   const bool reuse = projH_ == h && proj_.size() == m;  // the masses never change; the substep may
   projH_ = h;
@@ -224,56 +223,33 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
   }
   const double invH = 1 / h;
   const bool keepLambda = def_.iterations > 1;
-  const double keep = std::max(0.0, 1 - def_.damping * h);
-  // The substeps run on padded positions (see xpbd.h), loaded from x_ here
-  // (the caller may have moved particles) and stored back at the end.
+  // The substeps run on padded positions, velocities and forces (see
+  // xpbd.h), loaded from x_ and v_ here (the caller may have moved
+  // particles) and stored back at the end.
   x4_.resize(n);
-  xpbd::Point4* __restrict x = x4_.data();
-  Vec3* __restrict v = v_.data();
-  Vec3* __restrict prev = prev_.data();
-  const double* __restrict w = w_.data();
-  const Vec3* __restrict fe = fext_.data();
-  const Tether* tethers = tethers_.empty() ? nullptr : tethers_.data();
-  // Prediction: x += h v after gravity, wind and damping.
-  const Vec3 g = gravity;
-  auto predict = [=](size_t i) {
-    double* p = x[i].p;
-    prev[i] = Vec3(p[0], p[1], p[2]);
-    if (w[i] == 0) return;
-    for (int k = 0; k < 3; ++k) {
-      v[i][k] = (v[i][k] + h * (g[k] + fe[i][k] * w[i])) * keep;
-      p[k] += h * v[i][k];
-    }
-  };
-  // Long-range attachments (Kim, Chentanez & Muller 2012): no particle may
-  // be farther from a pin than its rest distance, which keeps a hanging
-  // cloth from stretching at few iterations. Then the velocity. Pins never
-  // move, so this may run beside another particle's prediction. Whether a
-  // tether is taut is data, so the clamp is a select, not a branch.
-  auto finish = [=](size_t i) {
-    double* p = x[i].p;
-    if (tethers && w[i] != 0) {
-      for (int t = 0; t < kTethers; ++t) {
-        const Tether& th = tethers[i * kTethers + t];
-        if (th.pin == UINT32_MAX) continue;
-        const double* q = x[th.pin].p;
-        const double d0 = p[0] - q[0], d1 = p[1] - q[1], d2 = p[2] - q[2];
-        const double len2 = (d0 * d0 + d1 * d1) + d2 * d2;
-        const bool taut = len2 > th.rest * th.rest;
-        const double s = th.rest / std::sqrt(taut ? len2 : 1.0);
-        p[0] = taut ? q[0] + d0 * s : p[0];
-        p[1] = taut ? q[1] + d1 * s : p[1];
-        p[2] = taut ? q[2] + d2 * s : p[2];
-      }
-    }
-    for (int k = 0; k < 3; ++k) v[i][k] = (p[k] - prev[i][k]) * invH;
-  };
+  v4_.resize(n);
+  prev4_.resize(n);
+  fext4_.resize(n);
+  xpbd::Point4* x = x4_.data();
+  const xpbd::Particles parts{x,
+                              v4_.data(),
+                              prev4_.data(),
+                              fext4_.data(),
+                              w_.data(),
+                              tethers_.empty() ? nullptr : tethers_.data(),
+                              {gravity.x(), gravity.y(), gravity.z()},
+                              h,
+                              invH,
+                              std::max(0.0, 1 - def_.damping * h)};
+  auto pad = [](const Vec3& p) { return xpbd::Point4{{p.x(), p.y(), p.z(), 0}}; };
   const size_t grain = BalancedGrain(pool, n, 512, 4096);
   ForRanges(pool, n, grain, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
-      x[i] = {{x_[i].x(), x_[i].y(), x_[i].z(), 0}};
-      predict(i);
+      x4_[i] = pad(x_[i]);
+      v4_[i] = pad(v_[i]);
+      fext4_[i] = pad(fext_[i]);
     }
+    xpbd::PredictRange(kernel_, parts, b, e);
   });
   for (int s = 0; s < subs; ++s) {
     for (int it = 0; it < def_.iterations; ++it) {
@@ -296,13 +272,11 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
     // prediction (or the store back).
     const bool last = s + 1 == subs;
     ForRanges(pool, n, grain, [&](size_t b, size_t e) {
+      xpbd::FinishRange(kernel_, parts, !last, b, e);
+      if (!last) return;
       for (size_t i = b; i < e; ++i) {
-        finish(i);
-        if (!last) {
-          predict(i);
-        } else {
-          x_[i] = Vec3(x[i].p[0], x[i].p[1], x[i].p[2]);
-        }
+        x_[i] = Vec3(x4_[i].p[0], x4_[i].p[1], x4_[i].p[2]);
+        v_[i] = Vec3(v4_[i].p[0], v4_[i].p[1], v4_[i].p[2]);
       }
     });
   }

@@ -100,20 +100,15 @@ class Cloth {
 
  private:
   void StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
-  struct Tether {
-    uint32_t pin;
-    double rest;
-  };
-  static constexpr int kTethers = 2;
-  std::vector<Tether> tethers_;         // kTethers a particle
+  std::vector<xpbd::Tether> tethers_;   // xpbd::kTethers a particle
   std::vector<size_t> colorStart_;      // constraints_ sorted by colour
   std::unique_ptr<ThreadPool> pool_;
   void AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f);
   class ExternalForce;                  // gravity, damping and wind for the implicit solver
   std::vector<Vec3> triForce_;          // AddWind's per-triangle forces
   ClothDef def_;
-  std::vector<Vec3> x_, v_, prev_, fext_;
-  std::vector<xpbd::Point4> x4_;        // the XPBD substeps' positions
+  std::vector<Vec3> x_, v_, fext_;
+  std::vector<xpbd::Point4> x4_, v4_, prev4_, fext4_;  // the XPBD substeps' state
   std::unique_ptr<System> implicit_;
   Vec3 gravity_, wind_;
   std::vector<double> w_;  // inverse masses

@@ -44,4 +44,34 @@ Kernel Best();
 void ProjectRange(Kernel kernel, bool firstIteration, bool keepLambda, const Projection* ps, double* lambda,
                   Point4* x, size_t first, size_t last);
 
+// A long-range attachment (Kim, Chentanez & Muller 2012): the particle may
+// be no farther than `rest` from pin `pin` (UINT32_MAX: none).
+struct Tether {
+  uint32_t pin;
+  double rest;
+};
+constexpr int kTethers = 2;  // a particle's nearest pins
+
+// The per-particle part of a substep, on padded positions, velocities and
+// the previous substep's positions; fext is the external force (wind) and w
+// the inverse masses (0: pinned, never moved). tethers has kTethers a
+// particle, or is null.
+struct Particles {
+  Point4 *x, *v, *prev;
+  const Point4* fext;
+  const double* w;
+  const Tether* tethers;
+  double gravity[3];
+  double h, invH, keep;  // substep, 1 / h, velocity kept after damping
+};
+
+// Prediction for particles [b, e): prev = x, then for free particles
+// v = (v + h (g + w f)) keep and x += h v.
+void PredictRange(Kernel kernel, const Particles& p, size_t b, size_t e);
+// The end of a substep for particles [b, e): clamps each free particle to
+// its tethers in order, sets v = (x - prev) / h, then (predictNext) runs the
+// next substep's prediction. A pin is read here but never written, so
+// ranges may run in parallel.
+void FinishRange(Kernel kernel, const Particles& p, bool predictNext, size_t b, size_t e);
+
 }  // namespace sylva::particles::xpbd

@@ -170,6 +170,62 @@ TEST(Xpbd, AvxKernelMatchesTheScalarKernelBitForBit) {
   }
 }
 
+// The same for the per-particle pass: tethers (taut, slack and absent),
+// velocities and the next prediction, four particles a lane; blocks with a
+// pin go through the scalar code.
+TEST(Xpbd, AvxParticlePassMatchesTheScalarPassBitForBit) {
+  if (xpbd::Best() != xpbd::Kernel::kAvx) GTEST_SKIP() << "this processor has no AVX";
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const size_t n = 1001;
+  auto random = [&] { return xpbd::Point4{{u(rng), u(rng), u(rng), 0}}; };
+  std::vector<xpbd::Point4> x0(n), v0(n), prev0(n), fext(n);
+  std::vector<double> w(n);
+  std::vector<xpbd::Tether> tethers(n * xpbd::kTethers);
+  for (size_t i = 0; i < n; ++i) {
+    x0[i] = random();
+    v0[i] = random();
+    prev0[i] = random();
+    fext[i] = random();
+    w[i] = i % 97 == 3 ? 0 : 1 + 0.5 * u(rng);
+  }
+  for (size_t i = 0; i < n; ++i) {
+    for (int t = 0; t < xpbd::kTethers; ++t) {
+      const bool none = (i + size_t(t)) % 7 == 0;
+      // Rest lengths around the current distances: about half are taut.
+      tethers[i * xpbd::kTethers + size_t(t)] = {none ? UINT32_MAX : uint32_t(3 + 97 * t),
+                                                 0.8 + 0.6 * (u(rng) + 1) / 2};
+    }
+  }
+  int taut = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const xpbd::Tether& th = tethers[i * xpbd::kTethers];
+    if (th.pin == UINT32_MAX) continue;
+    double d2 = 0;
+    for (int k = 0; k < 3; ++k) d2 += std::pow(x0[i].p[k] - x0[th.pin].p[k], 2);
+    taut += d2 > th.rest * th.rest;
+  }
+  EXPECT_GT(taut, 100) << "too few taut tethers to test the clamp";
+  for (bool predictNext : {true, false}) {
+    std::vector<xpbd::Point4> xs = x0, vs = v0, ps = prev0, xa = x0, va = v0, pa = prev0;
+    const xpbd::Particles s{xs.data(), vs.data(), ps.data(), fext.data(), w.data(), tethers.data(),
+                            {0.1, -9.81, 0.3}, 1e-3, 1e3, 0.999};
+    xpbd::Particles a = s;
+    a.x = xa.data();
+    a.v = va.data();
+    a.prev = pa.data();
+    xpbd::FinishRange(xpbd::Kernel::kScalar, s, predictNext, 0, n);
+    xpbd::FinishRange(xpbd::Kernel::kAvx, a, predictNext, 0, n);
+    EXPECT_EQ(0, std::memcmp(xs.data(), xa.data(), n * sizeof(xpbd::Point4)))
+        << "predictNext " << predictNext << ": x[1] scalar " << xs[1].p[0] << " avx " << xa[1].p[0];
+    EXPECT_EQ(0, std::memcmp(vs.data(), va.data(), n * sizeof(xpbd::Point4)))
+        << "predictNext " << predictNext << ": v[1] scalar " << vs[1].p[0] << " avx " << va[1].p[0];
+    EXPECT_EQ(0, std::memcmp(ps.data(), pa.data(), n * sizeof(xpbd::Point4)))
+        << "predictNext " << predictNext << ": prev[1] scalar " << ps[1].p[0] << " avx " << pa[1].p[0];
+    EXPECT_EQ(0, std::memcmp(&x0[3], &xa[3], sizeof(xpbd::Point4))) << "a pin moved";
+  }
+}
+
 TEST(Cloth, OneAndTwoThreadsAreBitIdentical) {
   for (ClothSolver solver : {ClothSolver::kXPBD, ClothSolver::kImplicit}) {
     auto run = [solver](int threads) {
