@@ -179,6 +179,7 @@ struct Soa {
         const __m256d len2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d[0], d[0]), _mm256_mul_pd(d[1], d[1])),
                                            _mm256_mul_pd(d[2], d[2]));
         const __m256d taut = _mm256_cmp_pd(len2, _mm256_mul_pd(r, r), _CMP_GT_OQ);
+        if (_mm256_movemask_pd(taut) == 0) continue;  // all slack (often so for a far pin's tether)
         const __m256d f = _mm256_div_pd(r, _mm256_sqrt_pd(_mm256_blendv_pd(_mm256_set1_pd(1.0), len2, taut)));
         for (int k = 0; k < 3; ++k) {
           x.c[k] = _mm256_blendv_pd(x.c[k], _mm256_add_pd(q.c[k], _mm256_mul_pd(d[k], f)), taut);
