@@ -115,7 +115,7 @@ class Cloth {
   std::vector<Constraint> constraints_;
   std::vector<xpbd::Projection> proj_;  // constraints_ as set for substeps of projH_ seconds
   double projH_ = 0;
-  xpbd::Kernel kernel_ = xpbd::Best();
+  xpbd::Kernel kernel_ = kernels::Best();
   bool lastColourShared_ = false;       // the colouring ran out: its last colour may share particles
   std::vector<double> lambda_;
   std::vector<std::array<uint32_t, 3>> tris_;

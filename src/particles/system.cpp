@@ -102,6 +102,7 @@ void Springs::Colour() const {
     order_[fill[colour[k] < 0 ? size_t(colours) : size_t(colour[k])]++] = uint32_t(k);
   }
   colouredSprings_ = springs_.size();
+  particles_ = n;
 }
 
 template <typename Fn>
@@ -136,9 +137,10 @@ void Springs::Accumulate(const ParticleState&, const Vec3* x, const Vec3* v, Vec
 Springs::Linear Springs::Linearise(const Spring& sp, const Vec3* x) {
   const Vec3 d = x[sp.a] - x[sp.b];
   const double len = d.norm();
-  if (!(len > 1e-300)) return {sp.a, sp.b, Vec3::Zero(), 0, 0, sp.kd};
+  if (!(len > 1e-300)) return {{0, 0, 0, 0}, sp.a, sp.b, 0, 0, sp.kd};
   const double kt = sp.ks * std::max(0.0, 1 - sp.rest / len);
-  return {sp.a, sp.b, d / len, kt, sp.ks - kt, sp.kd};
+  const Vec3 u = d / len;
+  return {{u.x(), u.y(), u.z(), 0}, sp.a, sp.b, kt, sp.ks - kt, sp.kd};
 }
 
 void Springs::PrepareJacobian(const ParticleState&, const Vec3* x, const Vec3*) {
@@ -148,52 +150,40 @@ void Springs::PrepareJacobian(const ParticleState&, const Vec3* x, const Vec3*) 
   ForColours([&](size_t j, const Spring& sp) { linear_[j] = Linearise(sp, x); });
 }
 
-namespace {
-
-// The product's kernel over springs [first, last) of one colour:
-// y_a += g, y_b -= g with g = -(cx kt) dp - (cx kl + cv kd) (u . dp) u.
-template <typename Lin>
-void ProductRange(const Lin* __restrict lin, size_t first, size_t last, double cx, double cv,
-                  const double* __restrict p, double* __restrict y) {
-  for (size_t j = first; j < last; ++j) {
-    const Lin& l = lin[j];
-    const size_t a = size_t(l.a) * 3, b = size_t(l.b) * 3;
-    const double d0 = p[a] - p[b], d1 = p[a + 1] - p[b + 1], d2 = p[a + 2] - p[b + 2];
-    const double ux = l.u[0], uy = l.u[1], uz = l.u[2];
-    const double t = -cx * l.kt;
-    const double s = -(cx * l.kl + cv * l.kd) * (ux * d0 + uy * d1 + uz * d2);
-    const double g0 = t * d0 + s * ux, g1 = t * d1 + s * uy, g2 = t * d2 + s * uz;
-    y[a] += g0;
-    y[a + 1] += g1;
-    y[a + 2] += g2;
-    y[b] -= g0;
-    y[b + 1] -= g1;
-    y[b + 2] -= g2;
-  }
-}
-
-}  // namespace
-
 void Springs::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
                                  const Vec3* p, Vec3* y) const {
   if (!(x == preparedX_ && linear_.size() == springs_.size())) {
     ForColours([&](size_t, const Spring& sp) {
       const Linear l = Linearise(sp, x);
-      ProductRange(&l, 0, 1, cx, cv, p[0].data(), y[0].data());
+      kernels::SpringProduct(l, cx, cv, p[l.a].data(), p[l.b].data(), y[l.a].data(), y[l.b].data());
     });
     return;
   }
+  // On padded copies of p and y (see kernels.h), colour by colour.
+  const size_t n = particles_;
+  p4_.resize(n);
+  y4_.resize(n);
+  const size_t grain = BalancedGrain(pool_, n, 512, 4096);
+  ForRanges(pool_, n, grain, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      p4_[i] = {{p[i].x(), p[i].y(), p[i].z(), 0}};
+      y4_[i] = {{y[i].x(), y[i].y(), y[i].z(), 0}};
+    }
+  });
   const Linear* lin = linear_.data();
   for (size_t c = 0; c + 1 < colourStart_.size(); ++c) {
     const size_t first = colourStart_[c], last = colourStart_[c + 1];
     if (serialGroup_ && c + 2 == colourStart_.size()) {
-      ProductRange(lin, first, last, cx, cv, p[0].data(), y[0].data());
+      kernels::SpringProductRange(kernels::Kernel::kScalar, lin, first, last, cx, cv, p4_.data(), y4_.data());
     } else {
       ForRanges(pool_, last - first, BalancedGrain(pool_, last - first, 256, 4096), [&](size_t b, size_t e) {
-        ProductRange(lin, first + b, first + e, cx, cv, p[0].data(), y[0].data());
+        kernels::SpringProductRange(kernel_, lin, first + b, first + e, cx, cv, p4_.data(), y4_.data());
       });
     }
   }
+  ForRanges(pool_, n, grain, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) y[i] = Vec3(y4_[i].p[0], y4_[i].p[1], y4_[i].p[2]);
+  });
 }
 
 void Springs::AddJacobianDiagonal(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
@@ -201,7 +191,7 @@ void Springs::AddJacobianDiagonal(const ParticleState&, const Vec3* x, const Vec
   const bool cached = x == preparedX_ && linear_.size() == springs_.size();
   ForColours([&](size_t j, const Spring& sp) {
     const Linear l = cached ? linear_[j] : Linearise(sp, x);
-    const Vec3 u2 = l.u.cwiseAbs2();
+    const Vec3 u2 = Vec3(l.u[0], l.u[1], l.u[2]).cwiseAbs2();
     const Vec3 g = -cx * (Vec3::Constant(l.kt) + l.kl * u2) - cv * l.kd * u2;
     diag[l.a] += g;
     diag[l.b] += g;

@@ -35,6 +35,7 @@
 #include "core/parallel.h"
 #include "core/status.h"
 #include "particles/collider.h"
+#include "particles/kernels.h"
 
 namespace sylva::particles {
 
@@ -156,11 +157,7 @@ class Springs : public Force {
 
  private:
   // A spring in colour order with its linearisation.
-  struct Linear {
-    uint32_t a, b;
-    Vec3 u;
-    double kt, kl, kd;
-  };
+  using Linear = kernels::SpringLinear;
   void Colour() const;
   // fn(spring index in colour order j, spring) for every spring, colour by
   // colour.
@@ -176,6 +173,9 @@ class Springs : public Force {
   mutable std::vector<size_t> colourStart_;
   mutable bool serialGroup_ = false;
   mutable size_t colouredSprings_ = SIZE_MAX;
+  mutable size_t particles_ = 0;         // 1 + the largest particle index of a spring
+  mutable std::vector<kernels::Point4> p4_, y4_;  // the product's padded operands
+  kernels::Kernel kernel_ = kernels::Best();
 };
 
 // A user force as a callable (evaluated for all particles at once).

@@ -218,11 +218,6 @@ void FinishRange(Kernel kernel, const Particles& p, bool predictNext, size_t b, 
   }
 }
 
-Kernel Best() {
-  static const Kernel best = __builtin_cpu_supports("avx") ? Kernel::kAvx : Kernel::kScalar;
-  return best;
-}
-
 void ProjectRange(Kernel kernel, bool firstIteration, bool keepLambda, const Projection* ps, double* lambda,
                   Point4* x, size_t first, size_t last) {
   if (firstIteration) {

@@ -2,18 +2,15 @@
 // "XPBD: Position-based simulation of compliant constrained dynamics",
 // MIG 2016), internal to the particles library.
 //
-// A projection does little arithmetic on a lot of memory operations, plus a
-// square root and a division. The solver therefore keeps positions padded to
-// four doubles (`Point4`, 32-byte aligned, the fourth always 0), so the AVX
-// kernel moves a particle with one load and one store, and it projects four
-// constraints of a colour (which share no particle) at a time: their square
-// roots and quotients take one vector instruction each. Every lane does the
-// scalar kernel's operations in the same order, and IEEE square root and
-// division are exactly rounded, so both kernels give bit-identical results.
+// On padded positions with an AVX kernel and its scalar twin (kernels.h):
+// the projection kernel takes four constraints of a colour (which share no
+// particle) at a time, the particle pass four particles.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+
+#include "particles/kernels.h"
 
 namespace sylva::particles::xpbd {
 
@@ -25,15 +22,8 @@ struct Projection {
   double rest, scale, ca, cb, alphaT;
 };
 
-// A position padded to 32 bytes; p[3] is 0.
-struct alignas(32) Point4 {
-  double p[4];
-};
-
-enum class Kernel { kScalar, kAvx };
-
-// The widest kernel this processor runs.
-Kernel Best();
+using kernels::Kernel;
+using kernels::Point4;
 
 // Projects constraints [first, last), which must share no particle:
 //   dl = (rest - len - alpha~ l) / (w_a + w_b + alpha~),  l += dl,

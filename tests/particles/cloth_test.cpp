@@ -136,7 +136,7 @@ TEST(ClothImplicit, ConjugateGradientsConvergeWhenGivenTheIterations) {
 // multipliers, a degenerate constraint (coincident ends), a pinned end and a
 // ragged tail.
 TEST(Xpbd, AvxKernelMatchesTheScalarKernelBitForBit) {
-  if (xpbd::Best() != xpbd::Kernel::kAvx) GTEST_SKIP() << "this processor has no AVX";
+  if (kernels::Best() != xpbd::Kernel::kAvx) GTEST_SKIP() << "this processor has no AVX";
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
   const size_t m = 1003;
@@ -174,7 +174,7 @@ TEST(Xpbd, AvxKernelMatchesTheScalarKernelBitForBit) {
 // velocities and the next prediction, four particles a lane; blocks with a
 // pin go through the scalar code.
 TEST(Xpbd, AvxParticlePassMatchesTheScalarPassBitForBit) {
-  if (xpbd::Best() != xpbd::Kernel::kAvx) GTEST_SKIP() << "this processor has no AVX";
+  if (kernels::Best() != xpbd::Kernel::kAvx) GTEST_SKIP() << "this processor has no AVX";
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
   const size_t n = 1001;

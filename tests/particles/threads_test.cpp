@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "particles/flocking.h"
 #include "particles/grid.h"
 #include "particles/helpers.h"
+#include "particles/kernels.h"
 #include "particles/system.h"
 
 namespace sylva::particles {
@@ -161,6 +163,32 @@ TEST(Springs, CachedJacobianProductEqualsTheDirectOne) {
     ASSERT_LT((cached[i] - direct[i]).norm(), 1e-12 * (1 + direct[i].norm()))
         << "particle " << i << ": cached " << cached[i].transpose() << ", direct " << direct[i].transpose();
   }
+}
+
+// The AVX spring product gives the scalar kernel's bits (kernels.h), on
+// disjoint springs with a ragged tail and a degenerate (zero) direction.
+TEST(Springs, AvxProductKernelMatchesTheScalarKernelBitForBit) {
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "this processor has no AVX";
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const size_t m = 1003;
+  std::vector<kernels::Point4> p(2 * m), y0(2 * m);
+  for (size_t i = 0; i < 2 * m; ++i) {
+    p[i] = {{u(rng), u(rng), u(rng), 0}};
+    y0[i] = {{u(rng), u(rng), u(rng), 0}};
+  }
+  std::vector<kernels::SpringLinear> lin(m);
+  for (size_t k = 0; k < m; ++k) {
+    const Vec3 dir = k == 5 ? Vec3::Zero() : Vec3(u(rng), u(rng), u(rng)).normalized();
+    lin[k] = {{dir.x(), dir.y(), dir.z(), 0}, uint32_t(2 * k + 1), uint32_t(2 * k), 10 * (1 + u(rng)),
+              20 * (1 + u(rng)), 0.5 * (1 + u(rng))};
+  }
+  std::vector<kernels::Point4> ys = y0, ya = y0;
+  kernels::SpringProductRange(kernels::Kernel::kScalar, lin.data(), 0, m, -1e-4, -1e-2, p.data(), ys.data());
+  kernels::SpringProductRange(kernels::Kernel::kAvx, lin.data(), 0, m, -1e-4, -1e-2, p.data(), ya.data());
+  EXPECT_EQ(0, std::memcmp(ys.data(), ya.data(), ys.size() * sizeof(kernels::Point4)))
+      << "y[1] scalar " << ys[1].p[0] << " avx " << ya[1].p[0];
+  EXPECT_NE(0, std::memcmp(ys.data(), y0.data(), ys.size() * sizeof(kernels::Point4))) << "the product added nothing";
 }
 
 }  // namespace

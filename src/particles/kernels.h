@@ -1,0 +1,59 @@
+// Vector kernels of the particles library's hot loops, internal to it.
+//
+// Solvers that stream over particles by index from constraint or spring
+// records (XPBD projections, the implicit solver's spring products) are
+// bound by memory operations more than arithmetic. They run on positions
+// padded to four doubles (`Point4`, 32-byte aligned, the fourth 0), so one
+// AVX load or store moves a particle, and the square roots and divisions of
+// four records take one vector instruction each. Each kernel has a scalar
+// twin doing the same operations in the same order (IEEE arithmetic is
+// exactly rounded, and the build does not contract into FMA), so the two
+// give bit-identical results; `Best()` picks AVX at run time where the
+// processor has it, and the binary still runs where it does not.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace sylva::particles::kernels {
+
+// A position padded to 32 bytes; p[3] is 0.
+struct alignas(32) Point4 {
+  double p[4];
+};
+
+enum class Kernel { kScalar, kAvx };
+
+// The widest kernel this processor runs.
+Kernel Best();
+
+// A spring linearised for the implicit solver (see Springs in system.h): its
+// unit direction u (padded), ends and stiffnesses.
+struct alignas(32) SpringLinear {
+  double u[4];
+  uint32_t a, b;
+  double kt, kl, kd;
+};
+
+// y_a += g, y_b -= g for springs [first, last), which must share no
+// particle, with d = p_a - p_b and
+//   g = -(cx kt) d - (cx kl + cv kd) (u . d) u.
+void SpringProductRange(Kernel kernel, const SpringLinear* lin, size_t first, size_t last, double cx, double cv,
+                        const Point4* p, Point4* y);
+
+// The same product for one spring on unpadded vectors (3 doubles).
+inline void SpringProduct(const SpringLinear& l, double cx, double cv, const double* pa, const double* pb,
+                          double* ya, double* yb) {
+  const double d0 = pa[0] - pb[0], d1 = pa[1] - pb[1], d2 = pa[2] - pb[2];
+  const double t = -cx * l.kt;
+  const double s = -(cx * l.kl + cv * l.kd) * ((l.u[0] * d0 + l.u[1] * d1) + l.u[2] * d2);
+  const double g0 = t * d0 + s * l.u[0], g1 = t * d1 + s * l.u[1], g2 = t * d2 + s * l.u[2];
+  ya[0] += g0;
+  ya[1] += g1;
+  ya[2] += g2;
+  yb[0] -= g0;
+  yb[1] -= g1;
+  yb[2] -= g2;
+}
+
+}  // namespace sylva::particles::kernels
