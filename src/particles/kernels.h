@@ -56,4 +56,18 @@ inline void SpringProduct(const SpringLinear& l, double cx, double cv, const dou
   yb[2] -= g2;
 }
 
+// Conjugate-gradient reductions over flat arrays of doubles (a Vec3 array
+// is 3n of them), for [begin, end) with begin a multiple of 4. Each sum runs
+// in four interleaved partial sums (element k into sum k mod 4, the AVX
+// register's lanes), combined as (s0 + s1) + (s2 + s3).
+//   Dot:     returns sum a_k b_k.
+//   CgStep:  dv += alpha p, r -= alpha q; returns {sum r_k (r_k z_k),
+//            sum r_k^2} with z the preconditioner (inverse diagonal).
+double Dot(Kernel kernel, const double* a, const double* b, size_t begin, size_t end);
+struct CgSums {
+  double rz, rr;
+};
+CgSums CgStep(Kernel kernel, double alpha, const double* p, const double* q, const double* z, double* dv, double* r,
+              size_t begin, size_t end);
+
 }  // namespace sylva::particles::kernels

@@ -559,39 +559,41 @@ void System::ImplicitEuler(double h) {
   const double bnorm = std::sqrt(start[1]);
   solve_ = {0, 0};
   if (bnorm > 0) {
+    // The iterations' vector passes run on the flat arrays of 3n doubles
+    // (kernels.h). Pinned particles take no part: q is zero there.
+    const size_t n3 = 3 * n;
+    double *pf = p[0].data(), *qf = q[0].data(), *rf = r[0].data(), *dvf = dv[0].data();
+    const double* zf = inv[0].data();
+    mass3_.resize(n3);
+    pinned_.clear();
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t k = 0; k < 3; ++k) mass3_[3 * i + k] = m[i];
+      if (w[i] == 0) pinned_.push_back(i);
+    }
+    const double* m3 = mass3_.data();
     double rnorm = bnorm;
     int it = 0;
     while (it < cgMaxIterations && rnorm > cgTolerance * bnorm) {
       for (const auto& f : forces_) f->AddJacobianProduct(state, X.data(), V.data(), -h * h, -h, p, q);
-      const double pq = SumChunks<1>(n, [&](size_t bb, size_t e) {
-        std::array<double, 1> s{};
-        for (size_t i = bb; i < e; ++i) {
-          if (w[i] == 0) q[i] = Vec3::Zero();
-          s[0] += p[i].dot(q[i]);
-        }
-        return s;
+      for (size_t i : pinned_) q[i] = Vec3::Zero();
+      const double pq = SumChunks<1>(n3, [&](size_t bb, size_t e) {
+        return std::array<double, 1>{kernels::Dot(kernel_, pf, qf, bb, e)};
       })[0];
       if (!(pq > 0)) break;  // not positive definite along p (or NaN)
       const double alpha = rz / pq;
-      const auto sums = SumChunks<2>(n, [&](size_t bb, size_t e) {
-        std::array<double, 2> s{};
-        for (size_t i = bb; i < e; ++i) {
-          dv[i] += alpha * p[i];
-          r[i] -= alpha * q[i];
-          s[0] += r[i].dot(r[i].cwiseProduct(inv[i]));
-          s[1] += r[i].squaredNorm();
-        }
-        return s;
+      const auto sums = SumChunks<2>(n3, [&](size_t bb, size_t e) {
+        const kernels::CgSums c = kernels::CgStep(kernel_, alpha, pf, qf, zf, dvf, rf, bb, e);
+        return std::array<double, 2>{c.rz, c.rr};
       });
       const double beta = sums[0] / rz;
       rz = sums[0];
       rnorm = std::sqrt(sums[1]);
       ++it;
       if (it < cgMaxIterations && rnorm > cgTolerance * bnorm) {
-        ForChunks(n, [&](size_t bb, size_t e) {
-          for (size_t i = bb; i < e; ++i) {
-            p[i] = r[i].cwiseProduct(inv[i]) + beta * p[i];
-            q[i] = m[i] * p[i];
+        ForRanges(pool_.get(), n3, BalancedGrain(pool_.get(), n3, 1536, 3 * kChunk), [&](size_t bb, size_t e) {
+          for (size_t k = bb; k < e; ++k) {
+            pf[k] = rf[k] * zf[k] + beta * pf[k];
+            qf[k] = m3[k] * pf[k];
           }
         });
       }

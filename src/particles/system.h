@@ -276,8 +276,9 @@ class System {
   void Finish(size_t i, const Vec3& x0, const Vec3& v0, Vec3 x1, Vec3 v1, double h);
   void Collide(size_t i, Vec3 a, Vec3 va, Vec3& x, Vec3& v, double h);
   void ImplicitEuler(double h);
-  // Sum of fn(begin, end) over the fixed chunks of [0, n), added in chunk
-  // order: the same bits for any thread count.
+  // Sum of fn(begin, end) over the fixed chunks of [0, n) (1024 elements,
+  // a multiple of 4), added in chunk order: the same bits for any thread
+  // count.
   template <int K, typename Fn>
   std::array<double, K> SumChunks(size_t n, Fn&& fn) const;
   void ParticleCollisions();
@@ -295,6 +296,9 @@ class System {
   double adaptiveStep_ = 0;
   // Scratch (sized once per particle count).
   mutable std::vector<Vec3> f_, k_[14], x_, v_, cg_[6];
+  std::vector<double> mass3_;   // the implicit solver's mass per coordinate
+  std::vector<size_t> pinned_;  // and its immovable particles
+  kernels::Kernel kernel_ = kernels::Best();
   std::atomic<bool> faulted_{false};  // set by Finish, read by CheckFaults
 };
 

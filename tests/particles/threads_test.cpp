@@ -191,5 +191,45 @@ TEST(Springs, AvxProductKernelMatchesTheScalarKernelBitForBit) {
   EXPECT_NE(0, std::memcmp(ys.data(), y0.data(), ys.size() * sizeof(kernels::Point4))) << "the product added nothing";
 }
 
+// The conjugate-gradient reductions: AVX and scalar kernels give the same
+// bits (four interleaved sums either way), and the sums are right. Short
+// arrays (a few terms a lane, ragged tails) so that any other order of
+// operations would show in the last bits.
+TEST(ImplicitEuler, AvxReductionKernelsMatchTheScalarKernelsBitForBit) {
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "this processor has no AVX";
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 300; ++trial) {
+    const size_t begin = trial % 2 ? 4 : 0, n = begin + 5 + size_t(trial) % 11;
+    std::vector<double> p(n), q(n), z(n), dv0(n), r0(n);
+    for (size_t i = 0; i < n; ++i) {
+      p[i] = u(rng);
+      q[i] = u(rng);
+      z[i] = 1 + u(rng);
+      dv0[i] = u(rng);
+      r0[i] = u(rng);
+    }
+    const double ds = kernels::Dot(kernels::Kernel::kScalar, p.data(), q.data(), begin, n);
+    const double da = kernels::Dot(kernels::Kernel::kAvx, p.data(), q.data(), begin, n);
+    ASSERT_EQ(ds, da) << "trial " << trial << ": dot";
+    double ref = 0;
+    for (size_t i = begin; i < n; ++i) ref += p[i] * q[i];
+    ASSERT_NEAR(ds, ref, 1e-14) << "trial " << trial << ": dot";
+    std::vector<double> dvs = dv0, rs = r0, dva = dv0, ra = r0;
+    const auto cs = kernels::CgStep(kernels::Kernel::kScalar, 0.3, p.data(), q.data(), z.data(), dvs.data(), rs.data(),
+                                    begin, n);
+    const auto ca = kernels::CgStep(kernels::Kernel::kAvx, 0.3, p.data(), q.data(), z.data(), dva.data(), ra.data(),
+                                    begin, n);
+    ASSERT_EQ(cs.rz, ca.rz) << "trial " << trial << ": r.z";
+    ASSERT_EQ(cs.rr, ca.rr) << "trial " << trial << ": r.r";
+    ASSERT_EQ(dvs, dva) << "trial " << trial;
+    ASSERT_EQ(rs, ra) << "trial " << trial;
+    double rz = 0;
+    for (size_t i = begin; i < n; ++i) rz += (r0[i] - 0.3 * q[i]) * (r0[i] - 0.3 * q[i]) * z[i];
+    ASSERT_NEAR(cs.rz, rz, 1e-14) << "trial " << trial;
+    ASSERT_EQ(dvs[begin], dv0[begin] + 0.3 * p[begin]) << "trial " << trial;
+  }
+}
+
 }  // namespace
 }  // namespace sylva::particles
