@@ -38,12 +38,12 @@ struct alignas(32) SpringLinear {
 // y_a += g, y_b -= g for springs [first, last), which must share no
 // particle, with d = p_a - p_b and
 //   g = -(cx kt) d - (cx kl + cv kd) (u . d) u.
-void SpringProductRange(Kernel kernel, const SpringLinear* lin, size_t first, size_t last, double cx, double cv,
-                        const Point4* p, Point4* y);
+void SpringProductRange(Kernel kernel, const SpringLinear* lin, size_t first, size_t last,
+                        double cx, double cv, const Point4* p, Point4* y);
 
 // The same product for one spring on unpadded vectors (3 doubles).
-inline void SpringProduct(const SpringLinear& l, double cx, double cv, const double* pa, const double* pb,
-                          double* ya, double* yb) {
+inline void SpringProduct(const SpringLinear& l, double cx, double cv, const double* pa,
+                          const double* pb, double* ya, double* yb) {
   const double d0 = pa[0] - pb[0], d1 = pa[1] - pb[1], d2 = pa[2] - pb[2];
   const double t = -cx * l.kt;
   const double s = -(cx * l.kl + cv * l.kd) * ((l.u[0] * d0 + l.u[1] * d1) + l.u[2] * d2);
@@ -67,7 +67,7 @@ double Dot(Kernel kernel, const double* a, const double* b, size_t begin, size_t
 struct CgSums {
   double rz, rr;
 };
-CgSums CgStep(Kernel kernel, double alpha, const double* p, const double* q, const double* z, double* dv, double* r,
-              size_t begin, size_t end);
+CgSums CgStep(Kernel kernel, double alpha, const double* p, const double* q, const double* z,
+              double* dv, double* r, size_t begin, size_t end);
 
 }  // namespace sylva::particles::kernels

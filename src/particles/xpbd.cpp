@@ -10,8 +10,8 @@ namespace {
 constexpr double kDegenerate = 1e-24;  // squared length below which a constraint has no direction
 
 template <bool kFirst>
-void Scalar(bool keep, const Projection* __restrict ps, double* __restrict lambda, Point4* __restrict x, size_t first,
-            size_t last) {
+void Scalar(bool keep, const Projection* __restrict ps, double* __restrict lambda,
+            Point4* __restrict x, size_t first, size_t last) {
   for (size_t k = first; k < last; ++k) {
     const Projection& c = ps[k];
     double* pa = x[c.a].p;
@@ -35,8 +35,9 @@ void Scalar(bool keep, const Projection* __restrict ps, double* __restrict lambd
 }
 
 template <bool kFirst>
-[[gnu::target("avx")]] size_t Avx(bool keep, const Projection* __restrict ps, double* __restrict lambda,
-                                  Point4* __restrict x, size_t first, size_t last) {
+[[gnu::target("avx")]] size_t Avx(bool keep, const Projection* __restrict ps,
+                                  double* __restrict lambda, Point4* __restrict x, size_t first,
+                                  size_t last) {
   size_t k = first;
   for (; k + 4 <= last; k += 4) {
     const Projection* c = ps + k;
@@ -49,8 +50,8 @@ template <bool kFirst>
     // len2 = (d0^2 + d1^2) + d2^2 for the four, in the scalar kernel's order.
     const __m256d h01 = _mm256_hadd_pd(_mm256_mul_pd(d[0], d[0]), _mm256_mul_pd(d[1], d[1]));
     const __m256d h23 = _mm256_hadd_pd(_mm256_mul_pd(d[2], d[2]), _mm256_mul_pd(d[3], d[3]));
-    const __m256d len2 =
-        _mm256_add_pd(_mm256_permute2f128_pd(h01, h23, 0x20), _mm256_permute2f128_pd(h01, h23, 0x31));
+    const __m256d len2 = _mm256_add_pd(_mm256_permute2f128_pd(h01, h23, 0x20),
+                                       _mm256_permute2f128_pd(h01, h23, 0x31));
     const __m256d len = _mm256_sqrt_pd(len2);
     __m256d err = _mm256_sub_pd(_mm256_set_pd(c[3].rest, c[2].rest, c[1].rest, c[0].rest), len);
     if (!kFirst) {
@@ -68,15 +69,18 @@ template <bool kFirst>
       }
       if (keep) lambda[k + size_t(l)] = (kFirst ? 0 : lambda[k + size_t(l)]) + e[l] * c[l].scale;
       const __m256d dn = _mm256_mul_pd(d[l], _mm256_broadcast_sd(q + l));
-      _mm256_store_pd(x[c[l].a].p, _mm256_add_pd(a[l], _mm256_mul_pd(_mm256_broadcast_sd(&c[l].ca), dn)));
-      _mm256_store_pd(x[c[l].b].p, _mm256_sub_pd(b[l], _mm256_mul_pd(_mm256_broadcast_sd(&c[l].cb), dn)));
+      _mm256_store_pd(x[c[l].a].p,
+                      _mm256_add_pd(a[l], _mm256_mul_pd(_mm256_broadcast_sd(&c[l].ca), dn)));
+      _mm256_store_pd(x[c[l].b].p,
+                      _mm256_sub_pd(b[l], _mm256_mul_pd(_mm256_broadcast_sd(&c[l].cb), dn)));
     }
   }
   return k;
 }
 
 template <bool kFirst>
-void Project(Kernel kernel, bool keep, const Projection* ps, double* lambda, Point4* x, size_t first, size_t last) {
+void Project(Kernel kernel, bool keep, const Projection* ps, double* lambda, Point4* x,
+             size_t first, size_t last) {
   if (kernel == Kernel::kAvx) first = Avx<kFirst>(keep, ps, lambda, x, first, last);
   Scalar<kFirst>(keep, ps, lambda, x, first, last);
 }
@@ -117,7 +121,8 @@ void Project(Kernel kernel, bool keep, const Projection* ps, double* lambda, Poi
 }
 
 // Rows a..d <-> columns: the 4x4 transpose, its own inverse.
-[[gnu::target("avx"), gnu::always_inline]] inline void Transpose(__m256d& a, __m256d& b, __m256d& c, __m256d& d) {
+[[gnu::target("avx"), gnu::always_inline]] inline void Transpose(__m256d& a, __m256d& b, __m256d& c,
+                                                                 __m256d& d) {
   const __m256d t0 = _mm256_unpacklo_pd(a, b), t1 = _mm256_unpackhi_pd(a, b);
   const __m256d t2 = _mm256_unpacklo_pd(c, d), t3 = _mm256_unpackhi_pd(c, d);
   a = _mm256_permute2f128_pd(t0, t2, 0x20);
@@ -131,9 +136,10 @@ struct Soa {
   __m256d c[3];
 };
 
-[[gnu::target("avx"), gnu::always_inline]] inline Soa Load4(const Point4* p0, const Point4* p1, const Point4* p2,
-                                                           const Point4* p3) {
-  __m256d a = _mm256_load_pd(p0->p), b = _mm256_load_pd(p1->p), c = _mm256_load_pd(p2->p), d = _mm256_load_pd(p3->p);
+[[gnu::target("avx"), gnu::always_inline]] inline Soa Load4(const Point4* p0, const Point4* p1,
+                                                            const Point4* p2, const Point4* p3) {
+  __m256d a = _mm256_load_pd(p0->p), b = _mm256_load_pd(p1->p), c = _mm256_load_pd(p2->p),
+          d = _mm256_load_pd(p3->p);
   Transpose(a, b, c, d);
   return {{a, b, c}};
 }
@@ -150,7 +156,8 @@ struct Soa {
 // Four particles a lane each, for blocks without a pin (a pin's lane would
 // be written back, racing with the tethers that read it).
 [[gnu::target("avx")]] size_t FinishAvx(const Particles& s, bool predictNext, size_t b, size_t e) {
-  const __m256d h = _mm256_set1_pd(s.h), invH = _mm256_set1_pd(s.invH), keep = _mm256_set1_pd(s.keep);
+  const __m256d h = _mm256_set1_pd(s.h), invH = _mm256_set1_pd(s.invH),
+                keep = _mm256_set1_pd(s.keep);
   size_t i = b;
   for (; i + 4 <= e; i += 4) {
     const __m256d w = _mm256_loadu_pd(s.w + i);
@@ -169,18 +176,21 @@ struct Soa {
         double rest[4];
         for (int l = 0; l < 4; ++l) {
           const Tether& tl = th[size_t(l) * kTethers];
-          pin[l] = tl.pin == UINT32_MAX ? uint32_t(i) + uint32_t(l) : tl.pin;  // a lane that never clamps
+          pin[l] = tl.pin == UINT32_MAX ? uint32_t(i) + uint32_t(l)
+                                        : tl.pin;  // a lane that never clamps
           rest[l] = tl.pin == UINT32_MAX ? 1e300 : tl.rest;
         }
         const Soa q = Load4(s.x + pin[0], s.x + pin[1], s.x + pin[2], s.x + pin[3]);
         const __m256d r = _mm256_set_pd(rest[3], rest[2], rest[1], rest[0]);
         __m256d d[3];
         for (int k = 0; k < 3; ++k) d[k] = _mm256_sub_pd(x.c[k], q.c[k]);
-        const __m256d len2 = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d[0], d[0]), _mm256_mul_pd(d[1], d[1])),
-                                           _mm256_mul_pd(d[2], d[2]));
+        const __m256d len2 =
+            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(d[0], d[0]), _mm256_mul_pd(d[1], d[1])),
+                          _mm256_mul_pd(d[2], d[2]));
         const __m256d taut = _mm256_cmp_pd(len2, _mm256_mul_pd(r, r), _CMP_GT_OQ);
         if (_mm256_movemask_pd(taut) == 0) continue;  // all slack (often so for a far pin's tether)
-        const __m256d f = _mm256_div_pd(r, _mm256_sqrt_pd(_mm256_blendv_pd(_mm256_set1_pd(1.0), len2, taut)));
+        const __m256d f =
+            _mm256_div_pd(r, _mm256_sqrt_pd(_mm256_blendv_pd(_mm256_set1_pd(1.0), len2, taut)));
         for (int k = 0; k < 3; ++k) {
           x.c[k] = _mm256_blendv_pd(x.c[k], _mm256_add_pd(q.c[k], _mm256_mul_pd(d[k], f)), taut);
         }
@@ -218,8 +228,8 @@ void FinishRange(Kernel kernel, const Particles& p, bool predictNext, size_t b, 
   }
 }
 
-void ProjectRange(Kernel kernel, bool firstIteration, bool keepLambda, const Projection* ps, double* lambda,
-                  Point4* x, size_t first, size_t last) {
+void ProjectRange(Kernel kernel, bool firstIteration, bool keepLambda, const Projection* ps,
+                  double* lambda, Point4* x, size_t first, size_t last) {
   if (firstIteration) {
     Project<true>(kernel, keepLambda, ps, lambda, x, first, last);
   } else {

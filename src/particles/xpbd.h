@@ -31,8 +31,8 @@ using kernels::Point4;
 // on positions x. The first iteration of a substep
 // starts from l = 0 and does not read the multipliers; keepLambda false
 // (one iteration a substep) skips storing them.
-void ProjectRange(Kernel kernel, bool firstIteration, bool keepLambda, const Projection* ps, double* lambda,
-                  Point4* x, size_t first, size_t last);
+void ProjectRange(Kernel kernel, bool firstIteration, bool keepLambda, const Projection* ps,
+                  double* lambda, Point4* x, size_t first, size_t last);
 
 // A long-range attachment (Kim, Chentanez & Muller 2012): the particle may
 // be no farther than `rest` from pin `pin` (UINT32_MAX: none).
