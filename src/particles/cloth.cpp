@@ -249,7 +249,7 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
       v4_[i] = pad(v_[i]);
       fext4_[i] = pad(fext_[i]);
     }
-    xpbd::PredictRange(kernel_, parts, b, e);
+    xpbd::PredictRange(parts, b, e);
   });
   for (int s = 0; s < subs; ++s) {
     for (int it = 0; it < def_.iterations; ++it) {

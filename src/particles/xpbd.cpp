@@ -216,7 +216,7 @@ struct Soa {
 
 }  // namespace
 
-void PredictRange(Kernel, const Particles& p, size_t b, size_t e) {
+void PredictRange(const Particles& p, size_t b, size_t e) {
   for (size_t i = b; i < e; ++i) Predict(p, i);
 }
 

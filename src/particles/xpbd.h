@@ -57,7 +57,7 @@ struct Particles {
 
 // Prediction for particles [b, e): prev = x, then for free particles
 // v = (v + h (g + w f)) keep and x += h v.
-void PredictRange(Kernel kernel, const Particles& p, size_t b, size_t e);
+void PredictRange(const Particles& p, size_t b, size_t e);
 // The end of a substep for particles [b, e): clamps each free particle to
 // its tethers in order, sets v = (x - prev) / h, then (predictNext) runs the
 // next substep's prediction. A pin is read here but never written, so
