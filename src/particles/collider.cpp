@@ -12,6 +12,12 @@ namespace {
 // Offset of a contact on a thin surface toward the particle's side.
 Vec3 Skin(const Vec3& p, const Vec3& n) { return p + n * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff())); }
 
+Vec3 Friction(const Vec3& vt, double maxChange) {
+  const double len = vt.norm();
+  if (len <= maxChange) return Vec3::Zero();
+  return vt * (1 - maxChange / len);
+}
+
 // Crossing of the segment a -> b with the plane through p with normal n (not
 // necessarily unit), from either side. Returns the fraction and the signed
 // distances' sign of the side the path came from (+1 or -1).
@@ -363,6 +369,84 @@ bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n) const {
       return false;
   }
   return false;
+}
+
+// --- contact response ---
+
+ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x, Vec3& v,
+                                 double h) {
+  Vec3 dv = v - va;  // velocity change from the forces over the segment
+  double rem = h;
+  int contacts = 0;
+  for (int iter = 0; iter < 4; ++iter) {
+    Contact best;
+    best.s = 2;
+    const Collider* hit = nullptr;
+    for (const Collider& c : colliders) {
+      Contact ct;
+      if (c.Intersect(a, x, &ct) && ct.s < best.s) {
+        best = ct;
+        hit = &c;
+      }
+    }
+    if (!hit) break;
+    ++contacts;
+    const Vec3& n = best.normal;
+    const Vec3 vc = va + best.s * dv;  // velocity at contact
+    const double tRest = (1 - best.s) * rem;
+    const Vec3 restDv = (1 - best.s) * dv;
+    if (hit->response == Response::kKill) {
+      x = best.point;
+      v = vc;
+      return ContactOutcome::kKilled;
+    }
+    if (hit->response == Response::kStick) {
+      x = best.point;
+      v = Vec3::Zero();
+      return ContactOutcome::kStuck;
+    }
+    const double vn = vc.dot(n);
+    const double approach = -vn;
+    // Speed gained toward the surface over the rest of the segment: a
+    // slower approach is resting or sliding contact, not a bounce.
+    const double gained = std::max(0.0, -dv.dot(n));
+    Vec3 out;
+    if (approach > gained) {
+      // Bounce: reverse the normal speed times e; Coulomb friction takes at
+      // most mu times the normal impulse from the tangential speed.
+      const double jn = (1 + hit->restitution) * approach;
+      out = Friction(vc - vn * n, hit->friction * jn) + hit->restitution * approach * n;
+      x = best.point + tRest * (out + 0.5 * restDv);
+      v = out + restDv;
+      va = out;
+      dv = restDv;
+    } else {
+      // Resting or sliding: the surface removes the inward normal velocity
+      // the step would end with (its impulse is what gravity pressed in),
+      // and friction removes up to mu times that from the tangential one.
+      const Vec3 end = vc + restDv;
+      const double en = end.dot(n);
+      const double jn = std::max(0.0, -en);
+      out = Friction(end - en * n, hit->friction * jn) + std::max(en, 0.0) * n;
+      x = best.point + tRest * out;
+      v = out;
+      va = out;
+      dv = Vec3::Zero();
+    }
+    a = best.point;
+    rem = tRest;
+  }
+  // Never leave a particle inside a solid.
+  if (contacts == 0) return ContactOutcome::kNone;
+  for (const Collider& c : colliders) {
+    Vec3 sp, sn;
+    if (c.Project(x, &sp, &sn)) {
+      x = sp;
+      const double vn = v.dot(sn);
+      if (vn < 0) v -= vn * sn;
+    }
+  }
+  return ContactOutcome::kResponded;
 }
 
 }  // namespace sylva::particles

@@ -6,7 +6,7 @@
 // exact for that path: a fraction s of the step found in closed form (plane,
 // sphere, box slabs, polygon and triangle crossings), the point on the
 // surface and its outward unit normal. The system then turns the contact
-// into a response (see System::Collide): bounce with restitution and Coulomb
+// into a response (see RespondToContacts below): bounce with restitution and Coulomb
 // friction, resting or sliding contact, stick, or kill.
 //
 // Kinds:
@@ -19,6 +19,9 @@
 // Thin two-sided surfaces (polygon, mesh) leave a contact point a small skin
 // (1e-9 relative) on the particle's side, so rounding can never put it on
 // the far side where the next step would not see a crossing.
+//
+// RespondToContacts turns contacts into the response, for both particle
+// systems (System, double precision, and BulkSystem, single).
 #pragma once
 
 #include <array>
@@ -108,6 +111,24 @@ struct Collider {
   bool IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const;
   bool ProjectAny(const Vec3& x, Vec3* surface, Vec3* normal) const;
 };
+
+// What RespondToContacts did to a particle.
+enum class ContactOutcome {
+  kNone,       // its path touched no collider
+  kResponded,  // bounced, rested or slid (x and v changed)
+  kKilled,     // hit a kKill collider: the caller ends its life
+  kStuck,      // hit a kStick collider: the caller makes it immovable
+};
+
+// Contact response for a particle moving from a (velocity va) to x (velocity
+// v) over h seconds, the step's straight path. Up to four contacts a step:
+// a bounce reverses the normal speed times e with Coulomb friction and goes
+// on along the rest of the path; a slower approach is resting or sliding
+// contact (the surface takes the inward normal velocity, friction up to mu
+// times that from the tangential one). A particle that touched anything is
+// finally projected out of every half-space solid. x and v are updated.
+ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x, Vec3& v,
+                                 double h);
 
 // --- inline ---
 

@@ -15,12 +15,6 @@ namespace {
 // Particles per chunk: the chunk's forces (96 KiB) stay in L2.
 constexpr size_t kChunk = 4096;
 
-Vec3 Friction(const Vec3& vt, double maxChange) {
-  const double len = vt.norm();
-  if (len <= maxChange) return Vec3::Zero();
-  return vt * (1 - maxChange / len);
-}
-
 std::string Format(const Vec3& v) {
   std::ostringstream o;
   o.precision(6);
@@ -288,81 +282,19 @@ uint64_t System::Hash() const {
   return h;
 }
 
-// Contact response for particle i moving from a (velocity va) to x
-// (velocity v) over h seconds; see collider.h. Up to four contacts a step.
+// Contact response for particle i (see RespondToContacts); kill and stick
+// change its cold data.
 [[gnu::noinline]] void System::Collide(size_t i, Vec3 a, Vec3 va, Vec3& x, Vec3& v, double h) {
-  Vec3 dv = v - va;  // velocity change from the forces over the segment
-  double rem = h;
-  int contacts = 0;
-  for (int iter = 0; iter < 4; ++iter) {
-    Contact best;
-    best.s = 2;
-    const Collider* hit = nullptr;
-    for (const Collider& c : colliders_) {
-      Contact ct;
-      if (c.Intersect(a, x, &ct) && ct.s < best.s) {
-        best = ct;
-        hit = &c;
-      }
-    }
-    if (!hit) break;
-    ++contacts;
-    const Vec3& n = best.normal;
-    const Vec3 vc = va + best.s * dv;  // velocity at contact
-    const double tRest = (1 - best.s) * rem;
-    const Vec3 restDv = (1 - best.s) * dv;
-    if (hit->response == Response::kKill) {
-      x = best.point;
-      v = vc;
+  switch (RespondToContacts(colliders_, a, va, x, v, h)) {
+    case ContactOutcome::kKilled:
       state.lifetime[i] = std::min(state.lifetime[i], state.age[i]);
-      return;
-    }
-    if (hit->response == Response::kStick) {
-      x = best.point;
-      v = Vec3::Zero();
+      break;
+    case ContactOutcome::kStuck:
       state.invMass[i] = 0;
-      return;
-    }
-    const double vn = vc.dot(n);
-    const double approach = -vn;
-    // Speed gained toward the surface over the rest of the segment: a
-    // slower approach is resting or sliding contact, not a bounce.
-    const double gained = std::max(0.0, -dv.dot(n));
-    Vec3 out;
-    if (approach > gained) {
-      // Bounce: reverse the normal speed times e; Coulomb friction takes at
-      // most mu times the normal impulse from the tangential speed.
-      const double jn = (1 + hit->restitution) * approach;
-      out = Friction(vc - vn * n, hit->friction * jn) + hit->restitution * approach * n;
-      x = best.point + tRest * (out + 0.5 * restDv);
-      v = out + restDv;
-      va = out;
-      dv = restDv;
-    } else {
-      // Resting or sliding: the surface removes the inward normal velocity
-      // the step would end with (its impulse is what gravity pressed in),
-      // and friction removes up to mu times that from the tangential one.
-      const Vec3 end = vc + restDv;
-      const double en = end.dot(n);
-      const double jn = std::max(0.0, -en);
-      out = Friction(end - en * n, hit->friction * jn) + std::max(en, 0.0) * n;
-      x = best.point + tRest * out;
-      v = out;
-      va = out;
-      dv = Vec3::Zero();
-    }
-    a = best.point;
-    rem = tRest;
-  }
-  // Never leave a particle inside a solid.
-  if (contacts == 0) return;
-  for (const Collider& c : colliders_) {
-    Vec3 sp, sn;
-    if (c.Project(x, &sp, &sn)) {
-      x = sp;
-      const double vn = v.dot(sn);
-      if (vn < 0) v -= vn * sn;
-    }
+      break;
+    case ContactOutcome::kNone:
+    case ContactOutcome::kResponded:
+      break;
   }
 }
 
