@@ -5,6 +5,7 @@
 #include <random>
 
 #include "core/parallel.h"
+#include "particles/bulk.h"
 #include "particles/cloth.h"
 #include "particles/flocking.h"
 #include "particles/grid.h"
@@ -54,6 +55,42 @@ BENCHMARK_CAPTURE(BM_Step, symplectic_euler, particles::Integrator::kSymplecticE
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Step, rk4, particles::Integrator::kRK4)
     ->ArgsProduct({{1000000}, {1, 2}, {50}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// The same scene for BulkSystem (single precision, structure of arrays).
+void BM_BulkStep(benchmark::State& state) {
+  particles::BulkSystem sys(int(state.range(1)));
+  const int n = int(state.range(0));
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto& s = sys.state;
+  s.Reserve(size_t(n));
+  for (int i = 0; i < n; ++i) {
+    if (i % 100 < state.range(2)) {
+      s.Add(Vec3(u(rng), -1, u(rng)), Vec3(u(rng), 0, u(rng)));
+    } else {
+      s.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)));
+    }
+  }
+  sys.fields.gravity = Vec3(0, -9.81, 0);
+  sys.fields.linearDrag = 0.1;
+  sys.fields.quadraticDrag = 0.01;
+  sys.AddCollider(particles::Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.8).Friction(0.1));
+  const particles::BulkState s0 = s;
+  for (auto _ : state) {
+    state.PauseTiming();
+    for (auto [to, from] : {std::pair{&s.px, &s0.px}, {&s.py, &s0.py}, {&s.pz, &s0.pz}, {&s.vx, &s0.vx},
+                            {&s.vy, &s0.vy}, {&s.vz, &s0.vz}}) {
+      std::copy(from->begin(), from->end(), to->begin());
+    }
+    state.ResumeTiming();
+    if (!sys.Step(1.0 / 240).ok()) state.SkipWithError("step failed");
+  }
+  state.SetItemsProcessed(state.range(0) * state.iterations());
+}
+BENCHMARK(BM_BulkStep)
+    ->ArgsProduct({{1000000, 10000000}, {1, 2}, {0, 50}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -2,6 +2,9 @@
 
 #include <immintrin.h>
 
+#include <cmath>
+#include <cstring>
+
 namespace sylva::particles::kernels {
 namespace {
 
@@ -79,6 +82,108 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   return CgStepScalar(alpha, p, q, z, dv, r, i, e, srz, srr);
 }
 
+// The bulk step for one particle; BulkAdvanceAvx does the same operations
+// in the same order on eight.
+[[gnu::always_inline]] inline bool BulkOne(const BulkParams& q, const BulkArrays& a, size_t i,
+                                           float* const* old, size_t o) {
+  const float x = a.px[i], y = a.py[i], z = a.pz[i];
+  const float u = a.vx[i], v = a.vy[i], s = a.vz[i], w = a.invMass[i];
+  const float rx = u - q.wx, ry = v - q.wy, rz = s - q.wz;
+  const float speed = std::sqrt((rx * rx + ry * ry) + rz * rz);
+  const float k = (q.k1 + q.k2 * speed) * w;
+  const bool movable = w > 0;
+  const float ax = (movable ? q.gx : 0.0f) - k * rx;
+  const float ay = (movable ? q.gy : 0.0f) - k * ry;
+  const float az = (movable ? q.gz : 0.0f) - k * rz;
+  const float u1 = movable ? u + q.h * ax : 0.0f;
+  const float v1 = movable ? v + q.h * ay : 0.0f;
+  const float s1 = movable ? s + q.h * az : 0.0f;
+  const float x1 = x + q.h * u1, y1 = y + q.h * v1, z1 = z + q.h * s1;
+  old[0][o] = x, old[1][o] = y, old[2][o] = z, old[3][o] = u, old[4][o] = v, old[5][o] = s;
+  a.px[i] = x1, a.py[i] = y1, a.pz[i] = z1, a.vx[i] = u1, a.vy[i] = v1, a.vz[i] = s1;
+  a.age[i] += q.h;
+  return std::fabs(x1) <= q.limit && std::fabs(y1) <= q.limit && std::fabs(z1) <= q.limit &&
+         std::fabs(u1) <= q.limit && std::fabs(v1) <= q.limit && std::fabs(s1) <= q.limit;
+}
+
+// All-ones lanes where |c| <= limit.
+[[gnu::target("avx")]] inline __m256 Within(__m256 c, __m256 abs, __m256 limit) {
+  return _mm256_cmp_ps(_mm256_and_ps(c, abs), limit, _CMP_LE_OQ);
+}
+
+// Returns the first index it did not do and ANDs its check into *ok.
+[[gnu::target("avx")]] size_t BulkAdvanceAvx(const BulkParams& q, const BulkArrays& a, size_t i,
+                                             size_t e, float* const* old, size_t o, bool* ok) {
+  const __m256 gx = _mm256_set1_ps(q.gx), gy = _mm256_set1_ps(q.gy), gz = _mm256_set1_ps(q.gz);
+  const __m256 wx = _mm256_set1_ps(q.wx), wy = _mm256_set1_ps(q.wy), wz = _mm256_set1_ps(q.wz);
+  const __m256 k1 = _mm256_set1_ps(q.k1), k2 = _mm256_set1_ps(q.k2), h = _mm256_set1_ps(q.h);
+  const __m256 zero = _mm256_setzero_ps(), limit = _mm256_set1_ps(q.limit);
+  const __m256 abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  __m256 good = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  for (; i + 8 <= e; i += 8, o += 8) {
+    const __m256 x = _mm256_loadu_ps(a.px + i), y = _mm256_loadu_ps(a.py + i);
+    const __m256 z = _mm256_loadu_ps(a.pz + i), u = _mm256_loadu_ps(a.vx + i);
+    const __m256 v = _mm256_loadu_ps(a.vy + i), s = _mm256_loadu_ps(a.vz + i);
+    const __m256 w = _mm256_loadu_ps(a.invMass + i);
+    const __m256 rx = _mm256_sub_ps(u, wx), ry = _mm256_sub_ps(v, wy), rz = _mm256_sub_ps(s, wz);
+    const __m256 speed = _mm256_sqrt_ps(_mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(rx, rx), _mm256_mul_ps(ry, ry)), _mm256_mul_ps(rz, rz)));
+    const __m256 k = _mm256_mul_ps(_mm256_add_ps(k1, _mm256_mul_ps(k2, speed)), w);
+    const __m256 movable = _mm256_cmp_ps(w, zero, _CMP_GT_OQ);
+    const __m256 ax = _mm256_sub_ps(_mm256_and_ps(movable, gx), _mm256_mul_ps(k, rx));
+    const __m256 ay = _mm256_sub_ps(_mm256_and_ps(movable, gy), _mm256_mul_ps(k, ry));
+    const __m256 az = _mm256_sub_ps(_mm256_and_ps(movable, gz), _mm256_mul_ps(k, rz));
+    const __m256 u1 = _mm256_and_ps(movable, _mm256_add_ps(u, _mm256_mul_ps(h, ax)));
+    const __m256 v1 = _mm256_and_ps(movable, _mm256_add_ps(v, _mm256_mul_ps(h, ay)));
+    const __m256 s1 = _mm256_and_ps(movable, _mm256_add_ps(s, _mm256_mul_ps(h, az)));
+    const __m256 x1 = _mm256_add_ps(x, _mm256_mul_ps(h, u1));
+    const __m256 y1 = _mm256_add_ps(y, _mm256_mul_ps(h, v1));
+    const __m256 z1 = _mm256_add_ps(z, _mm256_mul_ps(h, s1));
+    _mm256_storeu_ps(old[0] + o, x), _mm256_storeu_ps(old[1] + o, y);
+    _mm256_storeu_ps(old[2] + o, z), _mm256_storeu_ps(old[3] + o, u);
+    _mm256_storeu_ps(old[4] + o, v), _mm256_storeu_ps(old[5] + o, s);
+    _mm256_storeu_ps(a.px + i, x1), _mm256_storeu_ps(a.py + i, y1);
+    _mm256_storeu_ps(a.pz + i, z1), _mm256_storeu_ps(a.vx + i, u1);
+    _mm256_storeu_ps(a.vy + i, v1), _mm256_storeu_ps(a.vz + i, s1);
+    _mm256_storeu_ps(a.age + i, _mm256_add_ps(_mm256_loadu_ps(a.age + i), h));
+    good = _mm256_and_ps(
+        good, _mm256_and_ps(_mm256_and_ps(Within(x1, abs, limit), Within(y1, abs, limit)),
+                            _mm256_and_ps(Within(z1, abs, limit), Within(u1, abs, limit))));
+    good = _mm256_and_ps(good, _mm256_and_ps(Within(v1, abs, limit), Within(s1, abs, limit)));
+  }
+  *ok = *ok && _mm256_movemask_ps(good) == 0xff;
+  return i;
+}
+
+[[gnu::target("avx")]] size_t BulkPlaneAvx(const double* n, const double* p, const BulkArrays& a,
+                                           size_t i, size_t e, uint8_t* flags) {
+  // One byte a lane from a four-bit mask.
+  static constexpr uint32_t kBytes[16] = {
+      0x00000000, 0x00000001, 0x00000100, 0x00000101, 0x00010000, 0x00010001,
+      0x00010100, 0x00010101, 0x01000000, 0x01000001, 0x01000100, 0x01000101,
+      0x01010000, 0x01010001, 0x01010100, 0x01010101};
+  const __m256d n0 = _mm256_set1_pd(n[0]), n1 = _mm256_set1_pd(n[1]), n2 = _mm256_set1_pd(n[2]);
+  const __m256d p0 = _mm256_set1_pd(p[0]), p1 = _mm256_set1_pd(p[1]), p2 = _mm256_set1_pd(p[2]);
+  const __m256d zero = _mm256_setzero_pd();
+  uint8_t* f = flags;
+  for (; i + 4 <= e; i += 4, f += 4) {
+    const __m256d b0 = _mm256_cvtps_pd(_mm_loadu_ps(a.px + i));
+    const __m256d b1 = _mm256_cvtps_pd(_mm_loadu_ps(a.py + i));
+    const __m256d b2 = _mm256_cvtps_pd(_mm_loadu_ps(a.pz + i));
+    const __m256d d = _mm256_add_pd(
+        _mm256_add_pd(_mm256_mul_pd(n0, _mm256_sub_pd(b0, p0)), _mm256_mul_pd(n1, _mm256_sub_pd(b1, p1))),
+        _mm256_mul_pd(n2, _mm256_sub_pd(b2, p2)));
+    const int mask = _mm256_movemask_pd(_mm256_cmp_pd(d, zero, _CMP_LT_OQ));
+    if (mask) {
+      uint32_t bytes;
+      std::memcpy(&bytes, f, 4);
+      bytes |= kBytes[mask];
+      std::memcpy(f, &bytes, 4);
+    }
+  }
+  return i;
+}
+
 }  // namespace
 
 double Dot(Kernel kernel, const double* a, const double* b, size_t begin, size_t end) {
@@ -106,6 +211,26 @@ void SpringProductRange(Kernel kernel, const SpringLinear* lin, size_t first, si
   if (kernel == Kernel::kAvx) first = SpringProductAvx(lin, first, last, cx, cv, p, y);
   for (size_t j = first; j < last; ++j) {
     SpringProduct(lin[j], cx, cv, p[lin[j].a].p, p[lin[j].b].p, y[lin[j].a].p, y[lin[j].b].p);
+  }
+}
+
+bool BulkAdvance(Kernel kernel, const BulkParams& q, const BulkArrays& a, size_t begin, size_t end,
+                 float* const* old) {
+  bool ok = true;
+  size_t i = begin;
+  if (kernel == Kernel::kAvx) i = BulkAdvanceAvx(q, a, begin, end, old, 0, &ok);
+  for (; i < end; ++i) ok &= BulkOne(q, a, i, old, i - begin);
+  return ok;
+}
+
+void BulkPlaneCandidates(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
+                         size_t begin, size_t end, uint8_t* flags) {
+  size_t i = begin;
+  if (kernel == Kernel::kAvx) i = BulkPlaneAvx(n, p, a, begin, end, flags);
+  for (; i < end; ++i) {
+    const double d = (n[0] * (double(a.px[i]) - p[0]) + n[1] * (double(a.py[i]) - p[1])) +
+                     n[2] * (double(a.pz[i]) - p[2]);
+    flags[i - begin] |= d < 0;
   }
 }
 

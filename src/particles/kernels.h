@@ -70,4 +70,34 @@ struct CgSums {
 CgSums CgStep(Kernel kernel, double alpha, const double* p, const double* q, const double* z,
               double* dv, double* r, size_t begin, size_t end);
 
+// --- BulkSystem: single precision, structure of arrays ---
+
+// One step's uniform fields, in single precision: gravity g (an
+// acceleration), drag -(k1 + k2 |u|) u with u = v - wind (a force, times the
+// inverse mass), the step h, and the magnitude limit of the fault check.
+struct BulkParams {
+  float gx, gy, gz, wx, wy, wz, k1, k2, h, limit;
+};
+struct BulkArrays {
+  float *px, *py, *pz, *vx, *vy, *vz;
+  const float* invMass;
+  float* age;
+};
+
+// Symplectic Euler for particles [begin, end), in place, all in single
+// precision, per particle:
+//   u = v - wind, k = (k1 + k2 sqrt((ux^2 + uy^2) + uz^2)) w,
+//   v' = v + h (g - k u), x' = x + h v', age += h,
+// with an immovable particle (w = 0) kept where it is at zero velocity.
+// old[0..5][i - begin] receive the previous px, py, pz, vx, vy, vz. Returns
+// false if a new component c fails |c| <= limit (a NaN fails).
+bool BulkAdvance(Kernel kernel, const BulkParams& q, const BulkArrays& a, size_t begin, size_t end,
+                 float* const* old);
+
+// flags[i - begin] |= 1 for the particles of [begin, end) whose new position
+// b (the arrays, as doubles) has n . (b - p) < 0: a plane collider's MayHit,
+// computed as (n0 (b0 - p0) + n1 (b1 - p1)) + n2 (b2 - p2).
+void BulkPlaneCandidates(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
+                         size_t begin, size_t end, uint8_t* flags);
+
 }  // namespace sylva::particles::kernels

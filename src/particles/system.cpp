@@ -317,22 +317,28 @@ uint64_t System::Hash() const {
   state.velocity[i] = v1;
 }
 
+Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id, const Vec3& x,
+                               const Vec3& v, double limit) {
+  const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
+  std::ostringstream o;
+  o << "particles: " << what << " step " << step << " (from t = " << t << " s): particle id " << id
+    << " has position " << Format(x) << " and velocity " << Format(v)
+    << (std::isfinite(m) ? " beyond the limit of " : " (not finite)");
+  if (std::isfinite(m)) o << limit;
+  o << "; the state exploded: try a smaller step, a stabler integrator or softer forces";
+  Diagnostic d = MakeError({}, o.str());
+  d.kind = ErrorKind::kRuntime;
+  return d;
+}
+
 Status System::CheckFaults(const char* what) {
   if (!faulted_.load()) return {};
   for (size_t i = 0; i < state.size(); ++i) {
     const Vec3 &x = state.position[i], &v = state.velocity[i];
     const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
     if (m <= maxMagnitude) continue;
-    std::ostringstream o;
-    o << "particles: " << what << " step " << state.step << " (from t = " << state.time << " s): particle id " << state.id[i]
-      << " has position " << Format(x) << " and velocity " << Format(v)
-      << (std::isfinite(m) ? " beyond the limit of " : " (not finite)");
-    if (std::isfinite(m)) o << maxMagnitude;
-    o << "; the state exploded: try a smaller step, a stabler integrator or softer forces";
-    Diagnostic d = MakeError({}, o.str());
-    d.kind = ErrorKind::kRuntime;
-    fault_ = d;
-    return d;
+    fault_ = ExplosionDiagnostic(what, state.step, state.time, state.id[i], x, v, maxMagnitude);
+    return *fault_;
   }
   faulted_ = false;
   return {};

@@ -302,4 +302,10 @@ class System {
   std::atomic<bool> faulted_{false};  // set by Finish, read by CheckFaults
 };
 
+// The report of a particle whose position or velocity left the limit (or is
+// not finite), for both particle systems: the step, its start time and the
+// particle's id, position and velocity.
+Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id, const Vec3& x,
+                               const Vec3& v, double limit);
+
 }  // namespace sylva::particles

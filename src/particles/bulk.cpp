@@ -1,0 +1,231 @@
+#include "particles/bulk.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstring>
+
+#include "particles/system.h"
+
+namespace sylva::particles {
+namespace {
+
+// Particles a chunk: the chunk's previous state (6 floats a particle) and
+// candidate flags stay in L1.
+constexpr size_t kChunk = 512;
+
+Vec3f Round(const Vec3& x) { return Vec3f(float(x.x()), float(x.y()), float(x.z())); }
+
+// x rounded to single precision on the side of every collider that x (the
+// double-precision contact response) is on: rounding a point on a surface
+// may move it across (thin panels and meshes have a skin of only 1e-9
+// relative), and a particle must never end a step behind a surface. A
+// rounded point that crosses one is pushed off it along the contact normal
+// by a few single-precision ulps and rounded again.
+Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x) {
+  Vec3f xf = Round(x);
+  const double skin = 4 * double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
+  Vec3 base = x;
+  for (int tries = 0; tries < 4; ++tries) {
+    const Vec3 r = xf.cast<double>();
+    if (r == x) return xf;
+    bool crossed = false;
+    for (const Collider& c : colliders) {
+      Contact ct;
+      if (c.Intersect(x, r, &ct)) {
+        base += skin * ct.normal;
+        xf = Round(base);
+        crossed = true;
+        break;
+      }
+    }
+    if (!crossed) return xf;
+  }
+  return xf;
+}
+
+}  // namespace
+
+uint32_t BulkState::Add(const Vec3& p, const Vec3& v, double m, double life) {
+  px.push_back(float(p.x()));
+  py.push_back(float(p.y()));
+  pz.push_back(float(p.z()));
+  vx.push_back(float(v.x()));
+  vy.push_back(float(v.y()));
+  vz.push_back(float(v.z()));
+  invMass.push_back(m > 0 ? float(1 / m) : 0.0f);
+  age.push_back(0);
+  lifetime.push_back(float(std::min(life, 1e30)));
+  color.push_back(Vec3f(1, 1, 1));
+  radius.push_back(0.05f);
+  id.push_back(nextId);
+  return nextId++;
+}
+
+void BulkState::SetPosition(size_t i, const Vec3& p) {
+  px[i] = float(p.x());
+  py[i] = float(p.y());
+  pz[i] = float(p.z());
+}
+
+void BulkState::SetVelocity(size_t i, const Vec3& v) {
+  vx[i] = float(v.x());
+  vy[i] = float(v.y());
+  vz[i] = float(v.z());
+}
+
+void BulkState::Reserve(size_t n) {
+  for (auto* a : {&px, &py, &pz, &vx, &vy, &vz, &invMass, &age, &lifetime, &radius}) a->reserve(n);
+  color.reserve(n);
+  id.reserve(n);
+}
+
+BulkSystem::BulkSystem(int threads) { SetThreads(threads); }
+BulkSystem::~BulkSystem() = default;
+
+void BulkSystem::SetThreads(int threads) {
+  threads_ = threads <= 0 ? ThreadPool::HardwareThreads() : threads;
+  pool_ = threads_ > 1 ? std::make_unique<ThreadPool>(threads_) : nullptr;
+}
+
+int BulkSystem::threads() const { return threads_; }
+
+void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::BulkParams& q) {
+  BulkState& s = state;
+  const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(), s.vx.data(),
+                              s.vy.data(), s.vz.data(), s.invMass.data(), s.age.data()};
+  alignas(32) float old[6][kChunk];
+  float* const olds[6] = {old[0], old[1], old[2], old[3], old[4], old[5]};
+  alignas(32) uint8_t flags[kChunk];
+  for (size_t c = begin; c < end; c += kChunk) {
+    const size_t ce = std::min(end, c + kChunk), m = ce - c;
+    if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds)) faulted_.store(true, std::memory_order_relaxed);
+    if (colliders_.empty()) continue;
+    std::memset(flags, 0, m);
+    for (const Collider& col : colliders_) {
+      if (col.kind == Collider::Kind::kPlane) {
+        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a, c, ce, flags);
+        continue;
+      }
+      for (size_t j = 0; j < m; ++j) {
+        flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j));
+      }
+    }
+    for (size_t j = 0; j < m; ++j) {
+      const size_t i = c + j;
+      if (!flags[j] || s.invMass[i] == 0) continue;
+      Vec3 x = s.position(i), v = s.velocity(i);
+      const ContactOutcome out = RespondToContacts(colliders_, Vec3(old[0][j], old[1][j], old[2][j]),
+                                                   Vec3(old[3][j], old[4][j], old[5][j]), x, v, h);
+      if (out == ContactOutcome::kNone) continue;
+      if (out == ContactOutcome::kKilled) s.lifetime[i] = std::min(s.lifetime[i], s.age[i]);
+      if (out == ContactOutcome::kStuck) s.invMass[i] = 0;
+      const Vec3f xf = RoundOutside(colliders_, x);
+      s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
+      s.SetVelocity(i, v);
+      const double mag = std::max(xf.cast<double>().cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
+      if (!(mag <= maxMagnitude)) faulted_.store(true, std::memory_order_relaxed);
+    }
+  }
+}
+
+Status BulkSystem::Step(double h) {
+  if (fault_) return *fault_;
+  const Vec3& g = fields.gravity;
+  const Vec3& w = fields.wind;
+  const float limit = float(std::min(maxMagnitude, double(FLT_MAX)));
+  const kernels::BulkParams q{float(g.x()), float(g.y()), float(g.z()), float(w.x()), float(w.y()),
+                              float(w.z()), float(fields.linearDrag), float(fields.quadraticDrag),
+                              float(h), limit};
+  faulted_ = false;
+  const size_t n = state.size();
+  // Ranges of whole chunks, a few a thread.
+  const size_t grain = (BalancedGrain(pool_.get(), n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
+  ForRanges(pool_.get(), n, grain, [&](size_t b, size_t e) { StepRange(b, e, h, q); });
+  Status status = Fault();
+  time += h;
+  ++steps;
+  return status;
+}
+
+Status BulkSystem::Fault() {
+  if (!faulted_.load()) return {};
+  for (size_t i = 0; i < state.size(); ++i) {
+    const Vec3 x = state.position(i), v = state.velocity(i);
+    const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
+    if (m <= maxMagnitude) continue;
+    fault_ = ExplosionDiagnostic("in bulk", steps, time, state.id[i], x, v, maxMagnitude);
+    return *fault_;
+  }
+  faulted_ = false;
+  return {};
+}
+
+size_t BulkSystem::Append(const ParticleState& born, size_t begin) {
+  const size_t n = born.size();
+  if (begin >= n) return 0;
+  state.Reserve(state.size() + (n - begin));
+  for (size_t i = begin; i < n; ++i) {
+    const Vec3 &p = born.position[i], &v = born.velocity[i];
+    state.px.push_back(float(p.x()));
+    state.py.push_back(float(p.y()));
+    state.pz.push_back(float(p.z()));
+    state.vx.push_back(float(v.x()));
+    state.vy.push_back(float(v.y()));
+    state.vz.push_back(float(v.z()));
+    state.invMass.push_back(float(born.invMass[i]));
+    state.age.push_back(float(born.age[i]));
+    state.lifetime.push_back(float(std::min(born.lifetime[i], 1e30)));
+    state.color.push_back(born.color[i]);
+    state.radius.push_back(born.radius[i]);
+    state.id.push_back(born.id[i]);
+    state.nextId = std::max(state.nextId, born.id[i] + 1);
+  }
+  return n - begin;
+}
+
+size_t BulkSystem::RemoveDead() {
+  BulkState& s = state;
+  const size_t n = s.size();
+  size_t w = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (s.age[i] >= s.lifetime[i]) continue;
+    if (w != i) {
+      for (auto* a : {&s.px, &s.py, &s.pz, &s.vx, &s.vy, &s.vz, &s.invMass, &s.age, &s.lifetime, &s.radius}) {
+        (*a)[w] = (*a)[i];
+      }
+      s.color[w] = s.color[i];
+      s.id[w] = s.id[i];
+    }
+    ++w;
+  }
+  for (auto* a : {&s.px, &s.py, &s.pz, &s.vx, &s.vy, &s.vz, &s.invMass, &s.age, &s.lifetime, &s.radius}) {
+    a->resize(w);
+  }
+  s.color.resize(w);
+  s.id.resize(w);
+  return n - w;
+}
+
+double BulkSystem::KineticEnergy() const {
+  double e = 0;
+  for (size_t i = 0; i < state.size(); ++i) {
+    if (state.invMass[i] > 0) e += 0.5 * state.velocity(i).squaredNorm() / double(state.invMass[i]);
+  }
+  return e;
+}
+
+uint64_t BulkSystem::Hash() const {
+  uint64_t h = 1469598103934665603ULL;
+  for (size_t i = 0; i < state.size(); ++i) {
+    for (float c : {state.px[i], state.py[i], state.pz[i], state.vx[i], state.vy[i], state.vz[i]}) {
+      uint32_t bits;
+      std::memcpy(&bits, &c, 4);
+      h = (h ^ bits) * 1099511628211ULL;
+      h ^= h >> 29;
+    }
+  }
+  return h;
+}
+
+}  // namespace sylva::particles

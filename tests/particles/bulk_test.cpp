@@ -1,0 +1,322 @@
+// BulkSystem (single precision, structure of arrays) against the double
+// precision System, closed forms, and its own invariants: the AVX kernel and
+// its scalar twin give the same bits, and so do 1 and 2 threads.
+#include "particles/bulk.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "particles/emitter.h"
+#include "particles/system.h"
+
+namespace sylva::particles {
+namespace {
+
+constexpr double kG = 9.81;
+
+#define BULK_STEP_OK(sys, h)                        \
+  do {                                              \
+    ::sylva::Status st_ = (sys).Step(h);            \
+    ASSERT_TRUE(st_.ok()) << st_.error().message;   \
+  } while (0)
+
+// n particles in the unit cube above the floor y = -1 with random velocities
+// (some resting on the floor, every tenth immovable when `pins`).
+void Fill(BulkState& s, int n, uint32_t seed, bool pins) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < n; ++i) {
+    const bool resting = i % 4 == 0;
+    const Vec3 p(u(rng), resting ? -1 : u(rng), u(rng));
+    const Vec3 v(u(rng), resting ? 0 : 3 * u(rng), u(rng));
+    s.Add(p, v, pins && i % 10 == 3 ? 0 : 0.5 + 0.5 * (u(rng) + 1));
+  }
+}
+
+void Scene(BulkSystem& b) {
+  b.fields.gravity = Vec3(0, -kG, 0);
+  b.fields.linearDrag = 0.1;
+  b.fields.quadraticDrag = 0.02;
+  b.AddCollider(Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.6).Friction(0.3));
+  b.AddCollider(Collider::Sphere(Vec3(0.3, -0.6, 0.2), 0.3).Restitution(0.9));
+  b.AddCollider(Collider::Box(Vec3(-1.5, -1.5, -1.5), Vec3(1.5, 3, 1.5), true).Restitution(0.8));
+}
+
+TEST(Bulk, FollowsTheDoublePrecisionSystemWithinSinglePrecision) {
+  // Gravity, drag and a floor with friction, one second at 240 Hz: every
+  // particle of the single-precision system stays within 1e-4 m of the
+  // double-precision one (the same particles, rounded to floats first).
+  BulkSystem bulk;
+  Fill(bulk.state, 2000, 7, false);
+  bulk.fields.gravity = Vec3(0, -kG, 0);
+  bulk.fields.linearDrag = 0.1;
+  bulk.fields.quadraticDrag = 0.02;
+  const Collider floor = Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.6).Friction(0.3);
+  bulk.AddCollider(floor);
+  System sys;
+  for (size_t i = 0; i < bulk.state.size(); ++i) {
+    sys.state.Add(bulk.state.position(i), bulk.state.velocity(i), 1 / double(bulk.state.invMass[i]));
+  }
+  sys.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
+  sys.AddForce(std::make_shared<Drag>(0.1, 0.02));
+  sys.AddCollider(floor);
+  double worstX = 0, worstV = 0;
+  for (int k = 0; k < 240; ++k) {
+    BULK_STEP_OK(bulk, 1.0 / 240);
+    ASSERT_TRUE(sys.Step(1.0 / 240, Integrator::kSymplecticEuler).ok());
+  }
+  for (size_t i = 0; i < bulk.state.size(); ++i) {
+    worstX = std::max(worstX, (bulk.state.position(i) - sys.state.position[i]).norm());
+    worstV = std::max(worstV, (bulk.state.velocity(i) - sys.state.velocity[i]).norm());
+  }
+  EXPECT_LT(worstX, 1e-4) << "largest position difference after 1 s: " << worstX << " m";
+  EXPECT_LT(worstV, 1e-3) << "largest velocity difference after 1 s: " << worstV << " m/s";
+}
+
+TEST(Bulk, AvxKernelMatchesTheScalarKernelBitForBit) {
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
+  // 1003 particles: a ragged tail of 3 after the groups of eight, immovable
+  // lanes inside groups, every collider kind's candidates.
+  BulkSystem avx, scalar;
+  for (BulkSystem* b : {&avx, &scalar}) {
+    Fill(b->state, 1003, 11, true);
+    Scene(*b);
+    b->fields.wind = Vec3(2, 0, -1);
+  }
+  scalar.SetKernel(kernels::Kernel::kScalar);
+  for (int k = 0; k < 120; ++k) {
+    BULK_STEP_OK(avx, 1.0 / 120);
+    BULK_STEP_OK(scalar, 1.0 / 120);
+    ASSERT_EQ(avx.Hash(), scalar.Hash()) << "states differ after step " << k;
+  }
+  EXPECT_EQ(avx.state.age, scalar.state.age);
+}
+
+TEST(Bulk, PlaneCandidatesAreExactlyTheColliderTest) {
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
+  // Points on, just above and just below a tilted plane through a point
+  // that floats cannot represent.
+  const Collider c = Collider::Plane(Vec3(0.1, 0.2, 0.3), Vec3(1, 2, 2).normalized());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  BulkState s;
+  for (int i = 0; i < 4099; ++i) {
+    Vec3 p(u(rng), u(rng), u(rng));
+    p -= c.normal.dot(p - c.point) * c.normal;  // onto the plane, then a few ulps off
+    p += c.normal * (1e-7 * std::round(4 * u(rng)));
+    s.Add(p, Vec3::Zero());
+  }
+  const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(), s.vx.data(),
+                              s.vy.data(), s.vz.data(), s.invMass.data(), s.age.data()};
+  std::vector<uint8_t> fa(s.size(), 0), fs(s.size(), 0);
+  kernels::BulkPlaneCandidates(kernels::Kernel::kAvx, c.normal.data(), c.point.data(), a, 0, s.size(), fa.data());
+  kernels::BulkPlaneCandidates(kernels::Kernel::kScalar, c.normal.data(), c.point.data(), a, 0, s.size(), fs.data());
+  int below = 0;
+  for (size_t i = 0; i < s.size(); ++i) {
+    const bool expected = c.MayHit(s.position(i), s.position(i));
+    below += expected;
+    ASSERT_EQ(bool(fa[i]), expected) << "AVX flag of point " << i;
+    ASSERT_EQ(bool(fs[i]), expected) << "scalar flag of point " << i;
+  }
+  EXPECT_GT(below, 500) << "too few points behind the plane to test: " << below;
+}
+
+TEST(Bulk, SameBitsForOneAndTwoThreads) {
+  BulkSystem one(1), two(2);
+  for (BulkSystem* b : {&one, &two}) {
+    Fill(b->state, 20000, 5, true);
+    Scene(*b);
+  }
+  for (int k = 0; k < 60; ++k) {
+    BULK_STEP_OK(one, 1.0 / 60);
+    BULK_STEP_OK(two, 1.0 / 60);
+  }
+  EXPECT_EQ(one.Hash(), two.Hash());
+}
+
+// Apex heights of a ball dropped from height 1 on an elastic floor, stepped
+// by `step` (symplectic Euler at h = 1e-4).
+template <typename StepFn, typename VyFn, typename YFn>
+std::vector<double> Apexes(StepFn step, VyFn vy, YFn y) {
+  std::vector<double> apex;
+  double prevVy = 0;
+  for (int i = 0; i < 100000 && apex.size() < 3; ++i) {
+    if (!step()) return apex;
+    const double v = vy();
+    if (prevVy > 0 && v <= 0) apex.push_back(y() + v * v / (2 * kG));
+    prevVy = v;
+  }
+  return apex;
+}
+
+TEST(Bulk, ElasticBallReturnsToItsHeightAsTheDoubleSystemDoes) {
+  const double h = 1e-4;
+  const Collider floor = Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0)).Restitution(1);
+  BulkSystem b;
+  b.state.Add(Vec3(0, 1, 0), Vec3::Zero());
+  b.fields.gravity = Vec3(0, -kG, 0);
+  b.AddCollider(floor);
+  System s;
+  s.state.Add(Vec3(0, 1, 0), Vec3::Zero(), 1);
+  s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
+  s.AddCollider(floor);
+  const auto bulk = Apexes([&] { return b.Step(h).ok(); }, [&] { return double(b.state.vy[0]); },
+                           [&] { return double(b.state.py[0]); });
+  const auto exact = Apexes([&] { return s.Step(h, Integrator::kSymplecticEuler).ok(); },
+                            [&] { return s.state.velocity[0].y(); }, [&] { return s.state.position[0].y(); });
+  ASSERT_EQ(bulk.size(), 3u);
+  ASSERT_EQ(exact.size(), 3u);
+  for (size_t k = 0; k < 3; ++k) {
+    // Single precision adds about 1e-6 to the integrator's own O(h) loss
+    // (4.4e-4 a bounce at this step).
+    EXPECT_NEAR(bulk[k], exact[k], 5e-6) << "bounce " << k << ": single " << bulk[k] << ", double " << exact[k];
+    EXPECT_NEAR(bulk[k], 1.0, 1.5e-3) << "apex " << bulk[k] << " at bounce " << k;
+  }
+}
+
+TEST(Bulk, RestingParticleNeitherSinksNorJitters) {
+  // Floors at heights floats cannot represent, one tilted (friction holds
+  // it: tan 20 deg < 0.5).
+  const double t = 20 * M_PI / 180;
+  for (const Vec3& n : {Vec3(0, 1, 0), Vec3(std::sin(t), std::cos(t), 0)}) {
+    BulkSystem b;
+    const Vec3 point(0.1, 0.3, 0.7);
+    b.state.Add(point + 0.2 * n, Vec3::Zero());
+    b.fields.gravity = Vec3(0, -kG, 0);
+    b.AddCollider(Collider::Plane(point, n).Restitution(0.5).Friction(0.5));
+    double lowest = 1;
+    for (int i = 0; i < 12000; ++i) {
+      BULK_STEP_OK(b, 1e-3);
+      lowest = std::min(lowest, n.dot(b.state.position(0) - point));
+    }
+    const Vec3 rest = b.state.position(0);
+    double worst = 0, moved = 0;
+    for (int i = 0; i < 1000; ++i) {
+      BULK_STEP_OK(b, 1e-3);
+      worst = std::max(worst, b.state.velocity(0).norm());
+      moved = std::max(moved, (b.state.position(0) - rest).norm());
+    }
+    EXPECT_LT(worst, 1e-6) << "normal " << n.transpose() << ": |v| up to " << worst;
+    EXPECT_LT(moved, 1e-6) << "normal " << n.transpose() << ": drifted " << moved;
+    EXPECT_GE(lowest, 0) << "normal " << n.transpose() << ": sank to " << lowest;
+    EXPECT_LT(n.dot(rest - point), 1e-6) << "normal " << n.transpose() << ": floats above the floor";
+  }
+}
+
+TEST(Bulk, RoundingNeverPutsAParticleThroughAThinPanel) {
+  // Rain on a two-sided square at a height floats cannot represent: every
+  // drop that lands on it stays on it.
+  BulkSystem b;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.05, 0.95);
+  const double y = 0.7;  // float(0.7) is below 0.7
+  for (int i = 0; i < 2000; ++i) b.state.Add(Vec3(u(rng), y + 0.1 + u(rng), u(rng)), Vec3::Zero());
+  b.fields.gravity = Vec3(0, -kG, 0);
+  b.AddCollider(Collider::Polygon({Vec3(0, y, 0), Vec3(0, y, 1), Vec3(1, y, 1), Vec3(1, y, 0)}).Restitution(0.2));
+  for (int i = 0; i < 2000; ++i) BULK_STEP_OK(b, 1e-3);
+  int below = 0;
+  double worstV = 0;
+  for (size_t i = 0; i < b.state.size(); ++i) {
+    below += b.state.py[i] < y;
+    worstV = std::max(worstV, b.state.velocity(i).norm());
+  }
+  EXPECT_EQ(below, 0) << below << " of 2000 drops fell through the panel";
+  EXPECT_LT(worstV, 1e-6) << "drops still moving at " << worstV << " m/s";
+}
+
+TEST(Bulk, ImmovableParticlesStayPutAndAge) {
+  BulkSystem b;
+  b.state.Add(Vec3(1, 2, 3), Vec3(5, 5, 5), 0);
+  b.fields.gravity = Vec3(0, -kG, 0);
+  b.fields.linearDrag = 1;
+  for (int i = 0; i < 10; ++i) BULK_STEP_OK(b, 0.125);
+  EXPECT_EQ(b.state.position(0), Vec3(1, 2, 3));
+  EXPECT_EQ(b.state.velocity(0), Vec3::Zero());
+  EXPECT_EQ(b.state.age[0], 1.25f);
+}
+
+TEST(Bulk, DragRelativeToTheWindReachesTheWindSpeed) {
+  // Linear drag k toward a wind w: v(t) = w + (v0 - w) exp(-k t / m).
+  BulkSystem b;
+  b.state.Add(Vec3::Zero(), Vec3::Zero(), 2);
+  b.fields.linearDrag = 1;
+  b.fields.wind = Vec3(3, 0, -1);
+  const double h = 1e-3;
+  for (int i = 0; i < 2000; ++i) BULK_STEP_OK(b, h);
+  const Vec3 expected = b.fields.wind * (1 - std::exp(-2.0 / 2));
+  EXPECT_LT((b.state.velocity(0) - expected).norm(), 2e-3)
+      << "velocity " << b.state.velocity(0).transpose() << ", closed form " << expected.transpose();
+}
+
+TEST(Bulk, StickAndKill) {
+  BulkSystem b;
+  b.state.Add(Vec3(0, 1, 0), Vec3(1, 0, 0), 1, 100);
+  b.state.Add(Vec3(5, 1, 0), Vec3(1, 0, 0), 1, 100);
+  b.fields.gravity = Vec3(0, -kG, 0);
+  b.AddCollider(Collider::Polygon({Vec3(-1, 0, -1), Vec3(-1, 0, 1), Vec3(2, 0, 1), Vec3(2, 0, -1)}).Respond(Response::kStick));
+  b.AddCollider(Collider::Polygon({Vec3(4, 0, -1), Vec3(4, 0, 1), Vec3(7, 0, 1), Vec3(7, 0, -1)}).Respond(Response::kKill));
+  for (int i = 0; i < 1000; ++i) BULK_STEP_OK(b, 1e-3);
+  EXPECT_NEAR(b.state.px[0], std::sqrt(2 / kG), 2e-3) << "stuck where it landed";
+  EXPECT_NEAR(b.state.py[0], 0, 1e-6);
+  EXPECT_EQ(b.state.velocity(0), Vec3::Zero());
+  EXPECT_EQ(b.state.invMass[0], 0) << "stuck particles are immovable";
+  EXPECT_EQ(b.RemoveDead(), 1u) << "the killed particle is dead";
+  EXPECT_EQ(b.state.id[0], 0u);
+}
+
+TEST(Bulk, EmittedParticlesKeepTheirIdsAndTheLivingTheirOrder) {
+  EmitterDef def;
+  def.rate = 1000;
+  def.velocity = Vec3(0, 2, 0);
+  def.velocitySpread = 0.5;
+  def.lifetime = 0.5;
+  def.lifetimeJitter = 0.2;
+  Emitter emitter(def);
+  ParticleState born;
+  BulkSystem b;
+  b.fields.gravity = Vec3(0, -kG, 0);
+  for (int k = 0; k < 100; ++k) {
+    const size_t first = born.size();
+    emitter.Emit(born, 0.01);
+    b.Append(born, first);
+    BULK_STEP_OK(b, 0.01);
+    b.RemoveDead();
+  }
+  ASSERT_EQ(born.size(), 1000u) << "rate x time";
+  ASSERT_GT(b.state.size(), 0u);
+  EXPECT_LT(b.state.size(), 1000u) << "nobody died";
+  for (size_t i = 0; i < b.state.size(); ++i) {
+    EXPECT_LE(b.state.age[i], b.state.lifetime[i]) << "particle " << i;
+    if (i > 0) {
+      ASSERT_LT(b.state.id[i - 1], b.state.id[i]) << "the living kept their order";
+    }
+    const uint32_t id = b.state.id[i];
+    EXPECT_EQ(b.state.lifetime[i], float(born.lifetime[id])) << "id " << id << " has its own lifetime";
+  }
+  EXPECT_EQ(b.state.nextId, 1000u);
+}
+
+TEST(Bulk, AnExplosionIsReportedWithTheStepAndTheId) {
+  BulkSystem b;
+  b.state.Add(Vec3::Zero(), Vec3::Zero());
+  b.state.Add(Vec3::Zero(), Vec3(1e11, 0, 0));
+  b.fields.gravity = Vec3(0, -kG, 0);
+  for (int i = 0; i < 5; ++i) BULK_STEP_OK(b, 0.1);
+  b.state.vx[1] = 2e12f;
+  const Status st = b.Step(0.1);
+  ASSERT_FALSE(st.ok());
+  const std::string& m = st.error().message;
+  EXPECT_NE(m.find("step 5"), std::string::npos) << m;
+  EXPECT_NE(m.find("particle id 1"), std::string::npos) << m;
+  EXPECT_FALSE(b.Step(0.1).ok()) << "a faulted system refuses to step";
+  BulkSystem nan;
+  nan.state.Add(Vec3::Zero(), Vec3(std::nanf(""), 0, 0));
+  const Status sn = nan.Step(0.1);
+  ASSERT_FALSE(sn.ok());
+  EXPECT_NE(sn.error().message.find("not finite"), std::string::npos) << sn.error().message;
+}
+
+}  // namespace
+}  // namespace sylva::particles
