@@ -45,6 +45,7 @@ provenance() {
   provenance "Sylva particle benchmarks"
   echo "# BM_Step: gravity + linear/quadratic drag + one plane collider; args: particles/threads/% resting on the plane"
   echo "#   (every timed step starts from the same state); items = particle steps"
+  echo "# BM_BulkStep: the same scene in BulkSystem (single precision, structure of arrays, AVX)"
   echo "# BM_GridBuild: two-pass counting-sorted grid, args: points/threads; BM_Flocking: boids/threads, ~20 neighbours"
   echo "# BM_Cloth: one 1/60 s frame, args: k (k x k particles)/threads; stretch = largest structural strain"
   medians build/bench/bench_particles
