@@ -44,21 +44,24 @@ int main(int argc, char** argv) {
   const Vec3 ballCentre(0.3, 0.4, 0), ground(0, 0, 0);
   const double ballRadius = 0.4;
   snow.AddCollider(particles::Collider::Plane(ground, Vec3(0, 1, 0)).Restitution(0).Friction(0.8));
-  snow.AddCollider(particles::Collider::Sphere(ballCentre, ballRadius).Respond(particles::Response::kStick));
+  snow.AddCollider(
+      particles::Collider::Sphere(ballCentre, ballRadius).Respond(particles::Response::kStick));
 
   const double h = 1.0 / 120;
   double stepSeconds = 0;
   int steps = 0;
   for (; steps * h < seconds; ++steps) {
     // Gusts: the wind swings across x, slowly.
-    snow.fields.wind = Vec3(0.6 * std::sin(0.8 * snow.time), 0, 0.3 * std::cos(0.5 * snow.time));
+    snow.fields.wind =
+        Vec3(0.6 * std::sin(0.8 * snow.time()), 0, 0.3 * std::cos(0.5 * snow.time()));
     if (int(born.size()) < flakes) {
       const size_t first = born.size();
       emitter.Emit(born, h);
       if (int(born.size()) > flakes) {
         // Keep exactly the requested count.
         for (auto* a : {&born.position, &born.velocity}) a->resize(size_t(flakes));
-        for (auto* a : {&born.mass, &born.invMass, &born.age, &born.lifetime}) a->resize(size_t(flakes));
+        for (auto* a : {&born.mass, &born.invMass, &born.age, &born.lifetime})
+          a->resize(size_t(flakes));
         born.color.resize(size_t(flakes));
         born.radius.resize(size_t(flakes));
         born.id.resize(size_t(flakes));
@@ -87,10 +90,11 @@ int main(int argc, char** argv) {
       ++falling;
     }
   }
-  std::printf("%zu flakes, %.2f s in %d steps of 1/120 s (%.2f ms a step on %d threads): "
-              "%d resting on the ground, %d stuck to the ball, %d in the air, %d inside a solid\n",
-              snow.state.size(), snow.time, steps, 1e3 * stepSeconds / steps, snow.threads(), onGround, onBall,
-              falling, inside);
+  std::printf(
+      "%zu flakes, %.2f s in %d steps of 1/120 s (%.2f ms a step on %d threads): "
+      "%d resting on the ground, %d stuck to the ball, %d in the air, %d inside a solid\n",
+      snow.state.size(), snow.time(), steps, 1e3 * stepSeconds / steps, snow.threads(), onGround,
+      onBall, falling, inside);
   const bool ok = inside == 0 && onGround > 0 && onBall > 0 && int(snow.state.size()) == flakes;
 
   // The last frame: white flakes, the ball as a ring of its silhouette.
@@ -106,13 +110,15 @@ int main(int argc, char** argv) {
     const bool stuck = snow.state.invMass[i] == 0;
     batch.positions.push_back(snow.state.position(i).cast<float>());
     batch.sizes.push_back(0.012f);
-    batch.colors.push_back(stuck ? mesh::Vec3f(0.75f, 0.85f, 1.0f) : mesh::Vec3f(0.95f, 0.95f, 0.95f));
+    batch.colors.push_back(stuck ? mesh::Vec3f(0.75f, 0.85f, 1.0f)
+                                 : mesh::Vec3f(0.95f, 0.95f, 0.95f));
   }
   render::LineBatch lines;
   for (int k = 0; k < 64; ++k) {
     const double a0 = 2 * M_PI * k / 64, a1 = 2 * M_PI * (k + 1) / 64;
     for (double a : {a0, a1}) {
-      lines.points.push_back((ballCentre + ballRadius * Vec3(std::cos(a), std::sin(a), 0)).cast<float>());
+      lines.points.push_back(
+          (ballCentre + ballRadius * Vec3(std::cos(a), std::sin(a), 0)).cast<float>());
       lines.colors.push_back(mesh::Vec3f(0.9f, 0.5f, 0.2f));
     }
   }
@@ -126,7 +132,8 @@ int main(int argc, char** argv) {
   (*renderer)->SetBackground(mesh::Vec3f(0.12f, 0.14f, 0.2f));
   (*renderer)->SetPoints(batch);
   (*renderer)->SetLines(lines);
-  (*renderer)->Draw(render::Camera::Frame(Vec3(-2, 0, -2), Vec3(2, 3, 2), 480.0 / 360, 25, 15, false));
+  (*renderer)->Draw(
+      render::Camera::Frame(Vec3(-2, 0, -2), Vec3(2, 3, 2), 480.0 / 360, 25, 15, false));
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());
     return 1;

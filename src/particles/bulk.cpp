@@ -14,7 +14,9 @@ namespace {
 // candidate flags stay in L1.
 constexpr size_t kChunk = 512;
 
-Vec3f Round(const Vec3& x) { return Vec3f(float(x.x()), float(x.y()), float(x.z())); }
+Vec3f Round(const Vec3& x) {
+  return Vec3f(float(x.x()), float(x.y()), float(x.z()));
+}
 
 // x rounded to single precision on the side of every collider that x (the
 // double-precision contact response) is on: rounding a point on a surface
@@ -54,7 +56,7 @@ uint32_t BulkState::Add(const Vec3& p, const Vec3& v, double m, double life) {
   vy.push_back(float(v.y()));
   vz.push_back(float(v.z()));
   invMass.push_back(m > 0 ? float(1 / m) : 0.0f);
-  age.push_back(0);
+  birth.push_back(float(time));
   lifetime.push_back(float(std::min(life, 1e30)));
   color.push_back(Vec3f(1, 1, 1));
   radius.push_back(0.05f);
@@ -75,12 +77,15 @@ void BulkState::SetVelocity(size_t i, const Vec3& v) {
 }
 
 void BulkState::Reserve(size_t n) {
-  for (auto* a : {&px, &py, &pz, &vx, &vy, &vz, &invMass, &age, &lifetime, &radius}) a->reserve(n);
+  for (auto* a : {&px, &py, &pz, &vx, &vy, &vz, &invMass, &birth, &lifetime, &radius})
+    a->reserve(n);
   color.reserve(n);
   id.reserve(n);
 }
 
-BulkSystem::BulkSystem(int threads) { SetThreads(threads); }
+BulkSystem::BulkSystem(int threads) {
+  SetThreads(threads);
+}
 BulkSystem::~BulkSystem() = default;
 
 void BulkSystem::SetThreads(int threads) {
@@ -88,18 +93,21 @@ void BulkSystem::SetThreads(int threads) {
   pool_ = threads_ > 1 ? std::make_unique<ThreadPool>(threads_) : nullptr;
 }
 
-int BulkSystem::threads() const { return threads_; }
+int BulkSystem::threads() const {
+  return threads_;
+}
 
 void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::BulkParams& q) {
   BulkState& s = state;
-  const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(), s.vx.data(),
-                              s.vy.data(), s.vz.data(), s.invMass.data(), s.age.data()};
+  const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
+                              s.vy.data(), s.vz.data(), s.invMass.data()};
   alignas(32) float old[6][kChunk];
   float* const olds[6] = {old[0], old[1], old[2], old[3], old[4], old[5]};
   alignas(32) uint8_t flags[kChunk];
   for (size_t c = begin; c < end; c += kChunk) {
     const size_t ce = std::min(end, c + kChunk), m = ce - c;
-    if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds)) faulted_.store(true, std::memory_order_relaxed);
+    if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds))
+      faulted_.store(true, std::memory_order_relaxed);
     if (colliders_.empty()) continue;
     std::memset(flags, 0, m);
     for (const Collider& col : colliders_) {
@@ -115,10 +123,18 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       const size_t i = c + j;
       if (!flags[j] || s.invMass[i] == 0) continue;
       Vec3 x = s.position(i), v = s.velocity(i);
-      const ContactOutcome out = RespondToContacts(colliders_, Vec3(old[0][j], old[1][j], old[2][j]),
-                                                   Vec3(old[3][j], old[4][j], old[5][j]), x, v, h);
+      const ContactOutcome out =
+          RespondToContacts(colliders_, Vec3(old[0][j], old[1][j], old[2][j]),
+                            Vec3(old[3][j], old[4][j], old[5][j]), x, v, h);
       if (out == ContactOutcome::kNone) continue;
-      if (out == ContactOutcome::kKilled) s.lifetime[i] = std::min(s.lifetime[i], s.age[i]);
+      if (out == ContactOutcome::kKilled) {
+        // Dies at its age at the start of the step (rounded down), so it is
+        // dead at the end whatever the rounding.
+        const double age = s.age(i);
+        float life = float(age);
+        if (double(life) > age) life = std::nextafter(life, 0.0f);
+        s.lifetime[i] = std::min(s.lifetime[i], life);
+      }
       if (out == ContactOutcome::kStuck) s.invMass[i] = 0;
       const Vec3f xf = RoundOutside(colliders_, x);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
@@ -134,16 +150,24 @@ Status BulkSystem::Step(double h) {
   const Vec3& g = fields.gravity;
   const Vec3& w = fields.wind;
   const float limit = float(std::min(maxMagnitude, double(FLT_MAX)));
-  const kernels::BulkParams q{float(g.x()), float(g.y()), float(g.z()), float(w.x()), float(w.y()),
-                              float(w.z()), float(fields.linearDrag), float(fields.quadraticDrag),
-                              float(h), limit};
+  const kernels::BulkParams q{float(g.x()),
+                              float(g.y()),
+                              float(g.z()),
+                              float(w.x()),
+                              float(w.y()),
+                              float(w.z()),
+                              float(fields.linearDrag),
+                              float(fields.quadraticDrag),
+                              float(h),
+                              limit};
   faulted_ = false;
   const size_t n = state.size();
   // Ranges of whole chunks, a few a thread.
-  const size_t grain = (BalancedGrain(pool_.get(), n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
+  const size_t grain =
+      (BalancedGrain(pool_.get(), n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
   ForRanges(pool_.get(), n, grain, [&](size_t b, size_t e) { StepRange(b, e, h, q); });
   Status status = Fault();
-  time += h;
+  state.time += h;
   ++steps;
   return status;
 }
@@ -154,7 +178,7 @@ Status BulkSystem::Fault() {
     const Vec3 x = state.position(i), v = state.velocity(i);
     const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
     if (m <= maxMagnitude) continue;
-    fault_ = ExplosionDiagnostic("in bulk", steps, time, state.id[i], x, v, maxMagnitude);
+    fault_ = ExplosionDiagnostic("in bulk", steps, state.time, state.id[i], x, v, maxMagnitude);
     return *fault_;
   }
   faulted_ = false;
@@ -174,7 +198,7 @@ size_t BulkSystem::Append(const ParticleState& born, size_t begin) {
     state.vy.push_back(float(v.y()));
     state.vz.push_back(float(v.z()));
     state.invMass.push_back(float(born.invMass[i]));
-    state.age.push_back(float(born.age[i]));
+    state.birth.push_back(float(state.time - born.age[i]));
     state.lifetime.push_back(float(std::min(born.lifetime[i], 1e30)));
     state.color.push_back(born.color[i]);
     state.radius.push_back(born.radius[i]);
@@ -189,9 +213,10 @@ size_t BulkSystem::RemoveDead() {
   const size_t n = s.size();
   size_t w = 0;
   for (size_t i = 0; i < n; ++i) {
-    if (s.age[i] >= s.lifetime[i]) continue;
+    if (s.dead(i)) continue;
     if (w != i) {
-      for (auto* a : {&s.px, &s.py, &s.pz, &s.vx, &s.vy, &s.vz, &s.invMass, &s.age, &s.lifetime, &s.radius}) {
+      for (auto* a : {&s.px, &s.py, &s.pz, &s.vx, &s.vy, &s.vz, &s.invMass, &s.birth, &s.lifetime,
+                      &s.radius}) {
         (*a)[w] = (*a)[i];
       }
       s.color[w] = s.color[i];
@@ -199,7 +224,8 @@ size_t BulkSystem::RemoveDead() {
     }
     ++w;
   }
-  for (auto* a : {&s.px, &s.py, &s.pz, &s.vx, &s.vy, &s.vz, &s.invMass, &s.age, &s.lifetime, &s.radius}) {
+  for (auto* a :
+       {&s.px, &s.py, &s.pz, &s.vx, &s.vy, &s.vz, &s.invMass, &s.birth, &s.lifetime, &s.radius}) {
     a->resize(w);
   }
   s.color.resize(w);

@@ -48,16 +48,22 @@ struct BulkState {
   // hot
   std::vector<float> px, py, pz, vx, vy, vz;
   // cold
-  std::vector<float> invMass;   // 0: immovable
-  std::vector<float> age, lifetime;
+  std::vector<float> invMass;  // 0: immovable
+  // The clock's time at birth (s): a particle's age is time - birth, so a
+  // step does not touch it.
+  std::vector<float> birth;
+  std::vector<float> lifetime;  // s of age
   std::vector<Vec3f> color;
-  std::vector<float> radius;    // drawn size, metres
+  std::vector<float> radius;  // drawn size, metres
   std::vector<uint32_t> id;
   uint32_t nextId = 0;
+  double time = 0;  // the clock (s), advanced by BulkSystem::Step
 
   size_t size() const { return px.size(); }
-  // Adds a particle (rounded to single precision); mass 0 or less means
-  // immovable. Returns its id.
+  double age(size_t i) const { return time - double(birth[i]); }
+  bool dead(size_t i) const { return age(i) >= double(lifetime[i]); }
+  // Adds a particle born now (rounded to single precision); mass 0 or less
+  // means immovable. Returns its id.
   uint32_t Add(const Vec3& p, const Vec3& v, double mass = 1, double lifetime = 1e30);
   Vec3 position(size_t i) const { return Vec3(px[i], py[i], pz[i]); }
   Vec3 velocity(size_t i) const { return Vec3(vx[i], vy[i], vz[i]); }
@@ -71,7 +77,7 @@ struct BulkFields {
   Vec3 gravity{0, 0, 0};  // acceleration, m/s^2
   // Drag force -(linear + quadratic |u|) u, with u = v - wind (N).
   double linearDrag = 0, quadraticDrag = 0;
-  Vec3 wind{0, 0, 0};     // m/s
+  Vec3 wind{0, 0, 0};  // m/s
 };
 
 class BulkSystem {
@@ -83,8 +89,8 @@ class BulkSystem {
 
   BulkState state;
   BulkFields fields;
-  double time = 0;
   uint64_t steps = 0;
+  double time() const { return state.time; }
   double maxMagnitude = 1e12;  // a coordinate or speed beyond this is an explosion
 
   // 0 = every hardware thread.
@@ -100,10 +106,10 @@ class BulkSystem {
   [[nodiscard]] Status Step(double h);
 
   // Appends particles [begin, size) of `born` (an Emitter's output) with
-  // their ids, colours and sizes; nextId moves past the largest id. Returns
-  // the number appended.
+  // their ages, ids, colours and sizes; nextId moves past the largest id.
+  // Returns the number appended.
   size_t Append(const ParticleState& born, size_t begin = 0);
-  // Removes particles whose age has reached their lifetime, keeping the
+  // Removes particles whose age has reached their lifetime (`dead`), keeping the
   // order (and ids) of the living. Returns the number removed.
   size_t RemoveDead();
 

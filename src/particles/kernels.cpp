@@ -101,7 +101,6 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   const float x1 = x + q.h * u1, y1 = y + q.h * v1, z1 = z + q.h * s1;
   old[0][o] = x, old[1][o] = y, old[2][o] = z, old[3][o] = u, old[4][o] = v, old[5][o] = s;
   a.px[i] = x1, a.py[i] = y1, a.pz[i] = z1, a.vx[i] = u1, a.vy[i] = v1, a.vz[i] = s1;
-  a.age[i] += q.h;
   return std::fabs(x1) <= q.limit && std::fabs(y1) <= q.limit && std::fabs(z1) <= q.limit &&
          std::fabs(u1) <= q.limit && std::fabs(v1) <= q.limit && std::fabs(s1) <= q.limit;
 }
@@ -145,7 +144,6 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     _mm256_storeu_ps(a.px + i, x1), _mm256_storeu_ps(a.py + i, y1);
     _mm256_storeu_ps(a.pz + i, z1), _mm256_storeu_ps(a.vx + i, u1);
     _mm256_storeu_ps(a.vy + i, v1), _mm256_storeu_ps(a.vz + i, s1);
-    _mm256_storeu_ps(a.age + i, _mm256_add_ps(_mm256_loadu_ps(a.age + i), h));
     good = _mm256_and_ps(
         good, _mm256_and_ps(_mm256_and_ps(Within(x1, abs, limit), Within(y1, abs, limit)),
                             _mm256_and_ps(Within(z1, abs, limit), Within(u1, abs, limit))));

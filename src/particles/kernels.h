@@ -81,13 +81,12 @@ struct BulkParams {
 struct BulkArrays {
   float *px, *py, *pz, *vx, *vy, *vz;
   const float* invMass;
-  float* age;
 };
 
 // Symplectic Euler for particles [begin, end), in place, all in single
 // precision, per particle:
 //   u = v - wind, k = (k1 + k2 sqrt((ux^2 + uy^2) + uz^2)) w,
-//   v' = v + h (g - k u), x' = x + h v', age += h,
+//   v' = v + h (g - k u), x' = x + h v',
 // with an immovable particle (w = 0) kept where it is at zero velocity.
 // old[0..5][i - begin] receive the previous px, py, pz, vx, vy, vz. Returns
 // false if a new component c fails |c| <= limit (a NaN fails).
