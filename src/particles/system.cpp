@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <sstream>
+#include <utility>
 
 #include "particles/grid.h"
 
@@ -116,6 +117,21 @@ void Springs::ForColours(Fn&& fn) const {
 }
 
 void Springs::Accumulate(const ParticleState&, const Vec3* x, const Vec3* v, Vec3* f) const {
+  if (std::exchange(accumulateCached_, false) && x == preparedX_ && linear_.size() == springs_.size()) {
+    // The length and direction PrepareJacobian computed at these positions
+    // (the same operations, so the same bits).
+    ForColours([&](size_t j, const Spring& sp) {
+      const double len = length_[j];
+      if (!(len > 1e-300)) return;
+      const Linear& l = linear_[j];
+      const Vec3 dir(l.u[0], l.u[1], l.u[2]);
+      const double rate = (v[sp.a] - v[sp.b]).dot(dir);
+      const Vec3 fa = -(sp.ks * (len - sp.rest) + sp.kd * rate) * dir;
+      f[sp.a] += fa;
+      f[sp.b] -= fa;
+    });
+    return;
+  }
   ForColours([&](size_t, const Spring& sp) {
     const Vec3 d = x[sp.a] - x[sp.b];
     const double len = d.norm();
@@ -128,9 +144,10 @@ void Springs::Accumulate(const ParticleState&, const Vec3* x, const Vec3* v, Vec
   });
 }
 
-Springs::Linear Springs::Linearise(const Spring& sp, const Vec3* x) {
+Springs::Linear Springs::Linearise(const Spring& sp, const Vec3* x, double* length) {
   const Vec3 d = x[sp.a] - x[sp.b];
   const double len = d.norm();
+  *length = len;
   if (!(len > 1e-300)) return {{0, 0, 0, 0}, sp.a, sp.b, 0, 0, sp.kd};
   const double kt = sp.ks * std::max(0.0, 1 - sp.rest / len);
   const Vec3 u = d / len;
@@ -140,15 +157,18 @@ Springs::Linear Springs::Linearise(const Spring& sp, const Vec3* x) {
 void Springs::PrepareJacobian(const ParticleState&, const Vec3* x, const Vec3*) {
   Colour();
   preparedX_ = x;
+  accumulateCached_ = true;
   linear_.resize(springs_.size());
-  ForColours([&](size_t j, const Spring& sp) { linear_[j] = Linearise(sp, x); });
+  length_.resize(springs_.size());
+  ForColours([&](size_t j, const Spring& sp) { linear_[j] = Linearise(sp, x, &length_[j]); });
 }
 
 void Springs::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
                                  const Vec3* p, Vec3* y) const {
   if (!(x == preparedX_ && linear_.size() == springs_.size())) {
     ForColours([&](size_t, const Spring& sp) {
-      const Linear l = Linearise(sp, x);
+      double len;
+      const Linear l = Linearise(sp, x, &len);
       kernels::SpringProduct(l, cx, cv, p[l.a].data(), p[l.b].data(), y[l.a].data(), y[l.b].data());
     });
     return;
@@ -184,7 +204,8 @@ void Springs::AddJacobianDiagonal(const ParticleState&, const Vec3* x, const Vec
                                   Vec3* diag) const {
   const bool cached = x == preparedX_ && linear_.size() == springs_.size();
   ForColours([&](size_t j, const Spring& sp) {
-    const Linear l = cached ? linear_[j] : Linearise(sp, x);
+    double len;
+    const Linear l = cached ? linear_[j] : Linearise(sp, x, &len);
     const Vec3 u2 = Vec3(l.u[0], l.u[1], l.u[2]).cwiseAbs2();
     const Vec3 g = -cx * (Vec3::Constant(l.kt) + l.kl * u2) - cv * l.kd * u2;
     diag[l.a] += g;
@@ -465,8 +486,9 @@ void System::ImplicitEuler(double h) {
   Vec3* inv = cg_[5].data();
   k_[0].resize(n);
   Vec3* a0 = k_[0].data();
-  Accelerations(X.data(), V.data(), a0);
+  // Linearised first: springs then take their forces' lengths from it.
   for (const auto& f : forces_) f->PrepareJacobian(state, X.data(), V.data());
+  Accelerations(X.data(), V.data(), a0);
   const double* m = state.mass.data();
   const double* w = state.invMass.data();
   ForChunks(n, [&](size_t bb, size_t e) {

@@ -145,7 +145,8 @@ class Springs : public Force {
   //   df_a/dv_a = -kd u u'
   // PrepareJacobian caches u, kt and kl a spring; products at the same
   // positions array use the cache until the next PrepareJacobian (at any
-  // other array they linearise themselves).
+  // other array they linearise themselves), and so does the one Accumulate
+  // that follows it.
   void PrepareJacobian(const ParticleState& s, const Vec3* x, const Vec3* v) override;
   void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
                           const Vec3* p, Vec3* y) const override;
@@ -163,10 +164,15 @@ class Springs : public Force {
   // colour.
   template <typename Fn>
   void ForColours(Fn&& fn) const;
-  static Linear Linearise(const Spring& sp, const Vec3* x);
+  static Linear Linearise(const Spring& sp, const Vec3* x, double* length);
   std::vector<Spring> springs_;
   std::vector<Linear> linear_;           // from PrepareJacobian at preparedX_, colour order
+  std::vector<double> length_;           // and the springs' lengths
   const Vec3* preparedX_ = nullptr;
+  // The next Accumulate at preparedX_ (the implicit solver's, right after
+  // PrepareJacobian) takes lengths and directions from linear_; only that
+  // one, since the positions may change after it.
+  mutable bool accumulateCached_ = false;
   // Colour order: springs order_[colourStart_[c] .. colourStart_[c + 1]);
   // the last group is serial when serialGroup_.
   mutable std::vector<uint32_t> order_;
