@@ -77,8 +77,7 @@ void BulkState::SetVelocity(size_t i, const Vec3& v) {
 }
 
 void BulkState::Reserve(size_t n) {
-  for (auto* a : {&px, &py, &pz, &vx, &vy, &vz, &invMass, &birth, &lifetime, &radius})
-    a->reserve(n);
+  for (auto* a : FloatArrays()) a->reserve(n);
   color.reserve(n);
   id.reserve(n);
 }
@@ -215,19 +214,13 @@ size_t BulkSystem::RemoveDead() {
   for (size_t i = 0; i < n; ++i) {
     if (s.dead(i)) continue;
     if (w != i) {
-      for (auto* a : {&s.px, &s.py, &s.pz, &s.vx, &s.vy, &s.vz, &s.invMass, &s.birth, &s.lifetime,
-                      &s.radius}) {
-        (*a)[w] = (*a)[i];
-      }
+      for (auto* a : s.FloatArrays()) (*a)[w] = (*a)[i];
       s.color[w] = s.color[i];
       s.id[w] = s.id[i];
     }
     ++w;
   }
-  for (auto* a :
-       {&s.px, &s.py, &s.pz, &s.vx, &s.vy, &s.vz, &s.invMass, &s.birth, &s.lifetime, &s.radius}) {
-    a->resize(w);
-  }
+  for (auto* a : s.FloatArrays()) a->resize(w);
   s.color.resize(w);
   s.id.resize(w);
   return n - w;

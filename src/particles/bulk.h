@@ -27,6 +27,7 @@
 // give the same bits (kernels.h).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -70,6 +71,10 @@ struct BulkState {
   void SetPosition(size_t i, const Vec3& p);
   void SetVelocity(size_t i, const Vec3& v);
   void Reserve(size_t n);
+  // Every per-particle array of floats (all but color and id).
+  std::array<std::vector<float>*, 10> FloatArrays() {
+    return {&px, &py, &pz, &vx, &vy, &vz, &invMass, &birth, &lifetime, &radius};
+  }
 };
 
 // The uniform fields acting on every movable particle.
