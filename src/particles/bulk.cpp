@@ -164,7 +164,8 @@ Status BulkSystem::Step(double h) {
   // Ranges of whole chunks, a few a thread.
   const size_t grain =
       (BalancedGrain(pool_.get(), n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
-  ForRanges(pool_.get(), n, grain, [&](size_t b, size_t e) { StepRange(b, e, h, q); });
+  // Contacts see the step the kernel took (h rounded to a float).
+  ForRanges(pool_.get(), n, grain, [&](size_t b, size_t e) { StepRange(b, e, double(q.h), q); });
   Status status = Fault();
   state.time += h;
   ++steps;
