@@ -124,7 +124,10 @@ class BulkSystem {
   uint64_t Hash() const;
 
   // Chooses the vector kernel (tests compare AVX with its scalar twin).
-  void SetKernel(kernels::Kernel k) { kernel_ = k; }
+  // AVX only where the processor has it.
+  void SetKernel(kernels::Kernel k) {
+    kernel_ = k == kernels::Kernel::kAvx ? kernels::Best() : kernels::Kernel::kScalar;
+  }
 
  private:
   void StepRange(size_t begin, size_t end, double h, const kernels::BulkParams& q);
