@@ -11,13 +11,12 @@
 #include "app/commands.h"
 #include "core/atomic_file.h"
 #include "core/parallel.h"
-#include "lsys/deriver.h"
-#include "lsys/parser.h"
+#include <map>
 
 namespace sylva::app {
 
-static bool ParseDefines(const std::vector<std::string>& defs, lsys::ParseOptions* opt,
-                         std::ostream& err) {
+static bool ParseDefines(const std::vector<std::string>& defs,
+                         std::map<std::string, double>* overrides, std::ostream& err) {
   for (const auto& d : defs) {
     size_t eq = d.find('=');
     std::string name = d.substr(0, eq);
@@ -34,59 +33,61 @@ static bool ParseDefines(const std::vector<std::string>& defs, lsys::ParseOption
       err << "sylva: error: -D " << name << ": '" << value << "' is not a number\n";
       return false;
     }
-    opt->overrides[name] = v;
+    (*overrides)[name] = v;
   }
   return true;
 }
 
-std::optional<lsys::Grammar> LoadGrammar(const DeriveFlags& f, std::ostream& err, int* exit) {
-  lsys::ParseOptions opt;
-  if (!ParseDefines(f.defines, &opt, err)) {
+std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit) {
+  plant::PlantSpec spec;
+  spec.path = f.file;
+  if (!ParseDefines(f.defines, &spec.defines, err)) {
     *exit = kExitBadInput;
     return std::nullopt;
   }
-  lsys::ParseResult r = lsys::ParseGrammarFile(f.file, opt);
-  *exit = Report(r.diagnostics, err);
-  if (!r.grammar) {
-    if (*exit == kExitOk) *exit = kExitBadInput;
-    return std::nullopt;
-  }
-  return std::move(r.grammar);
+  spec.steps = f.steps;
+  spec.seed = f.seed;
+  spec.threads = f.threads;
+  if (f.maxModules) spec.limits.maxModules = f.maxModules;
+  return spec;
 }
 
-lsys::DeriveOptions DeriveOptionsFrom(const DeriveFlags& f) {
-  lsys::DeriveOptions opt;
-  if (f.steps) opt.steps = *f.steps;
-  opt.seed = f.seed;
-  opt.threads = f.threads;
-  if (f.maxModules) opt.maxModules = f.maxModules;
-  return opt;
+std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, std::ostream& err, int* exit) {
+  plant::PlantResult r = plant::BuildPlant(spec);
+  *exit = Report(r.diagnostics, err);
+  if (!r.plant && *exit == kExitOk) *exit = kExitBadInput;
+  return std::move(r.plant);
 }
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err) {
   int exit = kExitOk;
-  auto g = LoadGrammar(flags, err, &exit);
-  return g ? kExitOk : exit;
+  auto spec = SpecFrom(flags, err, &exit);
+  if (!spec) return exit;
+  spec->until = plant::Stage::kGrammar;
+  auto p = BuildPlant(*spec, err, &exit);
+  return p ? kExitOk : exit;
 }
 
-static void PrintStats(const lsys::Grammar& g, const lsys::DeriveResult& r, int threads,
-                       uint64_t seed, std::ostream& out) {
+static void PrintStats(const plant::Plant& p, int threads, uint64_t seed, std::ostream& out) {
+  const lsys::Grammar& g = p.grammar;
   char line[256];
   out << "grammar: " << g.path << " (" << g.name << ")\n";
   std::snprintf(line, sizeof line, "steps: %d  seed: %llu  threads: %d\n",
-                int(r.steps.size()) - 1, static_cast<unsigned long long>(seed), threads);
+                int(p.steps.size()) - 1, static_cast<unsigned long long>(seed), threads);
   out << line;
   out << "step       modules      time\n";
   uint64_t produced = 0;
-  for (const auto& s : r.steps) {
+  double seconds = 0;
+  for (const auto& s : p.steps) {
+    seconds += s.seconds;
     if (s.step > 0) produced += s.modules;
     std::snprintf(line, sizeof line, "%4d %13llu %9.4f s\n", s.step,
                   static_cast<unsigned long long>(s.modules), s.seconds);
     out << line;
   }
   std::vector<uint64_t> count(g.symbols.size(), 0);
-  for (lsys::SymbolId s : r.word.symbols) ++count[s];
-  out << "modules: " << r.word.size() << "\n";
+  for (lsys::SymbolId s : p.word.symbols) ++count[s];
+  out << "modules: " << p.word.size() << "\n";
   out << "per symbol:\n";
   for (size_t s = 0; s < count.size(); ++s) {
     if (!count[s]) continue;
@@ -97,27 +98,26 @@ static void PrintStats(const lsys::Grammar& g, const lsys::DeriveResult& r, int 
                   static_cast<unsigned long long>(count[s]));
     out << line;
   }
-  double rate = r.seconds > 0 ? double(produced) / r.seconds : 0;
+  double rate = seconds > 0 ? double(produced) / seconds : 0;
   std::snprintf(line, sizeof line,
-                "time: %.4f s (%llu modules produced, %.1f million modules/s)\n", r.seconds,
+                "time: %.4f s (%llu modules produced, %.1f million modules/s)\n", seconds,
                 static_cast<unsigned long long>(produced), rate / 1e6);
   out << line;
-  std::snprintf(line, sizeof line, "word memory: %.1f MiB\n", double(r.word.MemoryBytes()) / (1 << 20));
+  std::snprintf(line, sizeof line, "word memory: %.1f MiB\n", double(p.word.MemoryBytes()) / (1 << 20));
   out << line;
 }
 
 int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err) {
   int exit = kExitOk;
-  auto g = LoadGrammar(cmd.derive, err, &exit);
-  if (!g) return exit;
-
-  lsys::DeriveOptions opt = DeriveOptionsFrom(cmd.derive);
+  auto spec = SpecFrom(cmd.derive, err, &exit);
+  if (!spec) return exit;
+  spec->until = cmd.interpret ? plant::Stage::kInterpreted : plant::Stage::kWord;
   // Progress on a terminal, once a derivation has run for a second.
   const bool tty = &err == &std::cerr && isatty(2);
   const auto start = std::chrono::steady_clock::now();
   bool shown = false;
   if (tty) {
-    opt.progress = [&](int step, int steps, uint64_t modules) {
+    spec->progress = [&](int step, int steps, uint64_t modules) {
       double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (t < 1.0) return;
       shown = true;
@@ -125,20 +125,14 @@ int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err) {
                    static_cast<unsigned long long>(modules));
     };
   }
-  auto r = lsys::Derive(*g, opt);
+  auto p = BuildPlant(*spec, err, &exit);
   if (shown) std::fprintf(stderr, "\r%60s\r", "");
-  if (!r) return Report(r.error(), err);
-  lsys::Word* word = &r->word;
-  lsys::Word interpreted;
-  if (cmd.interpret) {
-    auto w = lsys::Interpret(*g, r->word, opt);
-    if (!w) return Report(w.error(), err);
-    interpreted = std::move(w).value();
-    word = &interpreted;
-  }
+  if (!p) return exit;
+  const lsys::Grammar* g = &p->grammar;
+  const lsys::Word* word = cmd.interpret ? &p->DrawnWord() : &p->word;
   if (cmd.stats) {
     int threads = cmd.derive.threads > 0 ? cmd.derive.threads : sylva::ThreadPool::HardwareThreads();
-    PrintStats(*g, *r, threads, opt.seed.value_or(g->seed), out);
+    PrintStats(*p, threads, spec->seed.value_or(g->seed), out);
     return kExitOk;
   }
   if (cmd.output.empty()) {

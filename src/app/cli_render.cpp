@@ -9,7 +9,6 @@
 #include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
-#include "turtle/interpreter.h"
 
 namespace sylva::app {
 
@@ -42,17 +41,18 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   int exit = kExitOk;
-  auto plant = DeriveAndDraw(cmd.derive, err, &exit);
+  auto spec = SpecFrom(cmd.derive, err, &exit);
+  if (!spec) return exit;
+  spec->detail.sides = cmd.sides;
+  spec->until = plant::Stage::kGeometry;
+  auto plant = BuildPlant(*spec, err, &exit);
   if (!plant) return exit;
-  const lsys::Grammar* g = &plant->grammar;
   const mesh::PlantGeometry* geometry = &plant->geometry;
-
-  const mesh::Palette palette = PaletteOf(*g);
+  const mesh::Palette& palette = plant->palette;
   // 2D figures (all in the z = 0 plane, nothing but segments) draw as lines
   // in an orthographic view from +Z; everything else as a lit mesh.
-  const bool lines = geometry->planar && geometry->polygons.empty() &&
-                     geometry->surfaces.empty() && geometry->spheres.empty();
-  mesh::TriangleMesh m;
+  const bool lines = plant::IsLineFigure(*geometry);
+  const mesh::TriangleMesh& m = plant->mesh;
   render::LineBatch batch;
   Vec3 lo = geometry->boundsMin, hi = geometry->boundsMax;
   if (lines) {
@@ -64,7 +64,10 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
       batch.colors.push_back(c);
     }
   } else {
-    if (!BuildMesh(*g, *geometry, cmd.sides, &m, err, &exit)) return exit;
+    DiagnosticList warnings;
+    Status s = plant::Tessellate(*plant, *spec, warnings);
+    exit = Report(warnings, err);
+    if (!s.ok()) return Report(s.error(), err);
     if (m.vertexCount()) {
       lo = hi = m.positions[0].cast<double>();
       for (const auto& p : m.positions) {

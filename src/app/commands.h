@@ -9,11 +9,7 @@
 #include <vector>
 
 #include "core/diagnostic.h"
-#include "lsys/deriver.h"
-#include "lsys/grammar.h"
-#include "mesh/export.h"
-#include "mesh/plant_geometry.h"
-#include "mesh/triangle_mesh.h"
+#include "plant/plant.h"
 
 namespace sylva::app {
 
@@ -52,29 +48,14 @@ int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err);
 int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err);
 int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 
-// Parses the grammar named by the flags (with -D), printing diagnostics.
-// Returns the grammar, or nullopt with the exit status in *exit.
-std::optional<lsys::Grammar> LoadGrammar(const DeriveFlags& f, std::ostream& err, int* exit);
-lsys::DeriveOptions DeriveOptionsFrom(const DeriveFlags& f);
+// The plant spec the flags describe (steps, seed, -D, threads, limits);
+// nullopt with *exit set when a flag is malformed (printed to `err`).
+std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit);
 
-// Grammar -> derived word -> interpretation rules -> turtle, as `mesh` and
-// `render` need it, printing diagnostics and the turtle's warnings; nullopt
-// with *exit set on failure. Times in milliseconds: derive (with the
-// interpretation rules) and turtle.
-struct DrawnPlant {
-  lsys::Grammar grammar;
-  uint64_t modules = 0;  // of the word the turtle read
-  mesh::PlantGeometry geometry;
-  double deriveMs = 0, turtleMs = 0;
-};
-std::optional<DrawnPlant> DeriveAndDraw(const DeriveFlags& f, std::ostream& err, int* exit);
+// Builds the plant up to `spec.until`, printing every diagnostic; nullopt
+// with *exit set on an error.
+std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, std::ostream& err, int* exit);
 
-// The grammar's palette, or the default one.
-mesh::Palette PaletteOf(const lsys::Grammar& g);
-// Loads the surfaces `geometry` places and tessellates it, printing
-// diagnostics and warnings; false with *exit set on failure.
-bool BuildMesh(const lsys::Grammar& g, const mesh::PlantGeometry& geometry, int sides,
-               mesh::TriangleMesh* out, std::ostream& err, int* exit);
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
 // Prints diagnostics; returns the exit status they call for (0 when there

@@ -22,10 +22,9 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
-#include "lsys/parser.h"
-#include "mesh/tessellator.h"
+#include "plant/plant.h"
+#include "plant/surface_library.h"
 #include "render/renderer.h"
-#include "turtle/interpreter.h"
 
 namespace sylva::app {
 namespace {
@@ -58,57 +57,32 @@ struct Result {
 Result RunJob(const Job& job) {
   Result r;
   r.id = job.id;
-  auto ms = [](auto a, auto b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
-  const auto t0 = Clock::now();
-  lsys::ParseOptions popt;
-  popt.overrides = job.overrides;
-  lsys::ParseResult parsed = lsys::ParseGrammarFile(job.path, popt);
-  r.diagnostics = parsed.diagnostics.FormatAll();
-  if (!parsed.grammar) return r;
-  const lsys::Grammar& g = *parsed.grammar;
-  r.derivationLength = g.derivationLength;
-  for (const auto& [k, v] : g.constants) r.constants.emplace_back(k, v);
+  plant::PlantSpec spec;
+  spec.path = job.path;
+  spec.defines = job.overrides;
+  spec.seed = job.seed;
+  if (job.steps >= 0) spec.steps = job.steps;
+  spec.detail.sides = job.sides;
+  plant::PlantResult built = plant::BuildPlant(spec);
+  r.diagnostics = built.diagnostics.FormatAll();
+  if (!built.plant) return r;
+  plant::Plant& p = *built.plant;
+  r.derivationLength = p.grammar.derivationLength;
+  for (const auto& [k, v] : p.grammar.constants) r.constants.emplace_back(k, v);
   std::sort(r.constants.begin(), r.constants.end());
-  lsys::DeriveOptions dopt;
-  dopt.steps = job.steps;
-  dopt.seed = job.seed;
-  auto derived = lsys::Derive(g, dopt);
-  if (!derived) {
-    r.diagnostics += derived.error().Format();
-    return r;
-  }
-  auto word = lsys::Interpret(g, derived->word, dopt);
-  if (!word) {
-    r.diagnostics += word.error().Format();
-    return r;
-  }
-  const auto t1 = Clock::now();
-  auto geometry = turtle::Interpret(*word, g.symbols, turtle::TurtleDefFrom(g));
-  if (!geometry) {
-    r.diagnostics += geometry.error().Format();
-    return r;
-  }
-  const auto t2 = Clock::now();
-  std::ostringstream err;
-  int exit = 0;
-  if (!BuildMesh(g, *geometry, job.sides, &r.mesh, err, &exit)) {
-    r.diagnostics += err.str();
-    return r;
-  }
-  r.diagnostics += err.str();
-  const auto t3 = Clock::now();
-  r.palette = PaletteOf(g);
-  r.modules = word->size();
+  r.mesh = std::move(p.mesh);
+  r.palette = p.palette;
+  r.modules = p.DrawnWord().size();
   if (r.mesh.vertexCount()) {
     r.lo = r.hi = r.mesh.positions[0].cast<double>();
-    for (const auto& p : r.mesh.positions) {
-      r.lo = r.lo.cwiseMin(p.cast<double>());
-      r.hi = r.hi.cwiseMax(p.cast<double>());
+    for (const auto& q : r.mesh.positions) {
+      r.lo = r.lo.cwiseMin(q.cast<double>());
+      r.hi = r.hi.cwiseMax(q.cast<double>());
     }
   }
-  r.deriveMs = ms(t0, t1);
-  r.turtleMs = ms(t1, t2);
-  r.tessellateMs = ms(t2, t3);
+  r.deriveMs = p.time.parse + p.time.derive + p.time.interpret;
+  r.turtleMs = p.time.turtle;
+  r.tessellateMs = p.time.tessellate;
   r.ok = true;
   return r;
 }
@@ -167,7 +141,7 @@ class Worker {
 };
 
 std::string DefaultGrammar() {
-  return (fs::path(SYLVA_DATA_DIR) / "grammars" / "abop" / "fig2_06a_monopodial.lsys").string();
+  return (fs::path(plant::BundledDataDir()) / "grammars" / "abop" / "fig2_06a_monopodial.lsys").string();
 }
 
 }  // namespace

@@ -704,10 +704,110 @@ Status RunSection(const Grammar& g, const Section& sec, ThreadPool& pool, Scratc
 
 }  // namespace
 
-Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
+// The state a derivation carries from one step to the next.
+struct Derivation::State {
+  State(const Grammar& grammar, const DeriveOptions& o)
+      : g(grammar),
+        seed(o.seed.value_or(grammar.seed)),
+        maxModules(std::min(o.maxModules, kMaxModulesCap)),
+        pool(o.threads),
+        table(BuildStaticTable(grammar, grammar.main)) {}
+
+  const Grammar& g;
+  const uint64_t seed;
+  const uint64_t maxModules;
+  ThreadPool pool;
+  const StaticTable table;
+  Scratch scratch;
+  Word word, next;
+  int step = 0;
+  bool fixedPoint = false;
+  std::vector<StepStats> stats;
+};
+
+Derivation::Derivation(std::unique_ptr<State> state) : state_(std::move(state)) {}
+Derivation::Derivation(Derivation&&) noexcept = default;
+Derivation& Derivation::operator=(Derivation&&) noexcept = default;
+Derivation::~Derivation() = default;
+
+Expected<Derivation> Derivation::Start(const Grammar& g, const DeriveOptions& options) {
   SYLVA_ASSERT(g.main.bySymbol.size() == g.symbols.size());  // a Grammar from the parser
+  auto state = std::make_unique<State>(g, options);
+  auto axiom = BuildAxiom(g, state->seed);
+  if (!axiom) return axiom.error();
+  state->word = std::move(axiom).value();
+  if (state->word.size() > state->maxModules) {
+    return LimitError("the axiom has " + std::to_string(state->word.size()) +
+                      " modules, more than the limit of " + std::to_string(state->maxModules));
+  }
+  state->stats.push_back(StepStats{0, state->word.size(), 0});
+  return Derivation(std::move(state));
+}
+
+Status Derivation::Step() {
+  State& s = *state_;
+  if (s.step >= kMaxDerivationLengthForDerive) {
+    return LimitError("derivation length " + std::to_string(s.step + 1) +
+                      " is more than the limit of " +
+                      std::to_string(kMaxDerivationLengthForDerive));
+  }
+  const auto ts = Clock::now();
+  const int step = s.step + 1;
+  if (!s.fixedPoint) {
+    bool changed = false;
+    Pass pass(s.g, s.g.main, s.table, s.pool, s.scratch, s.seed, kMainDraws, uint64_t(step), step,
+              s.maxModules);
+    if (Status st = pass.Run(s.word, s.next, &changed); !st.ok()) return st;
+    std::swap(s.word, s.next);
+    if (Status st = RunSection(s.g, s.g.decomposition, s.pool, s.scratch, s.seed,
+                               kDecompositionDraws, uint64_t(step), step, s.maxModules, s.word);
+        !st.ok())
+      return st;
+    if (s.g.cutSymbol && ContainsSymbol(s.word, *s.g.cutSymbol)) {
+      ApplyCut(s.word, *s.g.cutSymbol);
+      changed = true;
+    }
+    // With no production applied and no randomness, every later step gives
+    // this same word. (A caller that edits the word between steps breaks
+    // this: MutableWord() clears it.)
+    if (!changed && s.g.decomposition.empty() && !s.g.usesRandom) s.fixedPoint = true;
+  }
+  s.step = step;
+  s.stats.push_back(
+      StepStats{step, s.word.size(), std::chrono::duration<double>(Clock::now() - ts).count()});
+  return {};
+}
+
+int Derivation::step() const { return state_->step; }
+const Word& Derivation::word() const { return state_->word; }
+Word& Derivation::MutableWord() {
+  state_->fixedPoint = false;
+  return state_->word;
+}
+const std::vector<StepStats>& Derivation::stats() const { return state_->stats; }
+
+Expected<Word> Derivation::Interpreted() const {
+  State& s = *state_;
+  Word w = s.word;
+  if (s.g.interpretation.empty()) return w;
+  Scratch scratch;
+  if (Status st = RunSection(s.g, s.g.interpretation, s.pool, scratch, s.seed, kInterpretDraws, 0,
+                             0, s.maxModules, w);
+      !st.ok())
+    return st.error();
+  return w;
+}
+
+DeriveResult Derivation::Finish() && {
+  DeriveResult r;
+  r.word = std::move(state_->word);
+  r.steps = std::move(state_->stats);
+  for (const StepStats& s : r.steps) r.seconds += s.seconds;
+  return r;
+}
+
+Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
   const auto t0 = Clock::now();
-  const uint64_t seed = options.seed.value_or(g.seed);
   const int steps = options.steps >= 0 ? options.steps : g.derivationLength;
   if (steps > kMaxDerivationLengthForDerive) {
     Diagnostic d;
@@ -715,48 +815,13 @@ Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
                 std::to_string(kMaxDerivationLengthForDerive);
     return d;
   }
-  const uint64_t maxModules = std::min(options.maxModules, kMaxModulesCap);
-  ThreadPool pool(options.threads);
-
-  DeriveResult result;
-  auto axiom = BuildAxiom(g, seed);
-  if (!axiom) return axiom.error();
-  result.word = std::move(axiom).value();
-  if (result.word.size() > maxModules) {
-    return LimitError("the axiom has " + std::to_string(result.word.size()) +
-                      " modules, more than the limit of " + std::to_string(maxModules));
+  auto derivation = Derivation::Start(g, options);
+  if (!derivation) return derivation.error();
+  while (derivation->step() < steps) {
+    if (Status s = derivation->Step(); !s.ok()) return s.error();
+    if (options.progress) options.progress(derivation->step(), steps, derivation->word().size());
   }
-  result.steps.push_back(StepStats{0, result.word.size(), 0});
-
-  const StaticTable table = BuildStaticTable(g, g.main);
-  Scratch scratch;
-  Word next;
-  bool fixedPoint = false;
-  for (int step = 1; step <= steps; ++step) {
-    const auto ts = Clock::now();
-    if (!fixedPoint) {
-      bool changed = false;
-      Pass pass(g, g.main, table, pool, scratch, seed, kMainDraws, uint64_t(step), step,
-                maxModules);
-      if (Status s = pass.Run(result.word, next, &changed); !s.ok()) return s.error();
-      std::swap(result.word, next);
-      if (Status s = RunSection(g, g.decomposition, pool, scratch, seed, kDecompositionDraws,
-                                uint64_t(step), step, maxModules, result.word);
-          !s.ok())
-        return s.error();
-      if (g.cutSymbol && ContainsSymbol(result.word, *g.cutSymbol)) {
-        ApplyCut(result.word, *g.cutSymbol);
-        changed = true;
-      }
-      // With no production applied and no randomness, every later step
-      // gives this same word.
-      if (!changed && g.decomposition.empty() && !g.usesRandom) fixedPoint = true;
-    }
-    const double secs = std::chrono::duration<double>(Clock::now() - ts).count();
-    result.steps.push_back(StepStats{step, result.word.size(), secs});
-    if (options.progress) options.progress(step, steps, result.word.size());
-  }
-  next = Word();
+  DeriveResult result = std::move(*derivation).Finish();
   result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return result;
 }

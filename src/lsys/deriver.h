@@ -20,6 +20,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -59,6 +60,43 @@ struct DeriveResult {
 };
 
 Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options = {});
+
+// A derivation driven one step at a time, so a caller can look at (or
+// answer queries in) the word between steps: the plant library runs the
+// turtle between steps for environmental queries. Derive() is Start() and
+// Step() until the requested length. `g` must outlive the Derivation; it
+// holds its own thread pool (options.threads) and scratch memory.
+class Derivation {
+ public:
+  // Builds the axiom (step 0). options.steps and options.progress are not
+  // used: the caller decides how many steps to take.
+  static Expected<Derivation> Start(const Grammar& g, const DeriveOptions& options = {});
+
+  // Rewrites the word once (main section, then decomposition and cut).
+  // An error (a limit reached, an expression that fails) ends the
+  // derivation: the word is then undefined and must not be stepped again.
+  Status Step();
+
+  int step() const;  // steps taken; 0 after Start
+  const Word& word() const;
+  // The word, for a caller that fills query parameters between steps.
+  Word& MutableWord();
+  const std::vector<StepStats>& stats() const;  // stats()[0] is the axiom
+  // The current word through the interpretation section (what the turtle
+  // reads); a copy of word() when the section is empty.
+  Expected<Word> Interpreted() const;
+  // Ends the derivation, handing over the word and the statistics.
+  DeriveResult Finish() &&;
+
+  Derivation(Derivation&&) noexcept;
+  Derivation& operator=(Derivation&&) noexcept;
+  ~Derivation();
+
+ private:
+  struct State;
+  explicit Derivation(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
 
 // Applies the interpretation section (up to its maximum depth) to a derived
 // word: the word handed to the turtle. Returns a copy when the section is

@@ -1,0 +1,224 @@
+#include "plant/plant.h"
+
+#include <chrono>
+#include <utility>
+
+#include "lsys/parser.h"
+#include "plant/surface_library.h"
+#include "turtle/interpreter.h"
+
+namespace sylva::plant {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// The turtle and the tessellator report warnings as text naming the
+// module; they become warnings about the grammar file.
+void AddWarnings(const std::vector<std::string>& warnings, const std::string& path,
+                 DiagnosticList& out) {
+  for (const std::string& w : warnings) {
+    Diagnostic d;
+    d.severity = Severity::kWarning;
+    d.loc.file = path;
+    d.message = w;
+    out.Add(std::move(d));
+  }
+}
+
+Diagnostic SpecError(const std::string& message) {
+  Diagnostic d;
+  d.message = message;
+  return d;
+}
+
+lsys::DeriveOptions DeriveOptionsOf(const PlantSpec& spec) {
+  lsys::DeriveOptions o;
+  o.seed = spec.seed;
+  o.threads = spec.threads;
+  o.maxModules = spec.limits.maxModules;
+  return o;
+}
+
+}  // namespace
+
+DiagnosticList Validate(const PlantSpec& spec) {
+  DiagnosticList list;
+  if (!spec.text && spec.path.empty()) list.Add(SpecError("no grammar: give a file or a text"));
+  if (spec.steps && (*spec.steps < 0 || *spec.steps > lsys::kMaxDerivationLengthForDerive)) {
+    list.Add(SpecError("steps " + std::to_string(*spec.steps) + " is outside 0.." +
+                       std::to_string(lsys::kMaxDerivationLengthForDerive)));
+  }
+  if (spec.threads < 0 || spec.threads > 256) {
+    list.Add(SpecError("threads " + std::to_string(spec.threads) + " is outside 0..256"));
+  }
+  if (spec.detail.sides < 3 || spec.detail.sides > 256) {
+    list.Add(SpecError("sides " + std::to_string(spec.detail.sides) + " is outside 3..256"));
+  }
+  if (spec.limits.maxModules < 1 || spec.limits.maxModules > lsys::kMaxModulesCap) {
+    list.Add(SpecError("max modules " + std::to_string(spec.limits.maxModules) +
+                       " is outside 1.." + std::to_string(lsys::kMaxModulesCap)));
+  }
+  return list;
+}
+
+mesh::Palette PaletteOf(const lsys::Grammar& g) {
+  if (g.palette.empty()) return mesh::DefaultPalette();
+  mesh::Palette p;
+  for (const auto& c : g.palette) p.push_back(mesh::Vec3f(c[0], c[1], c[2]));
+  return p;
+}
+
+bool IsLineFigure(const mesh::PlantGeometry& geometry) {
+  return geometry.planar && geometry.polygons.empty() && geometry.surfaces.empty() &&
+         geometry.spheres.empty();
+}
+
+Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics) {
+  const auto t0 = Clock::now();
+  SurfaceLibrary surfaces(plant.grammar.path, spec.surfacePath, spec.readFile);
+  if (Status s = surfaces.LoadFor(plant.geometry, plant.grammar); !s.ok()) return s;
+  mesh::TessellateOptions options;
+  options.detail = spec.detail;
+  options.surfaces = &surfaces.meshes();
+  mesh::TessellateStats stats;
+  plant.mesh = mesh::TriangleMesh();
+  if (std::string problem = mesh::Tessellate(plant.geometry, options, plant.mesh, &stats);
+      !problem.empty()) {
+    Diagnostic d = SpecError(problem);
+    d.loc.file = plant.grammar.path;
+    return d;
+  }
+  AddWarnings(stats.warnings, plant.grammar.path, diagnostics);
+  plant.time.tessellate = MsSince(t0);
+  return {};
+}
+
+Grower::Grower(Grower&&) noexcept = default;
+Grower& Grower::operator=(Grower&&) noexcept = default;
+Grower::~Grower() = default;
+
+std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagnostics) {
+  DiagnosticList bad = Validate(spec);
+  if (bad.HasErrors()) {
+    for (auto& d : bad.items) diagnostics.Add(std::move(d));
+    return std::nullopt;
+  }
+  const auto t0 = Clock::now();
+  lsys::ParseOptions popt;
+  popt.overrides = spec.defines;
+  popt.readFile = spec.readFile;
+  lsys::ParseResult parsed = spec.text ? lsys::ParseGrammarText(*spec.text, spec.path, popt)
+                                       : lsys::ParseGrammarFile(spec.path, popt);
+  for (auto& d : parsed.diagnostics.items) diagnostics.Add(d);
+  if (!parsed.grammar) return std::nullopt;
+
+  Grower g;
+  g.spec_ = spec;
+  g.grammar_ = std::make_unique<lsys::Grammar>(std::move(*parsed.grammar));
+  g.diagnostics_ = std::move(parsed.diagnostics);
+  g.time_.parse = MsSince(t0);
+  g.steps_ = spec.steps.value_or(g.grammar_->derivationLength);
+  if (spec.until == Stage::kGrammar) return g;
+  const auto t1 = Clock::now();
+  auto derivation = lsys::Derivation::Start(*g.grammar_, DeriveOptionsOf(spec));
+  if (!derivation) {
+    diagnostics.Add(derivation.error());
+    return std::nullopt;
+  }
+  g.derivation_ = std::move(*derivation);
+  g.time_.derive = MsSince(t1);
+  return g;
+}
+
+int Grower::step() const { return derivation_ ? derivation_->step() : 0; }
+int Grower::steps() const { return derivation_ ? steps_ : 0; }
+const lsys::Word& Grower::word() const { return derivation_->word(); }
+lsys::Word& Grower::MutableWord() { return derivation_->MutableWord(); }
+
+Status Grower::Step() {
+  SYLVA_ASSERT(derivation_.has_value());
+  const auto t0 = Clock::now();
+  Status s = derivation_->Step();
+  time_.derive += MsSince(t0);
+  if (s.ok() && spec_.progress) spec_.progress(step(), steps_, word().size());
+  return s;
+}
+
+Expected<mesh::PlantGeometry> Grower::Draw(DiagnosticList* warnings) const {
+  const lsys::Grammar& g = *grammar_;
+  std::optional<lsys::Word> interpreted;
+  if (!g.interpretation.empty()) {
+    auto w = derivation_->Interpreted();
+    if (!w) return w.error();
+    interpreted = std::move(*w);
+  }
+  auto geometry = turtle::Interpret(interpreted ? *interpreted : word(), g.symbols,
+                                    turtle::TurtleDefFrom(g));
+  if (geometry && warnings) AddWarnings(geometry->warnings, g.path, *warnings);
+  return geometry;
+}
+
+PlantResult Grower::Finish() && {
+  PlantResult r;
+  r.diagnostics = std::move(diagnostics_);
+  Plant p;
+  p.time = time_;
+  p.palette = PaletteOf(*grammar_);
+  if (derivation_) {
+    lsys::DeriveResult derived = std::move(*derivation_).Finish();
+    derivation_.reset();
+    p.word = std::move(derived.word);
+    p.steps = std::move(derived.steps);
+  }
+  p.grammar = std::move(*grammar_);
+  grammar_.reset();
+  const lsys::Grammar& g = p.grammar;
+  if (spec_.until >= Stage::kInterpreted && !g.interpretation.empty()) {
+    const auto t0 = Clock::now();
+    auto w = lsys::Interpret(g, p.word, DeriveOptionsOf(spec_));
+    if (!w) {
+      r.diagnostics.Add(w.error());
+      return r;
+    }
+    p.interpreted = std::move(*w);
+    p.time.interpret = MsSince(t0);
+  }
+  if (spec_.until >= Stage::kGeometry) {
+    const auto t0 = Clock::now();
+    auto geometry = turtle::Interpret(p.DrawnWord(), g.symbols, turtle::TurtleDefFrom(g));
+    if (!geometry) {
+      r.diagnostics.Add(geometry.error());
+      return r;
+    }
+    p.geometry = std::move(*geometry);
+    AddWarnings(p.geometry.warnings, g.path, r.diagnostics);
+    p.time.turtle = MsSince(t0);
+  }
+  if (spec_.until >= Stage::kMesh) {
+    if (Status s = Tessellate(p, spec_, r.diagnostics); !s.ok()) {
+      r.diagnostics.Add(s.error());
+      return r;
+    }
+  }
+  r.plant = std::move(p);
+  return r;
+}
+
+PlantResult BuildPlant(const PlantSpec& spec) {
+  DiagnosticList diagnostics;
+  std::optional<Grower> grower = Grower::Start(spec, diagnostics);
+  if (!grower) return PlantResult{std::nullopt, std::move(diagnostics)};
+  while (!grower->done()) {
+    if (Status s = grower->Step(); !s.ok()) {
+      diagnostics.Add(s.error());
+      return PlantResult{std::nullopt, std::move(diagnostics)};
+    }
+  }
+  return std::move(*grower).Finish();
+}
+
+}  // namespace sylva::plant

@@ -1,0 +1,173 @@
+// A plant in one call: grammar file or text -> parse -> derive ->
+// interpretation rules -> turtle -> surfaces -> tessellation.
+//
+// Every Sylva front end (the CLI, the viewer, tests, benchmarks, scenes)
+// builds plants through this file, so they all run the same chain:
+//
+//   PlantSpec spec;
+//   spec.path = "grammars/abop/fig2_06a_monopodial.lsys";
+//   spec.steps = 8;
+//   plant::PlantResult r = plant::BuildPlant(spec);
+//   if (!r.plant) { std::cerr << r.diagnostics.FormatAll(); return 2; }
+//   mesh::WriteMesh(r.plant->mesh, r.plant->palette, "tree.glb");
+//
+// Derivation can also be driven one step at a time (Grower), so a caller
+// can draw the word between steps: the environmental queries of open
+// L-systems (?P ?H ?L ?U ?E) are answered that way.
+//
+// Bad numbers in a spec (a negative step count, 2 sides) are reported by
+// Validate() as diagnostics before any work: never clamped, never aborted
+// on (docs/design.md, "Bad numbers").
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/diagnostic.h"
+#include "core/status.h"
+#include "lsys/deriver.h"
+#include "lsys/grammar.h"
+#include "lsys/word.h"
+#include "mesh/export.h"
+#include "mesh/plant_geometry.h"
+#include "mesh/tessellator.h"
+#include "mesh/triangle_mesh.h"
+
+namespace sylva::plant {
+
+// How far BuildPlant goes.
+enum class Stage {
+  kGrammar,      // parse and check only
+  kWord,         // derive (Plant::word)
+  kInterpreted,  // the interpretation rules (Plant::interpreted)
+  kGeometry,     // the turtle (Plant::geometry)
+  kMesh,         // surfaces and tessellation (Plant::mesh)
+};
+
+struct Limits {
+  // The derived word (and every interpretation pass) stops with an error
+  // past this many modules. 2^28 modules: 512 MiB of symbols.
+  uint64_t maxModules = lsys::kDefaultMaxModules;
+};
+
+// Reads a file's text (the grammar, #include, surfaces); nullopt when it
+// cannot. Default: the file system.
+using FileReader = std::function<std::optional<std::string>(const std::string& path)>;
+
+struct PlantSpec {
+  std::string path;                 // the grammar file; with `text`, the name used in diagnostics
+  std::optional<std::string> text;  // grammar source; when set, `path` is not read
+  std::optional<int> steps;         // default: the grammar's derivation length; 0..100000
+  std::optional<uint64_t> seed;     // default: the grammar's `seed:`
+  std::map<std::string, double> defines;  // -D NAME=VALUE: overrides `#define NAME`
+  // Folders searched for NAME.obj before the grammar's own folder, its
+  // surfaces/ folder and the bundled grammars/surfaces (SurfaceLibrary).
+  std::vector<std::string> surfacePath;
+  int threads = 0;  // derivation threads; 0: all hardware threads; at most 256
+  Limits limits;
+  mesh::Detail detail;  // tessellation detail (sides 3..256)
+  Stage until = Stage::kMesh;
+  FileReader readFile;  // empty: the file system
+  // Called after each derivation step, from the calling thread.
+  std::function<void(int step, int steps, uint64_t modules)> progress;
+};
+
+// Reports every bad number in `spec` (steps, threads, sides, limits) as an
+// error diagnostic; empty when the spec is usable.
+DiagnosticList Validate(const PlantSpec& spec);
+
+// Wall-clock milliseconds of each stage that ran.
+struct Timings {
+  double parse = 0, derive = 0, interpret = 0, turtle = 0, tessellate = 0;
+};
+
+struct Plant {
+  lsys::Grammar grammar;
+  lsys::Word word;                       // the derived word
+  std::vector<lsys::StepStats> steps;    // steps[0] is the axiom
+  // The word through the interpretation rules (what the turtle read); empty
+  // when the grammar has no interpretation section: use DrawnWord().
+  lsys::Word interpreted;
+  mesh::PlantGeometry geometry;          // Stage::kGeometry and later
+  mesh::TriangleMesh mesh;               // Stage::kMesh
+  mesh::Palette palette;                 // the grammar's, or the default one (linear RGB)
+  Timings time;
+
+  // The word the turtle reads (from Stage::kInterpreted on).
+  const lsys::Word& DrawnWord() const {
+    return grammar.interpretation.empty() ? word : interpreted;
+  }
+};
+
+struct PlantResult {
+  std::optional<Plant> plant;   // set when there is no error
+  DiagnosticList diagnostics;   // errors and warnings of every stage, in order
+};
+
+// Builds the plant `spec` describes, up to spec.until.
+PlantResult BuildPlant(const PlantSpec& spec);
+
+// Loads the surfaces plant.geometry places and tessellates it into
+// plant.mesh (replacing what it held) at spec.detail. Warnings go to
+// `diagnostics`; an error is returned.
+Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics);
+
+// True when the geometry is a flat line figure (every point in z = 0,
+// nothing but segments): ABOP's 2D figures, drawn as lines, not tubes.
+bool IsLineFigure(const mesh::PlantGeometry& geometry);
+
+// The grammar's palette (`palette:`), or the exporters' default one.
+mesh::Palette PaletteOf(const lsys::Grammar& g);
+
+// A plant grown one derivation step at a time:
+//
+//   DiagnosticList diags;
+//   auto grower = Grower::Start(spec, diags);
+//   while (grower && !grower->done()) {
+//     if (Status s = grower->Step(); !s.ok()) ...
+//     auto geometry = grower->Draw();   // the turtle on this step's word
+//   }
+//   PlantResult r = std::move(*grower).Finish();
+class Grower {
+ public:
+  // Validates the spec, parses the grammar (diagnostics, warnings included,
+  // go to `diagnostics`) and builds the axiom. nullopt on an error.
+  static std::optional<Grower> Start(const PlantSpec& spec, DiagnosticList& diagnostics);
+
+  Status Step();  // one derivation step; an error ends the growth
+  int step() const;
+  int steps() const;  // the length asked for (spec.steps or the grammar's)
+  bool done() const { return step() >= steps(); }
+
+  const lsys::Grammar& grammar() const { return *grammar_; }
+  const lsys::Word& word() const;
+  lsys::Word& MutableWord();  // to fill query parameters between steps
+
+  // The current word through the interpretation rules and the turtle.
+  // Turtle warnings go to `warnings` when given.
+  Expected<mesh::PlantGeometry> Draw(DiagnosticList* warnings = nullptr) const;
+
+  // Runs the stages after derivation that spec.until asks for (without
+  // stepping further) and returns the plant.
+  PlantResult Finish() &&;
+
+  Grower(Grower&&) noexcept;
+  Grower& operator=(Grower&&) noexcept;
+  ~Grower();
+
+ private:
+  Grower() = default;
+  PlantSpec spec_;
+  std::unique_ptr<lsys::Grammar> grammar_;  // the derivation points into it
+  std::optional<lsys::Derivation> derivation_;
+  int steps_ = 0;
+  DiagnosticList diagnostics_;  // those Start reported, handed on by Finish
+  Timings time_;
+};
+
+}  // namespace sylva::plant

@@ -1,0 +1,80 @@
+#include "plant/surface_library.h"
+
+#include <sys/stat.h>
+
+#include <set>
+
+#include "mesh/obj_reader.h"
+
+namespace sylva::plant {
+
+std::string BundledDataDir() { return SYLVA_DATA_DIR; }
+
+static std::string Join(const std::string& dir, const std::string& name) {
+  if (dir.empty()) return name;
+  return dir.back() == '/' ? dir + name : dir + "/" + name;
+}
+
+static std::string ParentOf(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+SurfaceLibrary::SurfaceLibrary(const std::string& grammarPath, const std::vector<std::string>& extra,
+                               FileReader readFile)
+    : searchPath_(extra), readFile_(std::move(readFile)) {
+  const std::string dir = ParentOf(grammarPath);
+  searchPath_.push_back(dir);
+  searchPath_.push_back(Join(dir, "surfaces"));
+  searchPath_.push_back(Join(Join(BundledDataDir(), "grammars"), "surfaces"));
+}
+
+Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::Grammar& g) {
+  std::set<std::string> names;
+  for (const auto& si : geometry.surfaces) {
+    if (!meshes_.count(si.name)) names.insert(si.name);
+  }
+  for (const std::string& name : names) {
+    const std::string file = name + ".obj";
+    std::optional<std::string> text;
+    std::string found;
+    for (const std::string& dir : searchPath_) {
+      const std::string candidate = Join(dir, file);
+      if (readFile_) {
+        text = readFile_(candidate);
+        if (text) {
+          found = candidate;
+          break;
+        }
+        continue;
+      }
+      struct stat st;
+      if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+        found = candidate;
+        break;
+      }
+    }
+    if (found.empty()) {
+      Diagnostic d;
+      d.loc.file = g.path;
+      d.message = "unknown surface '" + name + "': no " + file + " in";
+      for (size_t i = 0; i < searchPath_.size(); ++i) {
+        d.message += (i ? ", " : " ") + searchPath_[i];
+      }
+      // Point at the surface's first use in the grammar.
+      if (auto it = g.symbolLoc.find("~" + name); it != g.symbolLoc.end()) {
+        d.loc = it->second.loc;
+        d.sourceLine = it->second.line;
+        d.length = int(name.size()) + 1;
+      }
+      return d;
+    }
+    auto surface = text ? mesh::ParseObj(*text, found) : mesh::ReadObj(found);
+    if (!surface) return surface.error();
+    meshes_.emplace(name, std::move(*surface));
+  }
+  return {};
+}
+
+}  // namespace sylva::plant

@@ -1,0 +1,52 @@
+// Predefined surfaces (`~leaf`, `~petal`, your own `~name`): the meshes a
+// plant's SurfaceInstances place, found by name in one place.
+//
+// A surface `~name` is the Wavefront OBJ file `name.obj`, searched in order
+// in: the folders the caller adds (PlantSpec::surfacePath), the grammar's
+// folder, its `surfaces/` folder, and the bundled `grammars/surfaces`.
+// The first file found wins. Meshes are loaded once per library.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "core/status.h"
+#include "lsys/grammar.h"
+#include "mesh/plant_geometry.h"
+#include "mesh/triangle_mesh.h"
+
+namespace sylva::plant {
+
+// The folder of bundled data (grammars/surfaces, shaders): the source tree
+// in a build, or the installed share/sylva.
+std::string BundledDataDir();
+
+class SurfaceLibrary {
+ public:
+  using FileReader = std::function<std::optional<std::string>(const std::string& path)>;
+
+  // `extra` folders first, then those of the grammar at `grammarPath`, then
+  // the bundled ones. `readFile` (optional) reads a file's text instead of
+  // the file system (tests, fuzzers).
+  SurfaceLibrary(const std::string& grammarPath, const std::vector<std::string>& extra = {},
+                 FileReader readFile = {});
+
+  // Loads every surface `geometry` places that is not loaded yet. An error
+  // (no such surface, a bad OBJ file) points at the surface's first use in
+  // `g` when it can.
+  Status LoadFor(const mesh::PlantGeometry& geometry, const lsys::Grammar& g);
+
+  // Surfaces by name (without `~`): what mesh::TessellateOptions takes.
+  const std::unordered_map<std::string, mesh::TriangleMesh>& meshes() const { return meshes_; }
+  const std::vector<std::string>& searchPath() const { return searchPath_; }
+
+ private:
+  std::vector<std::string> searchPath_;
+  FileReader readFile_;
+  std::unordered_map<std::string, mesh::TriangleMesh> meshes_;
+};
+
+}  // namespace sylva::plant
