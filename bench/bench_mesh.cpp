@@ -7,11 +7,9 @@
 #include <filesystem>
 #include <string>
 
-#include "lsys/deriver.h"
-#include "lsys/parser.h"
 #include "mesh/export.h"
 #include "mesh/tessellator.h"
-#include "turtle/interpreter.h"
+#include "plant/plant.h"
 
 namespace {
 
@@ -21,14 +19,17 @@ std::string Grammar(const char* name) {
   return std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/" + name + ".lsys";
 }
 
+plant::PlantSpec Spec(const char* name, int steps, plant::Stage until) {
+  plant::PlantSpec spec;
+  spec.path = Grammar(name);
+  spec.steps = steps;
+  spec.threads = 1;
+  spec.until = until;
+  return spec;
+}
+
 mesh::PlantGeometry Geometry(const char* name, int steps) {
-  auto r = lsys::ParseGrammarFile(Grammar(name));
-  lsys::DeriveOptions opt;
-  opt.steps = steps;
-  opt.threads = 1;
-  auto d = lsys::Derive(*r.grammar, opt);
-  auto w = lsys::Interpret(*r.grammar, d->word, opt);
-  return std::move(*turtle::Interpret(*w, r.grammar->symbols, turtle::TurtleDefFrom(*r.grammar)));
+  return std::move(plant::BuildPlant(Spec(name, steps, plant::Stage::kGeometry)).plant->geometry);
 }
 
 void BM_Tessellate(benchmark::State& state, const char* name, int steps) {
@@ -73,15 +74,17 @@ BENCHMARK_CAPTURE(BM_Write, ply, "ply")->Unit(benchmark::kMillisecond);
 void BM_EndToEndMillionSegments(benchmark::State& state) {
   const std::string path = (std::filesystem::temp_directory_path() / "sylva_bench_e2e.glb").string();
   size_t segments = 0, triangles = 0;
+  plant::PlantSpec spec = Spec("fig2_06a_monopodial", 20, plant::Stage::kMesh);
+  spec.detail.sides = 8;
   for (auto _ : state) {
-    mesh::PlantGeometry g = Geometry("fig2_06a_monopodial", 20);
-    mesh::TriangleMesh m;
-    mesh::TessellateOptions opt;
-    opt.detail.sides = 8;
-    mesh::Tessellate(g, opt, m);
-    if (!mesh::WriteMesh(m, mesh::DefaultPalette(), path).ok()) state.SkipWithError("write failed");
-    segments = g.segments.size();
-    triangles = m.triangleCount();
+    plant::PlantResult r = plant::BuildPlant(spec);
+    if (!r.plant) {
+      state.SkipWithError("the plant failed");
+      break;
+    }
+    if (!mesh::WriteMesh(r.plant->mesh, r.plant->palette, path).ok()) state.SkipWithError("write failed");
+    segments = r.plant->geometry.segments.size();
+    triangles = r.plant->mesh.triangleCount();
   }
   state.counters["segments"] = double(segments);
   state.counters["triangles"] = double(triangles);

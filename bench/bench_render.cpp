@@ -6,12 +6,9 @@
 #include <random>
 #include <string>
 
-#include "lsys/deriver.h"
-#include "lsys/parser.h"
-#include "mesh/tessellator.h"
+#include "plant/plant.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
-#include "turtle/interpreter.h"
 
 namespace {
 
@@ -34,15 +31,16 @@ Gl& Context() {
 }
 
 void BM_FrameMillionTrianglePlant(benchmark::State& state) {
-  auto r = lsys::ParseGrammarFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_08b_ternary.lsys");
-  lsys::DeriveOptions opt;
-  opt.steps = 8;
-  auto d = lsys::Derive(*r.grammar, opt);
-  auto g = turtle::Interpret(d->word, r.grammar->symbols, turtle::TurtleDefFrom(*r.grammar));
-  mesh::TriangleMesh m;
-  mesh::TessellateOptions topt;
-  topt.detail.sides = 22;  // about 1.01 M triangles
-  mesh::Tessellate(*g, topt, m);
+  plant::PlantSpec spec;
+  spec.path = std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_08b_ternary.lsys";
+  spec.steps = 8;
+  spec.detail.sides = 22;  // about 1.01 M triangles
+  plant::PlantResult r = plant::BuildPlant(spec);
+  if (!r.plant) {
+    state.SkipWithError(r.diagnostics.FormatAll().c_str());
+    return;
+  }
+  const mesh::TriangleMesh& m = r.plant->mesh;
   Vec3 lo = m.positions[0].cast<double>(), hi = lo;
   for (const auto& p : m.positions) {
     lo = lo.cwiseMin(p.cast<double>());

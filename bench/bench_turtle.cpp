@@ -6,8 +6,7 @@
 
 #include <string>
 
-#include "lsys/deriver.h"
-#include "lsys/parser.h"
+#include "plant/plant.h"
 #include "turtle/interpreter.h"
 
 namespace {
@@ -15,21 +14,23 @@ namespace {
 using namespace sylva;
 
 void BM_Turtle(benchmark::State& state, const char* file, int steps) {
-  auto r = lsys::ParseGrammarFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/" + file + ".lsys");
-  lsys::DeriveOptions opt;
-  opt.steps = steps;
-  auto d = lsys::Derive(*r.grammar, opt);
-  auto word = lsys::Interpret(*r.grammar, d->word);
-  const turtle::TurtleDef def = turtle::TurtleDefFrom(*r.grammar);
+  plant::PlantSpec spec;
+  spec.path = std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/" + file + ".lsys";
+  spec.steps = steps;
+  spec.until = plant::Stage::kInterpreted;
+  plant::PlantResult r = plant::BuildPlant(spec);
+  const lsys::Word* word = &r.plant->DrawnWord();
+  const lsys::Grammar* grammar = &r.plant->grammar;
+  const turtle::TurtleDef def = turtle::TurtleDefFrom(*grammar);
   size_t segments = 0;
   const bool reuse = state.range(0) == 1;
   turtle::PlantGeometry kept;
   for (auto _ : state) {
     if (reuse) {
-      (void)turtle::InterpretInto(*word, r.grammar->symbols, def, {}, kept);
+      (void)turtle::InterpretInto(*word, grammar->symbols, def, {}, kept);
       segments = kept.segments.size();
     } else {
-      auto g = turtle::Interpret(*word, r.grammar->symbols, def);
+      auto g = turtle::Interpret(*word, grammar->symbols, def);
       segments = g->segments.size();
       benchmark::DoNotOptimize(g->segments.data());
     }

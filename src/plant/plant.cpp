@@ -5,7 +5,6 @@
 
 #include "lsys/parser.h"
 #include "plant/surface_library.h"
-#include "turtle/interpreter.h"
 
 namespace sylva::plant {
 namespace {
@@ -157,7 +156,7 @@ Expected<mesh::PlantGeometry> Grower::Draw(DiagnosticList* warnings) const {
     interpreted = std::move(*w);
   }
   auto geometry = turtle::Interpret(interpreted ? *interpreted : word(), g.symbols,
-                                    turtle::TurtleDefFrom(g));
+                                    turtle::TurtleDefFrom(g), spec_.draw);
   if (geometry && warnings) AddWarnings(geometry->warnings, g.path, *warnings);
   return geometry;
 }
@@ -189,7 +188,8 @@ PlantResult Grower::Finish() && {
   }
   if (spec_.until >= Stage::kGeometry) {
     const auto t0 = Clock::now();
-    auto geometry = turtle::Interpret(p.DrawnWord(), g.symbols, turtle::TurtleDefFrom(g));
+    auto geometry =
+        turtle::Interpret(p.DrawnWord(), g.symbols, turtle::TurtleDefFrom(g), spec_.draw);
     if (!geometry) {
       r.diagnostics.Add(geometry.error());
       return r;

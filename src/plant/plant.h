@@ -37,6 +37,7 @@
 #include "mesh/plant_geometry.h"
 #include "mesh/tessellator.h"
 #include "mesh/triangle_mesh.h"
+#include "turtle/interpreter.h"
 
 namespace sylva::plant {
 
@@ -70,7 +71,8 @@ struct PlantSpec {
   std::vector<std::string> surfacePath;
   int threads = 0;  // derivation threads; 0: all hardware threads; at most 256
   Limits limits;
-  mesh::Detail detail;  // tessellation detail (sides 3..256)
+  turtle::DrawOptions draw;  // what the turtle records besides geometry
+  mesh::Detail detail;       // tessellation detail (sides 3..256)
   Stage until = Stage::kMesh;
   FileReader readFile;  // empty: the file system
   // Called after each derivation step, from the calling thread.

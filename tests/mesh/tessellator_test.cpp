@@ -8,30 +8,19 @@
 #include <unordered_map>
 
 #include "core/atomic_file.h"
-#include "lsys/deriver.h"
-#include "lsys/parser.h"
-#include "turtle/interpreter.h"
+#include "plant/plant_test_util.h"
 
 namespace sylva::mesh {
 namespace {
 
 PlantGeometry Draw(const std::string& text, int steps = -1) {
-  auto r = lsys::ParseGrammarText(text, "t.lsys");
-  if (!r.grammar) {
-    ADD_FAILURE() << r.diagnostics.FormatAll();
-    return {};
-  }
-  lsys::DeriveOptions o;
-  o.steps = steps;
-  auto w = lsys::Derive(*r.grammar, o);
-  auto iw = lsys::Interpret(*r.grammar, w->word);
-  auto g = turtle::Interpret(*iw, r.grammar->symbols, turtle::TurtleDefFrom(*r.grammar));
-  EXPECT_TRUE(g.ok());
-  return g.ok() ? std::move(*g) : PlantGeometry{};
+  auto p = testing::PlantFromText(text, steps);
+  return p ? std::move(p->geometry) : PlantGeometry{};
 }
 
 PlantGeometry DrawFile(const std::string& name, int steps = -1) {
-  return Draw(*ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/" + name + ".lsys"), steps);
+  auto p = testing::PlantFromFile("abop/" + name + ".lsys", steps);
+  return p ? std::move(p->geometry) : PlantGeometry{};
 }
 
 TriangleMesh Mesh(const PlantGeometry& g, int sides = 8) {

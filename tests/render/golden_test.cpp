@@ -11,13 +11,11 @@
 #include <filesystem>
 #include <random>
 
-#include "lsys/deriver.h"
-#include "lsys/parser.h"
+#include "plant/plant_test_util.h"
 #include "mesh/tessellator.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
 #include "render/render_fixture.h"
-#include "turtle/interpreter.h"
 
 namespace sylva::render {
 namespace {
@@ -67,13 +65,11 @@ class Golden : public testing::RenderFixture {
   }
 
   void DrawPlant(const std::string& file, int steps, bool lines) {
-    auto r = lsys::ParseGrammarFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/" + file + ".lsys");
-    ASSERT_TRUE(r.grammar);
-    lsys::DeriveOptions o;
-    o.steps = steps;
-    auto w = lsys::Derive(*r.grammar, o);
-    auto g = turtle::Interpret(w->word, r.grammar->symbols, turtle::TurtleDefFrom(*r.grammar));
-    ASSERT_TRUE(g.ok());
+    // Through the plant library, interpretation rules included.
+    auto p = sylva::testing::PlantFromFile("abop/" + file + ".lsys", steps,
+                                    lines ? plant::Stage::kGeometry : plant::Stage::kMesh, 8);
+    ASSERT_TRUE(p);
+    const mesh::PlantGeometry* g = &p->geometry;
     renderer_->SetMesh({}, {});
     renderer_->SetLines({});
     renderer_->SetPoints({});
@@ -90,10 +86,7 @@ class Golden : public testing::RenderFixture {
       renderer_->Draw(Camera::Frame(g->boundsMin, g->boundsMax, double(kW) / kH, 0, 0, true));
       return;
     }
-    mesh::TriangleMesh m;
-    mesh::TessellateOptions opt;
-    opt.detail.sides = 8;
-    ASSERT_EQ(mesh::Tessellate(*g, opt, m), "");
+    const mesh::TriangleMesh& m = p->mesh;
     Vec3 lo = m.positions[0].cast<double>(), hi = lo;
     for (const auto& p : m.positions) {
       lo = lo.cwiseMin(p.cast<double>());

@@ -10,14 +10,12 @@
 
 #include "app/cli.h"
 #include "core/atomic_file.h"
-#include "lsys/deriver.h"
-#include "lsys/parser.h"
+#include "plant/plant_test_util.h"
 #include "mesh/tessellator.h"
 #include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
 #include "render/render_fixture.h"
-#include "turtle/interpreter.h"
 
 namespace sylva::render {
 namespace {
@@ -74,12 +72,8 @@ std::array<int, 4> Silhouette(const Image& img, const uint8_t* bg) {
 }
 
 mesh::PlantGeometry Draw(const std::string& file, int steps) {
-  auto r = lsys::ParseGrammarFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/" + file);
-  lsys::DeriveOptions o;
-  o.steps = steps;
-  auto w = lsys::Derive(*r.grammar, o);
-  auto iw = lsys::Interpret(*r.grammar, w->word);
-  return std::move(*turtle::Interpret(*iw, r.grammar->symbols, turtle::TurtleDefFrom(*r.grammar)));
+  auto p = sylva::testing::PlantFromFile(file, steps);
+  return p ? std::move(p->geometry) : mesh::PlantGeometry{};
 }
 
 TEST_F(Render, EmptySceneIsTheBackgroundColour) {
@@ -96,11 +90,9 @@ TEST_F(Render, EmptySceneIsTheBackgroundColour) {
 }
 
 TEST_F(Render, PlantSilhouetteMatchesItsProjectedBounds) {
-  mesh::PlantGeometry g = Draw("abop/fig2_06a_monopodial.lsys", 6);
-  mesh::TriangleMesh m;
-  mesh::TessellateOptions opt;
-  opt.detail.sides = 16;
-  ASSERT_EQ(mesh::Tessellate(g, opt, m), "");
+  auto p = sylva::testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 6, plant::Stage::kMesh, 16);
+  ASSERT_TRUE(p);
+  const mesh::TriangleMesh& m = p->mesh;
   Vec3 lo = m.positions[0].cast<double>(), hi = lo;
   for (const auto& p : m.positions) {
     lo = lo.cwiseMin(p.cast<double>());

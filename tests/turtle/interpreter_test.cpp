@@ -5,8 +5,7 @@
 #include <random>
 
 #include "core/atomic_file.h"
-#include "lsys/deriver.h"
-#include "lsys/parser.h"
+#include "plant/plant_test_util.h"
 
 namespace sylva::turtle {
 namespace {
@@ -25,29 +24,14 @@ struct Drawn {
   PlantGeometry geometry;
 };
 
-// Parses, derives (interpretation rules applied) and draws.
+// Parses, derives (interpretation rules applied) and draws, through the
+// plant library.
 Drawn Draw(const std::string& text, int steps = -1, DrawOptions opt = {}) {
   Drawn d;
-  auto r = lsys::ParseGrammarText(text, "t.lsys");
-  if (!r.grammar) {
-    ADD_FAILURE() << r.diagnostics.FormatAll();
-    return d;
-  }
-  d.grammar = std::move(*r.grammar);
-  lsys::DeriveOptions o;
-  o.steps = steps;
-  auto w = lsys::Derive(d.grammar, o);
-  if (!w) {
-    ADD_FAILURE() << w.error().Format();
-    return d;
-  }
-  auto iw = lsys::Interpret(d.grammar, w->word);
-  auto g = Interpret(*iw, d.grammar.symbols, TurtleDefFrom(d.grammar), opt);
-  if (!g) {
-    ADD_FAILURE() << g.error().Format();
-    return d;
-  }
-  d.geometry = std::move(*g);
+  auto p = testing::PlantFromText(text, steps, plant::Stage::kGeometry, opt);
+  if (!p) return d;
+  d.grammar = std::move(p->grammar);
+  d.geometry = std::move(p->geometry);
   return d;
 }
 
@@ -229,14 +213,13 @@ namespace sylva::turtle {
 namespace {
 
 TEST(Turtle, RedrawingIntoAnExistingGeometryGivesTheSameResult) {
-  auto r = lsys::ParseGrammarText("axiom: F[+F{.F+F+F}]~a@O F\n", "t.lsys");
-  ASSERT_TRUE(r.grammar);
-  auto w = lsys::Derive(*r.grammar);
-  TurtleDef def = TurtleDefFrom(*r.grammar);
-  auto fresh = Interpret(w->word, r.grammar->symbols, def);
+  auto p = testing::PlantFromText("axiom: F[+F{.F+F+F}]~a@O F\n", -1, plant::Stage::kInterpreted);
+  ASSERT_TRUE(p);
+  TurtleDef def = TurtleDefFrom(p->grammar);
+  auto fresh = Interpret(p->DrawnWord(), p->grammar.symbols, def);
   PlantGeometry kept;
   for (int i = 0; i < 3; ++i) {
-    ASSERT_TRUE(InterpretInto(w->word, r.grammar->symbols, def, {}, kept).ok());
+    ASSERT_TRUE(InterpretInto(p->DrawnWord(), p->grammar.symbols, def, {}, kept).ok());
     EXPECT_EQ(kept.segments.size(), fresh->segments.size());
     EXPECT_EQ(kept.polygons.size(), 1u);
     EXPECT_EQ(kept.surfaces.size(), 1u);
@@ -258,11 +241,10 @@ TEST(Turtle, TropismMatchesTheExactRotationOverManySteps) {
   opt.recordModules = true;
   std::string axiom = "+(70)";
   for (int i = 0; i < 200; ++i) axiom += "F";
-  auto r = lsys::ParseGrammarText("tropism: 0.3 -1 0.2 0.35\naxiom: " + axiom + "\n", "t.lsys");
-  ASSERT_TRUE(r.grammar);
-  auto w = lsys::Derive(*r.grammar);
-  auto g = Interpret(w->word, r.grammar->symbols, TurtleDefFrom(*r.grammar), opt);
-  ASSERT_TRUE(g.ok());
+  auto p = testing::PlantFromText("tropism: 0.3 -1 0.2 0.35\naxiom: " + axiom + "\n", -1,
+                                  plant::Stage::kGeometry, opt);
+  ASSERT_TRUE(p);
+  const PlantGeometry* g = &p->geometry;
   Vec3 h(-std::sin(70 * kDegToRad), std::cos(70 * kDegToRad), 0);
   const Vec3 t(0.3, -1, 0.2);
   for (int i = 0; i < 200; ++i) {
