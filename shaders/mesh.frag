@@ -2,7 +2,7 @@
 // Key light (warm, from the upper left, casting shadows), fill light
 // (cool, from the right) and a hemisphere ambient term (sky above, ground
 // below): enough shape to judge a plant. Two-sided: back faces flip their
-// normal. Output in sRGB (gamma 2.2).
+// normal. Colours arrive linear (mesh/color.h); output is sRGB-encoded.
 in vec3 vPosition;
 in vec3 vNormal;
 in vec3 vColor;
@@ -12,6 +12,12 @@ uniform mat4 uLightViewProj;
 uniform sampler2DShadow uShadow;  // depth from the key light
 uniform int uShadows;
 out vec4 fragColor;
+
+// The exact sRGB transfer function (IEC 61966-2-1).
+vec3 EncodeSrgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+}
 
 // 3x3 percentage-closer filtering of the key light's shadow map.
 float KeyVisibility(vec3 n) {
@@ -30,7 +36,7 @@ void main() {
   vec3 n = normalize(vNormal);
   vec3 toEye = normalize(uEye - vPosition);
   if (dot(n, toEye) < 0.0) n = -n;
-  vec3 albedo = pow(vColor, vec3(2.2));
+  vec3 albedo = vColor;
   vec3 keyDir = normalize(uKeyDir);
   vec3 fillDir = normalize(vec3(0.7, 0.2, -0.4));
   float key = max(dot(n, keyDir), 0.0) * KeyVisibility(n);
@@ -40,5 +46,5 @@ void main() {
   vec3 h = normalize(keyDir + toEye);
   float spec = pow(max(dot(n, h), 0.0), 32.0) * 0.08;
   vec3 c = albedo * (ambient + key * vec3(1.0, 0.95, 0.85) * 0.9 + fill * vec3(0.55, 0.62, 0.75) * 0.35) + spec;
-  fragColor = vec4(pow(c, vec3(1.0 / 2.2)), 1.0);
+  fragColor = vec4(EncodeSrgb(c), 1.0);
 }

@@ -1,10 +1,15 @@
 #version 450 core
 in vec3 vColor;
 out vec4 fragColor;
+// Colours arrive linear (mesh/color.h); output is sRGB-encoded.
+vec3 EncodeSrgb(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+}
 void main() {
   vec2 d = gl_PointCoord * 2.0 - 1.0;
   float r2 = dot(d, d);
   if (r2 > 1.0) discard;
   // A little shading so a cloud of points reads as spheres.
-  fragColor = vec4(vColor * (1.0 - 0.35 * r2), 1.0);
+  fragColor = vec4(EncodeSrgb(vColor * (1.0 - 0.35 * r2)), 1.0);
 }

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
     const float speed = float(std::min(sys.state.velocity[i].norm() / 6.0, 1.0));
     batch.positions.push_back(sys.state.position[i].cast<float>());
     batch.sizes.push_back(0.035f);
-    batch.colors.push_back(mesh::Vec3f(0.95f, 0.35f + 0.6f * speed, 0.15f + 0.5f * (1 - speed)));
+    batch.colors.push_back(mesh::Srgb(0.95f, 0.35f + 0.6f * speed, 0.15f + 0.5f * (1 - speed)));
   }
   // The cube's edges as lines.
   render::LineBatch edges;
@@ -80,11 +80,11 @@ int main(int argc, char** argv) {
       auto corner = [](int k) { return mesh::Vec3f(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1); };
       edges.points.push_back(corner(a));
       edges.points.push_back(corner(b));
-      edges.colors.push_back(mesh::Vec3f(0.6f, 0.6f, 0.65f));
-      edges.colors.push_back(mesh::Vec3f(0.6f, 0.6f, 0.65f));
+      edges.colors.push_back(mesh::Srgb(0.6f, 0.6f, 0.65f));
+      edges.colors.push_back(mesh::Srgb(0.6f, 0.6f, 0.65f));
     }
   }
-  (*renderer)->SetBackground(mesh::Vec3f(0.08f, 0.08f, 0.1f));
+  (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
   (*renderer)->SetPoints(batch);
   (*renderer)->SetLines(edges);
   (*renderer)->Draw(render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 480.0 / 360, 30, 20, false));

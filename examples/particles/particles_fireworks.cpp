@@ -29,7 +29,9 @@ int main(int argc, char** argv) {
   enum Kind { kRocket, kSpark, kBursting };
   std::map<uint32_t, Kind> kind;
   std::map<uint32_t, particles::Emitter> emitterOf;
-  const Vec3f palette[4] = {{1.0f, 0.35f, 0.2f}, {0.3f, 0.7f, 1.0f}, {1.0f, 0.85f, 0.3f}, {0.7f, 1.0f, 0.4f}};
+  // Colours are linear inside Sylva; these were picked in sRGB.
+  const Vec3f palette[4] = {mesh::Srgb(1.0f, 0.35f, 0.2f), mesh::Srgb(0.3f, 0.7f, 1.0f),
+                            mesh::Srgb(1.0f, 0.85f, 0.3f), mesh::Srgb(0.7f, 1.0f, 0.4f)};
 
   EmitterDef rockets;
   rockets.rate = 3;
@@ -39,7 +41,7 @@ int main(int argc, char** argv) {
   rockets.velocitySpread = 2.5;
   rockets.lifetime = 1.0;
   rockets.lifetimeJitter = 0.2;
-  rockets.colorStart = rockets.colorEnd = Vec3f(1, 0.9f, 0.7f);
+  rockets.colorStart = rockets.colorEnd = mesh::Srgb(1, 0.9f, 0.7f);
   rockets.seed = 2026;
   particles::Emitter launcher(rockets);
   int bursts = 0, sparks = 0;
@@ -53,7 +55,7 @@ int main(int argc, char** argv) {
     d.lifetimeJitter = 0.3;
     d.mass = 0.5;  // drag decelerates sparks at 0.6 / 0.5 = 1.2 per second
     d.colorStart = palette[stream % 4];
-    d.colorEnd = Vec3f(0.25f, 0.05f, 0.05f);
+    d.colorEnd = mesh::Srgb(0.25f, 0.05f, 0.05f);
     d.seed = 2026;
     d.stream = stream++;
     particles::Emitter e(d);
@@ -108,7 +110,7 @@ int main(int argc, char** argv) {
     lo = lo.cwiseMin(sys.state.position[i]);
     hi = hi.cwiseMax(sys.state.position[i]);
   }
-  (*renderer)->SetBackground(mesh::Vec3f(0.03f, 0.03f, 0.07f));
+  (*renderer)->SetBackground(mesh::Srgb(0.03f, 0.03f, 0.07f));
   (*renderer)->SetPoints(batch);
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 0, 5, false));
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {

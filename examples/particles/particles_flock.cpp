@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
     const Vec3 v = sys.state.velocity[i].normalized();
     batch.positions.push_back(sys.state.position[i].cast<float>());
     batch.sizes.push_back(0.1f);
-    batch.colors.push_back(mesh::Vec3f(0.55f + 0.45f * float(v.x()), 0.6f + 0.4f * float(v.y()), 0.65f + 0.35f * float(v.z())));
+    batch.colors.push_back(mesh::Srgb(0.55f + 0.45f * float(v.x()), 0.6f + 0.4f * float(v.y()), 0.65f + 0.35f * float(v.z())));
   }
   // The obstacle as a ring of points on three great circles.
   for (int k = 0; k < 360; ++k) {
@@ -87,11 +87,11 @@ int main(int argc, char** argv) {
       p[(c + 1) % 3] = radius * std::sin(t);
       batch.positions.push_back((obstacle + p).cast<float>());
       batch.sizes.push_back(0.05f);
-      batch.colors.push_back(mesh::Vec3f(0.9f, 0.3f, 0.2f));
+      batch.colors.push_back(mesh::Srgb(0.9f, 0.3f, 0.2f));
     }
   }
   Vec3 lo = Vec3::Constant(-4.5), hi = Vec3::Constant(4.5);
-  (*renderer)->SetBackground(mesh::Vec3f(0.08f, 0.08f, 0.1f));
+  (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
   (*renderer)->SetPoints(batch);
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 30, 25, false));
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {

@@ -110,8 +110,8 @@ int main(int argc, char** argv) {
     const bool stuck = snow.state.invMass[i] == 0;
     batch.positions.push_back(snow.state.position(i).cast<float>());
     batch.sizes.push_back(0.012f);
-    batch.colors.push_back(stuck ? mesh::Vec3f(0.75f, 0.85f, 1.0f)
-                                 : mesh::Vec3f(0.95f, 0.95f, 0.95f));
+    batch.colors.push_back(stuck ? mesh::Srgb(0.75f, 0.85f, 1.0f)
+                                 : mesh::Srgb(0.95f, 0.95f, 0.95f));
   }
   render::LineBatch lines;
   for (int k = 0; k < 64; ++k) {
@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
     for (double a : {a0, a1}) {
       lines.points.push_back(
           (ballCentre + ballRadius * Vec3(std::cos(a), std::sin(a), 0)).cast<float>());
-      lines.colors.push_back(mesh::Vec3f(0.9f, 0.5f, 0.2f));
+      lines.colors.push_back(mesh::Srgb(0.9f, 0.5f, 0.2f));
     }
   }
   for (double x : {-2.0, 2.0}) {  // the ground's edge
@@ -127,9 +127,9 @@ int main(int argc, char** argv) {
     lines.points.push_back(mesh::Vec3f(float(x), 0, 2));
     lines.points.push_back(mesh::Vec3f(-2, 0, float(x)));
     lines.points.push_back(mesh::Vec3f(2, 0, float(x)));
-    for (int c = 0; c < 4; ++c) lines.colors.push_back(mesh::Vec3f(0.5f, 0.55f, 0.6f));
+    for (int c = 0; c < 4; ++c) lines.colors.push_back(mesh::Srgb(0.5f, 0.55f, 0.6f));
   }
-  (*renderer)->SetBackground(mesh::Vec3f(0.12f, 0.14f, 0.2f));
+  (*renderer)->SetBackground(mesh::Srgb(0.12f, 0.14f, 0.2f));
   (*renderer)->SetPoints(batch);
   (*renderer)->SetLines(lines);
   (*renderer)->Draw(

@@ -56,8 +56,12 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   render::LineBatch batch;
   Vec3 lo = geometry->boundsMin, hi = geometry->boundsMax;
   if (lines) {
+    const float lineShade = plant->grammar.palette.empty() ? std::pow(0.6f, 2.2f) : 1.0f;
     for (const auto& s : geometry->segments) {
-      const mesh::Vec3f c = palette.empty() ? mesh::Vec3f(0, 0, 0) : palette[s.color % palette.size()] * 0.6f;
+      // A grammar's own palette is drawn as written; the default palette is
+      // darkened (to 0.6 of its sRGB value) so lines read on white.
+      const mesh::Vec3f c = palette.empty() ? mesh::Vec3f(0, 0, 0)
+                                            : palette[s.color % palette.size()] * lineShade;
       batch.points.push_back(s.start.cast<float>());
       batch.points.push_back(s.end.cast<float>());
       batch.colors.push_back(c);

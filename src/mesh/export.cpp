@@ -2,18 +2,22 @@
 #include "mesh/export.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cstring>
 #include <filesystem>
 
 #include "core/atomic_file.h"
+#include "mesh/color.h"
 
 namespace sylva::mesh {
 
 const Palette& DefaultPalette() {
+  // Written in sRGB, kept linear.
   static const Palette p = {
-      {0.42f, 0.30f, 0.19f}, {0.24f, 0.50f, 0.16f}, {0.52f, 0.74f, 0.30f}, {0.93f, 0.55f, 0.70f},
-      {0.98f, 0.84f, 0.25f}, {0.95f, 0.95f, 0.92f}, {0.26f, 0.18f, 0.11f}, {0.80f, 0.15f, 0.12f},
+      Srgb(0.42f, 0.30f, 0.19f), Srgb(0.24f, 0.50f, 0.16f), Srgb(0.52f, 0.74f, 0.30f),
+      Srgb(0.93f, 0.55f, 0.70f), Srgb(0.98f, 0.84f, 0.25f), Srgb(0.95f, 0.95f, 0.92f),
+      Srgb(0.26f, 0.18f, 0.11f), Srgb(0.80f, 0.15f, 0.12f),
   };
   return p;
 }
@@ -75,7 +79,8 @@ Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string
   if (Status s = mtl.Open(mtlPath); !s.ok()) return s;
   std::string text = "# Sylva materials\n";
   for (uint16_t mat : groups.materials) {
-    Vec3f c = PaletteColor(palette, mat);
+    // Kd in sRGB: the values a `palette:` entry was written with.
+    Vec3f c = ToSrgb(PaletteColor(palette, mat));
     text += "newmtl color" + std::to_string(mat) + "\nKd ";
     Num(text, c.x());
     text += ' ';
@@ -165,6 +170,12 @@ Status WritePly(const TriangleMesh& m, const Palette& palette, const std::string
       std::to_string(m.triangleCount()) + "\nproperty list uchar uint vertex_indices\nend_header\n";
   if (Status s = f.Write(header); !s.ok()) return s;
   static_assert(sizeof(float) == 4);
+  // 8-bit vertex colours are sRGB; one conversion a palette entry.
+  std::vector<std::array<uint8_t, 3>> bytes(std::max<size_t>(palette.size(), 1));
+  for (size_t k = 0; k < bytes.size(); ++k) {
+    const Vec3f c = ToSrgb(PaletteColor(palette, uint16_t(k))) * 255.0f + Vec3f::Constant(0.5f);
+    bytes[k] = {uint8_t(c.x()), uint8_t(c.y()), uint8_t(c.z())};
+  }
   constexpr size_t kVertexBytes = 8 * 4 + 3;
   std::string buf;
   buf.reserve((1 << 20) + 64);
@@ -173,9 +184,7 @@ Status WritePly(const TriangleMesh& m, const Palette& palette, const std::string
     float v[8] = {m.positions[i].x(), m.positions[i].y(), m.positions[i].z(), m.normals[i].x(),
                   m.normals[i].y(),   m.normals[i].z(),   m.uvs[i].x(),       m.uvs[i].y()};
     put(v, sizeof v);
-    const Vec3f c = PaletteColor(palette, vmat[i]) * 255.0f + Vec3f::Constant(0.5f);
-    const uint8_t rgb[3] = {uint8_t(c.x()), uint8_t(c.y()), uint8_t(c.z())};
-    put(rgb, 3);
+    put(bytes[vmat[i] % bytes.size()].data(), 3);
     if (buf.size() >= (1 << 20)) {
       if (Status s = f.Write(buf); !s.ok()) return s;
       buf.clear();

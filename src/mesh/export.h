@@ -18,7 +18,7 @@
 
 namespace sylva::mesh {
 
-using Palette = std::vector<Vec3f>;  // linear RGB in [0, 1]
+using Palette = std::vector<Vec3f>;  // linear RGB in [0, 1] (mesh/color.h: the conventions)
 
 // Bark, leaf green, light green, petal pink, yellow, white, dark bark, red.
 const Palette& DefaultPalette();

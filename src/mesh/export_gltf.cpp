@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "mesh/color.h"
 #include "mesh/export.h"
 
 namespace sylva::mesh {
@@ -107,7 +108,7 @@ tinygltf::Model BuildModel(const TriangleMesh& m, const Palette& palette,
     tinygltf::Material mat;
     const uint16_t ci = groups.materials[k];
     mat.name = "color" + std::to_string(ci);
-    const Vec3f c = palette.empty() ? Vec3f(0.8f, 0.8f, 0.8f) : palette[ci % palette.size()];
+    const Vec3f c = palette.empty() ? Srgb(0.8f, 0.8f, 0.8f) : palette[ci % palette.size()];  // linear, as glTF wants
     mat.pbrMetallicRoughness.baseColorFactor = {c.x(), c.y(), c.z(), 1.0};
     mat.pbrMetallicRoughness.metallicFactor = 0.0;
     mat.pbrMetallicRoughness.roughnessFactor = 0.9;

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "lsys/parser.h"
+#include "mesh/color.h"
 #include "plant/surface_library.h"
 
 namespace sylva::plant {
@@ -67,7 +68,7 @@ DiagnosticList Validate(const PlantSpec& spec) {
 mesh::Palette PaletteOf(const lsys::Grammar& g) {
   if (g.palette.empty()) return mesh::DefaultPalette();
   mesh::Palette p;
-  for (const auto& c : g.palette) p.push_back(mesh::Vec3f(c[0], c[1], c[2]));
+  for (const auto& c : g.palette) p.push_back(mesh::Srgb(c[0], c[1], c[2]));  // written sRGB
   return p;
 }
 

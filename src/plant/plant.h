@@ -123,7 +123,8 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
 // nothing but segments): ABOP's 2D figures, drawn as lines, not tubes.
 bool IsLineFigure(const mesh::PlantGeometry& geometry);
 
-// The grammar's palette (`palette:`), or the exporters' default one.
+// The grammar's palette (`palette:`, written in sRGB) in linear RGB, or the
+// exporters' default one.
 mesh::Palette PaletteOf(const lsys::Grammar& g);
 
 // A plant grown one derivation step at a time:

@@ -227,7 +227,7 @@ Status Renderer::Resize(int width, int height, int samples) {
 void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette) {
   Gl& g = *gl_;
   // Per-vertex colour: the material of the first triangle using the vertex.
-  std::vector<mesh::Vec3f> color(m.vertexCount(), mesh::Vec3f(0.8f, 0.8f, 0.8f));
+  std::vector<mesh::Vec3f> color(m.vertexCount(), mesh::Srgb(0.8f, 0.8f, 0.8f));
   std::vector<uint8_t> seen(m.vertexCount(), 0);
   for (size_t t = 0; t < m.triangleCount(); ++t) {
     for (int e = 0; e < 3; ++e) {
@@ -269,7 +269,7 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
                             Vec3(c + r * Vec3(std::cos(a0), 0, std::sin(a0)))}) {
         pos.push_back(p.cast<float>());
         nor.push_back(mesh::Vec3f(0, 1, 0));
-        col.push_back(mesh::Vec3f(0.86f, 0.84f, 0.80f));
+        col.push_back(mesh::Srgb(0.86f, 0.84f, 0.80f));
       }
     }
     glBindVertexArray(g.groundVao);
@@ -357,7 +357,8 @@ void Renderer::Draw(const Camera& camera) {
   Gl& g = *gl_;
   glBindFramebuffer(GL_FRAMEBUFFER, g.msFbo);
   glViewport(0, 0, width_, height_);
-  glClearColor(background_.x(), background_.y(), background_.z(), 1);
+  const mesh::Vec3f clear = mesh::ToSrgb(background_);  // the framebuffer holds sRGB
+  glClearColor(clear.x(), clear.y(), clear.z(), 1);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
   glEnable(GL_MULTISAMPLE);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "mesh/color.h"
 #include "mesh/export.h"
 #include "mesh/triangle_mesh.h"
 #include "render/camera.h"
@@ -30,7 +31,7 @@ struct Image {
 
 struct LineBatch {
   std::vector<mesh::Vec3f> points;  // pairs: one segment per two points
-  std::vector<mesh::Vec3f> colors;  // one per point
+  std::vector<mesh::Vec3f> colors;  // one per point, linear RGB (mesh/color.h)
 };
 
 // Particles as the renderer sees them: plain arrays, one entry per point
@@ -40,7 +41,7 @@ struct LineBatch {
 struct PointBatch {
   std::vector<mesh::Vec3f> positions;
   std::vector<float> sizes;
-  std::vector<mesh::Vec3f> colors;
+  std::vector<mesh::Vec3f> colors;  // linear RGB (mesh::Srgb converts from sRGB)
 };
 
 // The shader folder: $SYLVA_SHADER_DIR if set, else `shaders/` beside the
@@ -57,7 +58,7 @@ class Renderer {
 
   // Size of the offscreen target in pixels (1..8192), with MSAA samples.
   Status Resize(int width, int height, int samples = 4);
-  void SetBackground(const mesh::Vec3f& rgb) { background_ = rgb; }
+  void SetBackground(const mesh::Vec3f& rgb) { background_ = rgb; }  // linear RGB
   mesh::Vec3f background() const { return background_; }
 
   // Replaces the mesh (uploaded once; drawing it again uploads nothing) and
@@ -85,7 +86,7 @@ class Renderer {
   struct Gl;
   std::unique_ptr<Gl> gl_;
   int width_ = 0, height_ = 0;
-  mesh::Vec3f background_{0.94f, 0.95f, 0.96f};
+  mesh::Vec3f background_ = mesh::Srgb(0.94f, 0.95f, 0.96f);  // linear
   bool ground_ = false, shadows_ = true;
   void RenderShadowMap();
 };

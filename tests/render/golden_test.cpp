@@ -78,8 +78,8 @@ class Golden : public testing::RenderFixture {
       for (const auto& s : g->segments) {
         b.points.push_back(s.start.cast<float>());
         b.points.push_back(s.end.cast<float>());
-        b.colors.push_back(mesh::Vec3f(0.2f, 0.15f, 0.1f));
-        b.colors.push_back(mesh::Vec3f(0.2f, 0.15f, 0.1f));
+        b.colors.push_back(mesh::Srgb(0.2f, 0.15f, 0.1f));
+        b.colors.push_back(mesh::Srgb(0.2f, 0.15f, 0.1f));
       }
       renderer_->SetBackground(mesh::Vec3f(1, 1, 1));
       renderer_->SetLines(b);
@@ -92,7 +92,7 @@ class Golden : public testing::RenderFixture {
       lo = lo.cwiseMin(p.cast<double>());
       hi = hi.cwiseMax(p.cast<double>());
     }
-    renderer_->SetBackground(mesh::Vec3f(0.94f, 0.95f, 0.96f));
+    renderer_->SetBackground(mesh::Srgb(0.94f, 0.95f, 0.96f));
     renderer_->SetMesh(m, mesh::DefaultPalette());
     renderer_->Draw(Camera::Frame(lo, hi, double(kW) / kH, 30, 12, false));
   }
@@ -117,11 +117,11 @@ TEST_F(Golden, PointBatch) {
   for (int i = 0; i < 400; ++i) {
     pts.positions.push_back(mesh::Vec3f(u(rng), u(rng), u(rng)));
     pts.sizes.push_back(0.08f);
-    pts.colors.push_back(mesh::Vec3f(0.9f, 0.5f + 0.4f * u(rng), 0.2f));
+    pts.colors.push_back(mesh::Srgb(0.9f, 0.5f + 0.4f * u(rng), 0.2f));
   }
   renderer_->SetMesh({}, {});
   renderer_->SetLines({});
-  renderer_->SetBackground(mesh::Vec3f(0.1f, 0.1f, 0.15f));
+  renderer_->SetBackground(mesh::Srgb(0.1f, 0.1f, 0.15f));
   renderer_->SetPoints(pts);
   renderer_->Draw(Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), double(kW) / kH, 30, 20, false));
   Compare("points");

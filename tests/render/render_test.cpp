@@ -2,6 +2,11 @@
 // depend on Mesa's exact pixels: an empty scene is the background colour,
 // and a plant's silhouette matches the projection of its mesh's bounds.
 #include <gtest/gtest.h>
+#include <stb_image.h>
+
+#include <algorithm>
+#include <array>
+#include <nlohmann/json.hpp>
 
 #include <cstdlib>
 #include <filesystem>
@@ -78,7 +83,7 @@ mesh::PlantGeometry Draw(const std::string& file, int steps) {
 
 TEST_F(Render, EmptySceneIsTheBackgroundColour) {
   ASSERT_TRUE(renderer_->Resize(64, 48).ok());
-  renderer_->SetBackground(mesh::Vec3f(0.2f, 0.4f, 0.6f));
+  renderer_->SetBackground(mesh::Srgb(0.2f, 0.4f, 0.6f));
   renderer_->Draw(Camera{});
   Image img = renderer_->ReadPixels();
   ASSERT_EQ(img.rgba.size(), size_t(64 * 48 * 4));
@@ -242,6 +247,62 @@ TEST_F(Render, PointBatchDrawsRoundSpritesOfTheirWorldSize) {
   EXPECT_NEAR(blueWidth, 12.5, 2);
   EXPECT_GT(img.Pixel(50, 50)[0], 150);
   EXPECT_EQ(img.Pixel(100, 50)[0], 255);  // between them: background
+}
+
+}  // namespace
+}  // namespace sylva::render
+
+namespace sylva::render {
+namespace {
+
+// One colour convention (mesh/color.h): a palette entry written #808080 is
+// sRGB 128 in the PNG and in OBJ's Kd, and linear 0.2158605 in glTF's
+// baseColorFactor.
+TEST(RenderCli, MidGreyPaletteEntryIsSrgbInThePngAndLinearInGltf) {
+  const fs::path dir = fs::temp_directory_path() / ("sylva_grey_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string grammar = (dir / "grey.lsys").string();
+  {
+    std::ofstream f(grammar);
+    f << "palette: #808080\nangle: 90\naxiom: F+F+F+F\n";
+  }
+  std::string err;
+  const std::string png = (dir / "grey.png").string();
+  ASSERT_EQ(RunCli({"render", grammar, "--size", "64x64", "-o", png}, &err), 0) << err;
+  int w = 0, h = 0, n = 0;
+  unsigned char* px = stbi_load(png.c_str(), &w, &h, &n, 4);
+  ASSERT_NE(px, nullptr);
+  // Lines are multisampled on white: the darkest pixel is one the line
+  // covers whole, so it has the line's colour.
+  std::array<int, 3> darkest = {255, 255, 255};
+  for (int i = 0; i < w * h; ++i) {
+    const unsigned char* p = px + 4 * i;
+    if (p[0] + p[1] + p[2] < darkest[0] + darkest[1] + darkest[2]) darkest = {p[0], p[1], p[2]};
+  }
+  stbi_image_free(px);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(darkest[k], 128, 1) << "channel " << k << " of the line colour in the PNG";
+  }
+
+  const std::string gltf = (dir / "grey.gltf").string();
+  ASSERT_EQ(RunCli({"mesh", grammar, "-o", gltf}, &err), 0) << err;
+  auto text = ReadFile(gltf);
+  ASSERT_TRUE(text.ok());
+  const nlohmann::json doc = nlohmann::json::parse(*text);
+  ASSERT_FALSE(doc["materials"].empty());
+  const auto& factor = doc["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"];
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(factor[k].get<double>(), 0.2158605, 1e-5) << "glTF baseColorFactor[" << k << "]";
+  }
+
+  const std::string obj = (dir / "grey.obj").string();
+  ASSERT_EQ(RunCli({"mesh", grammar, "-o", obj}, &err), 0) << err;
+  auto mtl = ReadFile((dir / "grey.mtl").string());
+  ASSERT_TRUE(mtl.ok());
+  const size_t kd = mtl->find("Kd ");
+  ASSERT_NE(kd, std::string::npos) << *mtl;
+  EXPECT_NEAR(std::strtod(mtl->c_str() + kd + 3, nullptr), 128.0 / 255, 1e-5) << *mtl;
+  fs::remove_all(dir);
 }
 
 }  // namespace
