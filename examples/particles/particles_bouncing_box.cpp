@@ -5,6 +5,7 @@
 //
 //   particles_bouncing_box [COUNT] [SECONDS] [OUT.png]
 #include <cstdio>
+#include <filesystem>
 #include <cstdlib>
 #include <random>
 
@@ -17,7 +18,7 @@ using namespace sylva;
 int main(int argc, char** argv) {
   const int count = argc > 1 ? std::atoi(argv[1]) : 2000;
   const double seconds = argc > 2 ? std::atof(argv[2]) : 3.0;
-  const char* out = argc > 3 ? argv[3] : "particles_bouncing_box.png";
+  const char* out = argc > 3 ? argv[3] : "out/particles_bouncing_box.png";
   if (count < 1 || !(seconds > 0)) {
     std::fprintf(stderr, "usage: particles_bouncing_box [COUNT >= 1] [SECONDS > 0] [OUT.png]\n");
     return 2;
@@ -88,6 +89,9 @@ int main(int argc, char** argv) {
   (*renderer)->SetPoints(batch);
   (*renderer)->SetLines(edges);
   (*renderer)->Draw(render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 480.0 / 360, 30, 20, false));
+  if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+  }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());
     return 1;

@@ -5,6 +5,7 @@
 //
 //   particles_fireworks [SECONDS] [OUT.png]
 #include <cstdio>
+#include <filesystem>
 #include <cstdlib>
 #include <map>
 
@@ -17,7 +18,7 @@ using particles::EmitterDef;
 
 int main(int argc, char** argv) {
   const double seconds = argc > 1 ? std::atof(argv[1]) : 2.6;
-  const char* out = argc > 2 ? argv[2] : "particles_fireworks.png";
+  const char* out = argc > 2 ? argv[2] : "out/particles_fireworks.png";
   if (!(seconds > 0)) {
     std::fprintf(stderr, "usage: particles_fireworks [SECONDS > 0] [OUT.png]\n");
     return 2;
@@ -113,6 +114,9 @@ int main(int argc, char** argv) {
   (*renderer)->SetBackground(mesh::Srgb(0.03f, 0.03f, 0.07f));
   (*renderer)->SetPoints(batch);
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 0, 5, false));
+  if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+  }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());
     return 1;

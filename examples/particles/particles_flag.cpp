@@ -6,6 +6,7 @@
 //   particles_flag [SECONDS] [OUT.png]
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <cstdlib>
 
 #include "particles/cloth.h"
@@ -16,7 +17,7 @@ using namespace sylva;
 
 int main(int argc, char** argv) {
   const double seconds = argc > 1 ? std::atof(argv[1]) : 3.0;
-  const char* out = argc > 2 ? argv[2] : "particles_flag.png";
+  const char* out = argc > 2 ? argv[2] : "out/particles_flag.png";
   if (!(seconds > 0)) {
     std::fprintf(stderr, "usage: particles_flag [SECONDS > 0] [OUT.png]\n");
     return 2;
@@ -87,6 +88,9 @@ int main(int argc, char** argv) {
     hi = hi.cwiseMax(p);
   }
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 25, 15, false));
+  if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+  }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());
     return 1;

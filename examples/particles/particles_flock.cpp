@@ -7,6 +7,7 @@
 //   particles_flock [COUNT] [SECONDS] [OUT.png]
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <cstdlib>
 #include <random>
 
@@ -20,7 +21,7 @@ using namespace sylva;
 int main(int argc, char** argv) {
   const int count = argc > 1 ? std::atoi(argv[1]) : 3000;
   const double seconds = argc > 2 ? std::atof(argv[2]) : 8.0;
-  const char* out = argc > 3 ? argv[3] : "particles_flock.png";
+  const char* out = argc > 3 ? argv[3] : "out/particles_flock.png";
   if (count < 1 || !(seconds > 0)) {
     std::fprintf(stderr, "usage: particles_flock [COUNT >= 1] [SECONDS > 0] [OUT.png]\n");
     return 2;
@@ -94,6 +95,9 @@ int main(int argc, char** argv) {
   (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
   (*renderer)->SetPoints(batch);
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 30, 25, false));
+  if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+  }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());
     return 1;

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <cstdlib>
 
 #include "particles/bulk.h"
@@ -20,7 +21,7 @@ using namespace sylva;
 int main(int argc, char** argv) {
   const int flakes = argc > 1 ? std::atoi(argv[1]) : 200000;
   const double seconds = argc > 2 ? std::atof(argv[2]) : 4.0;
-  const char* out = argc > 3 ? argv[3] : "particles_snow.png";
+  const char* out = argc > 3 ? argv[3] : "out/particles_snow.png";
   if (flakes < 1 || !(seconds > 0)) {
     std::fprintf(stderr, "usage: particles_snow [FLAKES >= 1] [SECONDS > 0] [OUT.png]\n");
     return 2;
@@ -134,6 +135,9 @@ int main(int argc, char** argv) {
   (*renderer)->SetLines(lines);
   (*renderer)->Draw(
       render::Camera::Frame(Vec3(-2, 0, -2), Vec3(2, 3, 2), 480.0 / 360, 25, 15, false));
+  if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+  }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());
     return 1;
