@@ -87,6 +87,24 @@ Result RunJob(const Job& job) {
   return r;
 }
 
+// A live edit can ask for anything (a word or mesh larger than memory): the
+// worker reports it as a failed job and the viewer keeps the last plant.
+Result RunJobSafely(const Job& job) {
+  try {
+    return RunJob(job);
+  } catch (const std::bad_alloc&) {
+    Result r;
+    r.id = job.id;
+    r.diagnostics = job.path + ": error: out of memory building the plant; lower the step or the detail\n";
+    return r;
+  } catch (const std::exception& e) {
+    Result r;
+    r.id = job.id;
+    r.diagnostics = job.path + ": error: " + e.what() + "\n";
+    return r;
+  }
+}
+
 class Worker {
  public:
   Worker() : thread_([this] { Loop(); }) {}
@@ -125,7 +143,7 @@ class Worker {
         pending_.reset();
         busy_ = true;
       }
-      Result r = RunJob(job);
+      Result r = RunJobSafely(job);
       std::lock_guard<std::mutex> lock(mutex_);
       busy_ = false;
       if (!pending_) done_ = std::move(r);  // overtaken results are dropped
@@ -144,6 +162,138 @@ std::string DefaultGrammar() {
   return (fs::path(plant::BundledDataDir()) / "grammars" / "abop" / "fig2_06a_monopodial.lsys").string();
 }
 
+// The window, its GL context and Dear ImGui, or an error message.
+struct Window {
+  GLFWwindow* handle = nullptr;
+  ~Window() {
+    if (!handle) return;
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    glfwDestroyWindow(handle);
+    glfwTerminate();
+  }
+};
+
+// Opens a window with an OpenGL 4.5 core context and Dear ImGui on it;
+// returns the exit status on failure (message printed).
+int OpenWindow(int width, int height, const std::string& title, bool vsync, Window& w,
+               std::ostream& err) {
+  if (!glfwInit()) {
+    err << "sylva: error: cannot open a window (no display? run under Xvfb, or use sylva render)\n";
+    return kExitRuntime;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  GLFWwindow* window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  if (!window) {
+    glfwTerminate();
+    err << "sylva: error: cannot create an OpenGL 4.5 window\n";
+    return kExitRuntime;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(vsync ? 1 : 0);
+  glewExperimental = GL_TRUE;
+  if (glewInit() != GLEW_OK) {
+    glfwDestroyWindow(window);
+    glfwTerminate();
+    err << "sylva: error: cannot load OpenGL functions\n";
+    return kExitRuntime;
+  }
+  glGetError();
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  ImGui::StyleColorsLight();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 450 core");
+  w.handle = window;
+  return kExitOk;
+}
+
+// Left drag orbits, right drag pans, the wheel zooms (when ImGui does not
+// want the mouse).
+struct MouseCamera {
+  double lastX = 0, lastY = 0;
+  void Update(GLFWwindow* window, render::Camera& camera) {
+    const ImGuiIO& io = ImGui::GetIO();
+    double mx, my;
+    glfwGetCursorPos(window, &mx, &my);
+    if (!io.WantCaptureMouse) {
+      if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
+        camera.azimuth -= (mx - lastX) * 0.4;
+        camera.elevation = std::clamp(camera.elevation + (my - lastY) * 0.4, -85.0, 85.0);
+      }
+      if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) {
+        const Mat4 v = camera.View();
+        const Vec3 right(v(0, 0), v(0, 1), v(0, 2)), up(v(1, 0), v(1, 1), v(1, 2));
+        const double k = camera.distance * 0.0015;
+        camera.target += (-right * (mx - lastX) + up * (my - lastY)) * k;
+      }
+      if (io.MouseWheel != 0) camera.distance *= std::pow(0.9, io.MouseWheel);
+    }
+    lastX = mx;
+    lastY = my;
+  }
+};
+
+// What the panel shows of the newest results.
+struct Shown {
+  std::optional<Result> plant;  // the last good plant
+  std::string diagnostics;
+  bool lastFailed = false;
+  std::vector<std::pair<std::string, double>> constants;
+  int derivationLength = 0;
+};
+
+// The control panel: step, seed, sides and a slider per #define; true when
+// the job changed.
+bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double frameMs, Job& job) {
+  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
+  ImGui::Begin("Sylva", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::TextWrapped("%s", fs::path(path).filename().string().c_str());
+  bool changed = false;
+  int steps = job.steps < 0 ? shown.derivationLength : job.steps;
+  if (ImGui::SliderInt("step", &steps, 0, std::max(shown.derivationLength, 1))) {
+    job.steps = steps;
+    changed = true;
+  }
+  int seed = int(job.seed.value_or(1));
+  if (ImGui::InputInt("seed", &seed)) {
+    job.seed = uint64_t(std::max(seed, 0));
+    changed = true;
+  }
+  if (ImGui::SliderInt("sides", &job.sides, 3, 32)) changed = true;
+  if (!shown.constants.empty() && ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
+    for (const auto& [name, value] : shown.constants) {
+      float v = float(job.overrides.count(name) ? job.overrides[name] : value);
+      const float lo = value > 0 ? 0.0f : float(value) - 10.0f;
+      const float hi = value > 0 ? float(value) * 2.0f : float(value) + 10.0f;
+      if (ImGui::SliderFloat(name.c_str(), &v, lo, hi)) {
+        job.overrides[name] = v;
+        changed = true;
+      }
+    }
+  }
+  if (busy) ImGui::ProgressBar(-1.0f * float(ImGui::GetTime()), ImVec2(-1, 0), "deriving...");
+  ImGui::Separator();
+  if (shown.plant) {
+    ImGui::Text("modules %llu, triangles %zu", static_cast<unsigned long long>(shown.plant->modules),
+                shown.plant->mesh.triangleCount());
+    ImGui::Text("derive %.1f ms, turtle %.1f ms, mesh %.1f ms", shown.plant->deriveMs,
+                shown.plant->turtleMs, shown.plant->tessellateMs);
+  }
+  ImGui::Text("frame %.1f ms", frameMs);
+  if (!shown.diagnostics.empty() && ImGui::CollapsingHeader("diagnostics", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (shown.lastFailed) ImGui::TextColored(ImVec4(0.8f, 0.1f, 0.1f, 1), "errors: showing the last good plant");
+    ImGui::TextWrapped("%s", shown.diagnostics.c_str());
+  }
+  ImGui::End();
+  return changed;
+}
+
 }  // namespace
 
 int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
@@ -157,209 +307,109 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     }
   }
   const std::string path = cmd.file.empty() ? DefaultGrammar() : cmd.file;
-  if (!fs::is_regular_file(path)) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) {
     err << path << ": error: cannot read file\n";
     return kExitBadInput;
   }
-  if (!glfwInit()) {
-    err << "sylva: error: cannot open a window (no display? run under Xvfb, or use sylva render)\n";
-    return kExitRuntime;
-  }
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  GLFWwindow* window = glfwCreateWindow(width, height, ("Sylva - " + path).c_str(), nullptr, nullptr);
-  if (!window) {
-    glfwTerminate();
-    err << "sylva: error: cannot create an OpenGL 4.5 window\n";
-    return kExitRuntime;
-  }
-  glfwMakeContextCurrent(window);
-  glfwSwapInterval(cmd.frames > 0 ? 0 : 1);
-  glewExperimental = GL_TRUE;
-  if (glewInit() != GLEW_OK) {
-    glfwDestroyWindow(window);
-    glfwTerminate();
-    err << "sylva: error: cannot load OpenGL functions\n";
-    return kExitRuntime;
-  }
-  glGetError();
+  Window window;
+  if (int code = OpenWindow(width, height, "Sylva - " + path, cmd.frames == 0, window, err)) return code;
+  // Declared after the window: its GL objects are destroyed before the context.
+  auto renderer = render::Renderer::Create(render::FindShaderDir());
+  if (!renderer) return Report(renderer.error(), err);
+  (*renderer)->SetGround(true);
+
   int exitCode = kExitOk;
-  {
-    auto renderer = render::Renderer::Create(render::FindShaderDir());
-    if (!renderer) {
-      glfwDestroyWindow(window);
-      glfwTerminate();
-      return Report(renderer.error(), err);
-    }
-    IMGUI_CHECKVERSION();
-    ImGui::CreateContext();
-    ImGui::GetIO().IniFilename = nullptr;
-    ImGui::StyleColorsLight();
-    ImGui_ImplGlfw_InitForOpenGL(window, true);
-    ImGui_ImplOpenGL3_Init("#version 450 core");
-    (*renderer)->SetGround(true);
+  Worker worker;
+  Job job;
+  job.path = path;
+  uint64_t nextId = 1;
+  auto post = [&] {
+    job.id = nextId++;
+    worker.Post(job);
+  };
+  post();
+  Shown shown;
+  render::Camera camera;
+  bool framed = false;
+  fs::file_time_type mtime = fs::last_write_time(path, ec);
+  auto lastPoll = Clock::now();
+  double frameMs = 0;
+  int frame = 0;
+  int shots = 0;
+  MouseCamera mouse;
 
-    Worker worker;
-    Job job;
-    job.path = path;
-    uint64_t nextId = 1;
-    auto post = [&] {
-      job.id = nextId++;
-      worker.Post(job);
-    };
-    post();
-    std::optional<Result> shown;  // last good plant
-    std::string diagnostics;
-    bool lastFailed = false;
-    std::vector<std::pair<std::string, double>> constants;
-    int derivationLength = 0;
-    render::Camera camera;
-    bool framed = false;
-    fs::file_time_type mtime = fs::last_write_time(path);
-    auto lastPoll = Clock::now();
-    double frameMs = 0;
-    int frame = 0;
-    int shots = 0;
-    double lastX = 0, lastY = 0;
-
-    while (!glfwWindowShouldClose(window)) {
-      const auto frameStart = Clock::now();
-      glfwPollEvents();
-      // Reload on change (polled four times a second).
-      if (Clock::now() - lastPoll > std::chrono::milliseconds(250)) {
-        lastPoll = Clock::now();
-        std::error_code ec;
-        auto t = fs::last_write_time(path, ec);
-        if (!ec && t != mtime) {
-          mtime = t;
-          post();
-        }
+  while (!glfwWindowShouldClose(window.handle)) {
+    const auto frameStart = Clock::now();
+    glfwPollEvents();
+    // Reload on change (polled four times a second).
+    if (Clock::now() - lastPoll > std::chrono::milliseconds(250)) {
+      lastPoll = Clock::now();
+      auto t = fs::last_write_time(path, ec);
+      if (!ec && t != mtime) {
+        mtime = t;
+        post();
       }
-      if (auto r = worker.Take()) {
-        diagnostics = r->diagnostics;
-        if (r->ok) {
-          constants = r->constants;
-          derivationLength = r->derivationLength;
-          (*renderer)->SetMesh(r->mesh, r->palette);
-          if (!framed) {
-            camera = render::Camera::Frame(r->lo, r->hi, double(width) / height, 30, 12, false);
-            framed = true;
-          }
-          shown = std::move(r);
-          lastFailed = false;
+    }
+    if (auto r = worker.Take()) {
+      shown.diagnostics = r->diagnostics;
+      if (r->ok) {
+        shown.constants = r->constants;
+        shown.derivationLength = r->derivationLength;
+        (*renderer)->SetMesh(r->mesh, r->palette);
+        if (!framed) {
+          camera = render::Camera::Frame(r->lo, r->hi, double(width) / height, 30, 12, false);
+          framed = true;
+        }
+        shown.plant = std::move(r);
+        shown.lastFailed = false;
+      } else {
+        // Keep the last good plant; report what went wrong.
+        err << "sylva view: the grammar has errors; keeping the last good plant\n" << shown.diagnostics;
+        shown.lastFailed = true;
+      }
+    }
+    int fbw = 0, fbh = 0;
+    glfwGetFramebufferSize(window.handle, &fbw, &fbh);
+    if (fbw > 0 && fbh > 0 && (fbw != (*renderer)->width() || fbh != (*renderer)->height())) {
+      (void)(*renderer)->Resize(fbw, fbh);
+    }
+    mouse.Update(window.handle, camera);
+
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    if (DrawPanel(path, shown, worker.Busy(), frameMs, job)) post();
+    ImGui::Render();
+
+    (*renderer)->Draw(camera);
+    (*renderer)->PresentToWindow(fbw, fbh);
+    glViewport(0, 0, fbw, fbh);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+
+    ++frame;
+    const bool key = glfwGetKey(window.handle, GLFW_KEY_P) == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard;
+    const bool done = cmd.frames > 0 && frame >= cmd.frames && shown.plant.has_value();
+    if (key || done) {
+      std::string file = done ? cmd.screenshot : "sylva-screenshot-" + std::to_string(++shots) + ".png";
+      if (!file.empty()) {
+        if (Status s = render::WritePng(render::ReadWindowPixels(fbw, fbh), file); !s.ok()) {
+          exitCode = Report(s.error(), err);
         } else {
-          // Keep the last good plant; report what went wrong.
-          err << "sylva view: the grammar has errors; keeping the last good plant\n" << diagnostics;
-          lastFailed = true;
+          out << "screenshot: " << file << "\n";
         }
-      }
-      int fbw = 0, fbh = 0;
-      glfwGetFramebufferSize(window, &fbw, &fbh);
-      if (fbw > 0 && fbh > 0 && (fbw != (*renderer)->width() || fbh != (*renderer)->height())) {
-        (void)(*renderer)->Resize(fbw, fbh);
-      }
-      // Mouse: orbit, pan, zoom (when ImGui does not want the mouse).
-      ImGuiIO& io = ImGui::GetIO();
-      double mx, my;
-      glfwGetCursorPos(window, &mx, &my);
-      if (!io.WantCaptureMouse) {
-        if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
-          camera.azimuth -= (mx - lastX) * 0.4;
-          camera.elevation = std::clamp(camera.elevation + (my - lastY) * 0.4, -85.0, 85.0);
-        }
-        if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) {
-          const Mat4 v = camera.View();
-          const Vec3 right(v(0, 0), v(0, 1), v(0, 2)), up(v(1, 0), v(1, 1), v(1, 2));
-          const double k = camera.distance * 0.0015;
-          camera.target += (-right * (mx - lastX) + up * (my - lastY)) * k;
-        }
-        if (io.MouseWheel != 0) camera.distance *= std::pow(0.9, io.MouseWheel);
-      }
-      lastX = mx;
-      lastY = my;
-
-      ImGui_ImplOpenGL3_NewFrame();
-      ImGui_ImplGlfw_NewFrame();
-      ImGui::NewFrame();
-      ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-      ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
-      ImGui::Begin("Sylva", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
-      ImGui::TextWrapped("%s", fs::path(path).filename().string().c_str());
-      bool changed = false;
-      int steps = job.steps < 0 ? derivationLength : job.steps;
-      if (ImGui::SliderInt("step", &steps, 0, std::max(derivationLength, 1))) {
-        job.steps = steps;
-        changed = true;
-      }
-      int seed = int(job.seed.value_or(1));
-      if (ImGui::InputInt("seed", &seed)) {
-        job.seed = uint64_t(std::max(seed, 0));
-        changed = true;
-      }
-      if (ImGui::SliderInt("sides", &job.sides, 3, 32)) changed = true;
-      if (!constants.empty() && ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
-        for (auto& [name, value] : constants) {
-          float v = float(job.overrides.count(name) ? job.overrides[name] : value);
-          const float lo = value > 0 ? 0.0f : float(value) - 10.0f;
-          const float hi = value > 0 ? float(value) * 2.0f : float(value) + 10.0f;
-          if (ImGui::SliderFloat(name.c_str(), &v, lo, hi)) {
-            job.overrides[name] = v;
-            changed = true;
-          }
-        }
-      }
-      if (changed) post();
-      if (worker.Busy()) ImGui::ProgressBar(-1.0f * float(ImGui::GetTime()), ImVec2(-1, 0), "deriving...");
-      ImGui::Separator();
-      if (shown) {
-        ImGui::Text("modules %llu, triangles %zu", static_cast<unsigned long long>(shown->modules),
-                    shown->mesh.triangleCount());
-        ImGui::Text("derive %.1f ms, turtle %.1f ms, mesh %.1f ms", shown->deriveMs, shown->turtleMs,
-                    shown->tessellateMs);
-      }
-      ImGui::Text("frame %.1f ms", frameMs);
-      if (!diagnostics.empty() && ImGui::CollapsingHeader("diagnostics", ImGuiTreeNodeFlags_DefaultOpen)) {
-        if (lastFailed) ImGui::TextColored(ImVec4(0.8f, 0.1f, 0.1f, 1), "errors: showing the last good plant");
-        ImGui::TextWrapped("%s", diagnostics.c_str());
-      }
-      ImGui::End();
-      ImGui::Render();
-
-      (*renderer)->Draw(camera);
-      (*renderer)->PresentToWindow(fbw, fbh);
-      glViewport(0, 0, fbw, fbh);
-      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-
-      ++frame;
-      const bool key = glfwGetKey(window, GLFW_KEY_P) == GLFW_PRESS && !io.WantCaptureKeyboard;
-      const bool done = cmd.frames > 0 && frame >= cmd.frames && shown.has_value();
-      if (key || done) {
-        std::string file = done ? cmd.screenshot : "sylva-screenshot-" + std::to_string(++shots) + ".png";
-        if (!file.empty()) {
-          if (Status s = render::WritePng(render::ReadWindowPixels(fbw, fbh), file); !s.ok()) {
-            exitCode = Report(s.error(), err);
-          } else {
-            out << "screenshot: " << file << "\n";
-          }
-        }
-      }
-      glfwSwapBuffers(window);
-      frameMs = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
-      if (done) break;
-      // Wait for the first plant no longer than a minute when taking a screenshot.
-      if (cmd.frames > 0 && frame > cmd.frames + 6000) {
-        err << "sylva view: no plant to show after " << frame << " frames\n";
-        exitCode = kExitRuntime;
-        break;
       }
     }
-    ImGui_ImplOpenGL3_Shutdown();
-    ImGui_ImplGlfw_Shutdown();
-    ImGui::DestroyContext();
+    glfwSwapBuffers(window.handle);
+    frameMs = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+    if (done) break;
+    // Wait for the first plant no longer than a minute when taking a screenshot.
+    if (cmd.frames > 0 && frame > cmd.frames + 6000) {
+      err << "sylva view: no plant to show after " << frame << " frames\n";
+      exitCode = kExitRuntime;
+      break;
+    }
   }
-  glfwDestroyWindow(window);
-  glfwTerminate();
   return exitCode;
 }
 
