@@ -1,5 +1,6 @@
 #include "plant/plant.h"
 
+#include <algorithm>
 #include <chrono>
 #include <utility>
 
@@ -27,6 +28,28 @@ void AddWarnings(const std::vector<std::string>& warnings, const std::string& pa
     d.message = w;
     out.Add(std::move(d));
   }
+}
+
+// cpfg and ABOP grammars give widths in pixels of their renderer (Fig. 2.6
+// starts at !(10) on unit internodes): drawn as world units, a tree becomes
+// a cone. When most segments are far wider than long and the grammar has no
+// `width scale:`, say so and name the fix.
+void WarnAboutPixelWidths(const lsys::Grammar& g, const mesh::PlantGeometry& geometry,
+                          DiagnosticList& out) {
+  if (g.widthScale != 1 || geometry.segments.size() < 4) return;
+  size_t fat = 0;
+  for (const mesh::Segment& s : geometry.segments) {
+    const double diameter = 2.0 * std::max(s.radiusStart, s.radiusEnd);
+    if (diameter > 3 * (s.end - s.start).norm()) ++fat;
+  }
+  if (fat * 2 <= geometry.segments.size()) return;
+  Diagnostic d;
+  d.severity = Severity::kWarning;
+  d.loc.file = g.path;
+  d.message = std::to_string(fat) + " of " + std::to_string(geometry.segments.size()) +
+              " segments are more than 3 times wider than long: widths in cpfg and ABOP grammars "
+              "are pixels; add 'width scale: 0.015' to draw them as printed (docs/grammar.md)";
+  out.Add(std::move(d));
 }
 
 Diagnostic SpecError(const std::string& message) {
@@ -93,6 +116,7 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
     return d;
   }
   AddWarnings(stats.warnings, plant.grammar.path, diagnostics);
+  WarnAboutPixelWidths(plant.grammar, plant.geometry, diagnostics);
   plant.time.tessellate = MsSince(t0);
   return {};
 }

@@ -209,3 +209,32 @@ TEST(SurfaceLibrary, UnknownSurfacePointsAtItsUseInTheGrammar) {
 
 }  // namespace
 }  // namespace sylva::plant
+
+namespace sylva::plant {
+namespace {
+
+TEST(Plant, PixelWidthsWithoutWidthScaleGetAWarningNamingTheFix) {
+  // ABOP Fig. 2.6a without its `width scale:` line: a brown cone.
+  std::string text = *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys");
+  const size_t at = text.find("width scale:");
+  ASSERT_NE(at, std::string::npos);
+  text.erase(at, text.find('\n', at) - at);
+  PlantSpec spec;
+  spec.path = "cone.lsys";
+  spec.text = text;
+  spec.steps = 6;
+  PlantResult r = BuildPlant(spec);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
+  const std::string all = r.diagnostics.FormatAll();
+  EXPECT_NE(all.find("warning:"), std::string::npos) << all;
+  EXPECT_NE(all.find("width scale: 0.015"), std::string::npos) << all;
+
+  spec.text = std::nullopt;
+  spec.path = std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys";
+  PlantResult scaled = BuildPlant(spec);
+  ASSERT_TRUE(scaled.plant);
+  EXPECT_EQ(scaled.diagnostics.items.size(), 0u) << scaled.diagnostics.FormatAll();
+}
+
+}  // namespace
+}  // namespace sylva::plant
