@@ -160,8 +160,14 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
 
 int Grower::step() const { return derivation_ ? derivation_->step() : 0; }
 int Grower::steps() const { return derivation_ ? steps_ : 0; }
-const lsys::Word& Grower::word() const { return derivation_->word(); }
-lsys::Word& Grower::MutableWord() { return derivation_->MutableWord(); }
+const lsys::Word& Grower::word() const {
+  SYLVA_ASSERT(derivation_.has_value());  // not with Stage::kGrammar
+  return derivation_->word();
+}
+lsys::Word& Grower::MutableWord() {
+  SYLVA_ASSERT(derivation_.has_value());
+  return derivation_->MutableWord();
+}
 
 Status Grower::Step() {
   SYLVA_ASSERT(derivation_.has_value());
