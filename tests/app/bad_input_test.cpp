@@ -70,7 +70,7 @@ std::vector<BadCase> Cases() {
       {"empty_condition", "axiom: F\nF : --> G\n", "2:3", "empty condition"},
       {"depth_in_main_section", "maximum depth: 2\naxiom: F\n", "1:1", "decomposition or interpretation"},
       {"negative_seed", "seed: -4\naxiom: F\n", "1:7", "whole number"},
-      {"deep_parentheses", "axiom: F(" + Many('(', 200) + "1" + Many(')', 200) + ")\n", "1:", "nested too deeply"},
+      {"deep_parentheses", "axiom: F(" + Many('(', 200) + "1" + Many(')', 200) + ")\n", "1:", "nested deeper than 48"},
       {"stray_close_paren", "axiom: F)\n", "1:9", "unbalanced ')'"},
       {"zero_tropism", "tropism: 0 0 0 1\naxiom: F\n", "1:10", "tropism vector is zero"},
       {"override_unknown_in_condition", "axiom: A\nA : q --> B\n", "2:5", "unknown name 'q'"},
