@@ -46,7 +46,7 @@ std::optional<lsys::Grammar> LoadGrammar(const DeriveFlags& f, std::ostream& err
     return std::nullopt;
   }
   lsys::ParseResult r = lsys::ParseGrammarFile(f.file, opt);
-  *exit = Report(r.diagnostics, err);
+  *exit = Report(r.diagnostics, err, f.maxErrors);
   if (!r.grammar) {
     if (*exit == kExitOk) *exit = kExitBadInput;
     return std::nullopt;

@@ -79,7 +79,7 @@ bool BuildMesh(const lsys::Grammar& g, const mesh::PlantGeometry& geometry, int 
                     (dir / "surfaces").string() + " or in the bundled grammars/surfaces";
         if (auto it = g.symbolLoc.find("~" + name); it != g.symbolLoc.end()) {
           d.loc = it->second.loc;
-          d.sourceLine = it->second.line;
+          SetExcerpt(d, g.SourceLine(d.loc));
           d.length = int(name.size()) + 1;
         }
         *exit = Report(d, err);

@@ -25,6 +25,7 @@ struct DeriveFlags {
   std::vector<std::string> defines;  // NAME=VALUE
   int threads = 0;
   uint64_t maxModules = 0;  // 0: the library default
+  int maxErrors = 20;       // errors (and warnings) printed; 0: all
 };
 
 struct DeriveCommand {
@@ -79,7 +80,7 @@ int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
 // Prints diagnostics; returns the exit status they call for (0 when there
 // are only warnings).
-int Report(const DiagnosticList& list, std::ostream& err);
+int Report(const DiagnosticList& list, std::ostream& err, int maxErrors = 0);
 int Report(const Diagnostic& d, std::ostream& err);
 
 }  // namespace sylva::app

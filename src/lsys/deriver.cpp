@@ -331,7 +331,7 @@ void Pass::Fail(Chunk& c, const Production& p, const EvalError& e, int column, s
   Diagnostic d = MakeError(SourceLoc{p.loc.file, p.loc.line, e.column ? e.column : column},
                            e.message + " (module " + std::to_string(i + 1) + " of the word, step " +
                                std::to_string(stepForMessages_) + ")",
-                           1, p.sourceLine);
+                           1, g_.SourceLine(p.loc));
   c.error = std::move(d);
 }
 
