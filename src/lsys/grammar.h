@@ -35,6 +35,10 @@ struct Successor {
   bool allConstant = true;  // every parameter is a constant
 };
 
+// Brackets a right context may nest (`A > [[[B]]]` is 3); deeper is a parse
+// error.
+inline constexpr int kMaxRightContextNesting = 64;
+
 struct Production {
   std::vector<FormalModule> left;   // in word order; empty = any
   FormalModule pred;

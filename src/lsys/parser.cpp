@@ -134,7 +134,12 @@ class GrammarParser {
   Successor axiom_;
   SourceLoc axiomLoc_;
   std::vector<int> axiomCols_;
-  std::vector<std::string> declared_;  // module: names, longest first
+  std::vector<std::string> declared_;  // module: names
+  // The same names for lexing: their distinct lengths, longest first, and
+  // the set to look a candidate of each length up in (O(lengths) a module,
+  // not O(names)).
+  std::vector<size_t> declaredLengths_;
+  std::unordered_set<std::string_view> declaredSet_;
   std::unordered_map<std::string, Define> defines_;
   std::unordered_set<std::string> usedConstants_;
   std::set<std::string> usedOverrides_;
@@ -294,10 +299,12 @@ void GrammarParser::Preprocess(std::shared_ptr<const std::string> shared, const 
 bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string* name) {
   const std::string& t = l.text;
   char c = t[pos];
-  for (const auto& d : declared_) {
-    if (pos + d.size() <= end && t.compare(pos, d.size(), d) == 0) {
-      *name = d;
-      pos += d.size();
+  for (size_t n : declaredLengths_) {
+    if (pos + n > end) continue;
+    auto it = declaredSet_.find(std::string_view(t).substr(pos, n));
+    if (it != declaredSet_.end()) {
+      *name = std::string(*it);
+      pos += n;
       return true;
     }
   }
@@ -890,6 +897,15 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     std::vector<SymbolId> syms;
     for (auto& fm : p.right) syms.push_back(fm.symbol);
     if (!CheckBrackets(l, syms, cols, "right context")) return;
+    int depth = 0;
+    for (size_t k = 0; k < syms.size(); ++k) {
+      depth += syms[k] == kOpenBracket ? 1 : (syms[k] == kCloseBracket ? -1 : 0);
+      if (depth > kMaxRightContextNesting) {
+        Error(l, cols[k], "right context nested deeper than " +
+                              std::to_string(kMaxRightContextNesting) + " brackets");
+        return;
+      }
+    }
   }
   p.formalCount = uint16_t(formals.size());
   ExprScope scope{&g_.constants, &usedConstants_, &formals};
@@ -1038,10 +1054,15 @@ void GrammarParser::WarnUnmatchable() {
   }
   for (auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation}) {
     const auto& occ = sec == &g_.interpretation ? occursInterp : occurs;
+    // Per symbol: the first production that always applies (no context,
+    // condition or weight), which shadows every later one.
+    std::vector<int64_t> firstAlways(g_.symbols.size(), -1);
     for (size_t i = 0; i < sec->productions.size(); ++i) {
       const Production& p = sec->productions[i];
       SymbolId s = p.pred.symbol;
       const std::string& name = g_.symbols.name(s);
+      const int64_t shadow = firstAlways[s];
+      if (shadow < 0 && !p.HasContext() && !p.condition && !p.weight) firstAlways[s] = int64_t(i);
       if (!occ[s]) {
         int a = g_.symbols.arity(s);
         Warn(p.loc, g_.SourceLine(p.loc),
@@ -1051,16 +1072,12 @@ void GrammarParser::WarnUnmatchable() {
         continue;
       }
       // Shadowed by an earlier production that always applies.
-      for (size_t j = 0; j < i; ++j) {
-        const Production& q = sec->productions[j];
-        if (q.pred.symbol == s && !q.HasContext() && !q.condition && !q.weight &&
-            !(p.weight && q.weight)) {
-          Warn(p.loc, g_.SourceLine(p.loc),
-               "production never applies: the production at line " +
-                   std::to_string(q.loc.line) + " always matches '" + name + "' first",
-               int(name.size()));
-          break;
-        }
+      if (shadow >= 0) {
+        const Production& q = sec->productions[size_t(shadow)];
+        Warn(p.loc, g_.SourceLine(p.loc),
+             "production never applies: the production at line " + std::to_string(q.loc.line) +
+                 " always matches '" + name + "' first",
+             int(name.size()));
       }
     }
   }
@@ -1148,8 +1165,13 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
       }
     }
   }
-  std::sort(declared_.begin(), declared_.end(),
-            [](const std::string& a, const std::string& b) { return a.size() > b.size(); });
+  for (const std::string& d : declared_) {
+    declaredSet_.insert(d);
+    declaredLengths_.push_back(d.size());
+  }
+  std::sort(declaredLengths_.begin(), declaredLengths_.end(), std::greater<>());
+  declaredLengths_.erase(std::unique(declaredLengths_.begin(), declaredLengths_.end()),
+                         declaredLengths_.end());
   for (const Line& l : lines_) {
     if (ended_) break;
     ParseLine(l);

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -224,6 +225,52 @@ TEST(ParserLimits, IncludedBytesHaveATotalBudgetAndAPerFileLimit) {
   EXPECT_EQ(r.diagnostics.items[1].loc.line, 3);
   EXPECT_EQ(r.diagnostics.items[1].message,
             "cannot read included file 'big': file is larger than the limit of 150 bytes");
+}
+
+TEST(ParserLimits, ManyDeclaredModuleNamesLexInTimeLinearInTheWord) {
+  // Each module was compared with every declared name: 20,000 names and a
+  // million modules took 46 s. The bound only catches that.
+  std::string decl = "module:";
+  for (int i = 0; i < 50000; ++i) decl += " m" + std::to_string(i);
+  std::string word;
+  for (int i = 0; i < 400000; ++i) word += "m49999m1m12F";
+  auto start = std::chrono::steady_clock::now();
+  ParseResult r = ParseGrammarText(decl + "\naxiom: A\nA --> " + word + "\n", "decl.lsys");
+  double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll(3);
+  EXPECT_LT(seconds, 30.0);
+  const Successor& succ = r.grammar->main.productions[0].successor;
+  ASSERT_EQ(succ.symbols.size(), 1600000u);
+  // Longest declared name first: m12 is one module, not m1 then 2.
+  EXPECT_EQ(r.grammar->symbols.name(succ.symbols[0]), "m49999");
+  EXPECT_EQ(r.grammar->symbols.name(succ.symbols[1]), "m1");
+  EXPECT_EQ(r.grammar->symbols.name(succ.symbols[2]), "m12");
+}
+
+TEST(ParserLimits, RightContextNestedDeeperThan64IsAnError) {
+  // The matcher gave up past 64 levels without a word: such a production
+  // silently never matched.
+  auto context = [](int n) { return std::string(size_t(n), '[') + "B" + std::string(size_t(n), ']'); };
+  EXPECT_TRUE(ParseGrammarText("axiom: A\nA > " + context(64) + " --> C\n", "ok.lsys").grammar);
+  ParseResult r = ParseGrammarText("axiom: A\nA > " + context(65) + " --> C\n", "deep.lsys");
+  ASSERT_EQ(r.diagnostics.ErrorCount(), 1u);
+  EXPECT_EQ(r.diagnostics.items[0].message, "right context nested deeper than 64 brackets");
+  EXPECT_EQ(r.diagnostics.items[0].loc.column, 5 + 64);
+}
+
+TEST(ParserLimits, ShadowWarningsNameTheFirstProductionThatAlwaysApplies) {
+  std::string text = "axiom: A(1)\nA(x) : x > 0 --> B\nA(x) --> C\n";
+  for (int i = 0; i < 1000; ++i) text += "A(x) : x == " + std::to_string(i) + " --> D\n";
+  text += "A(x) --> E\n";
+  ParseResult r = ParseGrammarText(text, "shadow.lsys");
+  ASSERT_TRUE(r.grammar);
+  ASSERT_EQ(r.diagnostics.items.size(), 1001u);
+  for (const Diagnostic& d : r.diagnostics.items) {
+    EXPECT_EQ(d.message, "production never applies: the production at line 3 always matches 'A' first")
+        << d.loc.line;
+  }
+  EXPECT_EQ(r.diagnostics.items.back().loc.line, 1004);
 }
 
 }  // namespace
