@@ -3,6 +3,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 
@@ -456,9 +457,11 @@ class Parser {
     }
     if (c == ')' || c == ',' || c == ':')
       return Error(col, "expected an expression before '" + std::string(1, c) + "'");
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "\\x%02x", static_cast<unsigned char>(c));
     std::string shown = static_cast<unsigned char>(c) >= 32 && static_cast<unsigned char>(c) < 127
                             ? std::string(1, c)
-                            : "\\x" + std::to_string(static_cast<unsigned char>(c));
+                            : std::string(hex);
     return Error(col, "unexpected character '" + shown + "' in expression");
   }
 

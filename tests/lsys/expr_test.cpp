@@ -187,6 +187,14 @@ TEST(Expr, EveryKindOfNestingStopsAtTheLimitWithItsColumn) {
   EXPECT_EQ(Eval(std::string(47, '(') + "7" + std::string(47, ')')), 7);
 }
 
+TEST(Expr, UnexpectedByteIsShownInHex) {
+  // Was "\\x255" (decimal).
+  Compiled c = Compile("1 + \xff");
+  EXPECT_FALSE(c.ok);
+  EXPECT_EQ(c.error.message, "unexpected character '\\xff' in expression");
+  EXPECT_EQ(c.error.column, 5);
+}
+
 TEST(Expr, RunTimeErrorColumnsPast65535AreExact) {
   // Columns were stored in 16 bits and clamped.
   std::string text = std::string(70000, ' ') + "1 / x";
