@@ -15,13 +15,22 @@ int Report(const Diagnostic& d, std::ostream& err) {
   return d.kind == ErrorKind::kRuntime ? kExitRuntime : kExitBadInput;
 }
 
-int Report(const DiagnosticList& list, std::ostream& err) {
-  int code = kExitOk;
+int Report(const DiagnosticList& list, std::ostream& err, int maxErrors) {
+  err << list.FormatAll(size_t(maxErrors));
+  int code = list.droppedErrors > 0 ? kExitBadInput : kExitOk;
   for (const auto& d : list.items) {
-    int c = Report(d, err);
+    if (d.severity != Severity::kError) continue;
+    int c = d.kind == ErrorKind::kRuntime ? kExitRuntime : kExitBadInput;
     if (c == kExitBadInput || code == kExitOk) code = c;
   }
   return code;
+}
+
+static void AddMaxErrorsFlag(CLI::App* cmd, DeriveFlags& f) {
+  cmd->add_option("--max-errors", f.maxErrors,
+                  "print at most this many errors (and warnings), then a count of the rest "
+                  "(default 20; 0: all)")
+      ->check(CLI::Range(0, 1000000));
 }
 
 static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
@@ -36,6 +45,7 @@ static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
                   "stop with an error when the word would grow past this many modules "
                   "(default 268435456)")
       ->check(CLI::Range(uint64_t(1), lsys::kMaxModulesCap));
+  AddMaxErrorsFlag(cmd, f);
 }
 
 int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
@@ -80,6 +90,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   CLI::App* c = app.add_subcommand("check", "parse and check a grammar; print diagnostics");
   c->add_option("file", check.file, "grammar file (.lsys)")->required();
   c->add_option("-D,--define", check.defines, "override a #define: NAME=VALUE (repeatable)");
+  AddMaxErrorsFlag(c, check);
 
   std::vector<std::string> rev(args.rbegin(), args.rend());
   try {

@@ -52,9 +52,10 @@ std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err
   return spec;
 }
 
-std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, std::ostream& err, int* exit) {
+std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErrors, std::ostream& err,
+                                       int* exit) {
   plant::PlantResult r = plant::BuildPlant(spec);
-  *exit = Report(r.diagnostics, err);
+  *exit = Report(r.diagnostics, err, maxErrors);
   if (!r.plant && *exit == kExitOk) *exit = kExitBadInput;
   return std::move(r.plant);
 }
@@ -64,7 +65,7 @@ int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err) {
   auto spec = SpecFrom(flags, err, &exit);
   if (!spec) return exit;
   spec->until = plant::Stage::kGrammar;
-  auto p = BuildPlant(*spec, err, &exit);
+  auto p = BuildPlant(*spec, flags.maxErrors, err, &exit);
   return p ? kExitOk : exit;
 }
 
@@ -125,7 +126,7 @@ int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err) {
                    static_cast<unsigned long long>(modules));
     };
   }
-  auto p = BuildPlant(*spec, err, &exit);
+  auto p = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit);
   if (shown) std::fprintf(stderr, "\r%60s\r", "");
   if (!p) return exit;
   const lsys::Grammar* g = &p->grammar;

@@ -45,7 +45,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (!spec) return exit;
   spec->detail.sides = cmd.sides;
   spec->until = plant::Stage::kGeometry;
-  auto plant = BuildPlant(*spec, err, &exit);
+  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit);
   if (!plant) return exit;
   const mesh::PlantGeometry* geometry = &plant->geometry;
   const mesh::Palette& palette = plant->palette;
@@ -70,7 +70,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   } else {
     DiagnosticList warnings;
     Status s = plant::Tessellate(*plant, *spec, warnings);
-    exit = Report(warnings, err);
+    exit = Report(warnings, err, cmd.derive.maxErrors);
     if (!s.ok()) return Report(s.error(), err);
     if (m.vertexCount()) {
       lo = hi = m.positions[0].cast<double>();

@@ -21,6 +21,7 @@ struct DeriveFlags {
   std::vector<std::string> defines;  // NAME=VALUE
   int threads = 0;
   uint64_t maxModules = 0;  // 0: the library default
+  int maxErrors = 20;       // errors (and warnings) printed; 0: all
 };
 
 struct DeriveCommand {
@@ -52,15 +53,17 @@ int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 // nullopt with *exit set when a flag is malformed (printed to `err`).
 std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit);
 
-// Builds the plant up to `spec.until`, printing every diagnostic; nullopt
+// Builds the plant up to `spec.until`, printing its diagnostics (at most
+// maxErrors of them, 0: all); nullopt
 // with *exit set on an error.
-std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, std::ostream& err, int* exit);
+std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErrors, std::ostream& err,
+                                       int* exit);
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
 // Prints diagnostics; returns the exit status they call for (0 when there
 // are only warnings).
-int Report(const DiagnosticList& list, std::ostream& err);
+int Report(const DiagnosticList& list, std::ostream& err, int maxErrors = 0);
 int Report(const Diagnostic& d, std::ostream& err);
 
 }  // namespace sylva::app

@@ -3,9 +3,11 @@
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
-#include <sstream>
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <cstdint>
 #include <sys/stat.h>
 
 namespace sylva {
@@ -80,24 +82,52 @@ Status AtomicFile::Commit() {
   return {};
 }
 
-Expected<std::string> ReadFile(const std::string& path) {
+Expected<std::string> ReadFile(const std::string& path, size_t maxBytes) {
+  auto fail = [&](std::string message) {
+    Diagnostic d;
+    d.loc.file = path;
+    d.message = std::move(message);
+    return d;
+  };
+  if (path.find('\0') != std::string::npos) return fail("file name contains a NUL byte");
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; the type is
+  // checked on the open file, so a link to a regular file is fine.
+  const int fd = open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return fail(std::string("cannot read file: ") + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() { close(fd); }
+  } closer{fd};
   struct stat st;
-  if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode)) {
-    Diagnostic d;
-    d.loc.file = path;
-    d.message = "is a directory, not a file";
-    return d;
+  if (fstat(fd, &st) != 0) return fail(std::string("cannot read file: ") + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) return fail("is a directory, not a file");
+  if (!S_ISREG(st.st_mode)) return fail("is not a regular file (a device, FIFO or socket)");
+  auto tooLarge = [&] {
+    return fail("file is larger than the limit of " +
+                (maxBytes >= (size_t(1) << 20) ? std::to_string(maxBytes >> 20) + " MiB"
+                                               : std::to_string(maxBytes) + " bytes"));
+  };
+  if (st.st_size > 0 && uint64_t(st.st_size) > maxBytes) return tooLarge();
+  // Read to the end: the size fstat gives can be stale (a growing file) or 0 (/proc).
+  std::string text;
+  text.resize(std::min<size_t>(size_t(st.st_size), maxBytes) + 1);
+  size_t used = 0;
+  for (;;) {
+    if (used == text.size()) {
+      if (used > maxBytes) return tooLarge();
+      text.resize(std::min(maxBytes + 1, used * 2 + 4096));
+    }
+    const ssize_t n = read(fd, text.data() + used, text.size() - used);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return fail(std::string("cannot read file: ") + std::strerror(errno));
+    }
+    if (n == 0) break;
+    used += size_t(n);
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    Diagnostic d;
-    d.loc.file = path;
-    d.message = std::string("cannot read file: ") + std::strerror(errno);
-    return d;
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  if (used > maxBytes) return tooLarge();
+  text.resize(used);
+  return text;
 }
 
 }  // namespace sylva

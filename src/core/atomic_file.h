@@ -34,7 +34,10 @@ class AtomicFile {
   FILE* file_ = nullptr;
 };
 
-// Reads a whole file; the error names the path.
-Expected<std::string> ReadFile(const std::string& path);
+// Reads a whole regular file (a link to one is fine) of at most maxBytes;
+// the error names the path. A directory, device, FIFO or socket is an
+// error, found without blocking, and so is a file larger than maxBytes.
+inline constexpr size_t kDefaultMaxReadBytes = size_t(64) << 20;
+Expected<std::string> ReadFile(const std::string& path, size_t maxBytes = kDefaultMaxReadBytes);
 
 }  // namespace sylva

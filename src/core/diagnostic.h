@@ -7,9 +7,14 @@
 //         |                               ^~
 // Lines and columns are 1-based; column counts bytes. A diagnostic with no
 // file (command-line errors) prints "sylva: error: ...".
+//
+// The excerpt is a window of at most about 100 columns around the caret,
+// with "..." where the line goes on; bytes that are not valid UTF-8 print as
+// \xNN and control bytes as spaces, and the caret stays under its column.
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace sylva {
@@ -33,23 +38,34 @@ struct Diagnostic {
   SourceLoc loc;
   int length = 1;          // columns underlined by the caret
   std::string message;
-  std::string sourceLine;  // the text of loc.line, for the excerpt; may be empty
+  // The text of loc.line (or the part of it around loc.column that
+  // SetExcerpt keeps), for the excerpt; may be empty.
+  std::string sourceLine;
+  int sourceLineOffset = 0;   // bytes of the line cut before sourceLine
+  bool sourceLineCut = false;  // the line goes on after sourceLine
 
   // "file:line:col: error: message" plus excerpt lines, newline-terminated.
   std::string Format() const;
 };
 
+// Sets d.sourceLine to the part of `line` around d.loc.column that an
+// excerpt can show (a few hundred bytes at most, whatever the line's length).
+void SetExcerpt(Diagnostic& d, std::string_view line);
+
 Diagnostic MakeError(SourceLoc loc, std::string message, int length = 1,
-                     std::string sourceLine = {});
+                     std::string_view sourceLine = {});
 
 // Diagnostics of one run, in the order found.
 struct DiagnosticList {
   std::vector<Diagnostic> items;
+  size_t droppedErrors = 0;  // errors found but not kept (a reader's own limit)
 
   void Add(Diagnostic d) { items.push_back(std::move(d)); }
   bool HasErrors() const;
   size_t ErrorCount() const;
-  std::string FormatAll() const;
+  // Every diagnostic, or at most maxErrors errors and maxErrors warnings
+  // followed by "sylva: note: N more errors not shown" (0 = no limit).
+  std::string FormatAll(size_t maxErrors = 0) const;
 };
 
 }  // namespace sylva

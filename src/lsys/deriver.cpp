@@ -174,6 +174,14 @@ class Pass {
   // General path.
   bool Choose(const WordView& w, size_t i, double* formals, uint32_t* choice, Chunk& c);
   // 1 matches, 0 does not, -1 error (recorded in c).
+  int Draw(const ProdInfo* pi, const ProdInfo* last, const WordView& w, size_t i,
+           const double* pp, int arity, double* formals, size_t& prev, size_t& next,
+           RandomStream& rng, Chunk& c, double* weights, uint32_t* cands, size_t capacity,
+           uint32_t* choice);
+  [[gnu::noinline]] bool DrawMany(const ProdInfo* pi, const ProdInfo* last, const WordView& w,
+                                  size_t i, const double* pp, int arity, double* formals,
+                                  size_t& prev, size_t& next, RandomStream rng, Chunk& c,
+                                  uint32_t* choice);
   int Matches(const ProdInfo& pi, const WordView& w, size_t i, const double* pp, int arity,
               double* formals, size_t& prev, size_t& next, RandomStream& rng, Chunk& c);
   void Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams);
@@ -331,7 +339,7 @@ void Pass::Fail(Chunk& c, const Production& p, const EvalError& e, int column, s
   Diagnostic d = MakeError(SourceLoc{p.loc.file, p.loc.line, e.column ? e.column : column},
                            e.message + " (module " + std::to_string(i + 1) + " of the word, step " +
                                std::to_string(stepForMessages_) + ")",
-                           1, p.sourceLine);
+                           1, g_.SourceLine(p.loc));
   c.error = std::move(d);
 }
 
@@ -367,6 +375,67 @@ int Pass::Matches(const ProdInfo& pi, const WordView& w, size_t i, const double*
   return 1;
 }
 
+// Draws one of the matching weighted productions from pi on, by weight
+// (kIdentity when every weight is 0), with room for `capacity` candidates in
+// weights/cands: 1 drawn, 0 more candidates than capacity, -1 an error
+// (reported in c).
+inline int Pass::Draw(const ProdInfo* pi, const ProdInfo* last, const WordView& w, size_t i,
+                      const double* pp, int arity, double* formals, size_t& prev, size_t& next,
+                      RandomStream& rng, Chunk& c, double* weights, uint32_t* cands,
+                      size_t capacity, uint32_t* choice) {
+  size_t nc = 0;
+  double total = 0;
+  for (const ProdInfo* qi = pi; qi != last; ++qi) {
+    if (!qi->hasWeight) continue;
+    if (qi != pi) {
+      int mq = Matches(*qi, w, i, pp, arity, formals, prev, next, rng, c);
+      if (mq < 0) return -1;
+      if (mq == 0) continue;
+    }
+    if (nc == capacity) return 0;
+    const Production& q = sec_.productions[qi->index];
+    double wv;
+    EvalError e;
+    if (!q.weight->Eval(formals, rng, &wv, &e)) {
+      Fail(c, q, e, q.weightColumn, i);
+      return -1;
+    }
+    if (wv < 0) {
+      e.message = "negative probability weight";
+      Fail(c, q, e, q.weightColumn, i);
+      return -1;
+    }
+    weights[nc] = wv;
+    cands[nc++] = qi->index;
+    total += wv;
+  }
+  if (total <= 0) {
+    *choice = kIdentity;
+    return 1;
+  }
+  double r = rng.Uniform() * total;
+  size_t pick = nc - 1;
+  for (size_t k = 0; k < nc; ++k) {
+    if (r < weights[k]) {
+      pick = k;
+      break;
+    }
+    r -= weights[k];
+  }
+  *choice = cands[pick];
+  return 1;
+}
+
+bool Pass::DrawMany(const ProdInfo* pi, const ProdInfo* last, const WordView& w, size_t i,
+                    const double* pp, int arity, double* formals, size_t& prev, size_t& next,
+                    RandomStream rng, Chunk& c, uint32_t* choice) {
+  const size_t capacity = size_t(last - pi);
+  std::vector<double> weights(capacity);
+  std::vector<uint32_t> cands(capacity);
+  return Draw(pi, last, w, i, pp, arity, formals, prev, next, rng, c, weights.data(),
+              cands.data(), capacity, choice) > 0;
+}
+
 bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice, Chunk& c) {
   const SymbolId sym = w.symbols[i];
   const ProdInfo* first = infos_.data() + infoStart_[sym];
@@ -384,49 +453,19 @@ bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice
       *choice = pi->index;
       return true;
     }
-    // Stochastic: draw among every matching production that carries a weight.
-    double weights[64];
-    uint32_t cands[64];
-    int nc = 0;
-    double total = 0;
-    for (const ProdInfo* qi = pi; qi != last && nc < 64; ++qi) {
-      if (!qi->hasWeight) continue;
-      if (qi != pi) {
-        int mq = Matches(*qi, w, i, pp, arity, formals, prev, next, rng, c);
-        if (mq < 0) return false;
-        if (mq == 0) continue;
-      }
-      const Production& q = sec_.productions[qi->index];
-      double wv;
-      EvalError e;
-      if (!q.weight->Eval(formals, rng, &wv, &e)) {
-        Fail(c, q, e, q.weightColumn, i);
-        return false;
-      }
-      if (wv < 0) {
-        e.message = "negative probability weight";
-        Fail(c, q, e, q.weightColumn, i);
-        return false;
-      }
-      weights[nc] = wv;
-      cands[nc++] = qi->index;
-      total += wv;
+    // Stochastic: draw among every matching production that carries a
+    // weight, however many: up to kInline here; past that, DrawMany draws
+    // again from the same random state with room for all of them.
+    constexpr size_t kInline = 64;
+    double weights[kInline];
+    uint32_t cands[kInline];
+    const RandomStream rngAtWeights = rng;
+    int got = Draw(pi, last, w, i, pp, arity, formals, prev, next, rng, c, weights, cands, kInline,
+                   choice);
+    if (got == 0) [[unlikely]] {
+      return DrawMany(pi, last, w, i, pp, arity, formals, prev, next, rngAtWeights, c, choice);
     }
-    if (total <= 0) {
-      *choice = kIdentity;
-      return true;
-    }
-    double r = rng.Uniform() * total;
-    int pick = nc - 1;
-    for (int k = 0; k < nc; ++k) {
-      if (r < weights[k]) {
-        pick = k;
-        break;
-      }
-      r -= weights[k];
-    }
-    *choice = cands[pick];
-    return true;
+    return got > 0;
   }
   *choice = kIdentity;
   return true;

@@ -3,6 +3,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 
@@ -166,14 +167,17 @@ bool Expr::Run(const double* formals, RandomStream& rng, double* out, EvalError*
         int k = OpArity(in.op);
         sp -= k;
         double r;
-        if (!ApplyPure(in.op, stack + sp, &r, err, in.column)) return false;
+        if (!ApplyPure(in.op, stack + sp, &r, err, 0)) {
+          if (err) err->column = int(columns_[pc]);
+          return false;
+        }
         stack[sp++] = r;
       }
     }
   }
   *out = stack[0];
   // Adds and multiplies skip their own checks in the loop above.
-  if (!std::isfinite(*out)) return Fail(err, code_.empty() ? 0 : code_.back().column,
+  if (!std::isfinite(*out)) return Fail(err, columns_.empty() ? 0 : int(columns_.back()),
                                         "result is not a finite number (overflow)");
   return true;
 }
@@ -190,6 +194,25 @@ struct Node {
   uint32_t slot = 0;
   std::vector<std::unique_ptr<Node>> kids;
   bool ternary = false;
+
+  Node() = default;
+  Node(Node&&) = default;
+  Node& operator=(Node&&) = default;
+  // A flat chain `1+1+...+1` is a tree as deep as it is long: free it with a
+  // work list, not recursion.
+  ~Node() {
+    std::vector<std::unique_ptr<Node>> pending;
+    for (auto& k : kids) {
+      if (k) pending.push_back(std::move(k));
+    }
+    while (!pending.empty()) {
+      std::unique_ptr<Node> n = std::move(pending.back());
+      pending.pop_back();
+      for (auto& k : n->kids) {
+        if (k) pending.push_back(std::move(k));
+      }
+    }
+  }
 };
 using NodePtr = std::unique_ptr<Node>;
 
@@ -214,7 +237,9 @@ bool IsRandom(OpCode op) {
   return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal;
 }
 
-constexpr int kMaxDepth = 48;
+// Nesting (parentheses, unary operators, '^', '?:', function arguments)
+// recurses in the parser; chains of binary operators do not.
+constexpr int kMaxDepth = kMaxExprNesting;
 
 class Parser {
  public:
@@ -256,7 +281,7 @@ class Parser {
   }
 
   NodePtr Ternary(int depth) {
-    if (depth > kMaxDepth) return Error(Col(), "expression nested too deeply");
+    if (depth > kMaxDepth) return Error(Col(), "expression nested deeper than " + std::to_string(kMaxDepth));
     NodePtr c = Binary(0, depth);
     if (!c) return nullptr;
     SkipSpace();
@@ -317,7 +342,7 @@ class Parser {
   }
 
   NodePtr Unary(int depth) {
-    if (depth > kMaxDepth) return Error(Col(), "expression nested too deeply");
+    if (depth > kMaxDepth) return Error(Col(), "expression nested deeper than " + std::to_string(kMaxDepth));
     SkipSpace();
     int col = Col();
     if (Accept("-")) {
@@ -432,9 +457,11 @@ class Parser {
     }
     if (c == ')' || c == ',' || c == ':')
       return Error(col, "expected an expression before '" + std::string(1, c) + "'");
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "\\x%02x", static_cast<unsigned char>(c));
     std::string shown = static_cast<unsigned char>(c) >= 32 && static_cast<unsigned char>(c) < 127
                             ? std::string(1, c)
-                            : "\\x" + std::to_string(static_cast<unsigned char>(c));
+                            : std::string(hex);
     return Error(col, "unexpected character '" + shown + "' in expression");
   }
 
@@ -478,11 +505,31 @@ class ExprCompiler {
  public:
   explicit ExprCompiler(ExprParseError* err) : err_(err) {}
 
-  // Folds constant subtrees in place; false on a compile-time error.
-  bool Fold(Node& n) {
-    for (auto& k : n.kids) {
-      if (!Fold(*k)) return false;
+  // Folds constant subtrees in place, children first; false on a
+  // compile-time error. A work list, not recursion: operator chains make
+  // trees as deep as they are long.
+  bool Fold(Node& root) {
+    struct Frame {
+      Node* node;
+      size_t next;
+    };
+    std::vector<Frame> stack{{&root, 0}};
+    while (!stack.empty()) {
+      Frame& f = stack.back();
+      if (f.next < f.node->kids.size()) {
+        Node* kid = f.node->kids[f.next++].get();
+        stack.push_back({kid, 0});
+        continue;
+      }
+      Node* n = f.node;
+      stack.pop_back();
+      if (!FoldNode(*n)) return false;
     }
+    return true;
+  }
+
+  // Folds one node whose children are folded.
+  bool FoldNode(Node& n) {
     if (n.op == OpCode::kConst || n.op == OpCode::kFormal || IsRandom(n.op)) return true;
     for (auto& k : n.kids) {
       if (k->op != OpCode::kConst) {
@@ -537,47 +584,66 @@ class ExprCompiler {
     return true;
   }
 
-  void Emit(const Node& n, std::vector<Instr>& code, int depth, int* maxDepth) {
-    auto push = [&](OpCode op, uint32_t arg = 0, double v = 0) {
-      code.push_back(Instr{op, uint16_t(n.column > 65535 ? 65535 : n.column), arg, v});
+  // Emits stack code for the tree, in post order with the jumps of '?:',
+  // '&&' and '||' between the operands; *maxDepth is the deepest evaluation
+  // stack the code reaches. A work list, not recursion (see Fold).
+  static void Emit(const Node& root, std::vector<Instr>& code, std::vector<uint32_t>& columns,
+                   int* maxDepth) {
+    struct Frame {
+      const Node* node;
+      int depth;      // stack depth the node's value lands at
+      size_t next;    // next child to emit
+      size_t jump1, jump2;  // instructions to patch
     };
-    if (depth > *maxDepth) *maxDepth = depth;
-    switch (n.op) {
-      case OpCode::kConst: push(OpCode::kConst, 0, n.value); return;
-      case OpCode::kFormal: push(OpCode::kFormal, n.slot); return;
-      default: break;
+    std::vector<Frame> stack{{&root, 1, 0, 0, 0}};
+    while (!stack.empty()) {
+      Frame& f = stack.back();
+      const Node& n = *f.node;
+      auto push = [&](OpCode op, uint32_t arg = 0, double v = 0) {
+        code.push_back(Instr{op, arg, v});
+        columns.push_back(uint32_t(n.column));
+      };
+      if (f.depth > *maxDepth) *maxDepth = f.depth;
+      if (n.op == OpCode::kConst || n.op == OpCode::kFormal) {
+        if (n.op == OpCode::kConst) push(OpCode::kConst, 0, n.value);
+        else push(OpCode::kFormal, n.slot);
+        stack.pop_back();
+        continue;
+      }
+      const bool shortCircuit = n.op == OpCode::kAndJump || n.op == OpCode::kOrJump;
+      if (f.next < n.kids.size()) {
+        size_t i = f.next++;
+        int depth = f.depth;
+        if (n.ternary) {
+          if (i == 1) {
+            f.jump1 = code.size();
+            push(OpCode::kJumpIfZero);
+          } else if (i == 2) {
+            f.jump2 = code.size();
+            push(OpCode::kJump);
+            code[f.jump1].arg = uint32_t(code.size());
+          }
+        } else if (shortCircuit) {
+          if (i == 1) {
+            f.jump1 = code.size();
+            push(n.op);
+          }
+        } else {
+          depth += int(i);
+        }
+        stack.push_back({n.kids[i].get(), depth, 0, 0, 0});  // f is invalid from here
+        continue;
+      }
+      if (n.ternary) {
+        code[f.jump2].arg = uint32_t(code.size());
+      } else if (shortCircuit) {
+        push(OpCode::kToBool);
+        code[f.jump1].arg = uint32_t(code.size());
+      } else {
+        push(n.op);
+      }
+      stack.pop_back();
     }
-    if (n.ternary) {
-      Emit(*n.kids[0], code, depth, maxDepth);
-      size_t jz = code.size();
-      push(OpCode::kJumpIfZero);
-      Emit(*n.kids[1], code, depth, maxDepth);
-      size_t jmp = code.size();
-      push(OpCode::kJump);
-      code[jz].arg = uint32_t(code.size());
-      Emit(*n.kids[2], code, depth, maxDepth);
-      code[jmp].arg = uint32_t(code.size());
-      return;
-    }
-    if (n.op == OpCode::kAndJump || n.op == OpCode::kOrJump) {
-      Emit(*n.kids[0], code, depth, maxDepth);
-      size_t j = code.size();
-      push(n.op);
-      Emit(*n.kids[1], code, depth, maxDepth);
-      push(OpCode::kToBool);
-      code[j].arg = uint32_t(code.size());
-      return;
-    }
-    for (size_t i = 0; i < n.kids.size(); ++i) Emit(*n.kids[i], code, depth + int(i), maxDepth);
-    push(n.op);
-  }
-
-  static bool AnyRandom(const Node& n) {
-    if (IsRandom(n.op)) return true;
-    for (const auto& k : n.kids) {
-      if (AnyRandom(*k)) return true;
-    }
-    return false;
   }
 
   bool Finish(const Node& root, Expr* out) {
@@ -589,13 +655,13 @@ class ExprCompiler {
     } else {
       e.kind_ = Expr::Kind::kCode;
       int maxDepth = 0;
-      Emit(root, e.code_, 1, &maxDepth);
+      Emit(root, e.code_, e.columns_, &maxDepth);
       if (maxDepth >= Expr::kMaxStack) {
         err_->column = root.column;
         err_->message = "expression too complex (evaluation stack deeper than 64)";
         return false;
       }
-      e.usesRandom_ = AnyRandom(root);
+      for (const Instr& in : e.code_) e.usesRandom_ |= IsRandom(in.op);
     }
     *out = std::move(e);
     return true;

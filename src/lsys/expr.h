@@ -34,9 +34,8 @@ enum class OpCode : uint8_t {
   kRan, kUniform, kNormal,
 };
 
-struct Instr {
+struct Instr {  // 16 bytes
   OpCode op;
-  uint16_t column;  // of the operation, for run-time errors
   uint32_t arg;     // formal slot or jump target
   double value;     // constant
 };
@@ -83,6 +82,7 @@ class Expr {
   uint32_t slot_ = 0;
   double constant_ = 0;
   std::vector<Instr> code_;
+  std::vector<uint32_t> columns_;  // per instruction: column of the operation, for errors
 };
 
 }  // namespace sylva::lsys

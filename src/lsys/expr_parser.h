@@ -22,6 +22,11 @@
 
 namespace sylva::lsys {
 
+// How deeply parentheses, unary operators, '^', '?:' and function calls may
+// nest in one expression; deeper is an error ("expression nested deeper
+// than 48"). Chains of binary operators (`1+1+...+1`) have no limit.
+inline constexpr int kMaxExprNesting = 48;
+
 // What names mean inside one expression.
 struct ExprScope {
   const std::unordered_map<std::string, double>* constants = nullptr;

@@ -7,8 +7,10 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -33,6 +35,10 @@ struct Successor {
   bool allConstant = true;  // every parameter is a constant
 };
 
+// Brackets a right context may nest (`A > [[[B]]]` is 3); deeper is a parse
+// error.
+inline constexpr int kMaxRightContextNesting = 64;
+
 struct Production {
   std::vector<FormalModule> left;   // in word order; empty = any
   FormalModule pred;
@@ -41,8 +47,7 @@ struct Production {
   std::optional<Expr> condition;    // none = always true
   std::optional<Expr> weight;       // none = not stochastic
   Successor successor;
-  SourceLoc loc;                    // of the predecessor
-  std::string sourceLine;
+  SourceLoc loc;                    // of the predecessor (Grammar::SourceLine has its text)
   // Columns of the parts, for run-time error messages.
   int conditionColumn = 0, weightColumn = 0;
 
@@ -93,9 +98,21 @@ struct Grammar {
   // stages can point into the grammar (an unknown surface `~name`).
   struct Use {
     SourceLoc loc;
-    std::string line;
   };
   std::unordered_map<std::string, Use> symbolLoc;
+
+  // The text of every file read (the main file, then each #include), kept
+  // so that a diagnostic can quote its line when it is made; locations store
+  // only file, line and column.
+  struct SourceFile {
+    std::string path;
+    std::shared_ptr<const std::string> text;
+    std::vector<size_t> lineStarts;  // byte offset of line n at [n - 1]
+  };
+  std::vector<SourceFile> sources;
+  // The text of line loc.line of loc.file, without its line break; empty
+  // when the file or line is unknown. Points into `sources`.
+  std::string_view SourceLine(const SourceLoc& loc) const;
 };
 
 }  // namespace sylva::lsys

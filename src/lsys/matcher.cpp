@@ -43,7 +43,8 @@ bool MatchLeft(const Production& p, const WordView& w, size_t prev, double* form
 }
 
 bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, double* formals) {
-  static constexpr int kMaxNesting = 64;
+  // The parser rejects right contexts nested deeper than this.
+  static constexpr int kMaxNesting = kMaxRightContextNesting;
   uint32_t opened[kMaxNesting];  // word positions of '[' the context descended into
   int depth = 0;
   size_t j = i + 1;

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <set>
 #include <unordered_set>
 
@@ -24,13 +25,12 @@ namespace {
 struct Line {
   int file = 0;
   int number = 0;
-  std::string text;      // comments blanked, same columns
-  std::string original;  // for excerpts
+  std::string text;           // comments blanked, same columns
+  std::string_view original;  // for excerpts: points into Grammar::sources
 };
 
 struct Define {
   SourceLoc loc;
-  std::string line;
   int length = 1;
 };
 
@@ -57,6 +57,13 @@ std::string Lower(std::string_view s) {
   return r;
 }
 
+// "64 MiB" or "100 bytes".
+std::string SizeText(size_t bytes) {
+  if (bytes >= (size_t(1) << 20) && bytes % (size_t(1) << 20) == 0)
+    return std::to_string(bytes >> 20) + " MiB";
+  return std::to_string(bytes) + " bytes";
+}
+
 std::string Printable(char c) {
   auto u = static_cast<unsigned char>(c);
   if (u >= 32 && u < 127) return std::string(1, c);
@@ -75,23 +82,22 @@ class GrammarParser {
   // --- diagnostics ---
   SourceLoc Loc(const Line& l, int col) const { return SourceLoc{files_[l.file], l.number, col}; }
   void Error(const Line& l, int col, std::string msg, int len = 1) {
-    if (int(diags_.ErrorCount()) >= kMaxErrors) return;
+    if (int(diags_.ErrorCount()) >= kMaxErrors) {
+      ++diags_.droppedErrors;  // counted, so the report can say how many
+      return;
+    }
     diags_.Add(MakeError(Loc(l, col), std::move(msg), len, l.original));
   }
-  void Warn(SourceLoc loc, std::string line, std::string msg, int len = 1) {
-    Diagnostic d = MakeError(std::move(loc), std::move(msg), len, std::move(line));
+  void Warn(SourceLoc loc, std::string_view line, std::string msg, int len = 1) {
+    Diagnostic d = MakeError(std::move(loc), std::move(msg), len, line);
     d.severity = Severity::kWarning;
     warnings_.push_back(std::move(d));
   }
 
   // --- preprocessing ---
-  std::optional<std::string> Read(const std::string& path) {
-    if (opt_.readFile) return opt_.readFile(path);
-    auto r = ReadFile(path);
-    if (!r) return std::nullopt;
-    return std::move(r).value();
-  }
-  void Preprocess(const std::string& text, const std::string& path, int depth,
+  // Reads an included file within the limits; on failure *why says why.
+  std::optional<std::string> Read(const std::string& path, std::string* why);
+  void Preprocess(std::shared_ptr<const std::string> text, const std::string& path, int depth,
                   std::vector<std::string>& stack);
 
   // --- parsing ---
@@ -128,45 +134,81 @@ class GrammarParser {
   Successor axiom_;
   SourceLoc axiomLoc_;
   std::vector<int> axiomCols_;
-  std::vector<std::string> declared_;  // module: names, longest first
+  std::vector<std::string> declared_;  // module: names
+  // The same names for lexing: their distinct lengths, longest first, and
+  // the set to look a candidate of each length up in (O(lengths) a module,
+  // not O(names)).
+  std::vector<size_t> declaredLengths_;
+  std::unordered_set<std::string_view> declaredSet_;
   std::unordered_map<std::string, Define> defines_;
   std::unordered_set<std::string> usedConstants_;
   std::set<std::string> usedOverrides_;
   std::unordered_map<std::string, ArityUse> arityUse_;
   std::set<std::string> ignoreNames_, considerNames_;
   bool haveIgnore_ = false, haveConsider_ = false;
-  std::vector<std::string> productionLines_;
+  size_t bytesRead_ = 0;  // all files, for kMaxGrammarBytes
+  int filesIncluded_ = 0;
 };
 
 // ---------------------------------------------------------------------------
 // Preprocessing
 
-void GrammarParser::Preprocess(const std::string& text, const std::string& path, int depth,
-                               std::vector<std::string>& stack) {
+std::optional<std::string> GrammarParser::Read(const std::string& path, std::string* why) {
+  std::optional<std::string> text;
+  if (opt_.readFile) {
+    text = opt_.readFile(path);
+    if (!text) *why = "cannot read file";
+  } else {
+    auto r = ReadFile(path, opt_.maxFileBytes);
+    if (r) {
+      text = std::move(r).value();
+    } else {
+      *why = r.error().message;
+    }
+  }
+  if (text && text->size() > opt_.maxFileBytes) {
+    *why = "file is larger than the limit of " + SizeText(opt_.maxFileBytes);
+    text.reset();
+  }
+  return text;
+}
+
+void GrammarParser::Preprocess(std::shared_ptr<const std::string> shared, const std::string& path,
+                               int depth, std::vector<std::string>& stack) {
   int file = int(files_.size());
   files_.push_back(path);
-  // Split into lines (\n, \r\n).
-  std::vector<std::string> raw;
-  size_t start = 0;
-  for (size_t i = 0; i <= text.size(); ++i) {
+  bytesRead_ += shared->size();
+  // Lines (\n, \r\n) as offsets into the text, which the grammar keeps for
+  // excerpts. A UTF-8 byte order mark at the start is skipped.
+  const std::string_view text = *shared;
+  Grammar::SourceFile source{path, shared, {}};
+  const size_t bom = text.substr(0, 3) == "\xEF\xBB\xBF" ? 3 : 0;
+  std::vector<std::string_view> raw;
+  size_t start = bom;
+  for (size_t i = bom; i <= text.size(); ++i) {
     if (i == text.size() || text[i] == '\n') {
-      std::string s = text.substr(start, i - start);
-      if (!s.empty() && s.back() == '\r') s.pop_back();
-      raw.push_back(std::move(s));
+      std::string_view s = text.substr(start, i - start);
+      if (!s.empty() && s.back() == '\r') s.remove_suffix(1);
+      raw.push_back(s);
+      source.lineStarts.push_back(start);
       start = i + 1;
     }
   }
-  if (!raw.empty() && raw.back().empty() && !text.empty()) raw.pop_back();
+  if (!raw.empty() && raw.back().empty() && text.size() > bom) {
+    raw.pop_back();
+    source.lineStarts.pop_back();
+  }
+  g_.sources.push_back(std::move(source));
 
   bool inBlock = false;
-  Line blockStart;
+  Line blockStart;  // text left empty: only for the error's location
   int blockCol = 0;
   for (size_t n = 0; n < raw.size(); ++n) {
     Line l;
     l.file = file;
     l.number = int(n) + 1;
     l.original = raw[n];
-    l.text = raw[n];
+    l.text = std::string(raw[n]);
     std::string& t = l.text;
     for (size_t i = 0; i < t.size(); ++i) {
       if (inBlock) {
@@ -179,7 +221,9 @@ void GrammarParser::Preprocess(const std::string& text, const std::string& path,
         }
       } else if (t[i] == '/' && i + 1 < t.size() && t[i + 1] == '*') {
         inBlock = true;
-        blockStart = l;
+        blockStart.file = l.file;
+        blockStart.number = l.number;
+        blockStart.original = l.original;
         blockCol = int(i) + 1;
         t[i] = t[i + 1] = ' ';
         ++i;
@@ -204,10 +248,15 @@ void GrammarParser::Preprocess(const std::string& text, const std::string& path,
         continue;
       }
       std::string name = t.substr(q + 1, e - q - 1);
+      int col = int(q) + 1, len = int(e - q) + 1;
+      if (name.empty() || name.find('\0') != std::string::npos) {
+        Error(l, col, name.empty() ? "empty file name after #include"
+                                   : "#include file name contains a NUL byte", len);
+        continue;
+      }
       std::filesystem::path target(name);
       if (target.is_relative()) target = std::filesystem::path(path).parent_path() / target;
       std::string resolved = target.lexically_normal().string();
-      int col = int(q) + 1, len = int(e - q) + 1;
       if (std::find(stack.begin(), stack.end(), resolved) != stack.end()) {
         Error(l, col, "#include recursion: '" + name + "' is already being included", len);
         continue;
@@ -216,13 +265,26 @@ void GrammarParser::Preprocess(const std::string& text, const std::string& path,
         Error(l, col, "#include nested deeper than " + std::to_string(kMaxIncludeDepth), len);
         continue;
       }
-      auto content = Read(resolved);
+      if (filesIncluded_ >= kMaxIncludedFiles) {
+        Error(l, col, "more than " + std::to_string(kMaxIncludedFiles) +
+                          " #include files in one grammar", len);
+        continue;
+      }
+      ++filesIncluded_;
+      std::string why;
+      auto content = Read(resolved, &why);
       if (!content) {
-        Error(l, col, "cannot read included file '" + resolved + "'", len);
+        Error(l, col, "cannot read included file '" + resolved + "': " + why, len);
+        continue;
+      }
+      if (bytesRead_ + content->size() > opt_.maxTotalBytes) {
+        Error(l, col, "#include of '" + resolved + "' goes past the limit of " +
+                          SizeText(opt_.maxTotalBytes) + " read for one grammar", len);
         continue;
       }
       stack.push_back(resolved);
-      Preprocess(*content, resolved, depth + 1, stack);
+      Preprocess(std::make_shared<const std::string>(std::move(*content)), resolved, depth + 1,
+                 stack);
       stack.pop_back();
       continue;
     }
@@ -237,10 +299,12 @@ void GrammarParser::Preprocess(const std::string& text, const std::string& path,
 bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string* name) {
   const std::string& t = l.text;
   char c = t[pos];
-  for (const auto& d : declared_) {
-    if (pos + d.size() <= end && t.compare(pos, d.size(), d) == 0) {
-      *name = d;
-      pos += d.size();
+  for (size_t n : declaredLengths_) {
+    if (pos + n > end) continue;
+    auto it = declaredSet_.find(std::string_view(t).substr(pos, n));
+    if (it != declaredSet_.end()) {
+      *name = std::string(*it);
+      pos += n;
       return true;
     }
   }
@@ -396,7 +460,7 @@ bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const
     if (!id) return false;
     out->symbols.push_back(*id);
     cols.push_back(col);
-    g_.symbolLoc.try_emplace(name, Grammar::Use{Loc(l, col), l.original});
+    if (g_.symbolLoc.find(name) == g_.symbolLoc.end()) g_.symbolLoc.emplace(name, Grammar::Use{Loc(l, col)});
   }
   return CheckBrackets(l, out->symbols, cols, "word");
 }
@@ -513,7 +577,7 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     usedOverrides_.insert(name);
   }
   g_.constants[name] = v;
-  defines_[name] = Define{Loc(l, col), l.original, int(name.size())};
+  defines_[name] = Define{Loc(l, col), int(name.size())};
 }
 
 // Header statements: "keyword:" at the start of a line, case-insensitive.
@@ -734,7 +798,8 @@ static size_t FindTopLevel(const std::string& t, size_t from, size_t to, std::st
     char c = t[i];
     if (c == '(') ++depth;
     else if (c == ')') --depth;
-    else if (depth == 0 && t.compare(i, what.size(), what) == 0 && i + what.size() <= to)
+    else if (depth == 0 && c == what[0] && i + what.size() <= to &&
+             t.compare(i, what.size(), what) == 0)
       return i;
   }
   return std::string::npos;
@@ -832,6 +897,15 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     std::vector<SymbolId> syms;
     for (auto& fm : p.right) syms.push_back(fm.symbol);
     if (!CheckBrackets(l, syms, cols, "right context")) return;
+    int depth = 0;
+    for (size_t k = 0; k < syms.size(); ++k) {
+      depth += syms[k] == kOpenBracket ? 1 : (syms[k] == kCloseBracket ? -1 : 0);
+      if (depth > kMaxRightContextNesting) {
+        Error(l, cols[k], "right context nested deeper than " +
+                              std::to_string(kMaxRightContextNesting) + " brackets");
+        return;
+      }
+    }
   }
   p.formalCount = uint16_t(formals.size());
   ExprScope scope{&g_.constants, &usedConstants_, &formals};
@@ -913,7 +987,6 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     p.weight = std::move(weight);
   }
   p.loc = Loc(l, pf.column);
-  p.sourceLine = l.original;
   if (section_->productions.size() >= kMaxProductionsPerSection) {
     Error(l, pf.column, "more than " + std::to_string(kMaxProductionsPerSection) +
                             " productions in one section");
@@ -981,29 +1054,30 @@ void GrammarParser::WarnUnmatchable() {
   }
   for (auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation}) {
     const auto& occ = sec == &g_.interpretation ? occursInterp : occurs;
+    // Per symbol: the first production that always applies (no context,
+    // condition or weight), which shadows every later one.
+    std::vector<int64_t> firstAlways(g_.symbols.size(), -1);
     for (size_t i = 0; i < sec->productions.size(); ++i) {
       const Production& p = sec->productions[i];
       SymbolId s = p.pred.symbol;
       const std::string& name = g_.symbols.name(s);
+      const int64_t shadow = firstAlways[s];
+      if (shadow < 0 && !p.HasContext() && !p.condition && !p.weight) firstAlways[s] = int64_t(i);
       if (!occ[s]) {
         int a = g_.symbols.arity(s);
-        Warn(p.loc, p.sourceLine,
+        Warn(p.loc, g_.SourceLine(p.loc),
              "production can never match: no module '" + name + "' with " + std::to_string(a) +
                  " parameter" + (a == 1 ? "" : "s") + " occurs in the axiom or any successor",
              int(name.size()));
         continue;
       }
       // Shadowed by an earlier production that always applies.
-      for (size_t j = 0; j < i; ++j) {
-        const Production& q = sec->productions[j];
-        if (q.pred.symbol == s && !q.HasContext() && !q.condition && !q.weight &&
-            !(p.weight && q.weight)) {
-          Warn(p.loc, p.sourceLine,
-               "production never applies: the production at line " +
-                   std::to_string(q.loc.line) + " always matches '" + name + "' first",
-               int(name.size()));
-          break;
-        }
+      if (shadow >= 0) {
+        const Production& q = sec->productions[size_t(shadow)];
+        Warn(p.loc, g_.SourceLine(p.loc),
+             "production never applies: the production at line " + std::to_string(q.loc.line) +
+                 " always matches '" + name + "' first",
+             int(name.size()));
       }
     }
   }
@@ -1027,7 +1101,7 @@ void GrammarParser::Finish() {
   }
   for (const auto& [name, def] : defines_) {
     if (!usedConstants_.count(name)) {
-      Warn(def.loc, def.line, "constant '" + name + "' is never used", def.length);
+      Warn(def.loc, g_.SourceLine(def.loc), "constant '" + name + "' is never used", def.length);
     }
   }
   if (diags_.HasErrors()) return;
@@ -1057,8 +1131,16 @@ void GrammarParser::Finish() {
 }
 
 ParseResult GrammarParser::Run(const std::string& text, const std::string& path) {
+  if (text.size() > opt_.maxFileBytes) {
+    ParseResult r;
+    Diagnostic d;
+    d.loc.file = path;
+    d.message = "file is larger than the limit of " + SizeText(opt_.maxFileBytes);
+    r.diagnostics.Add(std::move(d));
+    return r;
+  }
   std::vector<std::string> stack{std::filesystem::path(path).lexically_normal().string()};
-  Preprocess(text, path, 0, stack);
+  Preprocess(std::make_shared<const std::string>(text), path, 0, stack);
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
   // module: declarations apply to the whole file, wherever they stand.
@@ -1083,8 +1165,13 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
       }
     }
   }
-  std::sort(declared_.begin(), declared_.end(),
-            [](const std::string& a, const std::string& b) { return a.size() > b.size(); });
+  for (const std::string& d : declared_) {
+    declaredSet_.insert(d);
+    declaredLengths_.push_back(d.size());
+  }
+  std::sort(declaredLengths_.begin(), declaredLengths_.end(), std::greater<>());
+  declaredLengths_.erase(std::unique(declaredLengths_.begin(), declaredLengths_.end()),
+                         declaredLengths_.end());
   for (const Line& l : lines_) {
     if (ended_) break;
     ParseLine(l);
@@ -1099,6 +1186,20 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
 
 }  // namespace
 
+std::string_view Grammar::SourceLine(const SourceLoc& loc) const {
+  for (const SourceFile& f : sources) {
+    if (f.path != loc.file) continue;
+    if (loc.line < 1 || size_t(loc.line) > f.lineStarts.size()) return {};
+    const std::string_view text = *f.text;
+    const size_t begin = f.lineStarts[size_t(loc.line) - 1];
+    size_t end = text.find('\n', begin);
+    if (end == std::string_view::npos) end = text.size();
+    if (end > begin && text[end - 1] == '\r') --end;
+    return text.substr(begin, end - begin);
+  }
+  return {};
+}
+
 ParseResult ParseGrammarText(const std::string& text, const std::string& path,
                              const ParseOptions& options) {
   GrammarParser p(options);
@@ -1110,7 +1211,7 @@ ParseResult ParseGrammarFile(const std::string& path, const ParseOptions& option
   if (options.readFile) {
     text = options.readFile(path);
   } else {
-    auto r = ReadFile(path);
+    auto r = ReadFile(path, options.maxFileBytes);
     if (!r) {
       ParseResult res;
       res.diagnostics.Add(r.error());

@@ -20,6 +20,12 @@ namespace sylva::lsys {
 
 inline constexpr int kMaxErrors = 50;
 inline constexpr int kMaxIncludeDepth = 16;
+// What one grammar may read: each file (the main one or an #include) at most
+// kMaxGrammarFileBytes, all of them together kMaxGrammarBytes, and at most
+// kMaxIncludedFiles #include files (a file included twice counts twice).
+inline constexpr size_t kMaxGrammarFileBytes = size_t(64) << 20;
+inline constexpr size_t kMaxGrammarBytes = size_t(256) << 20;
+inline constexpr int kMaxIncludedFiles = 1000;
 inline constexpr int kMaxDerivationLength = 100000;
 inline constexpr size_t kMaxProductionsPerSection = 65000;
 
@@ -29,6 +35,9 @@ struct ParseOptions {
   // Reads a file (for the main file when parsing from disk, and #include).
   // Default: the file system.
   std::function<std::optional<std::string>(const std::string& path)> readFile;
+  // What may be read: per file, and all files of the grammar together.
+  size_t maxFileBytes = kMaxGrammarFileBytes;
+  size_t maxTotalBytes = kMaxGrammarBytes;
 };
 
 struct ParseResult {

@@ -10,7 +10,7 @@
 namespace sylva::mesh {
 
 Expected<TriangleMesh> ReadObj(const std::string& path) {
-  auto text = ReadFile(path);
+  auto text = ReadFile(path, kMaxObjFileBytes);
   if (!text) return text.error();
   return ParseObj(*text, path);
 }

@@ -11,6 +11,10 @@
 
 namespace sylva::mesh {
 
+// ReadObj reads regular files of at most this size (a leaf or flower surface
+// is a few kilobytes); anything else is an error naming the path.
+inline constexpr size_t kMaxObjFileBytes = size_t(256) << 20;
+
 Expected<TriangleMesh> ReadObj(const std::string& path);
 Expected<TriangleMesh> ParseObj(const std::string& text, const std::string& path);
 

@@ -65,7 +65,7 @@ Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::
       // Point at the surface's first use in the grammar.
       if (auto it = g.symbolLoc.find("~" + name); it != g.symbolLoc.end()) {
         d.loc = it->second.loc;
-        d.sourceLine = it->second.line;
+        SetExcerpt(d, g.SourceLine(d.loc));
         d.length = int(name.size()) + 1;
       }
       return d;

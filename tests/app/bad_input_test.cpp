@@ -1,6 +1,9 @@
 // Malformed grammars: each must give exit status 2 and its first diagnostic
 // at the right line and column, through the real `sylva derive` command.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <algorithm>
 
 #include "cli_test_util.h"
 
@@ -70,7 +73,7 @@ std::vector<BadCase> Cases() {
       {"empty_condition", "axiom: F\nF : --> G\n", "2:3", "empty condition"},
       {"depth_in_main_section", "maximum depth: 2\naxiom: F\n", "1:1", "decomposition or interpretation"},
       {"negative_seed", "seed: -4\naxiom: F\n", "1:7", "whole number"},
-      {"deep_parentheses", "axiom: F(" + Many('(', 200) + "1" + Many(')', 200) + ")\n", "1:", "nested too deeply"},
+      {"deep_parentheses", "axiom: F(" + Many('(', 200) + "1" + Many(')', 200) + ")\n", "1:", "nested deeper than 48"},
       {"stray_close_paren", "axiom: F)\n", "1:9", "unbalanced ')'"},
       {"zero_tropism", "tropism: 0 0 0 1\naxiom: F\n", "1:10", "tropism vector is zero"},
       {"override_unknown_in_condition", "axiom: A\nA : q --> B\n", "2:5", "unknown name 'q'"},
@@ -103,6 +106,39 @@ TEST(BadInput, DiagnosticShowsTheLineAndACaret) {
   EXPECT_EQ(r.err, path + ":2:30: error: unknown name 'r3' in expression\n"
                           "    2 | A(l,w) --> !(w)F(l)[&(45)B(l*r3,w)]\n"
                           "      |                              ^~\n");
+}
+
+TEST(BadInput, MaxErrorsCapsThePrintedErrorsAndCountsTheRest) {
+  std::string text = "axiom: F\n";
+  for (int i = 0; i < 30; ++i) text += "F --> G(\n";
+  std::string path = WriteFile("many_errors.lsys", text);
+  for (const char* cmd : {"derive", "check", "mesh", "render"}) {
+    std::vector<std::string> args = {cmd, path};
+    if (std::string(cmd) == "mesh") args.insert(args.end(), {"-o", (testing::Scratch() / "unused.obj").string()});
+    if (std::string(cmd) == "render") args.insert(args.end(), {"-o", (testing::Scratch() / "unused.png").string()});
+    auto r = RunSylva(args);
+    EXPECT_EQ(r.code, 2) << cmd;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 20 * 3 + 1) << cmd << "\n" << r.err;
+    EXPECT_NE(r.err.find("sylva: note: 10 more errors not shown\n"), std::string::npos) << cmd;
+  }
+  auto five = RunSylva({"check", "--max-errors", "5", path});
+  EXPECT_EQ(five.code, 2);
+  EXPECT_NE(five.err.find("sylva: note: 25 more errors not shown\n"), std::string::npos) << five.err;
+  auto all = RunSylva({"derive", "--max-errors", "0", path});
+  EXPECT_EQ(all.code, 2);
+  EXPECT_EQ(std::count(all.err.begin(), all.err.end(), '\n'), 30 * 3) << all.err;
+}
+
+TEST(BadInput, GrammarThatIsADeviceFifoOrDirectoryIsExitTwo) {
+  std::string fifo = (testing::Scratch() / "grammar.fifo").string();
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::string dir = testing::Scratch().string();
+  for (const std::string& p : {std::string("/dev/zero"), fifo, dir}) {
+    auto r = RunSylva({"derive", p});
+    EXPECT_EQ(r.code, 2) << p << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind(p + ": error: is ", 0), 0u) << r.err;
+  }
 }
 
 }  // namespace

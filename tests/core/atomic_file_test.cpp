@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -76,6 +80,72 @@ TEST(ReadFile, MissingFileNamesPath) {
   auto r = ReadFile("/no/such/file.lsys");
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().loc.file, "/no/such/file.lsys");
+}
+
+}  // namespace sylva
+
+namespace sylva {
+
+static Expected<std::string> ReadIn(const fs::path& p, size_t max = kDefaultMaxReadBytes) {
+  return ReadFile(p.string(), max);
+}
+
+TEST(ReadFile, ReadsRegularFilesAndLinksToThem) {
+  fs::path d = TempDir() / "read";
+  fs::create_directories(d);
+  std::ofstream(d / "a.txt", std::ios::binary) << "hello";
+  fs::remove(d / "link.txt");
+  fs::create_symlink(d / "a.txt", d / "link.txt");
+  auto a = ReadIn(d / "a.txt");
+  ASSERT_TRUE(a.ok()) << a.error().Format();
+  EXPECT_EQ(*a, "hello");
+  auto l = ReadIn(d / "link.txt");
+  ASSERT_TRUE(l.ok()) << l.error().Format();
+  EXPECT_EQ(*l, "hello");
+  // /proc files say they are empty and are not.
+  auto proc = ReadIn("/proc/self/status");
+  ASSERT_TRUE(proc.ok()) << proc.error().Format();
+  EXPECT_GT(proc->size(), 0u);
+}
+
+TEST(ReadFile, DevicesFifosAndDirectoriesAreErrorsWithoutBlocking) {
+  // /dev/zero used to end in bad_alloc and a FIFO blocked in open().
+  fs::path d = TempDir() / "special";
+  fs::create_directories(d);
+  fs::path fifo = d / "fifo";
+  fs::remove(fifo);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  fs::remove(d / "to_zero");
+  fs::create_symlink("/dev/zero", d / "to_zero");
+  for (const fs::path& p : {fs::path("/dev/zero"), fifo, d / "to_zero"}) {
+    auto r = ReadIn(p);
+    ASSERT_FALSE(r.ok()) << p;
+    EXPECT_EQ(r.error().message, "is not a regular file (a device, FIFO or socket)") << p;
+    EXPECT_EQ(r.error().loc.file, p.string());
+  }
+  auto dir = ReadIn(d);
+  ASSERT_FALSE(dir.ok());
+  EXPECT_EQ(dir.error().message, "is a directory, not a file");
+  auto missing = ReadIn(d / "missing");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("No such file"), std::string::npos)
+      << missing.error().message;
+}
+
+TEST(ReadFile, FilesLargerThanTheLimitAreErrors) {
+  fs::path d = TempDir() / "limit";
+  fs::create_directories(d);
+  std::ofstream(d / "ten.txt", std::ios::binary) << "0123456789";
+  auto ok = ReadIn(d / "ten.txt", 10);
+  ASSERT_TRUE(ok.ok()) << ok.error().Format();
+  EXPECT_EQ(ok->size(), 10u);
+  auto big = ReadIn(d / "ten.txt", 9);
+  ASSERT_FALSE(big.ok());
+  EXPECT_EQ(big.error().message, "file is larger than the limit of 9 bytes");
+  // A file that reports size 0 is still cut at the limit.
+  auto proc = ReadIn("/proc/self/maps", 16);
+  ASSERT_FALSE(proc.ok());
+  EXPECT_EQ(proc.error().message, "file is larger than the limit of 16 bytes");
 }
 
 }  // namespace sylva

@@ -145,7 +145,66 @@ TEST(Expr, DeepNestingIsAnErrorNotACrash) {
   deep += std::string(500, ')');
   Compiled c = Compile(deep);
   EXPECT_FALSE(c.ok);
-  EXPECT_EQ(c.error.message, "expression nested too deeply");
+  EXPECT_EQ(c.error.message, "expression nested deeper than 48");
+}
+
+std::string Chain(const std::string& term, const std::string& op, int n) {
+  std::string s = term;
+  for (int i = 1; i < n; ++i) s += op + term;
+  return s;
+}
+
+TEST(Expr, FlatOperatorChainsOf50000TermsCompileAndEvaluate) {
+  // Used to overflow the stack: the fold, the code emission and the tree's
+  // destructor recursed once per term.
+  Compiled folded = Compile(Chain("1", "+", 50000));
+  ASSERT_TRUE(folded.ok) << folded.error.message;
+  ASSERT_TRUE(folded.expr.IsConstant());
+  EXPECT_EQ(folded.expr.constant(), 50000);
+  EXPECT_EQ(Eval(Chain("x", "+", 50000), {0.5}, {"x"}), 25000);
+  EXPECT_EQ(Eval(Chain("x", "*", 50000), {1.0}, {"x"}), 1);
+  EXPECT_EQ(Eval(Chain("x > 0", " && ", 50000), {1.0}, {"x"}), 1);
+  EXPECT_EQ(Eval(Chain("x < 0", " || ", 50000), {1.0}, {"x"}), 0);
+  EXPECT_EQ(Eval(Chain("x", "-", 50001), {2.0}, {"x"}), -2.0 * 49999);
+}
+
+TEST(Expr, EveryKindOfNestingStopsAtTheLimitWithItsColumn) {
+  const int n = 100000;
+  std::string parens = std::string(n, '(') + "1" + std::string(n, ')');
+  std::string minus = Chain("-", " ", n) + " 1";
+  std::string nots = std::string(n, '!') + "1";
+  std::string power = Chain("2", "^", n);
+  std::string calls = Chain("sin(", "", n) + "1" + std::string(n, ')');
+  std::string ternary = Chain("1 ? 2 :", " ", n) + " 3";
+  for (const std::string* text : {&parens, &minus, &nots, &power, &calls, &ternary}) {
+    Compiled c = Compile(*text);
+    EXPECT_FALSE(c.ok) << text->substr(0, 20);
+    EXPECT_EQ(c.error.message, "expression nested deeper than 48") << text->substr(0, 20);
+    EXPECT_GT(c.error.column, 1) << text->substr(0, 20);
+    EXPECT_LT(c.error.column, 50 * 8) << text->substr(0, 20);
+  }
+  // 48 levels are fine.
+  EXPECT_EQ(Eval(std::string(47, '(') + "7" + std::string(47, ')')), 7);
+}
+
+TEST(Expr, UnexpectedByteIsShownInHex) {
+  // Was "\\x255" (decimal).
+  Compiled c = Compile("1 + \xff");
+  EXPECT_FALSE(c.ok);
+  EXPECT_EQ(c.error.message, "unexpected character '\\xff' in expression");
+  EXPECT_EQ(c.error.column, 5);
+}
+
+TEST(Expr, RunTimeErrorColumnsPast65535AreExact) {
+  // Columns were stored in 16 bits and clamped.
+  std::string text = std::string(70000, ' ') + "1 / x";
+  Compiled c = Compile(text, {"x"});
+  ASSERT_TRUE(c.ok) << c.error.message;
+  RandomStream rng{1, 0, 0, 0, 0};
+  double zero = 0, v;
+  EvalError e;
+  EXPECT_FALSE(c.expr.Eval(&zero, rng, &v, &e));
+  EXPECT_EQ(e.column, 70003) << e.message;
 }
 
 TEST(Expr, RandomFunctionsStayInRangeAndAreNotFolded) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -112,6 +113,70 @@ TEST(Stochastic, RandomParametersAreReproducibleAndInRange) {
     sum += r1.word.params[i];
   }
   EXPECT_NEAR(sum / 1024, 1.5, 0.03);
+}
+
+}  // namespace
+}  // namespace sylva::lsys
+
+namespace sylva::lsys {
+namespace {
+
+// 2^17 draws among 100 weighted productions of one predecessor; B(k) says
+// which one fired. weights[k - 1] is the weight of B(k).
+std::string HundredChoices(const std::vector<int>& weights) {
+  std::string g = "axiom: A(17)\nA(n) : n > 0 --> A(n-1)A(n-1)\n";
+  for (size_t k = 0; k < weights.size(); ++k) {
+    g += "A(n) : n == 0 --> B(" + std::to_string(k + 1) + ") : " + std::to_string(weights[k]) +
+         "\n";
+  }
+  return g;
+}
+
+std::vector<uint64_t> CountB(const Word& w, size_t n) {
+  std::vector<uint64_t> count(n + 1, 0);
+  for (size_t i = 0; i < w.size(); ++i) {
+    auto p = w.ParamsOf(i);
+    if (!p.empty()) count[size_t(p[0])]++;
+  }
+  return count;
+}
+
+TEST(Stochastic, HundredCandidatesTheLastCanFire) {
+  // Only the first 64 candidates used to be drawn from: B(100) never fired.
+  std::vector<int> weights(100, 0);
+  weights[99] = 1;
+  Grammar g = MustParse(HundredChoices(weights));
+  DeriveOptions opt;
+  opt.steps = 18;
+  auto r = MustDerive(g, opt);
+  ASSERT_EQ(r.word.size(), size_t(1) << 17);
+  EXPECT_EQ(CountB(r.word, 100)[100], uint64_t(1) << 17);
+}
+
+TEST(Stochastic, HundredCandidatesFollowTheirWeightsOnAnyThreadCount) {
+  std::vector<int> weights(100, 1);
+  weights[99] = 99;  // half of the draws
+  Grammar g = MustParse(HundredChoices(weights));
+  DeriveOptions opt;
+  opt.steps = 18;
+  opt.threads = 1;
+  auto one = MustDerive(g, opt);
+  const double n = double(size_t(1) << 17);
+  auto count = CountB(one.word, 100);
+  const double sigmaHalf = std::sqrt(n * 0.25);
+  EXPECT_NEAR(double(count[100]), n / 2, 5 * sigmaHalf) << "B(100) of " << n;
+  const double p = 1.0 / 198, sigma = std::sqrt(n * p * (1 - p));
+  for (size_t k = 1; k < 100; ++k) {
+    EXPECT_NEAR(double(count[k]), n * p, 6 * sigma) << "B(" << k << ")";
+  }
+  for (int threads : {2, 4}) {
+    opt.threads = threads;
+    auto r = MustDerive(g, opt);
+    ASSERT_EQ(r.word.params.size(), one.word.params.size()) << threads << " threads";
+    EXPECT_TRUE(std::equal(r.word.params.data(), r.word.params.data() + r.word.params.size(),
+                           one.word.params.data()))
+        << threads << " threads";
+  }
 }
 
 }  // namespace

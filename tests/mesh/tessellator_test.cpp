@@ -288,6 +288,16 @@ TEST(ObjReader, ErrorsNameLineAndColumn) {
   EXPECT_FALSE(ParseObj("# nothing\n", "e.obj").ok());
 }
 
+TEST(ObjReader, DevicesAndDirectoriesAreErrorsNotHangsOrCrashes) {
+  // ReadFile's checks: /dev/zero used to end in bad_alloc.
+  for (const char* p : {"/dev/zero", "/dev/null", "/tmp"}) {
+    auto m = ReadObj(p);
+    ASSERT_FALSE(m.ok()) << p;
+    EXPECT_EQ(m.error().loc.file, p);
+    EXPECT_EQ(m.error().message.rfind("is ", 0), 0u) << m.error().message;
+  }
+}
+
 TEST(ObjReader, BundledSurfacesAreValidMeshes) {
   for (const char* name : {"leaf", "petal", "flower"}) {
     auto m = ReadObj(std::string(SYLVA_SOURCE_DIR) + "/grammars/surfaces/" + name + ".obj");
