@@ -61,3 +61,15 @@ cat "$work/view.err"
 grep -q "tree.lsys:2:16: error: unknown name 'nope' in expression" "$work/view.err"
 kill -0 "$viewer"   # still running, with the last good plant
 echo "viewer reported the error and kept running"
+
+# Hostile edits: a 50,000-term operator chain with an error at its end (the
+# chain overflowed the stack), a word past the module limit. Each is reported; the viewer keeps running.
+python3 -c "print('axiom: F(' + '+'.join(['1'] * 50000) + '+nope)')" > "$work/next.lsys"; mv "$work/next.lsys" "$work/tree.lsys"
+for _ in $(seq 100); do [[ $(grep -c "the grammar has errors" "$work/view.err") -ge 2 ]] && break; sleep 0.1; done
+kill -0 "$viewer"
+grep -q "tree.lsys:1:100010: error: unknown name 'nope'" "$work/view.err" || { tail -c 2000 "$work/view.err"; exit 1; }
+printf 'derivation length: 60\naxiom: F\nF --> FF\n' > "$work/next.lsys"; mv "$work/next.lsys" "$work/tree.lsys"
+for _ in $(seq 300); do [[ $(grep -c "the grammar has errors" "$work/view.err") -ge 3 ]] && break; sleep 0.1; done
+kill -0 "$viewer"
+grep -q "more than the limit" "$work/view.err" || { tail -c 2000 "$work/view.err"; exit 1; }
+echo "viewer survived hostile edits"
