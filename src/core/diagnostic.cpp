@@ -100,6 +100,20 @@ Window KeepAround(std::string_view line, size_t caret) {
   return {begin, end};
 }
 
+// Messages quote user text (a name, a number); a quote of a megabyte-long
+// token keeps its two ends.
+constexpr size_t kMaxMessageBytes = 480;
+
+std::string_view ShortMessage(std::string_view m, std::string* buffer) {
+  if (m.size() <= kMaxMessageBytes) return m;
+  const size_t half = kMaxMessageBytes / 2;
+  size_t a = half, b = m.size() - half;
+  while (a > 0 && (m[a] & 0xC0) == 0x80) --a;
+  while (b < m.size() && (m[b] & 0xC0) == 0x80) ++b;
+  *buffer = std::string(m.substr(0, a)) + "..." + std::string(m.substr(b));
+  return *buffer;
+}
+
 const char* SeverityName(Severity s) {
   switch (s) {
     case Severity::kNote: return "note";
@@ -133,7 +147,8 @@ std::string Diagnostic::Format() const {
   out += ": ";
   out += SeverityName(severity);
   out += ": ";
-  out += Printable(message);
+  std::string shortened;
+  out += Printable(ShortMessage(message, &shortened));
   out += '\n';
   if (loc.line <= 0 || sourceLine.empty()) return out;
 
@@ -195,6 +210,8 @@ Diagnostic MakeError(SourceLoc loc, std::string message, int length, std::string
   d.severity = Severity::kError;
   d.loc = std::move(loc);
   d.length = length < 1 ? 1 : length;
+  std::string shortened;
+  if (ShortMessage(message, &shortened).size() < message.size()) message = std::move(shortened);
   d.message = std::move(message);
   SetExcerpt(d, sourceLine);
   return d;

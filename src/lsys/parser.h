@@ -2,8 +2,9 @@
 // line-oriented cpfg syntax of ../docs/grammar.md.
 //
 // Every problem is reported as a Diagnostic with file:line:col; parsing goes
-// on after an error to report more (up to kMaxErrors), and a grammar is
-// returned only when there is no error. Warnings: a production that can
+// on after an error to report more (the first kMaxErrors are kept, the
+// rest counted in DiagnosticList::droppedErrors), and a grammar is returned
+// only when there is no error. Warnings: a production that can
 // never match, a constant never used, a module name used with two different
 // parameter counts, a condition that is always false.
 #pragma once

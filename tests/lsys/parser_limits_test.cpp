@@ -113,6 +113,19 @@ TEST(ParserLimits, ParsingALongLineAllocatesInProportionToIt) {
   EXPECT_EQ(r.grammar->SourceLine(p.loc), "A --> " + succ);
 }
 
+TEST(ParserLimits, MessagesQuotingAHugeTokenStaySmall) {
+  // "malformed number '<the whole token>'" used to quote a megabyte.
+  for (const std::string& token : {std::string(1000000, '7') + "x", "q" + std::string(1000000, 'z')}) {
+    ParseResult r = ParseGrammarText("axiom: F(" + token + ")\n", "token.lsys");
+    ASSERT_EQ(r.diagnostics.ErrorCount(), 1u);
+    const Diagnostic& d = r.diagnostics.items[0];
+    EXPECT_LT(d.message.size(), 600u) << d.message.substr(0, 40);
+    EXPECT_LT(d.Format().size(), 1000u) << d.message.substr(0, 40);
+    EXPECT_NE(d.message.find("..."), std::string::npos) << d.message;
+    EXPECT_TRUE(d.message.rfind("'", d.message.size()) > d.message.size() - 20) << "keeps the end: " << d.message;
+  }
+}
+
 TEST(ParserLimits, RunTimeErrorsQuoteTheLineOfTheProduction) {
   Grammar g = testing::MustParse("axiom: A(0)\nA(x) --> F(1 / x)\n");
   DeriveOptions opt;
