@@ -75,29 +75,33 @@ Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string
   const std::string mtlName = p.stem().string() + ".mtl";
   const std::string mtlPath = (p.parent_path() / mtlName).string();
 
-  AtomicFile mtl;
-  if (Status s = mtl.Open(mtlPath); !s.ok()) return s;
-  std::string text = "# Sylva materials\n";
-  for (uint16_t mat : groups.materials) {
-    // Kd in sRGB: the values a `palette:` entry was written with.
-    Vec3f c = ToSrgb(PaletteColor(palette, mat));
-    text += "newmtl color" + std::to_string(mat) + "\nKd ";
-    Num(text, c.x());
-    text += ' ';
-    Num(text, c.y());
-    text += ' ';
-    Num(text, c.z());
-    text += "\nKa 0 0 0\nKs 0 0 0\nd 1\nillum 1\n\n";
-  }
-  if (Status s = mtl.Write(text); !s.ok()) return s;
-
   AtomicFile obj;
   if (Status s = obj.Open(path); !s.ok()) return s;
+  // Written to a device or FIFO (/dev/stdout): no .mtl beside it.
+  const bool withMtl = !obj.direct();
+  AtomicFile mtl;
+  if (withMtl) {
+    if (Status s = mtl.Open(mtlPath); !s.ok()) return s;
+    std::string text = "# Sylva materials\n";
+    for (uint16_t mat : groups.materials) {
+      // Kd in sRGB: the values a `palette:` entry was written with.
+      Vec3f c = ToSrgb(PaletteColor(palette, mat));
+      text += "newmtl color" + std::to_string(mat) + "\nKd ";
+      Num(text, c.x());
+      text += ' ';
+      Num(text, c.y());
+      text += ' ';
+      Num(text, c.z());
+      text += "\nKa 0 0 0\nKs 0 0 0\nd 1\nillum 1\n\n";
+    }
+    if (Status s = mtl.Write(text); !s.ok()) return s;
+  }
   static constexpr size_t kFlush = 1 << 20;
   std::string out;
   out.reserve(kFlush + 256);
   out = "# Sylva mesh: " + std::to_string(m.vertexCount()) + " vertices, " +
-        std::to_string(m.triangleCount()) + " triangles\nmtllib " + mtlName + "\n";
+        std::to_string(m.triangleCount()) + " triangles\n" +
+        (withMtl ? "mtllib " + mtlName + "\n" : std::string());
   auto flush = [&](bool force) -> Status {
     if (out.size() < kFlush && !force) return {};
     Status s = obj.Write(out);
@@ -118,9 +122,11 @@ Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string
     return {};
   };
   static_assert(sizeof(Vec3f) == 3 * sizeof(float) && sizeof(Vec2f) == 2 * sizeof(float));
-  if (Status s = attribute("v", m.positions.data()->data(), m.vertexCount(), 3); !s.ok()) return s;
-  if (Status s = attribute("vn", m.normals.data()->data(), m.vertexCount(), 3); !s.ok()) return s;
-  if (Status s = attribute("vt", m.uvs.data()->data(), m.vertexCount(), 2); !s.ok()) return s;
+  // Through float pointers: data() of an empty array is null (no ->data()).
+  auto floats = [](const auto& v) { return reinterpret_cast<const float*>(v.data()); };
+  if (Status s = attribute("v", floats(m.positions), m.vertexCount(), 3); !s.ok()) return s;
+  if (Status s = attribute("vn", floats(m.normals), m.vertexCount(), 3); !s.ok()) return s;
+  if (Status s = attribute("vt", floats(m.uvs), m.vertexCount(), 2); !s.ok()) return s;
   for (size_t k = 0; k < groups.materials.size(); ++k) {
     out += "usemtl color" + std::to_string(groups.materials[k]) + "\n";
     for (uint32_t o = groups.starts[k]; o < groups.starts[k + 1]; ++o) {
@@ -140,7 +146,16 @@ Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string
     }
   }
   if (Status s = flush(true); !s.ok()) return s;
-  if (Status s = mtl.Commit(); !s.ok()) return s;
+  // Both files complete (every write and flush checked) before either is
+  // renamed: the two renames back to back are the only window in which a
+  // crash could leave a new .mtl beside an old .obj.
+  if (withMtl) {
+    if (Status s = mtl.Finish(); !s.ok()) return s;
+  }
+  if (Status s = obj.Finish(); !s.ok()) return s;
+  if (withMtl) {
+    if (Status s = mtl.Commit(); !s.ok()) return s;
+  }
   return obj.Commit();
 }
 

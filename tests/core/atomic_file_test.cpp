@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <thread>
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -146,6 +148,113 @@ TEST(ReadFile, FilesLargerThanTheLimitAreErrors) {
   auto proc = ReadIn("/proc/self/maps", 16);
   ASSERT_FALSE(proc.ok());
   EXPECT_EQ(proc.error().message, "file is larger than the limit of 16 bytes");
+}
+
+}  // namespace sylva
+
+namespace sylva {
+
+static std::string Slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(f), {});
+}
+
+TEST(AtomicFile, SymlinkTargetStaysALinkAndItsFileGetsTheData) {
+  fs::path d = TempDir() / "symlink";
+  fs::remove_all(d);
+  fs::create_directories(d / "real");
+  std::ofstream(d / "real" / "data.txt") << "old";
+  fs::create_symlink("real/data.txt", d / "link.txt");
+  AtomicFile f;
+  ASSERT_TRUE(f.Open((d / "link.txt").string()).ok());
+  ASSERT_TRUE(f.Write("new").ok());
+  ASSERT_TRUE(f.Commit().ok());
+  EXPECT_TRUE(fs::is_symlink(d / "link.txt")) << "the link was replaced by a file";
+  EXPECT_EQ(Slurp(d / "real" / "data.txt"), "new");
+  EXPECT_EQ(CountEntries(d / "real"), 1) << "temporary file left beside the link's target";
+  // A dangling link names the file to create.
+  fs::create_symlink("real/fresh.txt", d / "dangling.txt");
+  ASSERT_TRUE(f.Open((d / "dangling.txt").string()).ok());
+  ASSERT_TRUE(f.Write("made").ok());
+  ASSERT_TRUE(f.Commit().ok());
+  EXPECT_TRUE(fs::is_symlink(d / "dangling.txt"));
+  EXPECT_EQ(Slurp(d / "real" / "fresh.txt"), "made");
+}
+
+TEST(AtomicFile, FifoIsWrittenThroughNeverReplaced) {
+  fs::path d = TempDir() / "fifo";
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const std::string fifo = (d / "pipe").string();
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::string got;
+  std::thread reader([&] { got = Slurp(fifo); });
+  AtomicFile f;
+  ASSERT_TRUE(f.Open(fifo).ok());
+  EXPECT_TRUE(f.direct());
+  ASSERT_TRUE(f.Write("through the pipe").ok());
+  ASSERT_TRUE(f.Commit().ok());
+  reader.join();
+  EXPECT_EQ(got, "through the pipe");
+  struct stat st;
+  ASSERT_EQ(lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode)) << "the FIFO was replaced; mode " << std::oct << st.st_mode;
+  EXPECT_EQ(CountEntries(d), 1);
+}
+
+TEST(AtomicFile, DeviceIsWrittenThroughAndAFullDeviceIsAnError) {
+  // /dev/null stays a character device; /dev/full fails at the flush.
+  AtomicFile f;
+  ASSERT_TRUE(f.Open("/dev/null").ok());
+  ASSERT_TRUE(f.Write("discarded").ok());
+  ASSERT_TRUE(f.Commit().ok());
+  struct stat st;
+  ASSERT_EQ(stat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << "mode " << std::oct << st.st_mode;
+  if (access("/dev/full", W_OK) == 0) {
+    ASSERT_TRUE(f.Open("/dev/full").ok());
+    (void)f.Write("no room");
+    Status s = f.Commit();
+    ASSERT_FALSE(s.ok()) << "a write to /dev/full reported success";
+    EXPECT_EQ(s.error().kind, ErrorKind::kRuntime);
+  }
+}
+
+TEST(AtomicFile, DirectoryTargetIsAnErrorAndStaysADirectory) {
+  fs::path d = TempDir() / "dir_target";
+  fs::create_directories(d);
+  AtomicFile f;
+  Status s = f.Open(d.string());
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("directory"), std::string::npos) << s.error().message;
+  EXPECT_TRUE(fs::is_directory(d));
+}
+
+TEST(AtomicFile, NewFilesHonourTheUmaskAndExistingFilesKeepTheirMode) {
+  fs::path d = TempDir() / "modes";
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const mode_t old = umask(027);
+  AtomicFile f;
+  ASSERT_TRUE(f.Open((d / "new.txt").string()).ok());
+  ASSERT_TRUE(f.Commit().ok());
+  umask(old);
+  struct stat st;
+  ASSERT_EQ(stat((d / "new.txt").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0640u) << "mode " << std::oct << (st.st_mode & 0777);
+  ASSERT_EQ(chmod((d / "new.txt").c_str(), 0600), 0);
+  ASSERT_TRUE(f.Open((d / "new.txt").string()).ok());
+  ASSERT_TRUE(f.Write("again").ok());
+  ASSERT_TRUE(f.Commit().ok());
+  ASSERT_EQ(stat((d / "new.txt").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u) << "mode " << std::oct << (st.st_mode & 0777);
+}
+
+TEST(AtomicFile, NameTooLongIsAnErrorNotAnException) {
+  AtomicFile f;
+  Status s = f.Open((TempDir() / std::string(300, 'x')).string() + ".txt");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("too long"), std::string::npos) << s.error().message;
 }
 
 }  // namespace sylva
