@@ -72,7 +72,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   RenderCommand render;
   CLI::App* re = app.add_subcommand("render", "derive a grammar and render it to a PNG, headless");
   AddDeriveFlags(re, render.derive);
-  re->add_option("-o,--output", render.output, "image file (.png)")->required();
+  re->add_option("-o,--output", render.output, "image file (.png, .jpg or .jpeg)")->required();
   re->add_option("--size", render.size, "image size WxH (default 960x540)");
   re->add_option("--camera", render.camera,
                  "azimuth,elevation,distance in degrees and units (distance 0: frame the plant)");
@@ -82,7 +82,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   ViewCommand view;
   CLI::App* vi = app.add_subcommand("view", "open the interactive viewer (reloads the file when it changes)");
   vi->add_option("file", view.file, "grammar file (.lsys); default: a bundled ABOP tree");
-  vi->add_option("--screenshot", view.screenshot, "save this PNG after --frames frames and quit");
+  vi->add_option("--screenshot", view.screenshot, "save this picture (.png, .jpg) after --frames frames and quit");
   vi->add_option("--frames", view.frames, "frames to draw before the screenshot")->check(CLI::Range(1, 1000000));
   vi->add_option("--size", view.size, "window size WxH (default 1280x720)");
 
@@ -107,15 +107,34 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     err << "run 'sylva --help' for usage\n";
     return kExitBadInput;
   }
-  if (d->parsed()) return RunDerive(derive, out, err);
-  if (c->parsed()) return RunCheck(check, out, err);
-  if (me->parsed()) return RunMesh(mesh, out, err);
-  if (re->parsed()) return RunRender(render, out, err);
-  if (vi->parsed()) {
-    if (!view.screenshot.empty() && view.frames == 0) view.frames = 3;
-    return RunView(view, out, err);
+  // The command boundary: nothing escapes as an exception (memory
+  // exhaustion in a library, a file system error), and output that could
+  // not be written is an error, not exit 0.
+  int code = kExitBadInput;
+  try {
+    if (d->parsed()) code = RunDerive(derive, out, err);
+    if (c->parsed()) code = RunCheck(check, out, err);
+    if (me->parsed()) code = RunMesh(mesh, out, err);
+    if (re->parsed()) code = RunRender(render, out, err);
+    if (vi->parsed()) {
+      if (!view.screenshot.empty() && view.frames == 0) view.frames = 3;
+      code = RunView(view, out, err);
+    }
+  } catch (const std::bad_alloc&) {
+    err << "sylva: error: out of memory; lower the derivation length (-n), the detail or the limits\n";
+    code = kExitRuntime;
+  } catch (const std::exception& e) {
+    err << "sylva: error: " << e.what() << "\n";
+    code = kExitRuntime;
   }
-  return kExitBadInput;
+  out.flush();
+  if (!out) {
+    err << "sylva: error: cannot write to standard output\n";
+    if (code == kExitOk) code = kExitRuntime;
+  }
+  err.flush();
+  if (!err && code == kExitOk) code = kExitRuntime;
+  return code;
 }
 
 }  // namespace sylva::app

@@ -27,6 +27,10 @@ static bool ParseCamera(const std::string& s, double v[3]) {
 }
 
 int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
+  if (!render::IsImagePath(cmd.output)) {
+    err << "sylva: error: " << cmd.output << ": unknown image format; use .png, .jpg or .jpeg\n";
+    return kExitBadInput;
+  }
   int width = 0, height = 0;
   if (!ParseSize(cmd.size, &width, &height)) {
     err << "sylva: error: --size '" << cmd.size << "': expected WxH from 1x1 to 8192x8192\n";
@@ -104,7 +108,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   }
   (*renderer)->Draw(camera);
   const render::Image image = (*renderer)->ReadPixels();
-  if (Status s = render::WritePng(image, cmd.output); !s.ok()) return Report(s.error(), err);
+  if (Status s = render::WriteImage(image, cmd.output); !s.ok()) return Report(s.error(), err);
   char line[256];
   std::snprintf(line, sizeof line, "%s: %dx%d, %s, %zu triangles, %zu lines (%s)\n", cmd.output.c_str(),
                 width, height, lines ? "lines, orthographic" : "mesh, perspective", m.triangleCount(),

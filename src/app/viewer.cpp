@@ -306,6 +306,10 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       return kExitBadInput;
     }
   }
+  if (!cmd.screenshot.empty() && !render::IsImagePath(cmd.screenshot)) {
+    err << "sylva: error: " << cmd.screenshot << ": unknown image format; use .png, .jpg or .jpeg\n";
+    return kExitBadInput;
+  }
   const std::string path = cmd.file.empty() ? DefaultGrammar() : cmd.file;
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) {
@@ -393,7 +397,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     if (key || done) {
       std::string file = done ? cmd.screenshot : "sylva-screenshot-" + std::to_string(++shots) + ".png";
       if (!file.empty()) {
-        if (Status s = render::WritePng(render::ReadWindowPixels(fbw, fbh), file); !s.ok()) {
+        if (Status s = render::WriteImage(render::ReadWindowPixels(fbw, fbh), file); !s.ok()) {
           exitCode = Report(s.error(), err);
         } else {
           out << "screenshot: " << file << "\n";

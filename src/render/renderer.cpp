@@ -21,8 +21,8 @@ std::string FindShaderDir() {
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
     for (fs::path dir = exe.parent_path(); !dir.empty(); dir = dir.parent_path()) {
-      if (fs::is_regular_file(dir / "shaders" / "mesh.vert")) return (dir / "shaders").string();
-      if (fs::is_regular_file(dir / "share" / "sylva" / "shaders" / "mesh.vert"))
+      if (fs::is_regular_file(dir / "shaders" / "mesh.vert", ec)) return (dir / "shaders").string();
+      if (fs::is_regular_file(dir / "share" / "sylva" / "shaders" / "mesh.vert", ec))
         return (dir / "share" / "sylva" / "shaders").string();
       if (dir == dir.root_path()) break;
     }
@@ -446,24 +446,58 @@ Image ReadWindowPixels(int width, int height) {
   return ReadBound(width, height);
 }
 
-Status WritePng(const Image& image, const std::string& path) {
-  std::string png;
+namespace {
+
+std::string LowerExtension(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  const size_t dot = path.rfind('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+Status EncodeAndWrite(const Image& image, const std::string& path, bool jpeg) {
+  std::string bytes;
   auto append = [](void* context, void* data, int size) {
     static_cast<std::string*>(context)->append(static_cast<const char*>(data), size_t(size));
   };
-  if (!stbi_write_png_to_func(append, &png, image.width, image.height, 4, image.rgba.data(),
-                              image.width * 4)) {
+  const int ok = jpeg ? stbi_write_jpg_to_func(append, &bytes, image.width, image.height, 4,
+                                               image.rgba.data(), 95)
+                      : stbi_write_png_to_func(append, &bytes, image.width, image.height, 4,
+                                               image.rgba.data(), image.width * 4);
+  if (!ok) {
     Diagnostic d;
     d.kind = ErrorKind::kRuntime;
     d.loc.file = path;
-    d.message = "PNG encoding failed";
+    d.message = jpeg ? "JPEG encoding failed" : "PNG encoding failed";
     return d;
   }
   AtomicFile f;
   Status s = f.Open(path);
-  if (s.ok()) s = f.Write(png);
+  if (s.ok()) s = f.Write(bytes);
   if (s.ok()) s = f.Commit();
   return s;
+}
+
+}  // namespace
+
+Status WritePng(const Image& image, const std::string& path) { return EncodeAndWrite(image, path, false); }
+
+bool IsImagePath(const std::string& path) {
+  const std::string ext = LowerExtension(path);
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+}
+
+Status WriteImage(const Image& image, const std::string& path) {
+  if (!IsImagePath(path)) {
+    Diagnostic d;
+    d.loc.file = path;
+    d.message = "unknown image format; use .png, .jpg or .jpeg";
+    return d;
+  }
+  const std::string ext = LowerExtension(path);
+  return EncodeAndWrite(image, path, ext != ".png");
 }
 
 }  // namespace sylva::render

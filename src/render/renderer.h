@@ -97,5 +97,10 @@ Image ReadWindowPixels(int width, int height);
 
 // Writes an RGBA image as PNG (stb_image_write), atomically.
 Status WritePng(const Image& image, const std::string& path);
+// Writes PNG (.png) or JPEG (.jpg, .jpeg; quality 95) by the file name's
+// extension, case-insensitive; any other extension is an input error.
+Status WriteImage(const Image& image, const std::string& path);
+// True when WriteImage knows the file name's extension.
+bool IsImagePath(const std::string& path);
 
 }  // namespace sylva::render
