@@ -39,7 +39,7 @@ void BM_Tessellate(benchmark::State& state, const char* name, int steps) {
   mesh::TriangleMesh m;
   for (auto _ : state) {
     m.Clear();
-    mesh::Tessellate(g, opt, m);
+    (void)mesh::Tessellate(g, opt, m);
     benchmark::DoNotOptimize(m.indices.data());
   }
   state.SetItemsProcessed(int64_t(m.triangleCount()) * state.iterations());
@@ -54,7 +54,7 @@ void BM_Write(benchmark::State& state, const char* ext) {
   mesh::PlantGeometry g = Geometry("fig2_06a_monopodial", 15);
   mesh::TriangleMesh m;
   mesh::TessellateOptions opt;
-  mesh::Tessellate(g, opt, m);
+  (void)mesh::Tessellate(g, opt, m);
   const std::string path = (std::filesystem::temp_directory_path() / (std::string("sylva_bench.") + ext)).string();
   size_t bytes = 0;
   for (auto _ : state) {

@@ -33,6 +33,13 @@ static void AddMaxErrorsFlag(CLI::App* cmd, DeriveFlags& f) {
       ->check(CLI::Range(0, 1000000));
 }
 
+static void AddMaxTrianglesFlag(CLI::App* cmd, DeriveFlags& f) {
+  cmd->add_option("--max-triangles", f.maxTriangles,
+                  "stop with an error, before meshing, when the mesh would have more triangles "
+                  "(default 67108864, about 2 GiB)")
+      ->check(CLI::Range(uint64_t(1), uint64_t(1) << 32));
+}
+
 static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
   cmd->add_option("file", f.file, "grammar file (.lsys)")->required();
   cmd->add_option("-n,--steps", f.steps, "derivation steps (default: the grammar's)")
@@ -66,6 +73,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   AddDeriveFlags(me, mesh.derive);
   me->add_option("-o,--output", mesh.output, "mesh file: .obj (+ .mtl), .ply, .glb or .gltf")
       ->required();
+  AddMaxTrianglesFlag(me, mesh.derive);
   me->add_option("--sides", mesh.sides, "vertices around each branch tube (3-256, default 8)")
       ->check(CLI::Range(3, 256));
 
@@ -76,6 +84,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   re->add_option("--size", render.size, "image size WxH (default 960x540)");
   re->add_option("--camera", render.camera,
                  "azimuth,elevation,distance in degrees and units (distance 0: frame the plant)");
+  AddMaxTrianglesFlag(re, render.derive);
   re->add_option("--sides", render.sides, "vertices around each branch tube (3-256, default 12)")
       ->check(CLI::Range(3, 256));
 

@@ -49,6 +49,7 @@ std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err
   spec.seed = f.seed;
   spec.threads = f.threads;
   if (f.maxModules) spec.limits.maxModules = f.maxModules;
+  if (f.maxTriangles) spec.limits.maxTriangles = f.maxTriangles;
   return spec;
 }
 

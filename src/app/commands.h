@@ -21,6 +21,7 @@ struct DeriveFlags {
   std::vector<std::string> defines;  // NAME=VALUE
   int threads = 0;
   uint64_t maxModules = 0;  // 0: the library default
+  uint64_t maxTriangles = 0;  // mesh and render only; 0: the library default
   int maxErrors = 20;       // errors (and warnings) printed; 0: all
 };
 

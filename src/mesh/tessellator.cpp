@@ -10,6 +10,9 @@ namespace sylva::mesh {
 namespace {
 
 constexpr double kTwoPi = 6.283185307179586476925;
+// Indices are 32-bit: a mesh keeps well under 2^32 vertices (a triangle
+// adds at most 3).
+constexpr uint64_t kMaxIndexedTriangles = (uint64_t(1) << 32) / 3 - 1;
 
 Vec3f F(const Vec3& v) { return v.cast<float>(); }
 
@@ -258,14 +261,18 @@ std::vector<uint32_t> TriangulatePolygon(const std::vector<Vec3>& in, Vec3* norm
   return tris;
 }
 
-std::string Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
-                       TessellateStats* stats) {
+Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
+                  TessellateStats* stats) {
   auto detailFor = [&](const Vec3& c, double r) {
     return ClampSides(options.detailFn ? options.detailFn(c, r).sides : options.detail.sides);
   };
   // Surfaces first: an unknown name fails before anything is appended.
   for (const SurfaceInstance& si : g.surfaces) {
-    if (!options.surfaces || !options.surfaces->count(si.name)) return "unknown surface '" + si.name + "'";
+    if (!options.surfaces || !options.surfaces->count(si.name)) {
+      Diagnostic d;
+      d.message = "unknown surface '" + si.name + "'";
+      return d;
+    }
   }
   const auto chains = BuildChains(g);
   // Choose every chain's detail first, so the arrays are sized exactly once.
@@ -285,6 +292,26 @@ std::string Tessellate(const PlantGeometry& g, const TessellateOptions& options,
     chainSides[c] = S;
     verts += (chain.size() + 1) * size_t(S + 1) + 2 * size_t(S + 1);
     tris += TubeTriangles(chain.size(), S);
+  }
+  // Everything else counted too, before any memory is allocated: spheres
+  // (S(2R - 2) triangles, R = max(2, S/2) rings), polygons (n - 2 at most),
+  // surfaces (their mesh each).
+  uint64_t total = tris;
+  for (const Sphere& s : g.spheres) {
+    if (!(s.radius > 0)) continue;
+    const uint64_t S = uint64_t(detailFor(s.center, s.radius)), R = std::max<uint64_t>(2, S / 2);
+    total += S * (2 * R - 2);
+  }
+  for (const Polygon& poly : g.polygons) total += poly.vertices.size() >= 3 ? poly.vertices.size() - 2 : 0;
+  for (const SurfaceInstance& si : g.surfaces) total += options.surfaces->at(si.name).triangleCount();
+  const uint64_t limit = std::min<uint64_t>(options.maxTriangles, kMaxIndexedTriangles);
+  if (out.triangleCount() + total > limit) {
+    Diagnostic d;
+    d.kind = ErrorKind::kRuntime;
+    d.message = "the mesh would have " + std::to_string(out.triangleCount() + total) +
+                " triangles, more than the limit of " + std::to_string(limit) +
+                "; lower the derivation length (-n) or the sides (--sides), or raise --max-triangles";
+    return d;
   }
   auto grow = [](auto& v, size_t extra) {
     using T = typename std::decay_t<decltype(v)>::value_type;

@@ -27,6 +27,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "core/status.h"
 #include "mesh/plant_geometry.h"
 #include "mesh/triangle_mesh.h"
 
@@ -46,9 +47,16 @@ constexpr size_t TubeTriangles(size_t segments, int sides) {
   return 2 * size_t(sides) * segments + 2 * size_t(sides);
 }
 
+// 2^26 triangles: about 2 GiB of mesh (a triangle costs about 30 bytes:
+// 12 of indices, 2 of material, and half a vertex of 32 bytes).
+inline constexpr uint64_t kDefaultMaxTriangles = uint64_t(1) << 26;
+
 struct TessellateOptions {
   Detail detail;     // used when detailFn is empty
   DetailFn detailFn;
+  // The mesh this call appends may not exceed this many triangles; the
+  // count is made before any memory is allocated.
+  uint64_t maxTriangles = kDefaultMaxTriangles;
   // Surfaces by name (without `~`), already loaded; unknown names are an error.
   const std::unordered_map<std::string, TriangleMesh>* surfaces = nullptr;
 };
@@ -58,10 +66,12 @@ struct TessellateStats {
   std::vector<std::string> warnings;
 };
 
-// Appends the triangles of `g` to `out`. Fails only on a surface name that
-// `options.surfaces` does not have (the message names it).
-std::string Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
-                       TessellateStats* stats = nullptr);
+// Appends the triangles of `g` to `out`. Fails, before appending anything,
+// on a surface name that `options.surfaces` does not have (an input error
+// naming it) and on a mesh larger than options.maxTriangles (a run-time
+// error with the count).
+Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
+                  TessellateStats* stats = nullptr);
 
 // Ear clipping of a simple polygon (any orientation, concave allowed) in 3D.
 // Returns triangles as index triples into `vertices`; empty when the polygon

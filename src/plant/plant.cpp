@@ -58,6 +58,14 @@ Diagnostic SpecError(const std::string& message) {
   return d;
 }
 
+// The turtle is bounded with the mesh: a drawn segment becomes at least a
+// few triangles, so a word may draw at most a quarter of maxTriangles.
+turtle::DrawOptions DrawOptionsOf(const PlantSpec& spec) {
+  turtle::DrawOptions o = spec.draw;
+  o.maxPrimitives = std::max<uint64_t>(1, spec.limits.maxTriangles / 4);
+  return o;
+}
+
 lsys::DeriveOptions DeriveOptionsOf(const PlantSpec& spec) {
   lsys::DeriveOptions o;
   o.seed = spec.seed;
@@ -81,6 +89,7 @@ DiagnosticList Validate(const PlantSpec& spec) {
   if (spec.detail.sides < 3 || spec.detail.sides > 256) {
     list.Add(SpecError("sides " + std::to_string(spec.detail.sides) + " is outside 3..256"));
   }
+  if (spec.limits.maxTriangles < 1) list.Add(SpecError("max triangles 0 is outside 1.."));
   if (spec.limits.maxModules < 1 || spec.limits.maxModules > lsys::kMaxModulesCap) {
     list.Add(SpecError("max modules " + std::to_string(spec.limits.maxModules) +
                        " is outside 1.." + std::to_string(lsys::kMaxModulesCap)));
@@ -107,13 +116,20 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
   mesh::TessellateOptions options;
   options.detail = spec.detail;
   options.surfaces = &surfaces.meshes();
+  options.maxTriangles = spec.limits.maxTriangles;
   mesh::TessellateStats stats;
   plant.mesh = mesh::TriangleMesh();
-  if (std::string problem = mesh::Tessellate(plant.geometry, options, plant.mesh, &stats);
-      !problem.empty()) {
-    Diagnostic d = SpecError(problem);
+  if (Status s = mesh::Tessellate(plant.geometry, options, plant.mesh, &stats); !s.ok()) {
+    Diagnostic d = s.error();
     d.loc.file = plant.grammar.path;
     return d;
+  }
+  if (plant.mesh.triangleCount() == 0) {
+    Diagnostic d;
+    d.severity = Severity::kWarning;
+    d.loc.file = plant.grammar.path;
+    d.message = "the plant draws nothing: the mesh is empty";
+    diagnostics.Add(std::move(d));
   }
   AddWarnings(stats.warnings, plant.grammar.path, diagnostics);
   WarnAboutPixelWidths(plant.grammar, plant.geometry, diagnostics);
@@ -187,7 +203,7 @@ Expected<mesh::PlantGeometry> Grower::Draw(DiagnosticList* warnings) const {
     interpreted = std::move(*w);
   }
   auto geometry = turtle::Interpret(interpreted ? *interpreted : word(), g.symbols,
-                                    turtle::TurtleDefFrom(g), spec_.draw);
+                                    turtle::TurtleDefFrom(g), DrawOptionsOf(spec_));
   if (geometry && warnings) AddWarnings(geometry->warnings, g.path, *warnings);
   return geometry;
 }
@@ -220,9 +236,11 @@ PlantResult Grower::Finish() && {
   if (spec_.until >= Stage::kGeometry) {
     const auto t0 = Clock::now();
     auto geometry =
-        turtle::Interpret(p.DrawnWord(), g.symbols, turtle::TurtleDefFrom(g), spec_.draw);
+        turtle::Interpret(p.DrawnWord(), g.symbols, turtle::TurtleDefFrom(g), DrawOptionsOf(spec_));
     if (!geometry) {
-      r.diagnostics.Add(geometry.error());
+      Diagnostic d = geometry.error();
+      if (d.loc.file.empty()) d.loc.file = g.path;
+      r.diagnostics.Add(std::move(d));
       return r;
     }
     p.geometry = std::move(*geometry);
@@ -245,7 +263,9 @@ PlantResult BuildPlant(const PlantSpec& spec) {
   if (!grower) return PlantResult{std::nullopt, std::move(diagnostics)};
   while (!grower->done()) {
     if (Status s = grower->Step(); !s.ok()) {
-      diagnostics.Add(s.error());
+      Diagnostic d = s.error();
+      if (d.loc.file.empty()) d.loc.file = grower->grammar().path;
+      diagnostics.Add(std::move(d));
       return PlantResult{std::nullopt, std::move(diagnostics)};
     }
   }

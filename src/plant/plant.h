@@ -54,6 +54,10 @@ struct Limits {
   // The derived word (and every interpretation pass) stops with an error
   // past this many modules. 2^28 modules: 512 MiB of symbols.
   uint64_t maxModules = lsys::kDefaultMaxModules;
+  // The mesh stops with an error, before it is allocated, past this many
+  // triangles (2^26: about 2 GiB), and the turtle past a quarter as many
+  // drawn primitives (2^24 segments: 1.75 GiB).
+  uint64_t maxTriangles = mesh::kDefaultMaxTriangles;
 };
 
 // Reads a file's text (the grammar, #include, surfaces); nullopt when it

@@ -182,6 +182,15 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
       spheres += op == Op::kSphere;
       surfaces += op == Op::kSurface;
     }
+    if (draws + spheres + surfaces > options.maxPrimitives) {
+      Diagnostic d;
+      d.kind = ErrorKind::kRuntime;
+      d.message = "the word draws " + std::to_string(draws + spheres + surfaces) +
+                  " primitives (segments, polygon vertices, spheres, surfaces), more than the "
+                  "limit of " + std::to_string(options.maxPrimitives) +
+                  "; lower the derivation length (-n) or raise --max-triangles";
+      return d;
+    }
     if (g.segments.capacity() < draws) {
       g.segments = std::vector<Segment>();
       g.segments.reserve(draws);

@@ -51,6 +51,10 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g);
 
 struct DrawOptions {
   bool recordModules = false;  // fill PlantGeometry::modulePosition / moduleFrame
+  // The word may draw at most this many primitives (segments and polygon
+  // vertices, spheres, surfaces); counted before anything is allocated. A
+  // segment takes 112 bytes: 2^24 of them, 1.75 GiB.
+  uint64_t maxPrimitives = uint64_t(1) << 24;
 };
 
 // Interprets `word` (already through the interpretation rules). Errors: an

@@ -27,7 +27,7 @@ TriangleMesh Mesh(const PlantGeometry& g, int sides = 8) {
   TriangleMesh m;
   TessellateOptions opt;
   opt.detail.sides = sides;
-  EXPECT_EQ(Tessellate(g, opt, m), "");
+  EXPECT_TRUE(Tessellate(g, opt, m).ok());
   return m;
 }
 
@@ -185,7 +185,7 @@ TEST(Tessellator, DetailIsChosenPerPrimitive) {
   TessellateOptions opt;
   opt.detailFn = [](const Vec3& c, double) { return Detail{c.norm() > 5 ? 4 : 12}; };
   TriangleMesh m;
-  ASSERT_EQ(Tessellate(g, opt, m), "");
+  ASSERT_TRUE(Tessellate(g, opt, m).ok());
   EXPECT_EQ(m.triangleCount(), TubeTriangles(1, 12) + TubeTriangles(1, 4));
 }
 
@@ -217,7 +217,7 @@ TEST(Tessellator, DegeneratePolygonsAreSkippedWithAWarning) {
   g.polygons.push_back(flat);
   TriangleMesh m;
   TessellateStats stats;
-  ASSERT_EQ(Tessellate(g, {}, m, &stats), "");
+  ASSERT_TRUE(Tessellate(g, {}, m, &stats).ok());
   EXPECT_EQ(m.triangleCount(), 0u);
   ASSERT_EQ(stats.warnings.size(), 1u);
   EXPECT_EQ(stats.warnings[0], "polygon at module 5 is degenerate; skipped");
@@ -244,7 +244,9 @@ TEST(Tessellator, SpheresAreClosedAndRound) {
 TEST(Tessellator, UnknownSurfaceIsAnError) {
   PlantGeometry g = Draw("axiom: F~nope\n");
   TriangleMesh m;
-  EXPECT_EQ(Tessellate(g, {}, m), "unknown surface 'nope'");
+  Status s = Tessellate(g, {}, m);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.error().message, "unknown surface 'nope'");
   EXPECT_EQ(m.triangleCount(), 0u);
 }
 
@@ -319,7 +321,7 @@ TEST(Tessellator, SurfacesArePlacedByTheTurtleFrameAndScaled) {
   TessellateOptions opt;
   opt.surfaces = &lib;
   TriangleMesh m;
-  ASSERT_EQ(Tessellate(g, opt, m), "");
+  ASSERT_TRUE(Tessellate(g, opt, m).ok());
   // After F+ the turtle is at (0,1,0) with H = (-1,0,0), L = (0,-1,0), U = (0,0,-1):
   // local x -> L, y -> H, z -> U, scaled by 2.
   const size_t n = m.vertexCount();

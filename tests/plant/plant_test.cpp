@@ -238,3 +238,48 @@ TEST(Plant, PixelWidthsWithoutWidthScaleGetAWarningNamingTheFix) {
 
 }  // namespace
 }  // namespace sylva::plant
+
+namespace sylva::plant {
+namespace {
+
+// F --> FF at n=25 made 33 M segments and aborted at 3.3 GB in meshing.
+TEST(Plant, MeshAndTurtleAreBoundedBeforeTheyAllocate) {
+  PlantSpec spec;
+  spec.path = "ff.lsys";
+  spec.text = "axiom: F\nF --> FF\n";
+  spec.steps = 25;
+  PlantResult r = BuildPlant(spec);
+  ASSERT_FALSE(r.plant);
+  std::string all = r.diagnostics.FormatAll();
+  EXPECT_NE(all.find("ff.lsys: error: the word draws 33554432 primitives"), std::string::npos) << all;
+  EXPECT_EQ(r.diagnostics.items.back().kind, ErrorKind::kRuntime);
+
+  spec.steps = 10;  // 1024 segments at 8 sides: 16,400 triangles
+  spec.limits.maxTriangles = 10000;
+  r = BuildPlant(spec);
+  ASSERT_FALSE(r.plant);
+  all = r.diagnostics.FormatAll();
+  EXPECT_NE(all.find("the mesh would have 16400 triangles, more than the limit of 10000"),
+            std::string::npos)
+      << all;
+  spec.limits.maxTriangles = 16400;
+  r = BuildPlant(spec);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
+  EXPECT_EQ(r.plant->mesh.triangleCount(), 16400u);
+}
+
+TEST(Plant, AnEmptyMeshIsAWarningNotSilence) {
+  auto p = sylva::testing::PlantFromText("axiom: f\n", -1, Stage::kGeometry);
+  ASSERT_TRUE(p);
+  PlantSpec spec;
+  spec.path = "empty.lsys";
+  spec.text = "axiom: f\n";
+  PlantResult r = BuildPlant(spec);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
+  EXPECT_EQ(r.plant->mesh.triangleCount(), 0u);
+  EXPECT_NE(r.diagnostics.FormatAll().find("warning: the plant draws nothing"), std::string::npos)
+      << r.diagnostics.FormatAll();
+}
+
+}  // namespace
+}  // namespace sylva::plant
