@@ -220,6 +220,13 @@ Status WritePly(const TriangleMesh& m, const Palette& palette, const std::string
 }
 
 Status WriteMesh(const TriangleMesh& m, const Palette& palette, const std::string& path) {
+  // The last defence: never write a file with a NaN or infinity in it.
+  if (std::string bad = FindNonFinite(m); !bad.empty()) {
+    Diagnostic d;
+    d.loc.file = path;
+    d.message = "not written: " + bad;
+    return d;
+  }
   auto format = FormatFromPath(path);
   if (!format) {
     Diagnostic d;

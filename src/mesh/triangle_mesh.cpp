@@ -32,6 +32,19 @@ std::pair<uint16_t, uint16_t> TriangleMesh::MaterialRange() const {
   return {lo, hi};
 }
 
+std::string FindNonFinite(const TriangleMesh& m) {
+  // allFinite() is false for NaN and infinity in any component.
+  auto bad = [&](const auto& array, const char* what) -> std::string {
+    for (size_t i = 0; i < array.size(); ++i) {
+      if (!array[i].allFinite()) return std::string(what) + " of vertex " + std::to_string(i) + " is not finite";
+    }
+    return {};
+  };
+  if (std::string s = bad(m.positions, "the position"); !s.empty()) return s;
+  if (std::string s = bad(m.normals, "the normal"); !s.empty()) return s;
+  return bad(m.uvs, "the texture coordinate");
+}
+
 std::string Validate(const TriangleMesh& m, float areaEpsilon) {
   const size_t n = m.positions.size();
   if (m.normals.size() != n || m.uvs.size() != n) return "attribute arrays differ in size";

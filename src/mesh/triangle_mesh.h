@@ -30,6 +30,11 @@ struct TriangleMesh {
   std::pair<uint16_t, uint16_t> MaterialRange() const;
 };
 
+// The first vertex whose position, normal or UV has a component that is not
+// a finite number (NaN in any of x, y, z counts), described; empty if none.
+// The exporters refuse such a mesh: no file with NaN in it is ever written.
+std::string FindNonFinite(const TriangleMesh& m);
+
 // Checks the invariants every mesh Sylva makes must hold: indices in range,
 // finite values, unit normals, no zero-area triangle, array sizes agree.
 // Returns a description of the first violation, or an empty string.

@@ -161,6 +161,53 @@ Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTabl
   return g;
 }
 
+// Module i as written: its name and parameters (%g), for error messages.
+static std::string ModuleText(const lsys::Word& word, const lsys::SymbolTable& symbols, size_t i) {
+  std::string text = symbols.name(word.symbols[i]);
+  const auto params = word.ParamsOf(i);
+  for (size_t k = 0; k < params.size(); ++k) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", params[k]);
+    text += (k ? "," : "(") + std::string(buf);
+  }
+  if (!params.empty()) text += ")";
+  return text;
+}
+
+// Every number the tessellator and the exporters will see must be finite
+// and small enough that float arithmetic on it stays finite (squared
+// lengths included): each component of every point, every radius and
+// scale. NaN is caught in any component (no max(|x|), which drops NaN).
+static Status CheckRange(const PlantGeometry& g, const lsys::Word& word, const lsys::SymbolTable& symbols) {
+  auto ok = [](double v) { return v >= -kMaxCoordinate && v <= kMaxCoordinate; };  // false for NaN
+  auto okPoint = [&](const Vec3& p) { return ok(p.x()) && ok(p.y()) && ok(p.z()); };
+  auto fail = [&](uint32_t module, const char* what) -> Status {
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", kMaxCoordinate);
+    std::string where = module < word.size() ? "module " + std::to_string(module + 1) + " (" +
+                                                   ModuleText(word, symbols, module) + ")"
+                                             : "a module";
+    return MakeError({}, where + " gives " + what + " that is not a finite number within +-" +
+                             limit + " units");
+  };
+  for (const Segment& sg : g.segments) {
+    if (!okPoint(sg.start) || !okPoint(sg.end)) return fail(sg.module, "a segment end");
+    if (!ok(sg.radiusStart) || !ok(sg.radiusEnd)) return fail(sg.module, "a segment width");
+  }
+  for (const Polygon& poly : g.polygons) {
+    for (const Vec3& v : poly.vertices) {
+      if (!okPoint(v)) return fail(poly.module, "a polygon vertex");
+    }
+  }
+  for (const Sphere& sp : g.spheres) {
+    if (!okPoint(sp.center) || !ok(sp.radius)) return fail(sp.module, "a sphere");
+  }
+  for (const SurfaceInstance& si : g.surfaces) {
+    if (!okPoint(si.position) || !ok(si.scale)) return fail(si.module, "a surface placement");
+  }
+  return {};
+}
+
 Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
                      const TurtleDef& def, const DrawOptions& options, PlantGeometry& g) {
   std::vector<Op> ops(symbols.size());
@@ -393,9 +440,9 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
     g.warnings.push_back("polygon opened at module " + std::to_string(poly.module + 1) +
                          " is never closed; skipped");
   }
-  if (!std::isfinite(lo.x() + lo.y() + lo.z() + hi.x() + hi.y() + hi.z())) {
+  if (Status s = CheckRange(g, word, symbols); !s.ok()) {
     g = PlantGeometry();
-    return MakeError({}, "the turtle moved to a position that is not a finite number");
+    return s;
   }
   g.boundsMin = lo;
   g.boundsMax = hi;

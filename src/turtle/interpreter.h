@@ -57,8 +57,13 @@ struct DrawOptions {
   uint64_t maxPrimitives = uint64_t(1) << 24;
 };
 
+// Coordinates, widths and scales the turtle may produce: beyond this, float
+// meshes lose all precision and squared lengths overflow.
+inline constexpr double kMaxCoordinate = 1e15;
+
 // Interprets `word` (already through the interpretation rules). Errors: an
-// unmatched `]` or `}`, a polygon left open, a non-finite position.
+// unmatched `]` or `}`, a polygon left open, and any coordinate, width or
+// scale that is not finite or beyond +-kMaxCoordinate (naming the module).
 Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTable& symbols,
                                   const TurtleDef& def, const DrawOptions& options = {});
 

@@ -2,12 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <filesystem>
 #include <functional>
+#include <limits>
 #include <map>
 #include <set>
 #include <unordered_map>
 
 #include "core/atomic_file.h"
+#include "mesh/export.h"
 #include "plant/plant_test_util.h"
 
 namespace sylva::mesh {
@@ -330,6 +334,31 @@ TEST(Tessellator, SurfacesArePlacedByTheTurtleFrameAndScaled) {
   EXPECT_LT((m.positions[n - 1] - Vec3f(-2, 1, 0)).norm(), 1e-6f);
   EXPECT_LT((m.normals[n - 1] - Vec3f(0, 0, -1)).norm(), 1e-6f);
   EXPECT_EQ(m.material.back(), 1);
+}
+
+}  // namespace
+}  // namespace sylva::mesh
+
+namespace sylva::mesh {
+namespace {
+
+TEST(Export, AMeshWithANonFiniteNumberIsNeverWritten) {
+  TriangleMesh m;
+  m.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
+  m.normals = {Vec3f(0, 0, 1), Vec3f(0, std::nanf(""), 1), Vec3f(0, 0, 1)};  // NaN in y
+  m.uvs = {Vec2f(0, 0), Vec2f(1, 0), Vec2f(0, 1)};
+  m.indices = {0, 1, 2};
+  m.material = {0};
+  EXPECT_EQ(FindNonFinite(m), "the normal of vertex 1 is not finite");
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("sylva_nan_" + std::to_string(::getpid()) + ".glb")).string();
+  Status s = WriteMesh(m, DefaultPalette(), path);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("not finite"), std::string::npos) << s.error().message;
+  EXPECT_FALSE(std::filesystem::exists(path));
+  m.normals[1] = Vec3f(0, 0, 1);
+  m.positions[2].z() = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(FindNonFinite(m), "the position of vertex 2 is not finite");
 }
 
 }  // namespace

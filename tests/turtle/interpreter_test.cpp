@@ -258,3 +258,39 @@ TEST(Turtle, TropismMatchesTheExactRotationOverManySteps) {
 
 }  // namespace
 }  // namespace sylva::turtle
+
+namespace sylva::turtle {
+namespace {
+
+// `!(1e300)F` and friends were written to glTF with exit 0 (109 validator
+// errors). Every number that reaches the mesh is checked, and the error
+// names the module.
+TEST(Turtle, OutOfRangeGeometryIsAnErrorNamingTheModule) {
+  struct Case {
+    const char* axiom;
+    const char* want;
+  };
+  const Case cases[] = {
+      {"!(1e300)F", "module 2 (F) gives a segment width"},
+      {"F(1e308)F(1e308)", "module 1 (F(1e+308)) gives a segment end"},
+      {"F(1)+(90)F(1e16)", "module 3 (F(1e+16)) gives a segment end"},
+      {"~leaf(1e300)", "module 1 (~leaf(1e+300)) gives a surface placement"},
+      {"@O(1e300)", "module 1 (@O(1e+300)) gives a sphere"},
+      {"F(1e10){.F(1e16).F(1)}", "module 2 ({) gives a polygon vertex"},
+      {"&(90)F(1e16)", "module 2 (F(1e+16)) gives a segment end"},  // the bad component is z
+  };
+  for (const Case& c : cases) {
+    auto p = testing::PlantFromText(std::string("axiom: ") + c.axiom + "\n", -1, plant::Stage::kInterpreted);
+    ASSERT_TRUE(p);
+    auto g = Interpret(p->DrawnWord(), p->grammar.symbols, TurtleDefFrom(p->grammar));
+    ASSERT_FALSE(g.ok()) << c.axiom << " was accepted";
+    EXPECT_NE(g.error().message.find(c.want), std::string::npos)
+        << c.axiom << ": " << g.error().message;
+  }
+  // Large but representable is fine.
+  auto p = testing::PlantFromText("axiom: F(1e14)!(1e10)F\n", -1, plant::Stage::kGeometry);
+  EXPECT_TRUE(p);
+}
+
+}  // namespace
+}  // namespace sylva::turtle
