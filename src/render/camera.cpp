@@ -48,8 +48,16 @@ Mat4 Camera::Projection(double aspect) const {
   return p;
 }
 
-Camera Camera::Frame(const Vec3& lo, const Vec3& hi, double aspect, double azimuth,
+Camera Camera::Frame(const Vec3& loIn, const Vec3& hiIn, double aspect, double azimuth,
                      double elevation, bool orthographic) {
+  // Components within +-1e30 (so the products below stay finite); the
+  // comparisons are false for NaN in any component.
+  auto within = [](const Vec3& v) { return (v.array().abs() <= 1e30).all(); };
+  const bool box = within(loIn) && within(hiIn) && (hiIn - loIn).minCoeff() >= 0;
+  const Vec3 lo = box ? loIn : Vec3(0, 0, 0), hi = box ? hiIn : Vec3(1, 1, 1);
+  if (!(std::isfinite(aspect) && aspect > 0)) aspect = 1;
+  if (!std::isfinite(azimuth)) azimuth = 0;
+  if (!std::isfinite(elevation)) elevation = 0;
   Camera c;
   c.azimuth = azimuth;
   c.elevation = elevation;

@@ -26,6 +26,11 @@ struct Camera {
   Mat4 ViewProjection(double aspect) const { return Projection(aspect) * View(); }
 
   // A camera at the given angles that frames the box [lo, hi] with a margin.
+  // Always a usable camera: a box with a non-finite, inverted or huge
+  // (beyond +-1e30) component
+  // (NaN hides in y and z too) is framed as the unit box at the origin, a
+  // non-finite angle as 0 and a non-positive or non-finite aspect as 1.
+  // Callers frame meshes the exporters would accept, so this is a guard.
   static Camera Frame(const Vec3& lo, const Vec3& hi, double aspect, double azimuth,
                       double elevation, bool orthographic);
 };

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
@@ -303,6 +305,33 @@ TEST(RenderCli, MidGreyPaletteEntryIsSrgbInThePngAndLinearInGltf) {
   ASSERT_NE(kd, std::string::npos) << *mtl;
   EXPECT_NEAR(std::strtod(mtl->c_str() + kd + 3, nullptr), 128.0 / 255, 1e-5) << *mtl;
   fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace sylva::render
+
+namespace sylva::render {
+namespace {
+
+TEST(Camera, FramingNonFiniteBoundsGivesAFiniteCamera) {
+  const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
+  const std::pair<Vec3, Vec3> boxes[] = {
+      {Vec3(0, nan, 0), Vec3(1, 1, 1)},  // NaN in y
+      {Vec3(0, 0, 0), Vec3(1, 1, nan)},  // NaN in z
+      {Vec3(-inf, 0, 0), Vec3(1, 1, 1)},
+      {Vec3(2, 2, 2), Vec3(1, 1, 1)},    // inverted
+      {Vec3(-1e300, 0, 0), Vec3(1e300, 1, 1)},  // its extent overflows
+  };
+  for (bool ortho : {false, true}) {
+    for (const auto& [lo, hi] : boxes) {
+      Camera c = Camera::Frame(lo, hi, 16.0 / 9, 30, 12, ortho);
+      const Mat4 vp = c.ViewProjection(16.0 / 9);
+      EXPECT_TRUE(vp.allFinite()) << "lo " << lo.transpose() << " hi " << hi.transpose() << " ortho " << ortho;
+      EXPECT_TRUE(c.Eye().allFinite()) << "lo " << lo.transpose() << " hi " << hi.transpose();
+    }
+  }
+  Camera c = Camera::Frame(Vec3(0, 0, 0), Vec3(1, 1, 1), nan, nan, inf, false);
+  EXPECT_TRUE(c.ViewProjection(1).allFinite());
 }
 
 }  // namespace
