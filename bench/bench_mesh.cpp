@@ -4,6 +4,7 @@
 //   interpret, tessellate at 8 sides, write .glb) in under 2 s.
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -91,6 +92,37 @@ void BM_EndToEndMillionSegments(benchmark::State& state) {
   std::filesystem::remove(path);
 }
 BENCHMARK(BM_EndToEndMillionSegments)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// Ear clipping of concave outlines (issue 14: a 130,000-vertex polygon took
+// over two minutes). Spirals: a band along an Archimedean spiral, nearly
+// every inner vertex reflex. Items: vertices.
+std::vector<Vec3> SpiralOutline(size_t n) {
+  const size_t m = n / 2;
+  const double turns = 3, pi = 3.14159265358979323846;
+  std::vector<Vec3> v;
+  for (size_t i = 0; i < m; ++i) {
+    const double t = turns * 2 * pi * double(i) / double(m - 1);
+    v.emplace_back((3 + t) * std::cos(t), (3 + t) * std::sin(t), 0);
+  }
+  for (size_t i = m; i-- > 0;) {
+    const double t = turns * 2 * pi * double(i) / double(m - 1);
+    v.emplace_back((0.5 + t) * std::cos(t), (0.5 + t) * std::sin(t), 0);
+  }
+  return v;
+}
+
+void BM_TriangulateSpiral(benchmark::State& state) {
+  const std::vector<Vec3> v = SpiralOutline(size_t(state.range(0)));
+  size_t tris = 0;
+  for (auto _ : state) {
+    Vec3 n;
+    tris = mesh::TriangulatePolygon(v, &n).size() / 3;
+    benchmark::DoNotOptimize(tris);
+  }
+  if (tris != v.size() - 2) state.SkipWithError("wrong triangle count");
+  state.SetItemsProcessed(int64_t(v.size()) * state.iterations());
+}
+BENCHMARK(BM_TriangulateSpiral)->Arg(1000)->Arg(10000)->Arg(130000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

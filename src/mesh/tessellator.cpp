@@ -195,72 +195,6 @@ void TessellateSphere(const Sphere& s, int sides, TriangleMesh& out) {
 
 }  // namespace
 
-std::vector<uint32_t> TriangulatePolygon(const std::vector<Vec3>& in, Vec3* normalOut) {
-  std::vector<uint32_t> tris;
-  const size_t n = in.size();
-  if (n < 3) return tris;
-  // Newell's normal: robust for non-planar and concave outlines.
-  Vec3 normal = Vec3::Zero();
-  for (size_t i = 0; i < n; ++i) {
-    const Vec3& a = in[i];
-    const Vec3& b = in[(i + 1) % n];
-    normal += Vec3((a.y() - b.y()) * (a.z() + b.z()), (a.z() - b.z()) * (a.x() + b.x()),
-                   (a.x() - b.x()) * (a.y() + b.y()));
-  }
-  const double area2 = normal.norm();
-  double scale = 0;
-  for (const Vec3& v : in) scale = std::max(scale, (v - in[0]).norm());
-  if (!(area2 > 1e-12 * scale * scale) || !std::isfinite(area2)) return tris;
-  normal /= area2;
-  if (normalOut) *normalOut = normal;
-  const Vec3 e1 = AnyPerpendicular(normal), e2 = normal.cross(e1);
-  std::vector<Vec2> p(n);
-  for (size_t i = 0; i < n; ++i) p[i] = Vec2((in[i] - in[0]).dot(e1), (in[i] - in[0]).dot(e2));
-  auto cross = [](const Vec2& a, const Vec2& b, const Vec2& c) {
-    return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
-  };
-  const double eps = 1e-12 * scale * scale;
-  std::vector<uint32_t> idx(n);
-  for (size_t i = 0; i < n; ++i) idx[i] = uint32_t(i);
-  while (idx.size() > 3) {
-    bool clipped = false;
-    const size_t k = idx.size();
-    for (size_t i = 0; i < k; ++i) {
-      const uint32_t a = idx[(i + k - 1) % k], b = idx[i], c = idx[(i + 1) % k];
-      if (cross(p[a], p[b], p[c]) <= eps) continue;  // reflex or flat
-      bool inside = false;
-      for (uint32_t q : idx) {
-        if (q == a || q == b || q == c) continue;
-        if (cross(p[a], p[b], p[q]) >= 0 && cross(p[b], p[c], p[q]) >= 0 &&
-            cross(p[c], p[a], p[q]) >= 0) {
-          inside = true;
-          break;
-        }
-      }
-      if (inside) continue;
-      tris.insert(tris.end(), {a, b, c});
-      idx.erase(idx.begin() + long(i));
-      clipped = true;
-      break;
-    }
-    if (!clipped) {
-      // Collinear or self-intersecting remainder: drop a flat vertex, or stop.
-      bool dropped = false;
-      for (size_t i = 0; i < idx.size() && !dropped; ++i) {
-        const size_t kk = idx.size();
-        if (std::abs(cross(p[idx[(i + kk - 1) % kk]], p[idx[i]], p[idx[(i + 1) % kk]])) <= eps) {
-          idx.erase(idx.begin() + long(i));
-          dropped = true;
-        }
-      }
-      if (!dropped) break;
-    }
-  }
-  if (idx.size() == 3 && cross(p[idx[0]], p[idx[1]], p[idx[2]]) > eps)
-    tris.insert(tris.end(), {idx[0], idx[1], idx[2]});
-  return tris;
-}
-
 Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
                   TessellateStats* stats) {
   auto detailFor = [&](const Vec3& c, double r) {
@@ -341,7 +275,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
       if (stats) {
         ++stats->polygonsSkipped;
         stats->warnings.push_back("polygon at module " + std::to_string(poly.module + 1) +
-                                  " is degenerate; skipped");
+                                  " is degenerate, crosses itself or is too complex to triangulate; skipped");
       }
       continue;
     }

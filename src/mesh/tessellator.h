@@ -30,6 +30,7 @@
 #include "core/status.h"
 #include "mesh/plant_geometry.h"
 #include "mesh/triangle_mesh.h"
+#include "mesh/triangulate.h"
 
 namespace sylva::mesh {
 
@@ -73,9 +74,6 @@ struct TessellateStats {
 Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
                   TessellateStats* stats = nullptr);
 
-// Ear clipping of a simple polygon (any orientation, concave allowed) in 3D.
-// Returns triangles as index triples into `vertices`; empty when the polygon
-// is degenerate (fewer than 3 distinct vertices or zero area).
-std::vector<uint32_t> TriangulatePolygon(const std::vector<Vec3>& vertices, Vec3* normalOut);
+
 
 }  // namespace sylva::mesh

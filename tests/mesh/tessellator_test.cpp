@@ -224,7 +224,8 @@ TEST(Tessellator, DegeneratePolygonsAreSkippedWithAWarning) {
   ASSERT_TRUE(Tessellate(g, {}, m, &stats).ok());
   EXPECT_EQ(m.triangleCount(), 0u);
   ASSERT_EQ(stats.warnings.size(), 1u);
-  EXPECT_EQ(stats.warnings[0], "polygon at module 5 is degenerate; skipped");
+  EXPECT_EQ(stats.warnings[0],
+            "polygon at module 5 is degenerate, crosses itself or is too complex to triangulate; skipped");
 }
 
 TEST(Tessellator, LeafPolygonsOfTheBush) {
