@@ -5,6 +5,11 @@
 
 #include "app/commands.h"
 #include "app/viewer.h"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include "lsys/deriver.h"
 
 namespace sylva::app {
@@ -55,7 +60,40 @@ static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
   AddMaxErrorsFlag(cmd, f);
 }
 
-int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+static int NotBuilt(const char* command, std::ostream& err) {
+  err << "sylva: error: this sylva was built without the " << command
+      << " command (SYLVA_BUILD_RENDER / SYLVA_BUILD_VIEWER off)\n";
+  return kExitBadInput;
+}
+
+// Replaces this process with sylva-graphics running the same arguments.
+// Returns only on failure.
+static int ExecGraphics(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  std::string self(4096, '\0');
+  const ssize_t n = readlink("/proc/self/exe", self.data(), self.size() - 1);
+  self.resize(n > 0 ? size_t(n) : 0);
+  const std::string dir = self.substr(0, self.rfind('/') == std::string::npos ? 0 : self.rfind('/'));
+  const std::string candidates[] = {dir + "/sylva-graphics", dir + "/../libexec/sylva/sylva-graphics"};
+  for (const std::string& path : candidates) {
+    if (access(path.c_str(), X_OK) != 0) continue;
+    std::vector<char*> argv;
+    argv.push_back(const_cast<char*>(path.c_str()));
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    out.flush();
+    err.flush();
+    execv(path.c_str(), argv.data());
+    err << "sylva: error: cannot run " << path << ": " << std::strerror(errno) << "\n";
+    return kExitRuntime;
+  }
+  err << "sylva: error: the drawing commands are not installed: no sylva-graphics beside "
+      << (self.empty() ? std::string("sylva") : self)
+      << " (or this sylva was built without them: SYLVA_BUILD_RENDER off)\n";
+  return kExitBadInput;
+}
+
+int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err,
+           const GraphicsCommands* graphics) {
   CLI::App app{"Sylva: L-system grammars and particle systems", "sylva"};
   app.require_subcommand(1, 1);
   app.set_version_flag("--version", "sylva 0.1.0");
@@ -124,10 +162,13 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (d->parsed()) code = RunDerive(derive, out, err);
     if (c->parsed()) code = RunCheck(check, out, err);
     if (me->parsed()) code = RunMesh(mesh, out, err);
-    if (re->parsed()) code = RunRender(render, out, err);
-    if (vi->parsed()) {
+    if (re->parsed() || vi->parsed()) {
       if (!view.screenshot.empty() && view.frames == 0) view.frames = 3;
-      code = RunView(view, out, err);
+      const GraphicsCommands none;
+      const GraphicsCommands& g = graphics ? *graphics : none;
+      if (g.execGraphicsBinary) return ExecGraphics(args, out, err);
+      if (re->parsed()) code = g.render ? g.render(render, out, err) : NotBuilt("render", err);
+      if (vi->parsed()) code = g.view ? g.view(view, out, err) : NotBuilt("view", err);
     }
   } catch (const std::bad_alloc&) {
     err << "sylva: error: out of memory; lower the derivation length (-n), the detail or the limits\n";

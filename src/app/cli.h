@@ -14,6 +14,26 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitRuntime = 1;
 inline constexpr int kExitBadInput = 2;
 
-int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+struct RenderCommand;
+struct ViewCommand;
+
+// The commands that draw (render, view) need OpenGL, EGL, X11 and GLFW.
+// The `sylva` executable links none of them, so `sylva derive` starts as
+// fast as a program can: for a command that draws it replaces itself
+// (exec) with `sylva-graphics`, found beside it (or in
+// ../libexec/sylva/ when installed), which links everything and passes
+// these runners. Tests that draw call RunCliWithGraphics (graphics.h).
+struct GraphicsCommands {
+  int (*render)(const RenderCommand&, std::ostream& out, std::ostream& err) = nullptr;
+  int (*view)(const ViewCommand&, std::ostream& out, std::ostream& err) = nullptr;
+  // Only the `sylva` executable sets this: render and view exec
+  // `sylva-graphics` with the same arguments (never in a test process).
+  bool execGraphicsBinary = false;
+};
+
+// `graphics` null or without a runner: render and view are an error saying
+// this build lacks them.
+int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err,
+           const GraphicsCommands* graphics = nullptr);
 
 }  // namespace sylva::app

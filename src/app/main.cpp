@@ -10,5 +10,8 @@ int main(int argc, char** argv) {
   // Ctrl-C or a kill while writing leaves no temporary files behind.
   sylva::InstallTemporaryFileCleanup();
   std::vector<std::string> args(argv + 1, argv + argc);
-  return sylva::app::RunCli(args, std::cout, std::cerr);
+  // render and view run in sylva-graphics, so this binary loads no GL.
+  sylva::app::GraphicsCommands exec;
+  exec.execGraphicsBinary = true;
+  return sylva::app::RunCli(args, std::cout, std::cerr, &exec);
 }

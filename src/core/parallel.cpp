@@ -30,8 +30,7 @@ int ThreadPool::HardwareThreads() {
 
 ThreadPool::ThreadPool(int threads) {
   if (threads <= 0) threads = HardwareThreads();
-  threads = std::min(threads, 256);
-  for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { WorkerLoop(); });
+  threads_ = std::min(threads, 256);
 }
 
 ThreadPool::~ThreadPool() {
@@ -86,9 +85,12 @@ void ThreadPool::WorkerLoop() {
 
 void ThreadPool::ParallelFor(size_t n, const std::function<void(size_t)>& fn) {
   if (n == 0) return;
-  if (workers_.empty() || n == 1) {
+  if (threads_ == 1 || n == 1) {
     for (size_t i = 0; i < n; ++i) fn(i);
     return;
+  }
+  if (workers_.empty()) {
+    for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { WorkerLoop(); });
   }
   if (n >= std::numeric_limits<uint32_t>::max()) {  // the claim word holds 32-bit indices
     const size_t half = n / 2;

@@ -35,7 +35,7 @@ class ThreadPool {
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;
 
-  int threads() const { return int(workers_.size()) + 1; }
+  int threads() const { return threads_; }
   void ParallelFor(size_t n, const std::function<void(size_t)>& fn);
 
   static int HardwareThreads();
@@ -46,6 +46,10 @@ class ThreadPool {
   // moved on to a later call.
   void RunTasks(uint32_t gen);
 
+  // Workers start on the first call with work for more than one thread, so
+  // a pool that only ever sees small jobs (a short derivation) costs no
+  // thread creation.
+  int threads_ = 1;
   std::vector<std::thread> workers_;
   // The claim word: generation in the high 32 bits, next index in the low.
   alignas(64) std::atomic<uint64_t> claim_{0};

@@ -24,7 +24,7 @@ void FormatWord(const Word& w, const SymbolTable& table, Sink&& sink) {
   }
   std::string buf;
   if (allSingle && !w.HasParams()) {
-    buf.resize(kBlock);
+    buf.resize(std::min(kBlock, n));  // a short word clears no megabyte
     const SymbolId* sym = w.symbols.data();
     const char* lut = single.data();
     for (size_t i = 0; i < n; i += kBlock) {
@@ -35,7 +35,7 @@ void FormatWord(const Word& w, const SymbolTable& table, Sink&& sink) {
     }
     return;
   }
-  buf.reserve(kBlock + 4096);
+  buf.reserve(std::min(kBlock, 16 * n) + 4096);
   const bool hasParams = w.HasParams();
   for (size_t i = 0; i < n; ++i) {
     const SymbolId s = w.symbols[i];

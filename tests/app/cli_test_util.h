@@ -10,6 +10,9 @@
 #include <vector>
 
 #include "app/cli.h"
+#ifdef SYLVA_TESTS_WITH_GRAPHICS
+#include "app/graphics.h"
+#endif
 
 namespace sylva::app::testing {
 
@@ -21,7 +24,11 @@ struct CliResult {
 inline CliResult RunSylva(std::vector<std::string> args) {
   std::ostringstream out, err;
   CliResult r;
+#ifdef SYLVA_TESTS_WITH_GRAPHICS
+  r.code = RunCliWithGraphics(args, out, err);
+#else
   r.code = RunCli(args, out, err);
+#endif
   r.out = out.str();
   r.err = err.str();
   return r;

@@ -5,9 +5,9 @@
 #  3. SIGTERM while an output is being written leaves no temporary file;
 #  4. a 300-character file name is a message and exit 1 (not an abort);
 #  5. -o onto a symbolic link writes the file it points to; the link stays.
-# Usage: outputs_test.sh SYLVA_BINARY SOURCE_DIR WORK_DIR
+# Usage: outputs_test.sh SYLVA_BINARY SOURCE_DIR WORK_DIR [graphics|nographics]
 set -euo pipefail
-sylva="$1"; src="$2"; work="$3"
+sylva="$1"; src="$2"; work="$3"; graphics="${4:-graphics}"
 rm -rf "$work"; mkdir -p "$work"
 g="$src/grammars/abop/fig1_24a_bracketed_plant.lsys"
 fail() { echo "FAIL: $*"; exit 1; }
@@ -21,6 +21,7 @@ grep -q "cannot write to standard output" "$work/full.err" || fail "no message: 
 echo "ok: --stats > /dev/full is exit 1"
 
 # 2.
+if [[ $graphics == graphics ]]; then
 "$sylva" render "$g" -n 2 --size 64x48 -o "$work/plant.jpg" 2>/dev/null
 [[ $(head -c 2 "$work/plant.jpg" | od -An -tx1 | tr -d ' ') == ffd8 ]] || fail "plant.jpg is not a JPEG"
 set +e
@@ -30,6 +31,14 @@ set -e
 [[ ! -e "$work/plant.bmp" ]] || fail "plant.bmp was written"
 grep -q "unknown image format" "$work/bmp.err" || fail "no message: $(cat "$work/bmp.err")"
 echo "ok: .jpg is JPEG, .bmp is refused"
+else
+  set +e
+  "$sylva" render "$g" -o "$work/plant.png" 2>"$work/nographics.err"; code=$?
+  set -e
+  [[ $code == 2 ]] || fail "render without the renderer exited $code"
+  grep -q "not installed\|built without" "$work/nographics.err" || fail "no message: $(cat "$work/nographics.err")"
+  echo "ok: render in a build without the renderer is exit 2 with a message"
+fi
 
 # 3. A mesh large enough to take a while to write; the signal arrives while
 # its temporary file exists.

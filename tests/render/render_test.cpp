@@ -15,7 +15,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "app/cli.h"
+#include "app/graphics.h"
 #include "core/atomic_file.h"
 #include "plant/plant_test_util.h"
 #include "mesh/tessellator.h"
@@ -175,7 +175,7 @@ TEST(RenderShaders, MissingOrBrokenShaderNamesTheFile) {
 
 int RunCli(std::vector<std::string> args, std::string* err) {
   std::ostringstream o, e;
-  int code = app::RunCli(args, o, e);
+  int code = app::RunCliWithGraphics(args, o, e);
   *err = e.str();
   return code;
 }
