@@ -1,6 +1,9 @@
 #include "plant/surface_library.h"
 
 #include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdlib>
 
 #include <set>
 
@@ -8,7 +11,26 @@
 
 namespace sylva::plant {
 
-std::string BundledDataDir() { return SYLVA_DATA_DIR; }
+std::string BundledDataDir() {
+  // $SYLVA_DATA_DIR; else share/sylva beside an installed executable, or
+  // where `cmake --install` put it; else the source tree of this build.
+  if (const char* env = std::getenv("SYLVA_DATA_DIR"); env && *env) return env;
+  auto isDir = [](const std::string& p) {
+    struct stat st;
+    return ::stat(p.c_str(), &st) == 0 && S_ISDIR(st.st_mode);
+  };
+  char exe[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
+  if (n > 0) {
+    std::string dir(exe, size_t(n));
+    for (int up = 0; up < 3 && dir.rfind('/') != std::string::npos; ++up) {
+      dir = dir.substr(0, dir.rfind('/'));
+      if (isDir(dir + "/share/sylva/grammars")) return dir + "/share/sylva";
+    }
+  }
+  if (isDir(std::string(SYLVA_INSTALLED_DATA_DIR) + "/grammars")) return SYLVA_INSTALLED_DATA_DIR;
+  return SYLVA_DATA_DIR;
+}
 
 static std::string Join(const std::string& dir, const std::string& name) {
   if (dir.empty()) return name;

@@ -20,8 +20,9 @@
 
 namespace sylva::plant {
 
-// The folder of bundled data (grammars/surfaces, shaders): the source tree
-// in a build, or the installed share/sylva.
+// The folder of bundled data (grammars/surfaces, shaders): $SYLVA_DATA_DIR,
+// else share/sylva beside the executable (an installed `sylva`) or where
+// `cmake --install` put it, else the source tree of the build.
 std::string BundledDataDir();
 
 class SurfaceLibrary {
