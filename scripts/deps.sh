@@ -21,3 +21,13 @@ if ((${#missing[@]})); then
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
+
+# The Khronos glTF validator for the export tests, into tools/ (not
+# committed), once: the tests never download anything.
+root="$(cd "$(dirname "$0")/.." && pwd)"
+if [[ ! -d "$root/tools/node_modules/gltf-validator" ]]; then
+  mkdir -p "$root/tools"
+  (cd "$root/tools" && { [[ -f package.json ]] || npm init -y >/dev/null 2>&1; } &&
+    npm install gltf-validator@2.0.0-dev.3.10 --no-audit --no-fund >/dev/null 2>&1) ||
+    echo "warning: could not install the glTF validator (npm); the export test will fail"
+fi

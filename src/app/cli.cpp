@@ -87,8 +87,7 @@ static int ExecGraphics(const std::vector<std::string>& args, std::ostream& out,
     return kExitRuntime;
   }
   err << "sylva: error: the drawing commands are not installed: no sylva-graphics beside "
-      << (self.empty() ? std::string("sylva") : self)
-      << " (or this sylva was built without them: SYLVA_BUILD_RENDER off)\n";
+      << (self.empty() ? std::string("sylva") : self) << " or in ../libexec/sylva\n";
   return kExitBadInput;
 }
 

@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   // render and view run in sylva-graphics, so this binary loads no GL.
   sylva::app::GraphicsCommands exec;
+#ifdef SYLVA_HAS_GRAPHICS
   exec.execGraphicsBinary = true;
+#endif
   return sylva::app::RunCli(args, std::cout, std::cerr, &exec);
 }

@@ -10,10 +10,11 @@
 set -euo pipefail
 sylva="$1"; src="$2"; work="$3"
 mkdir -p "$work"
-tools="$work/node_tools"
+# Installed by scripts/deps.sh (the set-up commands), never downloaded here.
+tools="$src/tools"
 if [[ ! -d "$tools/node_modules/gltf-validator" ]]; then
-  mkdir -p "$tools"
-  (cd "$tools" && npm init -y >/dev/null 2>&1 && npm install gltf-validator@2.0.0-dev.3.10 --no-audit --no-fund >/dev/null 2>&1)
+  echo "FAIL: the glTF validator is not installed: run scripts/deps.sh"
+  exit 1
 fi
 fail=0
 check() {  # what expected actual
