@@ -19,10 +19,10 @@
 // default build in single.
 #include <benchmark/benchmark.h>
 
-#include <btBulletDynamicsCommon.h>
 #include <BulletSoftBody/btSoftBodyHelpers.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
+#include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
 #include <cmath>
@@ -61,13 +61,17 @@ void BM_SylvaCloth(benchmark::State& state) {
     peak = std::max(peak, cloth.MaxStretch());
   }
   const auto& x = cloth.positions();
-  state.counters["sag"] = -0.5 * (x[size_t(cloth.Index(0, k - 1))].y() + x[size_t(cloth.Index(k - 1, k - 1))].y());
+  state.counters["sag"] =
+      -0.5 * (x[size_t(cloth.Index(0, k - 1))].y() + x[size_t(cloth.Index(k - 1, k - 1))].y());
   state.counters["stretch"] = cloth.MaxStretch();
   state.counters["peak"] = peak;
   for (auto _ : state) cloth.Step(kFrame, g);
   state.SetItemsProcessed(int64_t(k) * k * state.iterations());
 }
-BENCHMARK(BM_SylvaCloth)->ArgsProduct({{32, 64, 100}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SylvaCloth)
+    ->ArgsProduct({{32, 64, 100}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 struct BulletWorld {
   btSoftBodyRigidBodyCollisionConfiguration config;
@@ -84,8 +88,9 @@ struct BulletWorld {
     info.m_gravity = btVector3(0, btScalar(-kG), 0);
     info.m_sparsesdf.Initialize();
     // Corners 00 and 10 fixed (flags 1 + 2); diagonals generated (shear).
-    cloth = btSoftBodyHelpers::CreatePatch(info, btVector3(0, 0, 0), btVector3(1, 0, 0), btVector3(0, 0, 1),
-                                           btVector3(1, 0, 1), k, k, 1 + 2, true);
+    cloth =
+        btSoftBodyHelpers::CreatePatch(info, btVector3(0, 0, 0), btVector3(1, 0, 0),
+                                       btVector3(0, 0, 1), btVector3(1, 0, 1), k, k, 1 + 2, true);
     cloth->m_materials[0]->m_kLST = 1;
     cloth->generateBendingConstraints(2, cloth->m_materials[0]);
     cloth->m_cfg.piterations = iterations;
@@ -136,7 +141,10 @@ void BM_BulletSoftBodyCloth(benchmark::State& state) {
   for (auto _ : state) w.Frame();
   state.SetItemsProcessed(int64_t(k) * k * state.iterations());
 }
-BENCHMARK(BM_BulletSoftBodyCloth)->ArgsProduct({{32, 64, 100}, {1, 4}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BulletSoftBodyCloth)
+    ->ArgsProduct({{32, 64, 100}, {1, 4}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 

@@ -20,7 +20,8 @@ namespace {
 using namespace sylva::lsys;
 
 Grammar Load(const std::string& name) {
-  ParseResult r = ParseGrammarFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/" + name + ".lsys");
+  ParseResult r =
+      ParseGrammarFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/" + name + ".lsys");
   if (!r.grammar) {
     std::fprintf(stderr, "%s", r.diagnostics.FormatAll().c_str());
     std::abort();
@@ -52,9 +53,13 @@ void BM_Derive(benchmark::State& state, const char* file, int steps) {
       benchmark::Counter(double(produced) / 1e6, benchmark::Counter::kIsIterationInvariantRate);
 }
 
-#define SYLVA_DERIVE_BENCH(label, file, steps)                                              \
-  BENCHMARK_CAPTURE(BM_Derive, label, file, steps)->Arg(1)->Arg(2)->UseRealTime()->Unit( \
-      benchmark::kMillisecond)->MinTime(1.0)
+#define SYLVA_DERIVE_BENCH(label, file, steps)     \
+  BENCHMARK_CAPTURE(BM_Derive, label, file, steps) \
+      ->Arg(1)                                     \
+      ->Arg(2)                                     \
+      ->UseRealTime()                              \
+      ->Unit(benchmark::kMillisecond)              \
+      ->MinTime(1.0)
 
 SYLVA_DERIVE_BENCH(koch_1_6_n8, "fig1_06_koch_island", 8);
 SYLVA_DERIVE_BENCH(bracketed_1_24d_n14, "fig1_24d_bracketed_plant", 14);
@@ -90,8 +95,10 @@ void BM_FormatWord(benchmark::State& state, const char* file, int steps) {
   state.SetBytesProcessed(int64_t(bytes) * state.iterations());
   state.SetItemsProcessed(int64_t(r->word.size()) * state.iterations());
 }
-BENCHMARK_CAPTURE(BM_FormatWord, koch_1_6_n7, "fig1_06_koch_island", 7)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_FormatWord, monopodial_2_6a_n16, "fig2_06a_monopodial", 16)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FormatWord, koch_1_6_n7, "fig1_06_koch_island", 7)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FormatWord, monopodial_2_6a_n16, "fig2_06a_monopodial", 16)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -47,16 +47,20 @@ void BM_Tessellate(benchmark::State& state, const char* name, int steps) {
   state.counters["triangles"] = double(m.triangleCount());
 }
 BENCHMARK_CAPTURE(BM_Tessellate, monopodial_2_6a_n16, "fig2_06a_monopodial", 16)
-    ->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+    ->Arg(8)
+    ->Arg(16)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Tessellate, bracketed_1_24c_n5, "fig1_24c_bracketed_plant", 5)
-    ->Arg(8)->Unit(benchmark::kMillisecond);
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
 
 void BM_Write(benchmark::State& state, const char* ext) {
   mesh::PlantGeometry g = Geometry("fig2_06a_monopodial", 15);
   mesh::TriangleMesh m;
   mesh::TessellateOptions opt;
   (void)mesh::Tessellate(g, opt, m);
-  const std::string path = (std::filesystem::temp_directory_path() / (std::string("sylva_bench.") + ext)).string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / (std::string("sylva_bench.") + ext)).string();
   size_t bytes = 0;
   for (auto _ : state) {
     if (!mesh::WriteMesh(m, mesh::DefaultPalette(), path).ok()) state.SkipWithError("write failed");
@@ -73,7 +77,8 @@ BENCHMARK_CAPTURE(BM_Write, ply, "ply")->Unit(benchmark::kMillisecond);
 
 // End to end, as `sylva mesh fig2_06a -n 20 --sides 8 -o tree.glb` does on one core.
 void BM_EndToEndMillionSegments(benchmark::State& state) {
-  const std::string path = (std::filesystem::temp_directory_path() / "sylva_bench_e2e.glb").string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "sylva_bench_e2e.glb").string();
   size_t segments = 0, triangles = 0;
   plant::PlantSpec spec = Spec("fig2_06a_monopodial", 20, plant::Stage::kMesh);
   spec.detail.sides = 8;
@@ -83,7 +88,8 @@ void BM_EndToEndMillionSegments(benchmark::State& state) {
       state.SkipWithError("the plant failed");
       break;
     }
-    if (!mesh::WriteMesh(r.plant->mesh, r.plant->palette, path).ok()) state.SkipWithError("write failed");
+    if (!mesh::WriteMesh(r.plant->mesh, r.plant->palette, path).ok())
+      state.SkipWithError("write failed");
     segments = r.plant->geometry.segments.size();
     triangles = r.plant->mesh.triangleCount();
   }

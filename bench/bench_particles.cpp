@@ -76,12 +76,17 @@ void BM_BulkStep(benchmark::State& state) {
   sys.fields.gravity = Vec3(0, -9.81, 0);
   sys.fields.linearDrag = 0.1;
   sys.fields.quadraticDrag = 0.01;
-  sys.AddCollider(particles::Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.8).Friction(0.1));
+  sys.AddCollider(
+      particles::Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.8).Friction(0.1));
   const particles::BulkState s0 = s;
   for (auto _ : state) {
     state.PauseTiming();
-    for (auto [to, from] : {std::pair{&s.px, &s0.px}, {&s.py, &s0.py}, {&s.pz, &s0.pz}, {&s.vx, &s0.vx},
-                            {&s.vy, &s0.vy}, {&s.vz, &s0.vz}}) {
+    for (auto [to, from] : {std::pair{&s.px, &s0.px},
+                            {&s.py, &s0.py},
+                            {&s.pz, &s0.pz},
+                            {&s.vx, &s0.vx},
+                            {&s.vy, &s0.vy},
+                            {&s.vz, &s0.vz}}) {
       std::copy(from->begin(), from->end(), to->begin());
     }
     state.ResumeTiming();
@@ -111,7 +116,10 @@ void BM_GridBuild(benchmark::State& state) {
   }
   state.SetItemsProcessed(int64_t(n) * state.iterations());
 }
-BENCHMARK(BM_GridBuild)->ArgsProduct({{1000000}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_GridBuild)
+    ->ArgsProduct({{1000000}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Flocking: n boids, about 20 neighbours each, symplectic Euler steps.
 void BM_Flocking(benchmark::State& state) {
@@ -120,18 +128,23 @@ void BM_Flocking(benchmark::State& state) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1, 1);
   const double side = std::cbrt(n / 20.0);  // ~20 boids per unit cube
-  for (int i = 0; i < n; ++i) sys.state.Add(Vec3(u(rng), u(rng), u(rng)) * side, Vec3(u(rng), u(rng), u(rng)));
+  for (int i = 0; i < n; ++i)
+    sys.state.Add(Vec3(u(rng), u(rng), u(rng)) * side, Vec3(u(rng), u(rng), u(rng)));
   particles::FlockingDef def;
   def.radius = 0.6;
   def.separationRadius = 0.2;
   sys.AddForce(std::make_shared<particles::Flocking>(def));
   sys.AddForce(std::make_shared<particles::Drag>(0.1));
   for (auto _ : state) {
-    if (!sys.Step(1.0 / 60, particles::Integrator::kSymplecticEuler).ok()) state.SkipWithError("step failed");
+    if (!sys.Step(1.0 / 60, particles::Integrator::kSymplecticEuler).ok())
+      state.SkipWithError("step failed");
   }
   state.SetItemsProcessed(int64_t(n) * state.iterations());
 }
-BENCHMARK(BM_Flocking)->ArgsProduct({{100000}, {1, 2}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Flocking)
+    ->ArgsProduct({{100000}, {1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Cloth: one 1/60 s frame of a k x k cloth pinned at two corners, in wind.
 void BM_Cloth(benchmark::State& state, particles::ClothSolver solver) {
@@ -146,7 +159,8 @@ void BM_Cloth(benchmark::State& state, particles::ClothSolver solver) {
   def.pinned = {0, k - 1};
   def.threads = int(state.range(1));
   particles::Cloth cloth(def);
-  for (int i = 0; i < 30; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2));  // settle a little
+  for (int i = 0; i < 30; ++i)
+    cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2));  // settle a little
   for (auto _ : state) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2));
   state.counters["stretch"] = cloth.MaxStretch();
   state.SetItemsProcessed(int64_t(k) * k * state.iterations());

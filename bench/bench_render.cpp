@@ -57,7 +57,8 @@ void BM_FrameMillionTrianglePlant(benchmark::State& state) {
   }
   gl.renderer->SetMesh({}, {});
   state.counters["triangles"] = double(m.triangleCount());
-  state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["fps"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_FrameMillionTrianglePlant)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 
@@ -73,14 +74,16 @@ void BM_FrameMillionPoints(benchmark::State& state) {
   Gl& gl = Context();
   gl.renderer->SetMesh({}, {});
   gl.renderer->SetPoints(pts);
-  const render::Camera cam = render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 16.0 / 9, 30, 20, false);
+  const render::Camera cam =
+      render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 16.0 / 9, 30, 20, false);
   for (auto _ : state) {
     gl.renderer->Draw(cam);
     gl.renderer->Finish();
   }
   gl.renderer->SetPoints({});
   state.counters["points"] = 1e6;
-  state.counters["fps"] = benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["fps"] =
+      benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_FrameMillionPoints)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 

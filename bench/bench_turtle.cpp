@@ -40,10 +40,22 @@ void BM_Turtle(benchmark::State& state, const char* file, int steps) {
   state.counters["segments"] = double(segments);
 }
 
-BENCHMARK_CAPTURE(BM_Turtle, koch_1_6_n6, "fig1_06_koch_island", 6)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Turtle, bracketed_1_24d_n10, "fig1_24d_bracketed_plant", 10)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Turtle, monopodial_2_6a_n18, "fig2_06a_monopodial", 18)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Turtle, ternary_tropism_2_8a_n11, "fig2_08a_ternary", 11)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Turtle, koch_1_6_n6, "fig1_06_koch_island", 6)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Turtle, bracketed_1_24d_n10, "fig1_24d_bracketed_plant", 10)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Turtle, monopodial_2_6a_n18, "fig2_06a_monopodial", 18)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Turtle, ternary_tropism_2_8a_n11, "fig2_08a_ternary", 11)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -2,7 +2,7 @@
 # Installs the Debian 12 packages Sylva needs, only those missing.
 # Usage: scripts/deps.sh [--fuzz]   (--fuzz adds clang and its libFuzzer runtime)
 set -euo pipefail
-packages=(cmake g++ make pkg-config libeigen3-dev libcli11-dev libgtest-dev libbenchmark-dev python3
+packages=(cmake g++ make pkg-config clang-format libeigen3-dev libcli11-dev libgtest-dev libbenchmark-dev python3
           libtinygltf-dev nlohmann-json3-dev libstb-dev assimp-utils
           libegl-dev libgl-dev libglew-dev libgl1-mesa-dri libegl-mesa0
           libglfw3-dev libimgui-dev xvfb)

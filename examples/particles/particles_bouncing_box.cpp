@@ -5,8 +5,8 @@
 //
 //   particles_bouncing_box [COUNT] [SECONDS] [OUT.png]
 #include <cstdio>
-#include <filesystem>
 #include <cstdlib>
+#include <filesystem>
 #include <random>
 
 #include "particles/system.h"
@@ -26,7 +26,8 @@ int main(int argc, char** argv) {
   particles::System sys;
   std::mt19937 rng(42);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (int i = 0; i < count; ++i) sys.state.Add(Vec3(u(rng), u(rng), u(rng)) * 0.9, Vec3(u(rng), u(rng), u(rng)) * 3);
+  for (int i = 0; i < count; ++i)
+    sys.state.Add(Vec3(u(rng), u(rng), u(rng)) * 0.9, Vec3(u(rng), u(rng), u(rng)) * 3);
   sys.AddForce(std::make_shared<particles::Gravity>(Vec3(0, -9.81, 0)));
   for (int axis = 0; axis < 3; ++axis) {
     for (double side : {-1.0, 1.0}) {
@@ -53,9 +54,10 @@ int main(int argc, char** argv) {
     escaped += p.cwiseAbs().maxCoeff() > 1 + 1e-9;
     lowest = std::min(lowest, p.y());
   }
-  std::printf("%d particles, %.2f s in steps of 1/240 s: kinetic energy %.1f J -> %.1f J, "
-              "%d outside the box, lowest at y = %.3f\n",
-              count, sys.time, e0, sys.KineticEnergy(), escaped, lowest);
+  std::printf(
+      "%d particles, %.2f s in steps of 1/240 s: kinetic energy %.1f J -> %.1f J, "
+      "%d outside the box, lowest at y = %.3f\n",
+      count, sys.time, e0, sys.KineticEnergy(), escaped, lowest);
 
   // The last frame, coloured by speed, through the renderer's point pipeline.
   auto context = render::HeadlessContext::Create();
@@ -78,7 +80,9 @@ int main(int argc, char** argv) {
     for (int bit = 0; bit < 3; ++bit) {
       const int b = a | (1 << bit);
       if (b == a) continue;
-      auto corner = [](int k) { return mesh::Vec3f(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1); };
+      auto corner = [](int k) {
+        return mesh::Vec3f(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1);
+      };
       edges.points.push_back(corner(a));
       edges.points.push_back(corner(b));
       edges.colors.push_back(mesh::Srgb(0.6f, 0.6f, 0.65f));
@@ -88,9 +92,11 @@ int main(int argc, char** argv) {
   (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
   (*renderer)->SetPoints(batch);
   (*renderer)->SetLines(edges);
-  (*renderer)->Draw(render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 480.0 / 360, 30, 20, false));
+  (*renderer)->Draw(
+      render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 480.0 / 360, 30, 20, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
-    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
+                                        ec);  // out/ by default
   }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());

@@ -5,8 +5,8 @@
 //
 //   particles_fireworks [SECONDS] [OUT.png]
 #include <cstdio>
-#include <filesystem>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 
 #include "particles/emitter.h"
@@ -84,10 +84,13 @@ int main(int argc, char** argv) {
     for (size_t i = 0; i < sys.state.size(); ++i) {
       const uint32_t id = sys.state.id[i];
       auto e = emitterOf.find(id);
-      if (e != emitterOf.end()) sys.state.color[i] = e->second.ColorAt(sys.state.age[i], sys.state.lifetime[i]);
+      if (e != emitterOf.end())
+        sys.state.color[i] = e->second.ColorAt(sys.state.age[i], sys.state.lifetime[i]);
       if (sys.state.age[i] >= sys.state.lifetime[i]) {
-        if (kind[id] == kRocket) burst(sys.state.position[i], sys.state.velocity[i], 160, 7.0, true);
-        if (kind[id] == kBursting) burst(sys.state.position[i], sys.state.velocity[i], 25, 3.0, false);
+        if (kind[id] == kRocket)
+          burst(sys.state.position[i], sys.state.velocity[i], 160, 7.0, true);
+        if (kind[id] == kBursting)
+          burst(sys.state.position[i], sys.state.velocity[i], 25, 3.0, false);
       }
     }
     particles::RemoveDead(sys.state);
@@ -115,7 +118,8 @@ int main(int argc, char** argv) {
   (*renderer)->SetPoints(batch);
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 0, 5, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
-    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
+                                        ec);  // out/ by default
   }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());

@@ -6,8 +6,8 @@
 //   particles_flag [SECONDS] [OUT.png]
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <cstdlib>
+#include <filesystem>
 
 #include "particles/cloth.h"
 #include "render/headless_context.h"
@@ -48,11 +48,15 @@ int main(int argc, char** argv) {
   double stretch = 0;
   for (const auto& c : flag.constraints()) {
     if (c.compliance != def.stretchCompliance) continue;
-    stretch = std::max(stretch, (flag.positions()[c.a] - flag.positions()[c.b]).norm() / c.rest - 1);
+    stretch =
+        std::max(stretch, (flag.positions()[c.a] - flag.positions()[c.b]).norm() / c.rest - 1);
   }
   const Vec3 tip = flag.positions()[size_t(flag.Index(def.columns - 1, def.rows - 1))];
-  std::printf("%.1f s of wind: %zu particles, %zu triangles, largest stretch %.3f%%, free corner at (%.2f, %.2f, %.2f)\n",
-              seconds, flag.positions().size(), flag.triangles().size(), 100 * stretch, tip.x(), tip.y(), tip.z());
+  std::printf(
+      "%.1f s of wind: %zu particles, %zu triangles, largest stretch %.3f%%, free corner at (%.2f, "
+      "%.2f, %.2f)\n",
+      seconds, flag.positions().size(), flag.triangles().size(), 100 * stretch, tip.x(), tip.y(),
+      tip.z());
 
   auto context = render::HeadlessContext::Create();
   if (!context) {
@@ -89,7 +93,8 @@ int main(int argc, char** argv) {
   }
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 25, 15, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
-    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
+                                        ec);  // out/ by default
   }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());

@@ -7,8 +7,8 @@
 //   particles_flock [COUNT] [SECONDS] [OUT.png]
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <cstdlib>
+#include <filesystem>
 #include <random>
 
 #include "particles/flocking.h"
@@ -58,11 +58,14 @@ int main(int argc, char** argv) {
       std::fputs(st.error().Format().c_str(), stderr);
       return 1;
     }
-    for (const Vec3& p : sys.state.position) closest = std::min(closest, (p - obstacle).norm() - radius);
+    for (const Vec3& p : sys.state.position)
+      closest = std::min(closest, (p - obstacle).norm() - radius);
   }
   const double after = particles::OrderParameter(sys.state);
-  std::printf("%d boids, %.1f s on %d threads: order parameter %.2f -> %.2f, closest approach to the obstacle %.3f\n",
-              count, sys.time, sys.threads(), before, after, closest);
+  std::printf(
+      "%d boids, %.1f s on %d threads: order parameter %.2f -> %.2f, closest approach to the "
+      "obstacle %.3f\n",
+      count, sys.time, sys.threads(), before, after, closest);
   const bool ok = closest > 0;
 
   auto context = render::HeadlessContext::Create();
@@ -77,7 +80,8 @@ int main(int argc, char** argv) {
     const Vec3 v = sys.state.velocity[i].normalized();
     batch.positions.push_back(sys.state.position[i].cast<float>());
     batch.sizes.push_back(0.1f);
-    batch.colors.push_back(mesh::Srgb(0.55f + 0.45f * float(v.x()), 0.6f + 0.4f * float(v.y()), 0.65f + 0.35f * float(v.z())));
+    batch.colors.push_back(mesh::Srgb(0.55f + 0.45f * float(v.x()), 0.6f + 0.4f * float(v.y()),
+                                      0.65f + 0.35f * float(v.z())));
   }
   // The obstacle as a ring of points on three great circles.
   for (int k = 0; k < 360; ++k) {
@@ -96,7 +100,8 @@ int main(int argc, char** argv) {
   (*renderer)->SetPoints(batch);
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 30, 25, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
-    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
+                                        ec);  // out/ by default
   }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());

@@ -8,8 +8,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <cstdlib>
+#include <filesystem>
 
 #include "particles/bulk.h"
 #include "particles/emitter.h"
@@ -136,7 +136,8 @@ int main(int argc, char** argv) {
   (*renderer)->Draw(
       render::Camera::Frame(Vec3(-2, 0, -2), Vec3(2, 3, 2), 480.0 / 360, 25, 15, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
-    std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default
+    std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
+                                        ec);  // out/ by default
   }
   if (Status s = render::WritePng((*renderer)->ReadPixels(), out); !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());

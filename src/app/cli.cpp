@@ -68,12 +68,15 @@ static int NotBuilt(const char* command, std::ostream& err) {
 
 // Replaces this process with sylva-graphics running the same arguments.
 // Returns only on failure.
-static int ExecGraphics(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+static int ExecGraphics(const std::vector<std::string>& args, std::ostream& out,
+                        std::ostream& err) {
   std::string self(4096, '\0');
   const ssize_t n = readlink("/proc/self/exe", self.data(), self.size() - 1);
   self.resize(n > 0 ? size_t(n) : 0);
-  const std::string dir = self.substr(0, self.rfind('/') == std::string::npos ? 0 : self.rfind('/'));
-  const std::string candidates[] = {dir + "/sylva-graphics", dir + "/../libexec/sylva/sylva-graphics"};
+  const std::string dir =
+      self.substr(0, self.rfind('/') == std::string::npos ? 0 : self.rfind('/'));
+  const std::string candidates[] = {dir + "/sylva-graphics",
+                                    dir + "/../libexec/sylva/sylva-graphics"};
   for (const std::string& path : candidates) {
     if (access(path.c_str(), X_OK) != 0) continue;
     std::vector<char*> argv;
@@ -126,10 +129,13 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       ->check(CLI::Range(3, 256));
 
   ViewCommand view;
-  CLI::App* vi = app.add_subcommand("view", "open the interactive viewer (reloads the file when it changes)");
+  CLI::App* vi =
+      app.add_subcommand("view", "open the interactive viewer (reloads the file when it changes)");
   vi->add_option("file", view.file, "grammar file (.lsys); default: a bundled ABOP tree");
-  vi->add_option("--screenshot", view.screenshot, "save this picture (.png, .jpg) after --frames frames and quit");
-  vi->add_option("--frames", view.frames, "frames to draw before the screenshot")->check(CLI::Range(1, 1000000));
+  vi->add_option("--screenshot", view.screenshot,
+                 "save this picture (.png, .jpg) after --frames frames and quit");
+  vi->add_option("--frames", view.frames, "frames to draw before the screenshot")
+      ->check(CLI::Range(1, 1000000));
   vi->add_option("--size", view.size, "window size WxH (default 1280x720)");
 
   DeriveFlags check;
@@ -170,7 +176,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       if (vi->parsed()) code = g.view ? g.view(view, out, err) : NotBuilt("view", err);
     }
   } catch (const std::bad_alloc&) {
-    err << "sylva: error: out of memory; lower the derivation length (-n), the detail or the limits\n";
+    err << "sylva: error: out of memory; lower the derivation length (-n), the detail or the "
+           "limits\n";
     code = kExitRuntime;
   } catch (const std::exception& e) {
     err << "sylva: error: " << e.what() << "\n";

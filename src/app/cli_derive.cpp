@@ -7,11 +7,11 @@
 #include <iostream>
 #include <ostream>
 
+#include <map>
 #include "app/cli.h"
 #include "app/commands.h"
 #include "core/atomic_file.h"
 #include "core/parallel.h"
-#include <map>
 
 namespace sylva::app {
 
@@ -20,7 +20,8 @@ static bool ParseDefines(const std::vector<std::string>& defs,
   for (const auto& d : defs) {
     size_t eq = d.find('=');
     std::string name = d.substr(0, eq);
-    bool okName = !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
+    bool okName =
+        !name.empty() && (std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_');
     for (char ch : name) okName &= std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
     if (eq == std::string::npos || !okName) {
       err << "sylva: error: -D expects NAME=VALUE, got '" << d << "'\n";
@@ -53,8 +54,8 @@ std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err
   return spec;
 }
 
-std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErrors, std::ostream& err,
-                                       int* exit) {
+std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErrors,
+                                       std::ostream& err, int* exit) {
   plant::PlantResult r = plant::BuildPlant(spec);
   *exit = Report(r.diagnostics, err, maxErrors);
   if (!r.plant && *exit == kExitOk) *exit = kExitBadInput;
@@ -74,8 +75,8 @@ static void PrintStats(const plant::Plant& p, int threads, uint64_t seed, std::o
   const lsys::Grammar& g = p.grammar;
   char line[256];
   out << "grammar: " << g.path << " (" << g.name << ")\n";
-  std::snprintf(line, sizeof line, "steps: %d  seed: %llu  threads: %d\n",
-                int(p.steps.size()) - 1, static_cast<unsigned long long>(seed), threads);
+  std::snprintf(line, sizeof line, "steps: %d  seed: %llu  threads: %d\n", int(p.steps.size()) - 1,
+                static_cast<unsigned long long>(seed), threads);
   out << line;
   out << "step       modules      time\n";
   uint64_t produced = 0;
@@ -101,11 +102,11 @@ static void PrintStats(const plant::Plant& p, int threads, uint64_t seed, std::o
     out << line;
   }
   double rate = seconds > 0 ? double(produced) / seconds : 0;
-  std::snprintf(line, sizeof line,
-                "time: %.4f s (%llu modules produced, %.1f million modules/s)\n", seconds,
-                static_cast<unsigned long long>(produced), rate / 1e6);
+  std::snprintf(line, sizeof line, "time: %.4f s (%llu modules produced, %.1f million modules/s)\n",
+                seconds, static_cast<unsigned long long>(produced), rate / 1e6);
   out << line;
-  std::snprintf(line, sizeof line, "word memory: %.1f MiB\n", double(p.word.MemoryBytes()) / (1 << 20));
+  std::snprintf(line, sizeof line, "word memory: %.1f MiB\n",
+                double(p.word.MemoryBytes()) / (1 << 20));
   out << line;
 }
 
@@ -133,7 +134,8 @@ int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err) {
   const lsys::Grammar* g = &p->grammar;
   const lsys::Word* word = cmd.interpret ? &p->DrawnWord() : &p->word;
   if (cmd.stats) {
-    int threads = cmd.derive.threads > 0 ? cmd.derive.threads : sylva::ThreadPool::HardwareThreads();
+    int threads =
+        cmd.derive.threads > 0 ? cmd.derive.threads : sylva::ThreadPool::HardwareThreads();
     PrintStats(*p, threads, spec->seed.value_or(g->seed), out);
     return kExitOk;
   }

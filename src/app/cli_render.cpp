@@ -20,7 +20,8 @@ static bool ParseSize(const std::string& s, int* w, int* h) {
 
 static bool ParseCamera(const std::string& s, double v[3]) {
   int n = 0;
-  if (std::sscanf(s.c_str(), "%lf,%lf,%lf%n", &v[0], &v[1], &v[2], &n) != 3 || size_t(n) != s.size())
+  if (std::sscanf(s.c_str(), "%lf,%lf,%lf%n", &v[0], &v[1], &v[2], &n) != 3 ||
+      size_t(n) != s.size())
     return false;
   return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]) && v[2] >= 0 &&
          v[1] > -90 && v[1] < 90;
@@ -64,8 +65,8 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     for (const auto& s : geometry->segments) {
       // A grammar's own palette is drawn as written; the default palette is
       // darkened (to 0.6 of its sRGB value) so lines read on white.
-      const mesh::Vec3f c = palette.empty() ? mesh::Vec3f(0, 0, 0)
-                                            : palette[s.color % palette.size()] * lineShade;
+      const mesh::Vec3f c =
+          palette.empty() ? mesh::Vec3f(0, 0, 0) : palette[s.color % palette.size()] * lineShade;
       batch.points.push_back(s.start.cast<float>());
       batch.points.push_back(s.end.cast<float>());
       batch.colors.push_back(c);
@@ -90,8 +91,9 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     }
   }
   const double aspect = double(width) / height;
-  render::Camera camera = render::Camera::Frame(lo, hi, aspect, explicitCamera ? cam[0] : (lines ? 0 : 30),
-                                                explicitCamera ? cam[1] : (lines ? 0 : 12), lines);
+  render::Camera camera =
+      render::Camera::Frame(lo, hi, aspect, explicitCamera ? cam[0] : (lines ? 0 : 30),
+                            explicitCamera ? cam[1] : (lines ? 0 : 12), lines);
   if (explicitCamera && cam[2] > 0) camera.distance = cam[2];
 
   auto context = render::HeadlessContext::Create();
@@ -110,8 +112,9 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   const render::Image image = (*renderer)->ReadPixels();
   if (Status s = render::WriteImage(image, cmd.output); !s.ok()) return Report(s.error(), err);
   char line[256];
-  std::snprintf(line, sizeof line, "%s: %dx%d, %s, %zu triangles, %zu lines (%s)\n", cmd.output.c_str(),
-                width, height, lines ? "lines, orthographic" : "mesh, perspective", m.triangleCount(),
+  std::snprintf(line, sizeof line, "%s: %dx%d, %s, %zu triangles, %zu lines (%s)\n",
+                cmd.output.c_str(), width, height,
+                lines ? "lines, orthographic" : "mesh, perspective", m.triangleCount(),
                 batch.points.size() / 2, (*context)->Renderer().c_str());
   err << line;
   (void)out;

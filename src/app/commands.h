@@ -20,9 +20,9 @@ struct DeriveFlags {
   std::optional<uint64_t> seed;
   std::vector<std::string> defines;  // NAME=VALUE
   int threads = 0;
-  uint64_t maxModules = 0;  // 0: the library default
+  uint64_t maxModules = 0;    // 0: the library default
   uint64_t maxTriangles = 0;  // mesh and render only; 0: the library default
-  int maxErrors = 20;       // errors (and warnings) printed; 0: all
+  int maxErrors = 20;         // errors (and warnings) printed; 0: all
 };
 
 struct DeriveCommand {
@@ -40,9 +40,9 @@ struct MeshCommand {
 
 struct RenderCommand {
   DeriveFlags derive;
-  std::string output;          // .png
+  std::string output;  // .png
   std::string size = "960x540";
-  std::string camera;          // "azimuth,elevation,distance"; empty or distance 0: framed
+  std::string camera;  // "azimuth,elevation,distance"; empty or distance 0: framed
   int sides = 12;
 };
 
@@ -57,8 +57,8 @@ std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err
 // Builds the plant up to `spec.until`, printing its diagnostics (at most
 // maxErrors of them, 0: all); nullopt
 // with *exit set on an error.
-std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErrors, std::ostream& err,
-                                       int* exit);
+std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErrors,
+                                       std::ostream& err, int* exit);
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 

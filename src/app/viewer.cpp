@@ -44,7 +44,7 @@ struct Job {
 struct Result {
   uint64_t id = 0;
   bool ok = false;
-  std::string diagnostics;   // errors and warnings, formatted
+  std::string diagnostics;  // errors and warnings, formatted
   mesh::TriangleMesh mesh;
   mesh::Palette palette;
   Vec3 lo{0, 0, 0}, hi{1, 1, 1};
@@ -95,7 +95,8 @@ Result RunJobSafely(const Job& job) {
   } catch (const std::bad_alloc&) {
     Result r;
     r.id = job.id;
-    r.diagnostics = job.path + ": error: out of memory building the plant; lower the step or the detail\n";
+    r.diagnostics =
+        job.path + ": error: out of memory building the plant; lower the step or the detail\n";
     return r;
   } catch (const std::exception& e) {
     Result r;
@@ -159,7 +160,8 @@ class Worker {
 };
 
 std::string DefaultGrammar() {
-  return (fs::path(plant::BundledDataDir()) / "grammars" / "abop" / "fig2_06a_monopodial.lsys").string();
+  return (fs::path(plant::BundledDataDir()) / "grammars" / "abop" / "fig2_06a_monopodial.lsys")
+      .string();
 }
 
 // The window, its GL context and Dear ImGui, or an error message.
@@ -266,7 +268,8 @@ bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double fr
     changed = true;
   }
   if (ImGui::SliderInt("sides", &job.sides, 3, 32)) changed = true;
-  if (!shown.constants.empty() && ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
+  if (!shown.constants.empty() &&
+      ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
     for (const auto& [name, value] : shown.constants) {
       float v = float(job.overrides.count(name) ? job.overrides[name] : value);
       const float lo = value > 0 ? 0.0f : float(value) - 10.0f;
@@ -280,14 +283,17 @@ bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double fr
   if (busy) ImGui::ProgressBar(-1.0f * float(ImGui::GetTime()), ImVec2(-1, 0), "deriving...");
   ImGui::Separator();
   if (shown.plant) {
-    ImGui::Text("modules %llu, triangles %zu", static_cast<unsigned long long>(shown.plant->modules),
+    ImGui::Text("modules %llu, triangles %zu",
+                static_cast<unsigned long long>(shown.plant->modules),
                 shown.plant->mesh.triangleCount());
     ImGui::Text("derive %.1f ms, turtle %.1f ms, mesh %.1f ms", shown.plant->deriveMs,
                 shown.plant->turtleMs, shown.plant->tessellateMs);
   }
   ImGui::Text("frame %.1f ms", frameMs);
-  if (!shown.diagnostics.empty() && ImGui::CollapsingHeader("diagnostics", ImGuiTreeNodeFlags_DefaultOpen)) {
-    if (shown.lastFailed) ImGui::TextColored(ImVec4(0.8f, 0.1f, 0.1f, 1), "errors: showing the last good plant");
+  if (!shown.diagnostics.empty() &&
+      ImGui::CollapsingHeader("diagnostics", ImGuiTreeNodeFlags_DefaultOpen)) {
+    if (shown.lastFailed)
+      ImGui::TextColored(ImVec4(0.8f, 0.1f, 0.1f, 1), "errors: showing the last good plant");
     ImGui::TextWrapped("%s", shown.diagnostics.c_str());
   }
   ImGui::End();
@@ -301,13 +307,15 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   {
     int n = 0;
     if (std::sscanf(cmd.size.c_str(), "%dx%d%n", &width, &height, &n) != 2 ||
-        size_t(n) != cmd.size.size() || width < 64 || height < 64 || width > 8192 || height > 8192) {
+        size_t(n) != cmd.size.size() || width < 64 || height < 64 || width > 8192 ||
+        height > 8192) {
       err << "sylva: error: --size '" << cmd.size << "': expected WxH from 64x64 to 8192x8192\n";
       return kExitBadInput;
     }
   }
   if (!cmd.screenshot.empty() && !render::IsImagePath(cmd.screenshot)) {
-    err << "sylva: error: " << cmd.screenshot << ": unknown image format; use .png, .jpg or .jpeg\n";
+    err << "sylva: error: " << cmd.screenshot
+        << ": unknown image format; use .png, .jpg or .jpeg\n";
     return kExitBadInput;
   }
   const std::string path = cmd.file.empty() ? DefaultGrammar() : cmd.file;
@@ -317,7 +325,8 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   Window window;
-  if (int code = OpenWindow(width, height, "Sylva - " + path, cmd.frames == 0, window, err)) return code;
+  if (int code = OpenWindow(width, height, "Sylva - " + path, cmd.frames == 0, window, err))
+    return code;
   // Declared after the window: its GL objects are destroyed before the context.
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer) return Report(renderer.error(), err);
@@ -369,7 +378,8 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
         shown.lastFailed = false;
       } else {
         // Keep the last good plant; report what went wrong.
-        err << "sylva view: the grammar has errors; keeping the last good plant\n" << shown.diagnostics;
+        err << "sylva view: the grammar has errors; keeping the last good plant\n"
+            << shown.diagnostics;
         shown.lastFailed = true;
       }
     }
@@ -392,10 +402,12 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
     ++frame;
-    const bool key = glfwGetKey(window.handle, GLFW_KEY_P) == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard;
+    const bool key =
+        glfwGetKey(window.handle, GLFW_KEY_P) == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard;
     const bool done = cmd.frames > 0 && frame >= cmd.frames && shown.plant.has_value();
     if (key || done) {
-      std::string file = done ? cmd.screenshot : "sylva-screenshot-" + std::to_string(++shots) + ".png";
+      std::string file =
+          done ? cmd.screenshot : "sylva-screenshot-" + std::to_string(++shots) + ".png";
       if (!file.empty()) {
         if (Status s = render::WriteImage(render::ReadWindowPixels(fbw, fbh), file); !s.ok()) {
           exitCode = Report(s.error(), err);

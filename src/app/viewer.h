@@ -13,8 +13,8 @@
 namespace sylva::app {
 
 struct ViewCommand {
-  std::string file;          // empty: the bundled default grammar
-  std::string screenshot;    // with frames > 0: save this PNG after `frames` frames and quit
+  std::string file;        // empty: the bundled default grammar
+  std::string screenshot;  // with frames > 0: save this PNG after `frames` frames and quit
   int frames = 0;
   std::string size = "1280x720";
 };

@@ -2,17 +2,17 @@
 
 #include <signal.h>
 
-#include <atomic>
-#include <cerrno>
-#include <ctime>
-#include <cstdlib>
-#include <cstring>
 #include <fcntl.h>
 #include <unistd.h>
+#include <atomic>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
 
+#include <sys/stat.h>
 #include <algorithm>
 #include <cstdint>
-#include <sys/stat.h>
 
 namespace sylva {
 
@@ -87,7 +87,9 @@ void InstallTemporaryFileCleanup() {
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
 }
 
-AtomicFile::~AtomicFile() { Abandon(); }
+AtomicFile::~AtomicFile() {
+  Abandon();
+}
 
 void AtomicFile::Abandon() {
   if (file_) {
@@ -153,18 +155,27 @@ Status AtomicFile::Open(const std::string& path) {
   int fd = -1;
   for (uint64_t attempt = 0; attempt < 100 && fd < 0; ++attempt) {
     char suffix[32];
-    std::snprintf(suffix, sizeof suffix, ".tmp-%06llx",
-                  static_cast<unsigned long long>((salt + attempt * 0x2545F4914F6CDD1Dull) & 0xFFFFFF));
+    std::snprintf(
+        suffix, sizeof suffix, ".tmp-%06llx",
+        static_cast<unsigned long long>((salt + attempt * 0x2545F4914F6CDD1Dull) & 0xFFFFFF));
     tmpPath_ = target_ + suffix;
+    // Registered before it exists: a signal between the two finds at worst
+    // a name with no file, never a file it does not know.
+    slot_ = Register(tmpPath_);
     fd = open(tmpPath_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0 && errno != EEXIST) break;
+    if (fd < 0) {
+      const int saved = errno;
+      Unregister(slot_);
+      slot_ = -1;
+      errno = saved;
+      if (errno != EEXIST) break;
+    }
   }
   if (fd < 0) {
     Status s = IoError("cannot create output file");
     tmpPath_.clear();
     return s;
   }
-  slot_ = Register(tmpPath_);
   if (exists) fchmod(fd, st.st_mode & 07777);  // an existing file keeps its mode
   file_ = fdopen(fd, "wb");
   if (!file_) {
@@ -236,9 +247,9 @@ Expected<std::string> ReadFile(const std::string& path, size_t maxBytes) {
   if (S_ISDIR(st.st_mode)) return fail("is a directory, not a file");
   if (!S_ISREG(st.st_mode)) return fail("is not a regular file (a device, FIFO or socket)");
   auto tooLarge = [&] {
-    return fail("file is larger than the limit of " +
-                (maxBytes >= (size_t(1) << 20) ? std::to_string(maxBytes >> 20) + " MiB"
-                                               : std::to_string(maxBytes) + " bytes"));
+    return fail("file is larger than the limit of " + (maxBytes >= (size_t(1) << 20)
+                                                           ? std::to_string(maxBytes >> 20) + " MiB"
+                                                           : std::to_string(maxBytes) + " bytes"));
   };
   if (st.st_size > 0 && uint64_t(st.st_size) > maxBytes) return tooLarge();
   // Read to the end: the size fstat gives can be stale (a growing file) or 0 (/proc).

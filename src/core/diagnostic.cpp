@@ -116,9 +116,12 @@ std::string_view ShortMessage(std::string_view m, std::string* buffer) {
 
 const char* SeverityName(Severity s) {
   switch (s) {
-    case Severity::kNote: return "note";
-    case Severity::kWarning: return "warning";
-    case Severity::kError: return "error";
+    case Severity::kNote:
+      return "note";
+    case Severity::kWarning:
+      return "warning";
+    case Severity::kError:
+      return "error";
   }
   return "error";
 }
@@ -177,7 +180,8 @@ std::string Diagnostic::Format() const {
   // The window: up to kShowBefore columns before the caret, kShowWidth in all.
   size_t first = caretChar, last = caretChar;  // [first, last)
   int before = 0;
-  while (first > 0 && before + chars[first - 1].width <= kShowBefore) before += chars[--first].width;
+  while (first > 0 && before + chars[first - 1].width <= kShowBefore)
+    before += chars[--first].width;
   int width = before;
   while (last < chars.size() && (last == caretChar || width + chars[last].width <= kShowWidth))
     width += chars[last++].width;
@@ -217,7 +221,9 @@ Diagnostic MakeError(SourceLoc loc, std::string message, int length, std::string
   return d;
 }
 
-bool DiagnosticList::HasErrors() const { return ErrorCount() > 0; }
+bool DiagnosticList::HasErrors() const {
+  return ErrorCount() > 0;
+}
 
 size_t DiagnosticList::ErrorCount() const {
   size_t n = droppedErrors;

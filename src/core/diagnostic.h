@@ -36,12 +36,12 @@ struct Diagnostic {
   Severity severity = Severity::kError;
   ErrorKind kind = ErrorKind::kInput;
   SourceLoc loc;
-  int length = 1;          // columns underlined by the caret
+  int length = 1;  // columns underlined by the caret
   std::string message;
   // The text of loc.line (or the part of it around loc.column that
   // SetExcerpt keeps), for the excerpt; may be empty.
   std::string sourceLine;
-  int sourceLineOffset = 0;   // bytes of the line cut before sourceLine
+  int sourceLineOffset = 0;    // bytes of the line cut before sourceLine
   bool sourceLineCut = false;  // the line goes on after sourceLine
 
   // "file:line:col: error: message" plus excerpt lines, newline-terminated.

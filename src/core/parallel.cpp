@@ -18,8 +18,12 @@ namespace {
 // spins on the join before it yields its core.
 constexpr auto kSpin = std::chrono::microseconds(50);
 
-constexpr uint32_t Gen(uint64_t word) { return uint32_t(word >> 32); }
-constexpr uint32_t Index(uint64_t word) { return uint32_t(word); }
+constexpr uint32_t Gen(uint64_t word) {
+  return uint32_t(word >> 32);
+}
+constexpr uint32_t Index(uint64_t word) {
+  return uint32_t(word);
+}
 
 }  // namespace
 
@@ -52,7 +56,8 @@ void ThreadPool::RunTasks(uint32_t gen) {
     const size_t count = count_.load(std::memory_order_acquire);
     const std::function<void(size_t)>* fn = fn_.load(std::memory_order_acquire);
     if (Index(word) >= count) return;
-    if (!claim_.compare_exchange_weak(word, word + 1, std::memory_order_acq_rel, std::memory_order_acquire)) {
+    if (!claim_.compare_exchange_weak(word, word + 1, std::memory_order_acq_rel,
+                                      std::memory_order_acquire)) {
       continue;  // word now holds the current value
     }
     (*fn)(Index(word));

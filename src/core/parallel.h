@@ -17,9 +17,8 @@
 #include <algorithm>
 #include <atomic>
 #include <condition_variable>
+#include <cstddef>
 #include <cstdint>
-#include <cstddef>
-#include <cstddef>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -80,7 +79,8 @@ void ForRanges(ThreadPool* pool, size_t n, size_t grain, Fn&& fn) {
 // A grain that gives every thread of the pool about four ranges of at least
 // minGrain and at most maxGrain items: a loop of a few thousand items still
 // splits evenly over the threads.
-inline size_t BalancedGrain(const ThreadPool* pool, size_t n, size_t minGrain, size_t maxGrain = SIZE_MAX) {
+inline size_t BalancedGrain(const ThreadPool* pool, size_t n, size_t minGrain,
+                            size_t maxGrain = SIZE_MAX) {
   if (!pool) return std::max<size_t>(n, 1);
   const size_t even = (n + 4 * size_t(pool->threads()) - 1) / (4 * size_t(pool->threads()));
   return std::clamp(even, minGrain, std::max(minGrain, maxGrain));

@@ -34,7 +34,9 @@ constexpr uint64_t CounterHash(uint64_t seed, uint64_t a, uint64_t b = 0, uint64
 }
 
 // Uniform double in [0, 1) from the top 53 bits.
-constexpr double ToUnit(uint64_t bits) { return double(bits >> 11) * 0x1.0p-53; }
+constexpr double ToUnit(uint64_t bits) {
+  return double(bits >> 11) * 0x1.0p-53;
+}
 
 // A stream of draws with a fixed key; Next() advances only a local counter.
 struct RandomStream {

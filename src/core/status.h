@@ -14,7 +14,7 @@ namespace sylva {
 
 class [[nodiscard]] Status {
  public:
-  Status() = default;  // success
+  Status() = default;                             // success
   Status(Diagnostic d) : error_(std::move(d)) {}  // NOLINT: implicit on purpose
 
   bool ok() const { return !error_.has_value(); }
@@ -31,7 +31,7 @@ class [[nodiscard]] Status {
 template <typename T>
 class [[nodiscard]] Expected {
  public:
-  Expected(T value) : v_(std::move(value)) {}          // NOLINT
+  Expected(T value) : v_(std::move(value)) {}           // NOLINT
   Expected(Diagnostic error) : v_(std::move(error)) {}  // NOLINT
 
   bool ok() const { return v_.index() == 0; }

@@ -72,11 +72,11 @@ StaticTable BuildStaticTable(const Grammar& g, const Section& sec) {
 // What Choose needs of a production, packed (16 bytes) and stored per symbol
 // in file order, so trying the productions of a module touches one cache line.
 struct ProdInfo {
-  uint32_t index;        // into Section::productions
-  SymbolId left0;        // the left-context module nearest the predecessor
-  SymbolId right0;       // the first right-context module
-  uint8_t leftKind;      // 0 none; 1 one module, no parameters; 2 anything else
-  uint8_t rightKind;     // same for the right context
+  uint32_t index;     // into Section::productions
+  SymbolId left0;     // the left-context module nearest the predecessor
+  SymbolId right0;    // the first right-context module
+  uint8_t leftKind;   // 0 none; 1 one module, no parameters; 2 anything else
+  uint8_t rightKind;  // same for the right context
   uint8_t hasCondition;
   uint8_t hasWeight;
   uint32_t pad = 0;
@@ -97,7 +97,7 @@ struct ContextTable {
 
 struct Chunk {
   size_t begin = 0, end = 0;
-  uint64_t inParam = 0;                 // parameter offset of `begin` in the input
+  uint64_t inParam = 0;  // parameter offset of `begin` in the input
   uint64_t outModules = 0, outParams = 0;
   uint64_t outModuleAt = 0, outParamAt = 0;
   bool changed = false;
@@ -117,9 +117,17 @@ class Pass {
   Pass(const Grammar& g, const Section& sec, const StaticTable& table, ThreadPool& pool,
        Scratch& scratch, uint64_t seed, uint64_t purpose, uint64_t step, int stepForMessages,
        uint64_t maxModules)
-      : g_(g), sec_(sec), table_(table), pool_(pool), seed_(seed), purpose_(purpose),
-        step_(step), stepForMessages_(stepForMessages), maxModules_(maxModules),
-        choice_(scratch.choice), match_(scratch.match) {
+      : g_(g),
+        sec_(sec),
+        table_(table),
+        pool_(pool),
+        seed_(seed),
+        purpose_(purpose),
+        step_(step),
+        stepForMessages_(stepForMessages),
+        maxModules_(maxModules),
+        choice_(scratch.choice),
+        match_(scratch.match) {
     for (const auto& p : sec.productions) {
       maxFormals_ = std::max<size_t>(maxFormals_, p.formalCount);
       needsMatch_ |= p.HasContext();
@@ -174,10 +182,9 @@ class Pass {
   // General path.
   bool Choose(const WordView& w, size_t i, double* formals, uint32_t* choice, Chunk& c);
   // 1 matches, 0 does not, -1 error (recorded in c).
-  int Draw(const ProdInfo* pi, const ProdInfo* last, const WordView& w, size_t i,
-           const double* pp, int arity, double* formals, size_t& prev, size_t& next,
-           RandomStream& rng, Chunk& c, double* weights, uint32_t* cands, size_t capacity,
-           uint32_t* choice);
+  int Draw(const ProdInfo* pi, const ProdInfo* last, const WordView& w, size_t i, const double* pp,
+           int arity, double* formals, size_t& prev, size_t& next, RandomStream& rng, Chunk& c,
+           double* weights, uint32_t* cands, size_t capacity, uint32_t* choice);
   [[gnu::noinline]] bool DrawMany(const ProdInfo* pi, const ProdInfo* last, const WordView& w,
                                   size_t i, const double* pp, int arity, double* formals,
                                   size_t& prev, size_t& next, RandomStream rng, Chunk& c,
@@ -196,9 +203,9 @@ class Pass {
   uint64_t maxModules_;
   size_t maxFormals_ = 0;
   bool needsMatch_ = false;
-  std::vector<uint32_t> symChoice_;               // per symbol
-  std::vector<ProdInfo> infos_;                   // per symbol, in file order
-  std::vector<uint32_t> infoStart_;               // symbol -> first info
+  std::vector<uint32_t> symChoice_;                    // per symbol
+  std::vector<ProdInfo> infos_;                        // per symbol, in file order
+  std::vector<uint32_t> infoStart_;                    // symbol -> first info
   std::vector<std::unique_ptr<ContextTable>> tables_;  // per symbol, or null
 
   void BuildTable(SymbolId sym) {
@@ -319,9 +326,9 @@ Status Pass::Allocate(Word& out, bool outHasParams) {
                       " (--max-modules)");
   }
   if (params > kMaxParams) {
-    return LimitError("derivation step " + std::to_string(stepForMessages_) +
-                      " would need " + std::to_string(params) +
-                      " parameters, more than the limit of " + std::to_string(kMaxParams));
+    return LimitError("derivation step " + std::to_string(stepForMessages_) + " would need " +
+                      std::to_string(params) + " parameters, more than the limit of " +
+                      std::to_string(kMaxParams));
   }
   out.Clear();
   out.symbols.ResizeUninitialized(size_t(modules) + 16);  // slack for over-copying
@@ -432,8 +439,8 @@ bool Pass::DrawMany(const ProdInfo* pi, const ProdInfo* last, const WordView& w,
   const size_t capacity = size_t(last - pi);
   std::vector<double> weights(capacity);
   std::vector<uint32_t> cands(capacity);
-  return Draw(pi, last, w, i, pp, arity, formals, prev, next, rng, c, weights.data(),
-              cands.data(), capacity, choice) > 0;
+  return Draw(pi, last, w, i, pp, arity, formals, prev, next, rng, c, weights.data(), cands.data(),
+              capacity, choice) > 0;
 }
 
 bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice, Chunk& c) {
@@ -580,8 +587,7 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
     });
     // Changed unless every symbol maps to itself.
     bool any = false;
-    for (size_t s = 0; s < table_.length.size() && !any; ++s)
-      any = !sec_.bySymbol[s].empty();
+    for (size_t s = 0; s < table_.length.size() && !any; ++s) any = !sec_.bySymbol[s].empty();
     *changed = any && n > 0;
     return {};
   }
@@ -670,8 +676,10 @@ void ApplyCut(Word& w, SymbolId cut) {
       int depth = 0;
       for (; i < n; ++i) {
         SymbolId s = w.symbols[i];
-        if (s == kOpenBracket) ++depth;
-        else if (s == kCloseBracket && depth-- == 0) break;
+        if (s == kOpenBracket)
+          ++depth;
+        else if (s == kCloseBracket && depth-- == 0)
+          break;
       }
       continue;
     }
@@ -722,9 +730,8 @@ Expected<Word> BuildAxiom(const Grammar& g, uint64_t seed) {
 // Runs passes of a decomposition or interpretation section until nothing
 // changes or the maximum depth is reached.
 Status RunSection(const Grammar& g, const Section& sec, ThreadPool& pool, Scratch& scratch,
-                  uint64_t seed,
-                  uint64_t purpose, uint64_t step, int stepForMessages, uint64_t maxModules,
-                  Word& word) {
+                  uint64_t seed, uint64_t purpose, uint64_t step, int stepForMessages,
+                  uint64_t maxModules, Word& word) {
   if (sec.empty()) return {};
   StaticTable table = BuildStaticTable(g, sec);
   Word next;
@@ -817,13 +824,19 @@ Status Derivation::Step() {
   return {};
 }
 
-int Derivation::step() const { return state_->step; }
-const Word& Derivation::word() const { return state_->word; }
+int Derivation::step() const {
+  return state_->step;
+}
+const Word& Derivation::word() const {
+  return state_->word;
+}
 Word& Derivation::MutableWord() {
   state_->fixedPoint = false;
   return state_->word;
 }
-const std::vector<StepStats>& Derivation::stats() const { return state_->stats; }
+const std::vector<StepStats>& Derivation::stats() const {
+  return state_->stats;
+}
 
 Expected<Word> Derivation::Interpreted() const {
   State& s = *state_;

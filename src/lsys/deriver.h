@@ -39,9 +39,9 @@ inline constexpr uint64_t kMaxModulesCap = 0xFFFFFFF0ull;
 inline constexpr int kMaxDerivationLengthForDerive = 100000;  // steps
 
 struct DeriveOptions {
-  int steps = -1;                   // -1: the grammar's derivation length
-  std::optional<uint64_t> seed;     // overrides `seed:`
-  int threads = 0;                  // 0: all hardware threads
+  int steps = -1;                // -1: the grammar's derivation length
+  std::optional<uint64_t> seed;  // overrides `seed:`
+  int threads = 0;               // 0: all hardware threads
   uint64_t maxModules = kDefaultMaxModules;
   // Called after each step (from the calling thread).
   std::function<void(int step, int steps, uint64_t modules)> progress;

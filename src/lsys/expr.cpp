@@ -45,12 +45,24 @@ static bool Finite(double v, EvalError* err, int column, const char* what) {
 // Applies a pure (non-random, non-jump) operation to args; result in *out.
 static bool ApplyPure(OpCode op, const double* a, double* out, EvalError* err, int col) {
   switch (op) {
-    case OpCode::kNeg: *out = -a[0]; return true;
-    case OpCode::kNot: *out = a[0] == 0 ? 1 : 0; return true;
-    case OpCode::kToBool: *out = a[0] != 0 ? 1 : 0; return true;
-    case OpCode::kAdd: *out = a[0] + a[1]; return Finite(*out, err, col, "overflow in '+'");
-    case OpCode::kSub: *out = a[0] - a[1]; return Finite(*out, err, col, "overflow in '-'");
-    case OpCode::kMul: *out = a[0] * a[1]; return Finite(*out, err, col, "overflow in '*'");
+    case OpCode::kNeg:
+      *out = -a[0];
+      return true;
+    case OpCode::kNot:
+      *out = a[0] == 0 ? 1 : 0;
+      return true;
+    case OpCode::kToBool:
+      *out = a[0] != 0 ? 1 : 0;
+      return true;
+    case OpCode::kAdd:
+      *out = a[0] + a[1];
+      return Finite(*out, err, col, "overflow in '+'");
+    case OpCode::kSub:
+      *out = a[0] - a[1];
+      return Finite(*out, err, col, "overflow in '-'");
+    case OpCode::kMul:
+      *out = a[0] * a[1];
+      return Finite(*out, err, col, "overflow in '*'");
     case OpCode::kDiv:
       if (a[1] == 0) return Fail(err, col, "division by zero");
       *out = a[0] / a[1];
@@ -63,14 +75,30 @@ static bool ApplyPure(OpCode op, const double* a, double* out, EvalError* err, i
     case OpCode::kPowFn:
       *out = std::pow(a[0], a[1]);
       return Finite(*out, err, col, "power is not a finite number (negative base, or overflow)");
-    case OpCode::kEq: *out = a[0] == a[1]; return true;
-    case OpCode::kNe: *out = a[0] != a[1]; return true;
-    case OpCode::kLt: *out = a[0] < a[1]; return true;
-    case OpCode::kLe: *out = a[0] <= a[1]; return true;
-    case OpCode::kGt: *out = a[0] > a[1]; return true;
-    case OpCode::kGe: *out = a[0] >= a[1]; return true;
-    case OpCode::kSin: *out = std::sin(a[0] * kDegToRad); return true;
-    case OpCode::kCos: *out = std::cos(a[0] * kDegToRad); return true;
+    case OpCode::kEq:
+      *out = a[0] == a[1];
+      return true;
+    case OpCode::kNe:
+      *out = a[0] != a[1];
+      return true;
+    case OpCode::kLt:
+      *out = a[0] < a[1];
+      return true;
+    case OpCode::kLe:
+      *out = a[0] <= a[1];
+      return true;
+    case OpCode::kGt:
+      *out = a[0] > a[1];
+      return true;
+    case OpCode::kGe:
+      *out = a[0] >= a[1];
+      return true;
+    case OpCode::kSin:
+      *out = std::sin(a[0] * kDegToRad);
+      return true;
+    case OpCode::kCos:
+      *out = std::cos(a[0] * kDegToRad);
+      return true;
     case OpCode::kTan:
       *out = std::tan(a[0] * kDegToRad);
       return Finite(*out, err, col, "tan is infinite here");
@@ -82,39 +110,77 @@ static bool ApplyPure(OpCode op, const double* a, double* out, EvalError* err, i
       if (a[0] < -1 || a[0] > 1) return Fail(err, col, "acos argument outside [-1, 1]");
       *out = std::acos(a[0]) * kRadToDeg;
       return true;
-    case OpCode::kAtan: *out = std::atan(a[0]) * kRadToDeg; return true;
-    case OpCode::kAtan2: *out = std::atan2(a[0], a[1]) * kRadToDeg; return true;
+    case OpCode::kAtan:
+      *out = std::atan(a[0]) * kRadToDeg;
+      return true;
+    case OpCode::kAtan2:
+      *out = std::atan2(a[0], a[1]) * kRadToDeg;
+      return true;
     case OpCode::kSqrt:
       if (a[0] < 0) return Fail(err, col, "sqrt of a negative number");
       *out = std::sqrt(a[0]);
       return true;
-    case OpCode::kExp: *out = std::exp(a[0]); return Finite(*out, err, col, "exp overflows");
+    case OpCode::kExp:
+      *out = std::exp(a[0]);
+      return Finite(*out, err, col, "exp overflows");
     case OpCode::kLog:
       if (a[0] <= 0) return Fail(err, col, "log of a number that is not positive");
       *out = std::log(a[0]);
       return true;
-    case OpCode::kAbs: *out = std::fabs(a[0]); return true;
-    case OpCode::kFloor: *out = std::floor(a[0]); return true;
-    case OpCode::kCeil: *out = std::ceil(a[0]); return true;
-    case OpCode::kTrunc: *out = std::trunc(a[0]); return true;
-    case OpCode::kSign: *out = a[0] > 0 ? 1 : (a[0] < 0 ? -1 : 0); return true;
-    case OpCode::kMin: *out = a[0] < a[1] ? a[0] : a[1]; return true;
-    case OpCode::kMax: *out = a[0] > a[1] ? a[0] : a[1]; return true;
-    case OpCode::kClamp: *out = a[0] < a[1] ? a[1] : (a[0] > a[2] ? a[2] : a[0]); return true;
-    default: return Fail(err, col, "internal error: not a pure operation");
+    case OpCode::kAbs:
+      *out = std::fabs(a[0]);
+      return true;
+    case OpCode::kFloor:
+      *out = std::floor(a[0]);
+      return true;
+    case OpCode::kCeil:
+      *out = std::ceil(a[0]);
+      return true;
+    case OpCode::kTrunc:
+      *out = std::trunc(a[0]);
+      return true;
+    case OpCode::kSign:
+      *out = a[0] > 0 ? 1 : (a[0] < 0 ? -1 : 0);
+      return true;
+    case OpCode::kMin:
+      *out = a[0] < a[1] ? a[0] : a[1];
+      return true;
+    case OpCode::kMax:
+      *out = a[0] > a[1] ? a[0] : a[1];
+      return true;
+    case OpCode::kClamp:
+      *out = a[0] < a[1] ? a[1] : (a[0] > a[2] ? a[2] : a[0]);
+      return true;
+    default:
+      return Fail(err, col, "internal error: not a pure operation");
   }
 }
 
 static int OpArity(OpCode op) {
   switch (op) {
-    case OpCode::kNeg: case OpCode::kNot: case OpCode::kToBool:
-    case OpCode::kSin: case OpCode::kCos: case OpCode::kTan: case OpCode::kAsin:
-    case OpCode::kAcos: case OpCode::kAtan: case OpCode::kSqrt: case OpCode::kExp:
-    case OpCode::kLog: case OpCode::kAbs: case OpCode::kFloor: case OpCode::kCeil:
-    case OpCode::kSign: case OpCode::kTrunc: case OpCode::kRan:
+    case OpCode::kNeg:
+    case OpCode::kNot:
+    case OpCode::kToBool:
+    case OpCode::kSin:
+    case OpCode::kCos:
+    case OpCode::kTan:
+    case OpCode::kAsin:
+    case OpCode::kAcos:
+    case OpCode::kAtan:
+    case OpCode::kSqrt:
+    case OpCode::kExp:
+    case OpCode::kLog:
+    case OpCode::kAbs:
+    case OpCode::kFloor:
+    case OpCode::kCeil:
+    case OpCode::kSign:
+    case OpCode::kTrunc:
+    case OpCode::kRan:
       return 1;
-    case OpCode::kClamp: return 3;
-    default: return 2;
+    case OpCode::kClamp:
+      return 3;
+    default:
+      return 2;
   }
 }
 
@@ -126,13 +192,32 @@ bool Expr::Run(const double* formals, RandomStream& rng, double* out, EvalError*
   for (size_t pc = 0; pc < n; ++pc) {
     const Instr& in = code[pc];
     switch (in.op) {
-      case OpCode::kConst: stack[sp++] = in.value; break;
-      case OpCode::kFormal: stack[sp++] = formals[in.arg]; break;
-      case OpCode::kAdd: --sp; stack[sp - 1] += stack[sp]; break;
-      case OpCode::kSub: --sp; stack[sp - 1] -= stack[sp]; break;
-      case OpCode::kMul: --sp; stack[sp - 1] *= stack[sp]; break;
-      case OpCode::kLt: --sp; stack[sp - 1] = stack[sp - 1] < stack[sp]; break;
-      case OpCode::kGt: --sp; stack[sp - 1] = stack[sp - 1] > stack[sp]; break;
+      case OpCode::kConst:
+        stack[sp++] = in.value;
+        break;
+      case OpCode::kFormal:
+        stack[sp++] = formals[in.arg];
+        break;
+      case OpCode::kAdd:
+        --sp;
+        stack[sp - 1] += stack[sp];
+        break;
+      case OpCode::kSub:
+        --sp;
+        stack[sp - 1] -= stack[sp];
+        break;
+      case OpCode::kMul:
+        --sp;
+        stack[sp - 1] *= stack[sp];
+        break;
+      case OpCode::kLt:
+        --sp;
+        stack[sp - 1] = stack[sp - 1] < stack[sp];
+        break;
+      case OpCode::kGt:
+        --sp;
+        stack[sp - 1] = stack[sp - 1] > stack[sp];
+        break;
       case OpCode::kAndJump:
         if (stack[sp - 1] == 0) {
           stack[sp - 1] = 0;
@@ -153,8 +238,12 @@ bool Expr::Run(const double* formals, RandomStream& rng, double* out, EvalError*
         --sp;
         if (stack[sp] == 0) pc = in.arg - 1;
         break;
-      case OpCode::kJump: pc = in.arg - 1; break;
-      case OpCode::kRan: stack[sp - 1] = stack[sp - 1] * rng.Uniform(); break;
+      case OpCode::kJump:
+        pc = in.arg - 1;
+        break;
+      case OpCode::kRan:
+        stack[sp - 1] = stack[sp - 1] * rng.Uniform();
+        break;
       case OpCode::kUniform:
         --sp;
         stack[sp - 1] = stack[sp - 1] + (stack[sp] - stack[sp - 1]) * rng.Uniform();
@@ -177,8 +266,9 @@ bool Expr::Run(const double* formals, RandomStream& rng, double* out, EvalError*
   }
   *out = stack[0];
   // Adds and multiplies skip their own checks in the loop above.
-  if (!std::isfinite(*out)) return Fail(err, columns_.empty() ? 0 : int(columns_.back()),
-                                        "result is not a finite number (overflow)");
+  if (!std::isfinite(*out))
+    return Fail(err, columns_.empty() ? 0 : int(columns_.back()),
+                "result is not a finite number (overflow)");
   return true;
 }
 
@@ -223,13 +313,13 @@ struct FunctionInfo {
 };
 
 constexpr FunctionInfo kFunctions[] = {
-    {"sin", OpCode::kSin, 1},     {"cos", OpCode::kCos, 1},     {"tan", OpCode::kTan, 1},
-    {"asin", OpCode::kAsin, 1},   {"acos", OpCode::kAcos, 1},   {"atan", OpCode::kAtan, 1},
-    {"atan2", OpCode::kAtan2, 2}, {"sqrt", OpCode::kSqrt, 1},   {"exp", OpCode::kExp, 1},
-    {"log", OpCode::kLog, 1},     {"pow", OpCode::kPowFn, 2},   {"abs", OpCode::kAbs, 1},
-    {"floor", OpCode::kFloor, 1}, {"ceil", OpCode::kCeil, 1},   {"min", OpCode::kMin, 2},
-    {"max", OpCode::kMax, 2},     {"clamp", OpCode::kClamp, 3}, {"sign", OpCode::kSign, 1},
-    {"trunc", OpCode::kTrunc, 1}, {"ran", OpCode::kRan, 1},     {"uniform", OpCode::kUniform, 2},
+    {"sin", OpCode::kSin, 1},       {"cos", OpCode::kCos, 1},     {"tan", OpCode::kTan, 1},
+    {"asin", OpCode::kAsin, 1},     {"acos", OpCode::kAcos, 1},   {"atan", OpCode::kAtan, 1},
+    {"atan2", OpCode::kAtan2, 2},   {"sqrt", OpCode::kSqrt, 1},   {"exp", OpCode::kExp, 1},
+    {"log", OpCode::kLog, 1},       {"pow", OpCode::kPowFn, 2},   {"abs", OpCode::kAbs, 1},
+    {"floor", OpCode::kFloor, 1},   {"ceil", OpCode::kCeil, 1},   {"min", OpCode::kMin, 2},
+    {"max", OpCode::kMax, 2},       {"clamp", OpCode::kClamp, 3}, {"sign", OpCode::kSign, 1},
+    {"trunc", OpCode::kTrunc, 1},   {"ran", OpCode::kRan, 1},     {"uniform", OpCode::kUniform, 2},
     {"normal", OpCode::kNormal, 2},
 };
 
@@ -281,7 +371,8 @@ class Parser {
   }
 
   NodePtr Ternary(int depth) {
-    if (depth > kMaxDepth) return Error(Col(), "expression nested deeper than " + std::to_string(kMaxDepth));
+    if (depth > kMaxDepth)
+      return Error(Col(), "expression nested deeper than " + std::to_string(kMaxDepth));
     NodePtr c = Binary(0, depth);
     if (!c) return nullptr;
     SkipSpace();
@@ -316,33 +407,77 @@ class Parser {
 
   bool MatchOp(int level, OpCode* op) {
     switch (level) {
-      case 0: if (Accept("||")) { *op = OpCode::kOrJump; return true; } return false;
-      case 1: if (Accept("&&")) { *op = OpCode::kAndJump; return true; } return false;
+      case 0:
+        if (Accept("||")) {
+          *op = OpCode::kOrJump;
+          return true;
+        }
+        return false;
+      case 1:
+        if (Accept("&&")) {
+          *op = OpCode::kAndJump;
+          return true;
+        }
+        return false;
       case 2:
-        if (Accept("==")) { *op = OpCode::kEq; return true; }
-        if (Accept("!=")) { *op = OpCode::kNe; return true; }
+        if (Accept("==")) {
+          *op = OpCode::kEq;
+          return true;
+        }
+        if (Accept("!=")) {
+          *op = OpCode::kNe;
+          return true;
+        }
         return false;
       case 3:
-        if (Accept("<=")) { *op = OpCode::kLe; return true; }
-        if (Accept(">=")) { *op = OpCode::kGe; return true; }
-        if (Accept("<")) { *op = OpCode::kLt; return true; }
-        if (Accept(">")) { *op = OpCode::kGt; return true; }
+        if (Accept("<=")) {
+          *op = OpCode::kLe;
+          return true;
+        }
+        if (Accept(">=")) {
+          *op = OpCode::kGe;
+          return true;
+        }
+        if (Accept("<")) {
+          *op = OpCode::kLt;
+          return true;
+        }
+        if (Accept(">")) {
+          *op = OpCode::kGt;
+          return true;
+        }
         return false;
       case 4:
-        if (Accept("+")) { *op = OpCode::kAdd; return true; }
-        if (Accept("-")) { *op = OpCode::kSub; return true; }
+        if (Accept("+")) {
+          *op = OpCode::kAdd;
+          return true;
+        }
+        if (Accept("-")) {
+          *op = OpCode::kSub;
+          return true;
+        }
         return false;
       case 5:
-        if (Accept("*")) { *op = OpCode::kMul; return true; }
-        if (Accept("/")) { *op = OpCode::kDiv; return true; }
-        if (Accept("%")) { *op = OpCode::kMod; return true; }
+        if (Accept("*")) {
+          *op = OpCode::kMul;
+          return true;
+        }
+        if (Accept("/")) {
+          *op = OpCode::kDiv;
+          return true;
+        }
+        if (Accept("%")) {
+          *op = OpCode::kMod;
+          return true;
+        }
         return false;
     }
     return false;
   }
 
   NodePtr Unary(int depth) {
-    if (depth > kMaxDepth) return Error(Col(), "expression nested deeper than " + std::to_string(kMaxDepth));
+    if (depth > kMaxDepth)
+      return Error(Col(), "expression nested deeper than " + std::to_string(kMaxDepth));
     SkipSpace();
     int col = Col();
     if (Accept("-")) {
@@ -388,11 +523,11 @@ class Parser {
     std::string s(t_.substr(start, p_ - start));
     if (s == ".") return Error(col, "malformed number '.'");
     // A number directly followed by a letter, digit or '.' is malformed (1.2.3, 3x).
-    if (p_ < t_.size() && (std::isalnum(static_cast<unsigned char>(t_[p_])) || t_[p_] == '.' ||
-                           t_[p_] == '_')) {
+    if (p_ < t_.size() &&
+        (std::isalnum(static_cast<unsigned char>(t_[p_])) || t_[p_] == '.' || t_[p_] == '_')) {
       size_t q = p_;
-      while (q < t_.size() && (std::isalnum(static_cast<unsigned char>(t_[q])) || t_[q] == '.' ||
-                               t_[q] == '_'))
+      while (q < t_.size() &&
+             (std::isalnum(static_cast<unsigned char>(t_[q])) || t_[q] == '.' || t_[q] == '_'))
         ++q;
       return Error(col, "malformed number '" + std::string(t_.substr(start, q - start)) + "'",
                    int(q - start));
@@ -419,8 +554,7 @@ class Parser {
     }
     if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') {
       size_t start = p_;
-      while (p_ < t_.size() &&
-             (std::isalnum(static_cast<unsigned char>(t_[p_])) || t_[p_] == '_'))
+      while (p_ < t_.size() && (std::isalnum(static_cast<unsigned char>(t_[p_])) || t_[p_] == '_'))
         ++p_;
       std::string name(t_.substr(start, p_ - start));
       int len = int(name.size());
@@ -591,8 +725,8 @@ class ExprCompiler {
                    int* maxDepth) {
     struct Frame {
       const Node* node;
-      int depth;      // stack depth the node's value lands at
-      size_t next;    // next child to emit
+      int depth;            // stack depth the node's value lands at
+      size_t next;          // next child to emit
       size_t jump1, jump2;  // instructions to patch
     };
     std::vector<Frame> stack{{&root, 1, 0, 0, 0}};
@@ -605,8 +739,10 @@ class ExprCompiler {
       };
       if (f.depth > *maxDepth) *maxDepth = f.depth;
       if (n.op == OpCode::kConst || n.op == OpCode::kFormal) {
-        if (n.op == OpCode::kConst) push(OpCode::kConst, 0, n.value);
-        else push(OpCode::kFormal, n.slot);
+        if (n.op == OpCode::kConst)
+          push(OpCode::kConst, 0, n.value);
+        else
+          push(OpCode::kFormal, n.slot);
         stack.pop_back();
         continue;
       }

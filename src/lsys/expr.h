@@ -21,23 +21,55 @@
 namespace sylva::lsys {
 
 enum class OpCode : uint8_t {
-  kConst, kFormal,
-  kNeg, kNot, kAdd, kSub, kMul, kDiv, kMod, kPow,
-  kEq, kNe, kLt, kLe, kGt, kGe,
-  kAndJump,   // if top == 0: top = 0 and jump; else pop
-  kOrJump,    // if top != 0: top = 1 and jump; else pop
+  kConst,
+  kFormal,
+  kNeg,
+  kNot,
+  kAdd,
+  kSub,
+  kMul,
+  kDiv,
+  kMod,
+  kPow,
+  kEq,
+  kNe,
+  kLt,
+  kLe,
+  kGt,
+  kGe,
+  kAndJump,  // if top == 0: top = 0 and jump; else pop
+  kOrJump,   // if top != 0: top = 1 and jump; else pop
   kToBool,
   kJumpIfZero,  // pop; jump if zero
   kJump,
-  kSin, kCos, kTan, kAsin, kAcos, kAtan, kAtan2,
-  kSqrt, kExp, kLog, kPowFn, kAbs, kFloor, kCeil, kMin, kMax, kClamp, kSign, kTrunc,
-  kRan, kUniform, kNormal,
+  kSin,
+  kCos,
+  kTan,
+  kAsin,
+  kAcos,
+  kAtan,
+  kAtan2,
+  kSqrt,
+  kExp,
+  kLog,
+  kPowFn,
+  kAbs,
+  kFloor,
+  kCeil,
+  kMin,
+  kMax,
+  kClamp,
+  kSign,
+  kTrunc,
+  kRan,
+  kUniform,
+  kNormal,
 };
 
 struct Instr {  // 16 bytes
   OpCode op;
-  uint32_t arg;     // formal slot or jump target
-  double value;     // constant
+  uint32_t arg;  // formal slot or jump target
+  double value;  // constant
 };
 
 struct EvalError {

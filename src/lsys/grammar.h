@@ -40,14 +40,14 @@ struct Successor {
 inline constexpr int kMaxRightContextNesting = 64;
 
 struct Production {
-  std::vector<FormalModule> left;   // in word order; empty = any
+  std::vector<FormalModule> left;  // in word order; empty = any
   FormalModule pred;
   std::vector<FormalModule> right;  // may contain brackets; empty = any
   uint16_t formalCount = 0;
-  std::optional<Expr> condition;    // none = always true
-  std::optional<Expr> weight;       // none = not stochastic
+  std::optional<Expr> condition;  // none = always true
+  std::optional<Expr> weight;     // none = not stochastic
   Successor successor;
-  SourceLoc loc;                    // of the predecessor (Grammar::SourceLine has its text)
+  SourceLoc loc;  // of the predecessor (Grammar::SourceLine has its text)
   // Columns of the parts, for run-time error messages.
   int conditionColumn = 0, weightColumn = 0;
 
@@ -55,9 +55,9 @@ struct Production {
 };
 
 struct Section {
-  std::vector<Production> productions;                // file order
-  std::vector<std::vector<uint32_t>> bySymbol;        // symbol id -> production indices
-  int maxDepth = 1;                                   // decomposition/interpretation passes
+  std::vector<Production> productions;          // file order
+  std::vector<std::vector<uint32_t>> bySymbol;  // symbol id -> production indices
+  int maxDepth = 1;                             // decomposition/interpretation passes
 
   bool empty() const { return productions.empty(); }
 };
@@ -67,14 +67,14 @@ struct Tropism {
 };
 
 struct Grammar {
-  std::string name;             // `lsystem:` or the file name
-  std::string path;             // main file
+  std::string name;  // `lsystem:` or the file name
+  std::string path;  // main file
   int derivationLength = 0;
-  double angle = 90;            // degrees
+  double angle = 90;  // degrees
   double step = 1;
   double width = 1;
   double widthFactor = 0.7;
-  double widthScale = 1;        // drawing: diameter = width x widthScale (cpfg's pixel widths)
+  double widthScale = 1;  // drawing: diameter = width x widthScale (cpfg's pixel widths)
   std::optional<Tropism> tropism;
   uint64_t seed = 1;
   // `palette: #rrggbb ...`: material colour of each colour index (sRGB as

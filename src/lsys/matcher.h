@@ -45,7 +45,6 @@ inline size_t NextInContext(const WordView& w, size_t j);
 bool MatchLeft(const Production& p, const WordView& w, size_t prev, double* formals);
 bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, double* formals);
 
-
 // --- inline definitions (hot: called once or twice per module) ---
 
 inline size_t PrevInContext(const WordView& w, size_t j) {

@@ -39,16 +39,22 @@ struct ArityUse {
   SourceLoc loc;
 };
 
-bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-bool IsIdentStart(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
-bool IsIdentChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+bool IsSpace(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
+bool IsIdentStart(char c) {
+  return std::isalpha(static_cast<unsigned char>(c)) || c == '_';
+}
+bool IsIdentChar(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+}
 
 // Single-character module names besides letters and digits.
 constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_";
 
 // cpfg's @ commands, longest first where they share a prefix.
 constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS",
-                                            "@PD", "@Ts", "@Sx", "@O", "@o",  "@c",  "@v",
+                                            "@PD", "@Ts", "@Sx", "@O",  "@o",  "@c",  "@v",
                                             "@M",  "@m",  "@R",  "@D",  "@i",  "@L",  "@b"};
 
 std::string Lower(std::string_view s) {
@@ -103,6 +109,12 @@ class GrammarParser {
   // --- parsing ---
   void ParseLine(const Line& l);
   bool ParseHeader(const Line& l, size_t pos);
+  // The statements of ParseHeader with more than a line of work.
+  void ParseAxiom(const Line& l, int col, size_t after, size_t end);
+  void ParseContextNames(const Line& l, size_t after, size_t end, bool ignore);
+  void ParsePalette(const Line& l, int col, size_t after, size_t end);
+  void ParseTropism(const Line& l, size_t after, size_t end);
+  void ParseNumberStatement(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseDefine(const Line& l, size_t pos);
   void ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen);
   bool LexName(const Line& l, size_t& pos, size_t end, std::string* name);
@@ -116,8 +128,8 @@ class GrammarParser {
   };
   bool ParseFormalWord(const Line& l, size_t& pos, size_t end, std::vector<Formal>* out);
   bool ParseConstExpr(const Line& l, size_t pos, size_t end, double* out, Expr* expr = nullptr);
-  bool CheckBrackets(const Line& l, const std::vector<SymbolId>& syms,
-                     const std::vector<int>& cols, const char* what);
+  bool CheckBrackets(const Line& l, const std::vector<SymbolId>& syms, const std::vector<int>& cols,
+                     const char* what);
   std::optional<SymbolId> Intern(const Line& l, int col, const std::string& name, int arity);
   void Finish();
   void WarnUnmatchable();
@@ -250,8 +262,10 @@ void GrammarParser::Preprocess(std::shared_ptr<const std::string> shared, const 
       std::string name = t.substr(q + 1, e - q - 1);
       int col = int(q) + 1, len = int(e - q) + 1;
       if (name.empty() || name.find('\0') != std::string::npos) {
-        Error(l, col, name.empty() ? "empty file name after #include"
-                                   : "#include file name contains a NUL byte", len);
+        Error(l, col,
+              name.empty() ? "empty file name after #include"
+                           : "#include file name contains a NUL byte",
+              len);
         continue;
       }
       std::filesystem::path target(name);
@@ -266,8 +280,9 @@ void GrammarParser::Preprocess(std::shared_ptr<const std::string> shared, const 
         continue;
       }
       if (filesIncluded_ >= kMaxIncludedFiles) {
-        Error(l, col, "more than " + std::to_string(kMaxIncludedFiles) +
-                          " #include files in one grammar", len);
+        Error(l, col,
+              "more than " + std::to_string(kMaxIncludedFiles) + " #include files in one grammar",
+              len);
         continue;
       }
       ++filesIncluded_;
@@ -278,8 +293,10 @@ void GrammarParser::Preprocess(std::shared_ptr<const std::string> shared, const 
         continue;
       }
       if (bytesRead_ + content->size() > opt_.maxTotalBytes) {
-        Error(l, col, "#include of '" + resolved + "' goes past the limit of " +
-                          SizeText(opt_.maxTotalBytes) + " read for one grammar", len);
+        Error(l, col,
+              "#include of '" + resolved + "' goes past the limit of " +
+                  SizeText(opt_.maxTotalBytes) + " read for one grammar",
+              len);
         continue;
       }
       stack.push_back(resolved);
@@ -344,7 +361,8 @@ bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string*
     Error(l, int(pos) + 1, "expected a query letter after '?' (?P, ?H, ?L, ?U)");
     return false;
   }
-  if (std::isalnum(static_cast<unsigned char>(c)) || kModuleChars.find(c) != std::string_view::npos) {
+  if (std::isalnum(static_cast<unsigned char>(c)) ||
+      kModuleChars.find(c) != std::string_view::npos) {
     *name = std::string(1, c);
     ++pos;
     return true;
@@ -362,8 +380,8 @@ bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string*
 std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std::string& name,
                                               int arity) {
   if (arity > kMaxArity) {
-    Error(l, col, "module '" + name + "' has more than " + std::to_string(kMaxArity) +
-                      " parameters");
+    Error(l, col,
+          "module '" + name + "' has more than " + std::to_string(kMaxArity) + " parameters");
     return std::nullopt;
   }
   if ((name == "[" || name == "]" || name == "%") && arity > 0) {
@@ -460,7 +478,8 @@ bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const
     if (!id) return false;
     out->symbols.push_back(*id);
     cols.push_back(col);
-    if (g_.symbolLoc.find(name) == g_.symbolLoc.end()) g_.symbolLoc.emplace(name, Grammar::Use{Loc(l, col)});
+    if (g_.symbolLoc.find(name) == g_.symbolLoc.end())
+      g_.symbolLoc.emplace(name, Grammar::Use{Loc(l, col)});
   }
   return CheckBrackets(l, out->symbols, cols, "word");
 }
@@ -559,8 +578,9 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     return;
   }
   if (defines_.count(name)) {
-    Error(l, col, "redefinition of '" + name + "' (first defined at line " +
-                      std::to_string(defines_[name].loc.line) + ")",
+    Error(l, col,
+          "redefinition of '" + name + "' (first defined at line " +
+              std::to_string(defines_[name].loc.line) + ")",
           int(name.size()));
     return;
   }
@@ -581,14 +601,160 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
 }
 
 // Header statements: "keyword:" at the start of a line, case-insensitive.
+void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end) {
+  if (haveAxiom_) {
+    Error(l, col, "second axiom (the first is at line " + std::to_string(axiomLoc_.line) + ")", 5);
+    return;
+  }
+  ExprScope scope{&g_.constants, &usedConstants_, nullptr};
+  Successor s;
+  if (!ParseActualWord(l, after, end, scope, &s)) return;
+  if (s.symbols.empty()) {
+    Error(l, col, "empty axiom", 5);
+    return;
+  }
+  haveAxiom_ = true;
+  axiomLoc_ = Loc(l, int(after) + 1);
+  axiom_ = std::move(s);
+  return;
+}
+
+void GrammarParser::ParseContextNames(const Line& l, size_t after, size_t end, bool ignore) {
+  const std::string& t = l.text;
+  (ignore ? haveIgnore_ : haveConsider_) = true;
+  size_t p = after;
+  while (p < end) {
+    if (IsSpace(t[p])) {
+      ++p;
+      continue;
+    }
+    int c = int(p) + 1;
+    std::string name;
+    if (!LexName(l, p, end, &name)) return;
+    if (name == "[" || name == "]") {
+      Error(l, c,
+            "brackets cannot be " + std::string(ignore ? "ignored" : "considered") +
+                ": they give the branching structure");
+      return;
+    }
+    (ignore ? ignoreNames_ : considerNames_).insert(name);
+  }
+  return;
+}
+
+void GrammarParser::ParsePalette(const Line& l, int col, size_t after, size_t end) {
+  const std::string& t = l.text;
+  size_t q = after;
+  g_.palette.clear();
+  while (q < end) {
+    while (q < end && (IsSpace(t[q]) || t[q] == ',')) ++q;
+    if (q >= end) break;
+    size_t s0 = q;
+    while (q < end && !IsSpace(t[q]) && t[q] != ',') ++q;
+    std::string tok = t.substr(s0, q - s0);
+    bool ok = tok.size() == 7 && tok[0] == '#';
+    for (size_t i = 1; ok && i < 7; ++i) ok = std::isxdigit(static_cast<unsigned char>(tok[i]));
+    if (!ok) {
+      Error(l, int(s0) + 1, "expected a colour as #rrggbb in 'palette:'", int(tok.size()));
+      return;
+    }
+    std::array<float, 3> c;
+    for (int i = 0; i < 3; ++i)
+      c[size_t(i)] = float(std::stoi(tok.substr(1 + 2 * size_t(i), 2), nullptr, 16)) / 255.0f;
+    g_.palette.push_back(c);
+  }
+  if (g_.palette.empty()) Error(l, col, "'palette:' needs at least one colour", 8);
+  return;
+}
+
+void GrammarParser::ParseTropism(const Line& l, size_t after, size_t end) {
+  const std::string& t = l.text;
+  // Four numbers separated by commas or spaces.
+  std::vector<std::pair<size_t, size_t>> parts;
+  bool commas = t.find(',', after) < end;
+  size_t p = after;
+  while (p < end) {
+    while (p < end && (IsSpace(t[p]) || (commas && t[p] == ','))) ++p;
+    if (p >= end) break;
+    size_t s = p;
+    if (commas) {
+      while (p < end && t[p] != ',') ++p;
+    } else {
+      while (p < end && !IsSpace(t[p])) ++p;
+    }
+    parts.emplace_back(s, p);
+  }
+  if (parts.size() != 4) {
+    Error(l, int(after) + 1, "tropism needs four numbers: X Y Z susceptibility");
+    return;
+  }
+  double v[4];
+  for (int i = 0; i < 4; ++i) {
+    if (!ParseConstExpr(l, parts[i].first, parts[i].second, &v[i])) return;
+  }
+  if (v[0] == 0 && v[1] == 0 && v[2] == 0) {
+    Error(l, int(after) + 1, "tropism vector is zero");
+    return;
+  }
+  g_.tropism = Tropism{v[0], v[1], v[2], v[3]};
+  return;
+}
+
+void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, size_t after,
+                                         size_t end) {
+  double v;
+  if (!ParseConstExpr(l, after, end, &v)) return;
+  int vcol = int(after) + 1;
+  if (k == "derivation length") {
+    if (v != std::floor(v) || v < 0 || v > kMaxDerivationLength) {
+      Error(l, vcol,
+            "derivation length must be a whole number from 0 to " +
+                std::to_string(kMaxDerivationLength));
+      return;
+    }
+    g_.derivationLength = int(v);
+  } else if (k == "angle") {
+    g_.angle = v;
+  } else if (k == "step") {
+    g_.step = v;
+  } else if (k == "width") {
+    g_.width = v;
+  } else if (k == "width factor") {
+    g_.widthFactor = v;
+  } else if (k == "width scale") {
+    if (!(v > 0)) {
+      Error(l, vcol, "width scale must be positive");
+      return;
+    }
+    g_.widthScale = v;
+  } else if (k == "seed") {
+    if (v != std::floor(v) || v < 0 || v > 18446744073709549568.0) {
+      Error(l, vcol, "seed must be a whole number >= 0");
+      return;
+    }
+    g_.seed = uint64_t(v);
+  }
+}
+
 bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
-  static const char* kKeywords[] = {"derivation length", "width factor", "width scale",
+  static const char* kKeywords[] = {"derivation length",
+                                    "width factor",
+                                    "width scale",
                                     "maximum depth",
-                                    "lsystem",           "axiom",        "angle",
-                                    "step",              "width",        "tropism",
-                                    "seed",              "ignore",       "consider",
-                                    "module",            "decomposition", "interpretation",
-                                    "homomorphism",      "endlsystem",
+                                    "lsystem",
+                                    "axiom",
+                                    "angle",
+                                    "step",
+                                    "width",
+                                    "tropism",
+                                    "seed",
+                                    "ignore",
+                                    "consider",
+                                    "module",
+                                    "decomposition",
+                                    "interpretation",
+                                    "homomorphism",
+                                    "endlsystem",
                                     "palette"};
   const std::string& t = l.text;
   std::string lower = Lower(t.substr(pos, 20));
@@ -627,9 +793,9 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
   bool inMain = section_ == &g_.main;
   auto mainOnly = [&]() {
     if (inMain) return true;
-    Error(l, col, "'" + k + ":' belongs before the productions, not in a " +
-                      (section_ == &g_.decomposition ? "decomposition" : "interpretation") +
-                      " section",
+    Error(l, col,
+          "'" + k + ":' belongs before the productions, not in a " +
+              (section_ == &g_.decomposition ? "decomposition" : "interpretation") + " section",
           int(k.size()));
     return false;
   };
@@ -667,128 +833,22 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
   }
   if (!mainOnly()) return true;
   if (k == "axiom") {
-    if (haveAxiom_) {
-      Error(l, col, "second axiom (the first is at line " + std::to_string(axiomLoc_.line) + ")",
-            5);
-      return true;
-    }
-    ExprScope scope{&g_.constants, &usedConstants_, nullptr};
-    Successor s;
-    if (!ParseActualWord(l, after, end, scope, &s)) return true;
-    if (s.symbols.empty()) {
-      Error(l, col, "empty axiom", 5);
-      return true;
-    }
-    haveAxiom_ = true;
-    axiomLoc_ = Loc(l, int(after) + 1);
-    axiom_ = std::move(s);
+    ParseAxiom(l, col, after, end);
     return true;
   }
   if (k == "ignore" || k == "consider") {
-    bool ignore = k == "ignore";
-    (ignore ? haveIgnore_ : haveConsider_) = true;
-    size_t p = after;
-    while (p < end) {
-      if (IsSpace(t[p])) {
-        ++p;
-        continue;
-      }
-      int c = int(p) + 1;
-      std::string name;
-      if (!LexName(l, p, end, &name)) return true;
-      if (name == "[" || name == "]") {
-        Error(l, c, "brackets cannot be " + std::string(ignore ? "ignored" : "considered") +
-                        ": they give the branching structure");
-        return true;
-      }
-      (ignore ? ignoreNames_ : considerNames_).insert(name);
-    }
+    ParseContextNames(l, after, end, k == "ignore");
     return true;
   }
   if (k == "palette") {
-    size_t q = after;
-    g_.palette.clear();
-    while (q < end) {
-      while (q < end && (IsSpace(t[q]) || t[q] == ',')) ++q;
-      if (q >= end) break;
-      size_t s0 = q;
-      while (q < end && !IsSpace(t[q]) && t[q] != ',') ++q;
-      std::string tok = t.substr(s0, q - s0);
-      bool ok = tok.size() == 7 && tok[0] == '#';
-      for (size_t i = 1; ok && i < 7; ++i) ok = std::isxdigit(static_cast<unsigned char>(tok[i]));
-      if (!ok) {
-        Error(l, int(s0) + 1, "expected a colour as #rrggbb in 'palette:'", int(tok.size()));
-        return true;
-      }
-      std::array<float, 3> c;
-      for (int i = 0; i < 3; ++i) c[size_t(i)] = float(std::stoi(tok.substr(1 + 2 * size_t(i), 2), nullptr, 16)) / 255.0f;
-      g_.palette.push_back(c);
-    }
-    if (g_.palette.empty()) Error(l, col, "'palette:' needs at least one colour", 8);
+    ParsePalette(l, col, after, end);
     return true;
   }
   if (k == "tropism") {
-    // Four numbers separated by commas or spaces.
-    std::vector<std::pair<size_t, size_t>> parts;
-    bool commas = t.find(',', after) < end;
-    size_t p = after;
-    while (p < end) {
-      while (p < end && (IsSpace(t[p]) || (commas && t[p] == ','))) ++p;
-      if (p >= end) break;
-      size_t s = p;
-      if (commas) {
-        while (p < end && t[p] != ',') ++p;
-      } else {
-        while (p < end && !IsSpace(t[p])) ++p;
-      }
-      parts.emplace_back(s, p);
-    }
-    if (parts.size() != 4) {
-      Error(l, int(after) + 1, "tropism needs four numbers: X Y Z susceptibility");
-      return true;
-    }
-    double v[4];
-    for (int i = 0; i < 4; ++i) {
-      if (!ParseConstExpr(l, parts[i].first, parts[i].second, &v[i])) return true;
-    }
-    if (v[0] == 0 && v[1] == 0 && v[2] == 0) {
-      Error(l, int(after) + 1, "tropism vector is zero");
-      return true;
-    }
-    g_.tropism = Tropism{v[0], v[1], v[2], v[3]};
+    ParseTropism(l, after, end);
     return true;
   }
-  double v;
-  if (!ParseConstExpr(l, after, end, &v)) return true;
-  int vcol = int(after) + 1;
-  if (k == "derivation length") {
-    if (v != std::floor(v) || v < 0 || v > kMaxDerivationLength) {
-      Error(l, vcol, "derivation length must be a whole number from 0 to " +
-                         std::to_string(kMaxDerivationLength));
-      return true;
-    }
-    g_.derivationLength = int(v);
-  } else if (k == "angle") {
-    g_.angle = v;
-  } else if (k == "step") {
-    g_.step = v;
-  } else if (k == "width") {
-    g_.width = v;
-  } else if (k == "width factor") {
-    g_.widthFactor = v;
-  } else if (k == "width scale") {
-    if (!(v > 0)) {
-      Error(l, vcol, "width scale must be positive");
-      return true;
-    }
-    g_.widthScale = v;
-  } else if (k == "seed") {
-    if (v != std::floor(v) || v < 0 || v > 18446744073709549568.0) {
-      Error(l, vcol, "seed must be a whole number >= 0");
-      return true;
-    }
-    g_.seed = uint64_t(v);
-  }
+  ParseNumberStatement(l, k, after, end);
   return true;
 }
 
@@ -796,8 +856,10 @@ static size_t FindTopLevel(const std::string& t, size_t from, size_t to, std::st
   int depth = 0;
   for (size_t i = from; i < to; ++i) {
     char c = t[i];
-    if (c == '(') ++depth;
-    else if (c == ')') --depth;
+    if (c == '(')
+      ++depth;
+    else if (c == ')')
+      --depth;
     else if (depth == 0 && c == what[0] && i + what.size() <= to &&
              t.compare(i, what.size(), what) == 0)
       return i;
@@ -816,7 +878,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   std::vector<Formal> w1, w2, w3;
   size_t q = pos;
   if (!ParseFormalWord(l, q, ctxEnd, &w1)) return;
-  std::vector<Formal> *left = nullptr, *pred = &w1, *right = nullptr;
+  std::vector<Formal>*left = nullptr, *pred = &w1, *right = nullptr;
   if (q < ctxEnd && t[q] == '<') {
     ++q;
     left = &w1;
@@ -834,8 +896,9 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   }
   if (pred->size() != 1 || (*pred)[0].wildcard) {
     int c = pred->empty() ? int(pos) + 1 : (*pred)[0].column;
-    Error(l, c, pred->empty() ? "production has no predecessor"
-                              : "the predecessor must be exactly one module");
+    Error(l, c,
+          pred->empty() ? "production has no predecessor"
+                        : "the predecessor must be exactly one module");
     return;
   }
   auto isWildcard = [](const std::vector<Formal>* w) {
@@ -901,8 +964,9 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     for (size_t k = 0; k < syms.size(); ++k) {
       depth += syms[k] == kOpenBracket ? 1 : (syms[k] == kCloseBracket ? -1 : 0);
       if (depth > kMaxRightContextNesting) {
-        Error(l, cols[k], "right context nested deeper than " +
-                              std::to_string(kMaxRightContextNesting) + " brackets");
+        Error(l, cols[k],
+              "right context nested deeper than " + std::to_string(kMaxRightContextNesting) +
+                  " brackets");
         return;
       }
     }
@@ -952,8 +1016,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   size_t s1 = succEnd;
   while (s1 > s0 && IsSpace(t[s1 - 1])) --s1;
   if (s0 >= s1) {
-    Error(l, int(arrow) + 1, "empty successor (write '*' for the empty word)",
-          int(arrowLen));
+    Error(l, int(arrow) + 1, "empty successor (write '*' for the empty word)", int(arrowLen));
     return;
   }
   if (!(s1 == s0 + 1 && t[s0] == '*')) {
@@ -988,8 +1051,8 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   }
   p.loc = Loc(l, pf.column);
   if (section_->productions.size() >= kMaxProductionsPerSection) {
-    Error(l, pf.column, "more than " + std::to_string(kMaxProductionsPerSection) +
-                            " productions in one section");
+    Error(l, pf.column,
+          "more than " + std::to_string(kMaxProductionsPerSection) + " productions in one section");
     return;
   }
   section_->productions.push_back(std::move(p));

@@ -26,7 +26,9 @@ inline float LinearToSrgb(float c) {
 inline Vec3f Srgb(float r, float g, float b) {
   return Vec3f(SrgbToLinear(r), SrgbToLinear(g), SrgbToLinear(b));
 }
-inline Vec3f Srgb(const Vec3f& c) { return Srgb(c.x(), c.y(), c.z()); }
+inline Vec3f Srgb(const Vec3f& c) {
+  return Srgb(c.x(), c.y(), c.z());
+}
 
 // A linear colour as sRGB (0..1 a channel).
 inline Vec3f ToSrgb(const Vec3f& c) {

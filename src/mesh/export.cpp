@@ -174,15 +174,15 @@ Status WritePly(const TriangleMesh& m, const Palette& palette, const std::string
   }
   AtomicFile f;
   if (Status s = f.Open(path); !s.ok()) return s;
-  std::string header =
-      "ply\nformat binary_little_endian 1.0\ncomment Sylva mesh\nelement vertex " +
-      std::to_string(m.vertexCount()) +
-      "\nproperty float x\nproperty float y\nproperty float z\n"
-      "property float nx\nproperty float ny\nproperty float nz\n"
-      "property float s\nproperty float t\n"
-      "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-      "element face " +
-      std::to_string(m.triangleCount()) + "\nproperty list uchar uint vertex_indices\nend_header\n";
+  std::string header = "ply\nformat binary_little_endian 1.0\ncomment Sylva mesh\nelement vertex " +
+                       std::to_string(m.vertexCount()) +
+                       "\nproperty float x\nproperty float y\nproperty float z\n"
+                       "property float nx\nproperty float ny\nproperty float nz\n"
+                       "property float s\nproperty float t\n"
+                       "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                       "element face " +
+                       std::to_string(m.triangleCount()) +
+                       "\nproperty list uchar uint vertex_indices\nend_header\n";
   if (Status s = f.Write(header); !s.ok()) return s;
   static_assert(sizeof(float) == 4);
   // 8-bit vertex colours are sRGB; one conversion a palette entry.
@@ -235,10 +235,14 @@ Status WriteMesh(const TriangleMesh& m, const Palette& palette, const std::strin
     return d;
   }
   switch (*format) {
-    case MeshFormat::kObj: return WriteObj(m, palette, path);
-    case MeshFormat::kPly: return WritePly(m, palette, path);
-    case MeshFormat::kGlb: return WriteGltf(m, palette, path, true);
-    case MeshFormat::kGltf: return WriteGltf(m, palette, path, false);
+    case MeshFormat::kObj:
+      return WriteObj(m, palette, path);
+    case MeshFormat::kPly:
+      return WritePly(m, palette, path);
+    case MeshFormat::kGlb:
+      return WriteGltf(m, palette, path, true);
+    case MeshFormat::kGltf:
+      return WriteGltf(m, palette, path, false);
   }
   return {};
 }

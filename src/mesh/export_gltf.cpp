@@ -81,11 +81,13 @@ tinygltf::Model BuildModel(const TriangleMesh& m, const Palette& palette,
       lo = lo.cwiseMin(p);
       hi = hi.cwiseMax(p);
     }
-    base.attributes["POSITION"] = accessor(
-        view(layout.positions, nv * 12, TINYGLTF_TARGET_ARRAY_BUFFER), TINYGLTF_COMPONENT_TYPE_FLOAT,
-        nv, TINYGLTF_TYPE_VEC3, {lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()});
-    base.attributes["NORMAL"] = accessor(view(layout.normals, nv * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
-                                         TINYGLTF_COMPONENT_TYPE_FLOAT, nv, TINYGLTF_TYPE_VEC3);
+    base.attributes["POSITION"] =
+        accessor(view(layout.positions, nv * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                 TINYGLTF_COMPONENT_TYPE_FLOAT, nv, TINYGLTF_TYPE_VEC3, {lo.x(), lo.y(), lo.z()},
+                 {hi.x(), hi.y(), hi.z()});
+    base.attributes["NORMAL"] =
+        accessor(view(layout.normals, nv * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                 TINYGLTF_COMPONENT_TYPE_FLOAT, nv, TINYGLTF_TYPE_VEC3);
     base.attributes["TEXCOORD_0"] = accessor(view(layout.uvs, nv * 8, TINYGLTF_TARGET_ARRAY_BUFFER),
                                              TINYGLTF_COMPONENT_TYPE_FLOAT, nv, TINYGLTF_TYPE_VEC2);
   }
@@ -102,13 +104,15 @@ tinygltf::Model BuildModel(const TriangleMesh& m, const Palette& palette,
     }
     const size_t count = size_t(groups.starts[k + 1] - groups.starts[k]) * 3;
     tinygltf::Primitive prim = base;
-    prim.indices = accessor(view(layout.indexOffset[k], count * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
-                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, count, TINYGLTF_TYPE_SCALAR,
-                            {double(lo)}, {double(hi)});
+    prim.indices =
+        accessor(view(layout.indexOffset[k], count * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                 TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, count, TINYGLTF_TYPE_SCALAR, {double(lo)},
+                 {double(hi)});
     tinygltf::Material mat;
     const uint16_t ci = groups.materials[k];
     mat.name = "color" + std::to_string(ci);
-    const Vec3f c = palette.empty() ? Srgb(0.8f, 0.8f, 0.8f) : palette[ci % palette.size()];  // linear, as glTF wants
+    const Vec3f c = palette.empty() ? Srgb(0.8f, 0.8f, 0.8f)
+                                    : palette[ci % palette.size()];  // linear, as glTF wants
     mat.pbrMetallicRoughness.baseColorFactor = {c.x(), c.y(), c.z(), 1.0};
     mat.pbrMetallicRoughness.metallicFactor = 0.0;
     mat.pbrMetallicRoughness.roughnessFactor = 0.9;
@@ -200,7 +204,8 @@ Status WriteGltf(const TriangleMesh& m, const Palette& palette, const std::strin
     model.buffers.push_back(placeholder);
   }
   std::ostringstream stream;
-  if (!writer.WriteGltfSceneToStream(&model, stream, false, false)) return SerialisationFailed(path);
+  if (!writer.WriteGltfSceneToStream(&model, stream, false, false))
+    return SerialisationFailed(path);
   nlohmann::json doc = nlohmann::json::parse(stream.str(), nullptr, false);
   if (doc.is_discarded()) return SerialisationFailed(path);
   if (layout.total > 0) doc["buffers"] = nlohmann::json::array({{{"byteLength", layout.total}}});

@@ -27,17 +27,17 @@ struct Segment {
   Vec3 left;                 // turtle L at the start; H is (end - start) normalised
   float radiusStart = 0.5f;  // half the turtle width at the start and the end
   float radiusEnd = 0.5f;
-  uint32_t branch = 0;       // id of the branch (a `[`...`]` span) it belongs to
-  uint32_t parent = 0;       // branch that this branch grew from (itself for the trunk)
-  uint16_t depth = 0;        // bracket nesting depth
-  uint16_t color = 0;        // colour index
-  uint32_t module = 0;       // index of the module that drew it
+  uint32_t branch = 0;  // id of the branch (a `[`...`]` span) it belongs to
+  uint32_t parent = 0;  // branch that this branch grew from (itself for the trunk)
+  uint16_t depth = 0;   // bracket nesting depth
+  uint16_t color = 0;   // colour index
+  uint32_t module = 0;  // index of the module that drew it
 };
 
 struct Polygon {
   std::vector<Vec3> vertices;  // in drawing order; not closed (first != last)
   uint16_t color = 0;
-  uint32_t module = 0;         // the `{` that opened it
+  uint32_t module = 0;  // the `{` that opened it
 };
 
 struct SurfaceInstance {

@@ -1,8 +1,8 @@
 #include "mesh/tessellator.h"
 
 #include <algorithm>
-#include <type_traits>
 #include <cmath>
+#include <type_traits>
 
 #include "core/memory.h"
 
@@ -14,14 +14,18 @@ constexpr double kTwoPi = 6.283185307179586476925;
 // adds at most 3).
 constexpr uint64_t kMaxIndexedTriangles = (uint64_t(1) << 32) / 3 - 1;
 
-Vec3f F(const Vec3& v) { return v.cast<float>(); }
+Vec3f F(const Vec3& v) {
+  return v.cast<float>();
+}
 
 Vec3 AnyPerpendicular(const Vec3& t) {
   Vec3 a = std::abs(t.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
   return (a - t * t.dot(a)).normalized();
 }
 
-int ClampSides(int s) { return std::clamp(s, 3, 256); }
+int ClampSides(int s) {
+  return std::clamp(s, 3, 256);
+}
 
 // Builds chains: runs of segments of one branch where each starts where the
 // previous ended.
@@ -125,10 +129,14 @@ void TessellateChain(const PlantGeometry& g, const std::vector<uint32_t>& chain,
   for (size_t k = 0; k < m; ++k) {
     const uint16_t sm = g.segments[chain[k]].color;
     for (int j = 0; j < S; ++j) {
-      const uint32_t a = base + uint32_t(k * ring) + uint32_t(j), b = a + 1,
-                     d = a + uint32_t(ring), c = d + 1;
-      idx[0] = a; idx[1] = b; idx[2] = c;
-      idx[3] = a; idx[4] = c; idx[5] = d;
+      const uint32_t a = base + uint32_t(k * ring) + uint32_t(j), b = a + 1, d = a + uint32_t(ring),
+                     c = d + 1;
+      idx[0] = a;
+      idx[1] = b;
+      idx[2] = c;
+      idx[3] = a;
+      idx[4] = c;
+      idx[5] = d;
       idx += 6;
       *mat++ = sm;
       *mat++ = sm;
@@ -236,15 +244,18 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     const uint64_t S = uint64_t(detailFor(s.center, s.radius)), R = std::max<uint64_t>(2, S / 2);
     total += S * (2 * R - 2);
   }
-  for (const Polygon& poly : g.polygons) total += poly.vertices.size() >= 3 ? poly.vertices.size() - 2 : 0;
-  for (const SurfaceInstance& si : g.surfaces) total += options.surfaces->at(si.name).triangleCount();
+  for (const Polygon& poly : g.polygons)
+    total += poly.vertices.size() >= 3 ? poly.vertices.size() - 2 : 0;
+  for (const SurfaceInstance& si : g.surfaces)
+    total += options.surfaces->at(si.name).triangleCount();
   const uint64_t limit = std::min<uint64_t>(options.maxTriangles, kMaxIndexedTriangles);
   if (out.triangleCount() + total > limit) {
     Diagnostic d;
     d.kind = ErrorKind::kRuntime;
-    d.message = "the mesh would have " + std::to_string(out.triangleCount() + total) +
-                " triangles, more than the limit of " + std::to_string(limit) +
-                "; lower the derivation length (-n) or the sides (--sides), or raise --max-triangles";
+    d.message =
+        "the mesh would have " + std::to_string(out.triangleCount() + total) +
+        " triangles, more than the limit of " + std::to_string(limit) +
+        "; lower the derivation length (-n) or the sides (--sides), or raise --max-triangles";
     return d;
   }
   auto grow = [](auto& v, size_t extra) {
@@ -274,8 +285,9 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     if (polyTris.empty()) {
       if (stats) {
         ++stats->polygonsSkipped;
-        stats->warnings.push_back("polygon at module " + std::to_string(poly.module + 1) +
-                                  " is degenerate, crosses itself or is too complex to triangulate; skipped");
+        stats->warnings.push_back(
+            "polygon at module " + std::to_string(poly.module + 1) +
+            " is degenerate, crosses itself or is too complex to triangulate; skipped");
       }
       continue;
     }
@@ -295,7 +307,8 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
       out.uvs.push_back(q.cast<float>());
     }
     for (size_t t = 0; t < polyTris.size(); t += 3) {
-      out.indices.insert(out.indices.end(), {base + polyTris[t], base + polyTris[t + 1], base + polyTris[t + 2]});
+      out.indices.insert(out.indices.end(),
+                         {base + polyTris[t], base + polyTris[t + 1], base + polyTris[t + 2]});
       out.material.push_back(poly.color);
     }
   }

@@ -53,7 +53,7 @@ constexpr size_t TubeTriangles(size_t segments, int sides) {
 inline constexpr uint64_t kDefaultMaxTriangles = uint64_t(1) << 26;
 
 struct TessellateOptions {
-  Detail detail;     // used when detailFn is empty
+  Detail detail;  // used when detailFn is empty
   DetailFn detailFn;
   // The mesh this call appends may not exceed this many triangles; the
   // count is made before any memory is allocated.
@@ -73,7 +73,5 @@ struct TessellateStats {
 // error with the count).
 Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
                   TessellateStats* stats = nullptr);
-
-
 
 }  // namespace sylva::mesh

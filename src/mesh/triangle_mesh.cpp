@@ -36,7 +36,8 @@ std::string FindNonFinite(const TriangleMesh& m) {
   // allFinite() is false for NaN and infinity in any component.
   auto bad = [&](const auto& array, const char* what) -> std::string {
     for (size_t i = 0; i < array.size(); ++i) {
-      if (!array[i].allFinite()) return std::string(what) + " of vertex " + std::to_string(i) + " is not finite";
+      if (!array[i].allFinite())
+        return std::string(what) + " of vertex " + std::to_string(i) + " is not finite";
     }
     return {};
   };
@@ -58,7 +59,8 @@ std::string Validate(const TriangleMesh& m, float areaEpsilon) {
   }
   for (size_t t = 0; t < m.triangleCount(); ++t) {
     const uint32_t a = m.indices[3 * t], b = m.indices[3 * t + 1], c = m.indices[3 * t + 2];
-    if (a >= n || b >= n || c >= n) return "triangle " + std::to_string(t) + " has an index out of range";
+    if (a >= n || b >= n || c >= n)
+      return "triangle " + std::to_string(t) + " has an index out of range";
     const Eigen::Vector3d pa = m.positions[a].cast<double>(), pb = m.positions[b].cast<double>(),
                           pc = m.positions[c].cast<double>();
     const double area = 0.5 * (pb - pa).cross(pc - pa).norm();

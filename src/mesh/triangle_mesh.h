@@ -17,10 +17,10 @@ using Vec2f = Eigen::Vector2f;
 
 struct TriangleMesh {
   std::vector<Vec3f> positions;
-  std::vector<Vec3f> normals;          // unit, one per vertex
-  std::vector<Vec2f> uvs;              // one per vertex
-  std::vector<uint32_t> indices;       // 3 per triangle, counter-clockwise seen from outside
-  std::vector<uint16_t> material;      // one per triangle
+  std::vector<Vec3f> normals;      // unit, one per vertex
+  std::vector<Vec2f> uvs;          // one per vertex
+  std::vector<uint32_t> indices;   // 3 per triangle, counter-clockwise seen from outside
+  std::vector<uint16_t> material;  // one per triangle
 
   size_t vertexCount() const { return positions.size(); }
   size_t triangleCount() const { return indices.size() / 3; }

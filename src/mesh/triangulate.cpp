@@ -101,14 +101,16 @@ class ReflexGrid {
         xmin = lo.x();
         xmax = hi.x();
       }
-      const int xa = std::max(x0, Coord(xmin, 0, nx_) - 1), xb = std::min(x1, Coord(xmax, 0, nx_) + 1);
+      const int xa = std::max(x0, Coord(xmin, 0, nx_) - 1),
+                xb = std::min(x1, Coord(xmax, 0, nx_) + 1);
       for (int x = xa; x <= xb; ++x) {
         for (uint32_t q : cells_[size_t(y) * size_t(nx_) + size_t(x)]) {
           ++*work;
           if (q == a || q == b || q == c) continue;
           const Vec2& pq = p_[q];
           if (pq.x() < lo.x() || pq.x() > hi.x() || pq.y() < lo.y() || pq.y() > hi.y()) continue;
-          if (Cross(pa, pb, pq) >= 0 && Cross(pb, pc, pq) >= 0 && Cross(pc, pa, pq) >= 0) return true;
+          if (Cross(pa, pb, pq) >= 0 && Cross(pb, pc, pq) >= 0 && Cross(pc, pa, pq) >= 0)
+            return true;
         }
       }
     }
@@ -234,7 +236,8 @@ std::vector<uint32_t> TriangulatePolygon(const std::vector<Vec3>& in, Vec3* norm
     queued[ear] = 0;
     if (removed[ear]) continue;
     const uint32_t a = prev[ear], c = next[ear];
-    if (reflex[ear] || !(Cross(p[a], p[ear], p[c]) > eps) || grid.AnyInside(a, ear, c, &work)) continue;
+    if (reflex[ear] || !(Cross(p[a], p[ear], p[c]) > eps) || grid.AnyInside(a, ear, c, &work))
+      continue;
     tris.insert(tris.end(), {a, ear, c});
     remove(ear);
     update(a);

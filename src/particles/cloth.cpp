@@ -35,7 +35,8 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
   w_.assign(n, double(n) / def_.mass);
   for (int r = 0; r < nr; ++r)
     for (int c = 0; c < nc; ++c)
-      x_[size_t(Index(c, r))] = def_.origin + def_.u * (double(c) / (nc - 1)) + def_.v * (double(r) / (nr - 1));
+      x_[size_t(Index(c, r))] =
+          def_.origin + def_.u * (double(c) / (nc - 1)) + def_.v * (double(r) / (nr - 1));
   for (int p : def_.pinned) {
     if (p >= 0 && size_t(p) < n) w_[size_t(p)] = 0;
   }
@@ -114,11 +115,13 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
     implicit_ = std::make_unique<System>(def_.threads);
     implicit_->cgMaxIterations = std::max(1, def_.cgIterations);
     implicit_->cgTolerance = 1e-12;
-    for (size_t i = 0; i < n; ++i) implicit_->state.Add(x_[i], Vec3::Zero(), w_[i] > 0 ? 1 / w_[i] : 0);
+    for (size_t i = 0; i < n; ++i)
+      implicit_->state.Add(x_[i], Vec3::Zero(), w_[i] > 0 ? 1 / w_[i] : 0);
     auto springs = std::make_shared<Springs>();
     for (const Constraint& c : constraints_) {
       springs->Add(c.a, c.b, c.rest,
-                   c.compliance > 0 ? std::min(1 / c.compliance, def_.implicitStiffness) : def_.implicitStiffness,
+                   c.compliance > 0 ? std::min(1 / c.compliance, def_.implicitStiffness)
+                                    : def_.implicitStiffness,
                    def_.implicitDamping);
     }
     implicit_->AddForce(springs);
@@ -164,7 +167,7 @@ void Cloth::AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& 
       auto cell = [&](int cc, int rr) { return 2 * (size_t(rr) * size_t(nc - 1) + size_t(cc)); };
       Vec3 sum = Vec3::Zero();
       if (c + 1 < nc && r + 1 < nr) sum += triForce_[cell(c, r)];  // as a
-      if (c > 0 && r + 1 < nr) {                                     // as b
+      if (c > 0 && r + 1 < nr) {                                   // as b
         const size_t k = cell(c - 1, r);
         sum += triForce_[k] + triForce_[k + 1];
       }
@@ -259,12 +262,13 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
       for (size_t c = 0; c + 1 < colorStart_.size(); ++c) {
         const size_t first = colorStart_[c], count = colorStart_[c + 1] - first;
         if (lastColourShared_ && c + 2 == colorStart_.size()) {
-          xpbd::ProjectRange(xpbd::Kernel::kScalar, it == 0, keepLambda, proj_.data(), lambda_.data(), x, first,
-                             first + count);
+          xpbd::ProjectRange(xpbd::Kernel::kScalar, it == 0, keepLambda, proj_.data(),
+                             lambda_.data(), x, first, first + count);
           continue;
         }
         ForRanges(pool, count, BalancedGrain(pool, count, 256, 4096), [&](size_t b, size_t e) {
-          xpbd::ProjectRange(kernel_, it == 0, keepLambda, proj_.data(), lambda_.data(), x, first + b, first + e);
+          xpbd::ProjectRange(kernel_, it == 0, keepLambda, proj_.data(), lambda_.data(), x,
+                             first + b, first + e);
         });
       }
     }

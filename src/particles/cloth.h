@@ -27,9 +27,9 @@
 // A (n.u) n, the pressure on a flat plate, which is the default.
 //
 // The implicit solver (ClothDef::solver = kImplicit) turns every constraint
-// into a damped spring of stiffness 1/compliance, at most `implicitStiffness` and takes backward-Euler steps (Baraff & Witkin 1998) with
-// `cgIterations` of matrix-free conjugate gradients: larger steps, softer
-// cloth, more numerical damping.
+// into a damped spring of stiffness 1/compliance, at most `implicitStiffness` and takes
+// backward-Euler steps (Baraff & Witkin 1998) with `cgIterations` of matrix-free conjugate
+// gradients: larger steps, softer cloth, more numerical damping.
 #pragma once
 
 #include <array>
@@ -47,33 +47,33 @@ namespace sylva::particles {
 enum class ClothSolver { kXPBD, kImplicit };
 
 struct ClothDef {
-  int columns = 20, rows = 20;          // particles along u and v (>= 2)
-  Vec3 origin{0, 0, 0};                 // corner (0, 0)
-  Vec3 u{1, 0, 0}, v{0, -1, 0};         // edges of the whole cloth
-  double mass = 1;                      // total, kg
-  double stretchCompliance = 0;         // m/N: 0 = inextensible
+  int columns = 20, rows = 20;   // particles along u and v (>= 2)
+  Vec3 origin{0, 0, 0};          // corner (0, 0)
+  Vec3 u{1, 0, 0}, v{0, -1, 0};  // edges of the whole cloth
+  double mass = 1;               // total, kg
+  double stretchCompliance = 0;  // m/N: 0 = inextensible
   double shearCompliance = 1e-4;
   double bendCompliance = 1e-2;
   // Substeps x iterations decide how stiff "inextensible" really is: a flag
   // in a strong wind (examples/particles/particles_flag) stretches 13% at
   // 10 x 1, 1.3% at 20 x 4 and 0.5% at 40 x 4.
   int substeps = 10;
-  int iterations = 1;                   // per substep
-  double damping = 0;                   // fraction of velocity removed per second
+  int iterations = 1;  // per substep
+  double damping = 0;  // fraction of velocity removed per second
   // Air force coefficients, N per (m^2 * m/s); see the notes above.
-  double windDrag = 1.0;                // c_d, along the relative air speed
-  double windLift = 1.0;                // c_l, across it
-  double windFriction = 0;              // c_f, along the triangle
-  std::vector<int> pinned;              // particle indices (row * columns + column)
+  double windDrag = 1.0;    // c_d, along the relative air speed
+  double windLift = 1.0;    // c_l, across it
+  double windFriction = 0;  // c_f, along the triangle
+  std::vector<int> pinned;  // particle indices (row * columns + column)
   // Long-range attachments: tethers from every particle to its two nearest
   // pins, at their rest distance (XPBD only).
   bool longRangeAttachments = true;
-  int threads = 1;                      // 0 = every hardware thread
+  int threads = 1;  // 0 = every hardware thread
   ClothSolver solver = ClothSolver::kXPBD;
   // Implicit solver only.
-  double implicitStiffness = 2000;      // N/m for constraints of compliance 0
-  double implicitDamping = 0.02;        // N s/m along each spring
-  int implicitSubsteps = 1;             // backward-Euler steps per Step
+  double implicitStiffness = 2000;  // N/m for constraints of compliance 0
+  double implicitDamping = 0.02;    // N s/m along each spring
+  int implicitSubsteps = 1;         // backward-Euler steps per Step
   int cgIterations = 20;
 };
 
@@ -100,12 +100,12 @@ class Cloth {
 
  private:
   void StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
-  std::vector<xpbd::Tether> tethers_;   // xpbd::kTethers a particle
-  std::vector<size_t> colorStart_;      // constraints_ sorted by colour
+  std::vector<xpbd::Tether> tethers_;  // xpbd::kTethers a particle
+  std::vector<size_t> colorStart_;     // constraints_ sorted by colour
   std::unique_ptr<ThreadPool> pool_;
   void AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f);
-  class ExternalForce;                  // gravity, damping and wind for the implicit solver
-  std::vector<Vec3> triForce_;          // AddWind's per-triangle forces
+  class ExternalForce;          // gravity, damping and wind for the implicit solver
+  std::vector<Vec3> triForce_;  // AddWind's per-triangle forces
   ClothDef def_;
   std::vector<Vec3> x_, v_, fext_;
   std::vector<xpbd::Point4> x4_, v4_, prev4_, fext4_;  // the XPBD substeps' state
@@ -116,7 +116,7 @@ class Cloth {
   std::vector<xpbd::Projection> proj_;  // constraints_ as set for substeps of projH_ seconds
   double projH_ = 0;
   xpbd::Kernel kernel_ = kernels::Best();
-  bool lastColourShared_ = false;       // the colouring ran out: its last colour may share particles
+  bool lastColourShared_ = false;  // the colouring ran out: its last colour may share particles
   std::vector<double> lambda_;
   std::vector<std::array<uint32_t, 3>> tris_;
 };

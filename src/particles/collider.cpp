@@ -10,7 +10,9 @@ namespace sylva::particles {
 namespace {
 
 // Offset of a contact on a thin surface toward the particle's side.
-Vec3 Skin(const Vec3& p, const Vec3& n) { return p + n * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff())); }
+Vec3 Skin(const Vec3& p, const Vec3& n) {
+  return p + n * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff()));
+}
 
 Vec3 Friction(const Vec3& vt, double maxChange) {
   const double len = vt.norm();
@@ -21,7 +23,8 @@ Vec3 Friction(const Vec3& vt, double maxChange) {
 // Crossing of the segment a -> b with the plane through p with normal n (not
 // necessarily unit), from either side. Returns the fraction and the signed
 // distances' sign of the side the path came from (+1 or -1).
-bool CrossPlane(const Vec3& a, const Vec3& b, const Vec3& p, const Vec3& n, double* s, double* side) {
+bool CrossPlane(const Vec3& a, const Vec3& b, const Vec3& p, const Vec3& n, double* s,
+                double* side) {
   const double d0 = n.dot(a - p), d1 = n.dot(b - p);
   if (d0 > 0 && d1 < 0) {
     *side = 1;
@@ -108,7 +111,9 @@ uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
   int axis;
   (chi - clo).maxCoeff(&axis);
   const uint32_t mid = first + count / 2;
-  auto key = [&](const std::array<uint32_t, 3>& t) { return v_[t[0]][axis] + v_[t[1]][axis] + v_[t[2]][axis]; };
+  auto key = [&](const std::array<uint32_t, 3>& t) {
+    return v_[t[0]][axis] + v_[t[1]][axis] + v_[t[2]][axis];
+  };
   std::nth_element(tris_.begin() + first, tris_.begin() + mid, tris_.begin() + first + count,
                    [&](const auto& x, const auto& y) { return key(x) < key(y); });
   const uint32_t left = Build(first, mid - first, depth + 1);
@@ -194,7 +199,8 @@ Collider Collider::Polygon(std::vector<Vec3> vertices) {
   Collider c;
   c.kind = Kind::kPolygon;
   Vec3 n = Vec3::Zero();  // Newell's normal
-  for (size_t i = 0; i < vertices.size(); ++i) n += vertices[i].cross(vertices[(i + 1) % vertices.size()]);
+  for (size_t i = 0; i < vertices.size(); ++i)
+    n += vertices[i].cross(vertices[(i + 1) % vertices.size()]);
   c.normal = n.normalized();
   c.point = vertices[0];
   c.polygon = std::move(vertices);
@@ -373,8 +379,8 @@ bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n) const {
 
 // --- contact response ---
 
-ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x, Vec3& v,
-                                 double h) {
+ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
+                                 Vec3& v, double h) {
   Vec3 dv = v - va;  // velocity change from the forces over the segment
   double rem = h;
   int contacts = 0;

@@ -41,9 +41,9 @@ enum class Response {
 };
 
 struct Contact {
-  double s = 0;       // fraction of the path a -> b, in [0, 1]
-  Vec3 point;         // on the surface (plus the skin for thin surfaces)
-  Vec3 normal;        // unit, pointing to the side the particle came from
+  double s = 0;  // fraction of the path a -> b, in [0, 1]
+  Vec3 point;    // on the surface (plus the skin for thin surfaces)
+  Vec3 normal;   // unit, pointing to the side the particle came from
 };
 
 // Triangles with an axis-aligned bounding-volume hierarchy (median split on
@@ -78,12 +78,12 @@ struct Collider {
   Vec3 point{0, 0, 0}, normal{0, 1, 0};
   double radius = 1;
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};
-  bool inside = false;                     // sphere and box: keep particles inside
-  std::vector<Vec3> polygon;               // convex, counter-clockwise about normal
+  bool inside = false;        // sphere and box: keep particles inside
+  std::vector<Vec3> polygon;  // convex, counter-clockwise about normal
   std::shared_ptr<const TriangleBvh> mesh;
   // Material.
-  double restitution = 1;                  // e: normal speed out / in
-  double friction = 0;                     // Coulomb mu: tangential impulse <= mu * normal impulse
+  double restitution = 1;  // e: normal speed out / in
+  double friction = 0;     // Coulomb mu: tangential impulse <= mu * normal impulse
   Response response = Response::kBounce;
 
   static Collider Plane(const Vec3& point, const Vec3& normal);
@@ -91,9 +91,18 @@ struct Collider {
   static Collider Box(const Vec3& lo, const Vec3& hi, bool inside = false);
   static Collider Polygon(std::vector<Vec3> convexVertices);  // normal from the winding
   static Collider Mesh(std::shared_ptr<const TriangleBvh> bvh);
-  Collider& Restitution(double e) { restitution = e; return *this; }
-  Collider& Friction(double mu) { friction = mu; return *this; }
-  Collider& Respond(Response r) { response = r; return *this; }
+  Collider& Restitution(double e) {
+    restitution = e;
+    return *this;
+  }
+  Collider& Friction(double mu) {
+    friction = mu;
+    return *this;
+  }
+  Collider& Respond(Response r) {
+    response = r;
+    return *this;
+  }
 
   // First entry of the path a -> b into the solid. A path that starts inside
   // (a half-space kind only) reports s = 0 at the nearest surface point.
@@ -127,8 +136,8 @@ enum class ContactOutcome {
 // contact (the surface takes the inward normal velocity, friction up to mu
 // times that from the tangential one). A particle that touched anything is
 // finally projected out of every half-space solid. x and v are updated.
-ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x, Vec3& v,
-                                 double h);
+ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
+                                 Vec3& v, double h);
 
 // --- inline ---
 
@@ -163,14 +172,18 @@ inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n) const {
     case Kind::kPlane:
       return normal.dot(b - point) < 0;
     case Kind::kSphere:
-      if (inside) return (b - point).squaredNorm() > radius * radius || (a - point).squaredNorm() > radius * radius;
-      return ((a.cwiseMin(b) - point).array() <= radius).all() && ((a.cwiseMax(b) - point).array() >= -radius).all();
+      if (inside)
+        return (b - point).squaredNorm() > radius * radius ||
+               (a - point).squaredNorm() > radius * radius;
+      return ((a.cwiseMin(b) - point).array() <= radius).all() &&
+             ((a.cwiseMax(b) - point).array() >= -radius).all();
     case Kind::kBox:
       if (inside) {
-        return (b.array() < lo.array()).any() || (b.array() > hi.array()).any() || (a.array() < lo.array()).any() ||
-               (a.array() > hi.array()).any();
+        return (b.array() < lo.array()).any() || (b.array() > hi.array()).any() ||
+               (a.array() < lo.array()).any() || (a.array() > hi.array()).any();
       }
-      return (a.cwiseMin(b).array() <= hi.array()).all() && (a.cwiseMax(b).array() >= lo.array()).all();
+      return (a.cwiseMin(b).array() <= hi.array()).all() &&
+             (a.cwiseMax(b).array() >= lo.array()).all();
     case Kind::kPolygon: {
       const double d0 = normal.dot(a - point), d1 = normal.dot(b - point);
       return (d0 <= 0 && d1 >= 0) || (d0 >= 0 && d1 <= 0);

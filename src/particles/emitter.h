@@ -10,18 +10,18 @@
 namespace sylva::particles {
 
 struct EmitterDef {
-  double rate = 100;              // particles per second (0: bursts only)
+  double rate = 100;  // particles per second (0: bursts only)
   Vec3 position{0, 0, 0};
-  double positionRadius = 0;      // uniform in a ball of this radius
+  double positionRadius = 0;  // uniform in a ball of this radius
   Vec3 velocity{0, 1, 0};
-  double velocitySpread = 0;      // plus a uniform vector in a ball of this radius
-  double lifetime = 2;            // seconds, uniform in [lifetime - jitter, lifetime + jitter]
+  double velocitySpread = 0;  // plus a uniform vector in a ball of this radius
+  double lifetime = 2;        // seconds, uniform in [lifetime - jitter, lifetime + jitter]
   double lifetimeJitter = 0;
   double mass = 1;
   Vec3f colorStart{1, 1, 1}, colorEnd{1, 1, 1};  // linear in age / lifetime
   float radiusStart = 0.05f, radiusEnd = 0.05f;  // drawn size, linear in age / lifetime
   uint64_t seed = 1;
-  uint32_t stream = 0;            // tells emitters with one seed apart
+  uint32_t stream = 0;  // tells emitters with one seed apart
 };
 
 class Emitter {

@@ -47,7 +47,8 @@ void Flocking::Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, 
         const double dist = len - radius;
         if (!(len > 0) || dist >= def_.avoidDistance) continue;
         const Vec3 out = r / len;
-        const double closeness = (def_.avoidDistance - dist) / def_.avoidDistance;  // 0 .. 1 (more inside)
+        const double closeness =
+            (def_.avoidDistance - dist) / def_.avoidDistance;  // 0 .. 1 (more inside)
         steer += def_.avoid * closeness / std::max(dist, 0.01 * def_.avoidDistance) * out;
         const double vn = vi.dot(out);
         if (vn < 0) steer -= def_.avoid * closeness * vn * out;

@@ -14,12 +14,12 @@
 namespace sylva::particles {
 
 struct FlockingDef {
-  double radius = 1;               // neighbourhood
-  double cohesion = 1;             // gain toward the neighbours' centre
-  double separation = 1;           // gain away from close neighbours
-  double separationRadius = 0.3;   // "too close"
-  double alignment = 1;            // gain toward the neighbours' mean velocity
-  double seek = 0;                 // gain toward `target`
+  double radius = 1;              // neighbourhood
+  double cohesion = 1;            // gain toward the neighbours' centre
+  double separation = 1;          // gain away from close neighbours
+  double separationRadius = 0.3;  // "too close"
+  double alignment = 1;           // gain toward the neighbours' mean velocity
+  double seek = 0;                // gain toward `target`
   Vec3 target{0, 0, 0};
   // Avoid: spherical obstacles (centre, radius). Within `avoidDistance` of
   // an obstacle's surface a boid is pushed out along the normal, harder the

@@ -8,8 +8,8 @@
 
 namespace sylva::particles {
 
-void RandomDrift::AccumulateRange(const ParticleState& s, const Vec3*, const Vec3*, Vec3* f, size_t begin,
-                                  size_t end) const {
+void RandomDrift::AccumulateRange(const ParticleState& s, const Vec3*, const Vec3*, Vec3* f,
+                                  size_t begin, size_t end) const {
   for (size_t i = begin; i < end; ++i) {
     RandomStream r{seed_, 0xd21f7, s.id[i], s.step, 0};
     const double a = r.Normal(), b = r.Normal(), c = r.Normal();
@@ -50,18 +50,19 @@ Vec3 NoiseWind::Velocity(const Vec3& x, double t) const {
   return u;
 }
 
-void NoiseWind::AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
-                                size_t end) const {
+void NoiseWind::AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f,
+                                size_t begin, size_t end) const {
   for (size_t i = begin; i < end; ++i) f[i - begin] += def_.drag * (Velocity(x[i], s.time) - v[i]);
 }
 
-void NoiseWind::AddJacobianProduct(const ParticleState& s, const Vec3*, const Vec3*, double, double cv,
-                                   const Vec3* p, Vec3* y) const {
+void NoiseWind::AddJacobianProduct(const ParticleState& s, const Vec3*, const Vec3*, double,
+                                   double cv, const Vec3* p, Vec3* y) const {
   if (cv == 0) return;
   for (size_t i = 0; i < s.size(); ++i) y[i] -= cv * def_.drag * p[i];  // df/dv = -drag I
 }
 
-FieldGrid::FieldGrid(const Vec3& lo, const Vec3& hi, std::array<int, 3> n, std::vector<Vec3> samples, bool clamp)
+FieldGrid::FieldGrid(const Vec3& lo, const Vec3& hi, std::array<int, 3> n,
+                     std::vector<Vec3> samples, bool clamp)
     : lo_(lo), hi_(hi), n_(n), samples_(std::move(samples)), clamp_(clamp) {
   SYLVA_ASSERT(n[0] >= 2 && n[1] >= 2 && n[2] >= 2);
   SYLVA_ASSERT(samples_.size() == size_t(n[0]) * n[1] * n[2]);
@@ -92,8 +93,8 @@ Vec3 FieldGrid::At(const Vec3& x) const {
   return y0 * (1 - t[2]) + y1 * t[2];
 }
 
-void FieldGrid::AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3*, Vec3* f, size_t begin,
-                                size_t end) const {
+void FieldGrid::AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3*, Vec3* f,
+                                size_t begin, size_t end) const {
   for (size_t i = begin; i < end; ++i) f[i - begin] += s.mass[i] * At(x[i]);
 }
 
@@ -144,8 +145,8 @@ void Penalty::Accumulate(const ParticleState&, const Vec3* x, const Vec3* v, Vec
   }
 }
 
-void Penalty::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
-                                 const Vec3* p, Vec3* y) const {
+void Penalty::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3*, double cx,
+                                 double cv, const Vec3* p, Vec3* y) const {
   for (const Term& t : terms_) {
     if (t.kind == Kind::kAnchor) {
       y[t.i] -= (cx * t.ks + cv * t.kd) * p[t.i];
@@ -157,7 +158,8 @@ void Penalty::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3
       const Vec3 dp = p[t.i] - p[t.j];
       const double along = u.dot(dp);
       const double transverse = std::max(0.0, 1 - t.value / len);
-      const Vec3 g = -cx * t.ks * (along * u + transverse * (dp - along * u)) - cv * t.kd * along * u;
+      const Vec3 g =
+          -cx * t.ks * (along * u + transverse * (dp - along * u)) - cv * t.kd * along * u;
       y[t.i] += g;
       y[t.j] -= g;
     }
@@ -169,10 +171,18 @@ double Penalty::Energy(const Vec3* x) const {
   for (const Term& t : terms_) {
     double c = 0;
     switch (t.kind) {
-      case Kind::kAnchor: c = (x[t.i] - t.point).norm(); break;
-      case Kind::kDistance: c = (x[t.i] - x[t.j]).norm() - t.value; break;
-      case Kind::kPlane: c = t.normal.dot(x[t.i] - t.point); break;
-      case Kind::kSphere: c = (x[t.i] - t.point).norm() - t.value; break;
+      case Kind::kAnchor:
+        c = (x[t.i] - t.point).norm();
+        break;
+      case Kind::kDistance:
+        c = (x[t.i] - x[t.j]).norm() - t.value;
+        break;
+      case Kind::kPlane:
+        c = t.normal.dot(x[t.i] - t.point);
+        break;
+      case Kind::kSphere:
+        c = (x[t.i] - t.point).norm() - t.value;
+        break;
     }
     e += 0.5 * t.ks * c * c;
   }

@@ -47,8 +47,8 @@ class NoiseWind : public LocalForce {
   Vec3 Velocity(const Vec3& x, double t) const;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
-  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
-                          const Vec3* p, Vec3* y) const override;
+  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx,
+                          double cv, const Vec3* p, Vec3* y) const override;
 
  private:
   struct Mode {
@@ -64,7 +64,8 @@ class NoiseWind : public LocalForce {
 // the box the field is zero, or the nearest border value with `clamp`.
 class FieldGrid : public LocalForce {
  public:
-  FieldGrid(const Vec3& lo, const Vec3& hi, std::array<int, 3> n, std::vector<Vec3> samples, bool clamp = false);
+  FieldGrid(const Vec3& lo, const Vec3& hi, std::array<int, 3> n, std::vector<Vec3> samples,
+            bool clamp = false);
   Vec3 At(const Vec3& x) const;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
@@ -92,8 +93,8 @@ class Penalty : public Force {
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
   // The implicit solver's Jacobian, for anchors and distances (the stiff
   // ones); plane and sphere terms are treated explicitly.
-  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
-                          const Vec3* p, Vec3* y) const override;
+  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx,
+                          double cv, const Vec3* p, Vec3* y) const override;
   // Total penalty energy sum ks C^2 / 2 at positions x.
   double Energy(const Vec3* x) const;
 

@@ -6,15 +6,17 @@
 
 namespace sylva::particles {
 
-void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool, bool copyPositions) {
+void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool,
+                          bool copyPositions) {
   cell_ = cellSize > 0 ? cellSize : 1;
   invCell_ = 1 / cell_;
   uint32_t slots = 1;
   while ((slots < 2 * n || slots < 64) && slots < (1u << 30)) slots <<= 1;
   // Row offsets B dy + C dz (dy, dz in -1..1) must be 3 or more slots apart
   // modulo the table, or two rows of one neighbourhood would share a slot.
-  static constexpr uint64_t kB[] = {0x9E3779B97F4A7C15ULL, 0xC2B2AE3D27D4EB4FULL, 0x165667B19E3779F9ULL,
-                                    0xD6E8FEB86659FD93ULL, 0xA0761D6478BD642FULL, 0xE7037ED1A0B428DBULL};
+  static constexpr uint64_t kB[] = {0x9E3779B97F4A7C15ULL, 0xC2B2AE3D27D4EB4FULL,
+                                    0x165667B19E3779F9ULL, 0xD6E8FEB86659FD93ULL,
+                                    0xA0761D6478BD642FULL, 0xE7037ED1A0B428DBULL};
   for (bool found = false; !found; slots <<= 1) {
     mask_ = slots - 1;
     for (uint64_t attempt = 0; attempt < 64 && !found; ++attempt) {
@@ -23,7 +25,8 @@ void NeighbourGrid::Build(const Vec3* x, size_t n, double cellSize, ThreadPool* 
       uint64_t row[9];
       int r = 0;
       for (int64_t dz = -1; dz <= 1; ++dz) {
-        for (int64_t dy = -1; dy <= 1; ++dy) row[r++] = (uint64_t(dy) * B_ + uint64_t(dz) * C_) & mask_;
+        for (int64_t dy = -1; dy <= 1; ++dy)
+          row[r++] = (uint64_t(dy) * B_ + uint64_t(dz) * C_) & mask_;
       }
       found = true;
       for (int a = 0; a < 9 && found; ++a) {

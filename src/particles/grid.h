@@ -37,7 +37,8 @@ class NeighbourGrid {
   // candidates contiguously instead of through the index (about one more
   // pass over x; worth it when every particle queries, and valid only
   // while x does not change).
-  void Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool = nullptr, bool copyPositions = false);
+  void Build(const Vec3* x, size_t n, double cellSize, ThreadPool* pool = nullptr,
+             bool copyPositions = false);
   // Calls fn(j) for every particle j != i within `radius` of x[i], in the
   // same order whatever the thread count.
   template <typename Fn>
@@ -63,7 +64,7 @@ class NeighbourGrid {
   uint32_t mask_ = 0;
   uint64_t B_ = 0, C_ = 0;
   std::vector<uint32_t> start_, order_;
-  std::vector<Vec3> sorted_;           // x in slot order (copyPositions)
+  std::vector<Vec3> sorted_;  // x in slot order (copyPositions)
   bool copied_ = false;
   std::vector<uint64_t> keys_, tmp_;   // slot << 32 | index
   std::vector<uint32_t> hist_;         // per range, per top digit

@@ -156,10 +156,10 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
 [[gnu::target("avx")]] size_t BulkPlaneAvx(const double* n, const double* p, const BulkArrays& a,
                                            size_t i, size_t e, uint8_t* flags) {
   // One byte a lane from a four-bit mask.
-  static constexpr uint32_t kBytes[16] = {
-      0x00000000, 0x00000001, 0x00000100, 0x00000101, 0x00010000, 0x00010001,
-      0x00010100, 0x00010101, 0x01000000, 0x01000001, 0x01000100, 0x01000101,
-      0x01010000, 0x01010001, 0x01010100, 0x01010101};
+  static constexpr uint32_t kBytes[16] = {0x00000000, 0x00000001, 0x00000100, 0x00000101,
+                                          0x00010000, 0x00010001, 0x00010100, 0x00010101,
+                                          0x01000000, 0x01000001, 0x01000100, 0x01000101,
+                                          0x01010000, 0x01010001, 0x01010100, 0x01010101};
   const __m256d n0 = _mm256_set1_pd(n[0]), n1 = _mm256_set1_pd(n[1]), n2 = _mm256_set1_pd(n[2]);
   const __m256d p0 = _mm256_set1_pd(p[0]), p1 = _mm256_set1_pd(p[1]), p2 = _mm256_set1_pd(p[2]);
   const __m256d zero = _mm256_setzero_pd();
@@ -168,9 +168,9 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     const __m256d b0 = _mm256_cvtps_pd(_mm_loadu_ps(a.px + i));
     const __m256d b1 = _mm256_cvtps_pd(_mm_loadu_ps(a.py + i));
     const __m256d b2 = _mm256_cvtps_pd(_mm_loadu_ps(a.pz + i));
-    const __m256d d = _mm256_add_pd(
-        _mm256_add_pd(_mm256_mul_pd(n0, _mm256_sub_pd(b0, p0)), _mm256_mul_pd(n1, _mm256_sub_pd(b1, p1))),
-        _mm256_mul_pd(n2, _mm256_sub_pd(b2, p2)));
+    const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, _mm256_sub_pd(b0, p0)),
+                                                  _mm256_mul_pd(n1, _mm256_sub_pd(b1, p1))),
+                                    _mm256_mul_pd(n2, _mm256_sub_pd(b2, p2)));
     const int mask = _mm256_movemask_pd(_mm256_cmp_pd(d, zero, _CMP_LT_OQ));
     if (mask) {
       uint32_t bytes;

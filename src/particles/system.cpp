@@ -1,8 +1,8 @@
 #include "particles/system.h"
 
 #include <algorithm>
-#include <bit>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -40,8 +40,8 @@ uint32_t ParticleState::Add(const Vec3& p, const Vec3& v, double m, double life)
 
 // --- forces ---
 
-void Gravity::AccumulateRange(const ParticleState& s, const Vec3*, const Vec3*, Vec3* f, size_t begin,
-                              size_t end) const {
+void Gravity::AccumulateRange(const ParticleState& s, const Vec3*, const Vec3*, Vec3* f,
+                              size_t begin, size_t end) const {
   const double* m = s.mass.data();
   for (size_t i = begin; i < end; ++i) f[i - begin] += m[i] * g_;
 }
@@ -117,7 +117,8 @@ void Springs::ForColours(Fn&& fn) const {
 }
 
 void Springs::Accumulate(const ParticleState&, const Vec3* x, const Vec3* v, Vec3* f) const {
-  if (std::exchange(accumulateCached_, false) && x == preparedX_ && linear_.size() == springs_.size()) {
+  if (std::exchange(accumulateCached_, false) && x == preparedX_ &&
+      linear_.size() == springs_.size()) {
     // The length and direction PrepareJacobian computed at these positions
     // (the same operations, so the same bits).
     ForColours([&](size_t j, const Spring& sp) {
@@ -163,8 +164,8 @@ void Springs::PrepareJacobian(const ParticleState&, const Vec3* x, const Vec3*) 
   ForColours([&](size_t j, const Spring& sp) { linear_[j] = Linearise(sp, x, &length_[j]); });
 }
 
-void Springs::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
-                                 const Vec3* p, Vec3* y) const {
+void Springs::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3*, double cx,
+                                 double cv, const Vec3* p, Vec3* y) const {
   if (!(x == preparedX_ && linear_.size() == springs_.size())) {
     ForColours([&](size_t, const Spring& sp) {
       double len;
@@ -188,11 +189,14 @@ void Springs::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3
   for (size_t c = 0; c + 1 < colourStart_.size(); ++c) {
     const size_t first = colourStart_[c], last = colourStart_[c + 1];
     if (serialGroup_ && c + 2 == colourStart_.size()) {
-      kernels::SpringProductRange(kernels::Kernel::kScalar, lin, first, last, cx, cv, p4_.data(), y4_.data());
+      kernels::SpringProductRange(kernels::Kernel::kScalar, lin, first, last, cx, cv, p4_.data(),
+                                  y4_.data());
     } else {
-      ForRanges(pool_, last - first, BalancedGrain(pool_, last - first, 256, 4096), [&](size_t b, size_t e) {
-        kernels::SpringProductRange(kernel_, lin, first + b, first + e, cx, cv, p4_.data(), y4_.data());
-      });
+      ForRanges(pool_, last - first, BalancedGrain(pool_, last - first, 256, 4096),
+                [&](size_t b, size_t e) {
+                  kernels::SpringProductRange(kernel_, lin, first + b, first + e, cx, cv,
+                                              p4_.data(), y4_.data());
+                });
     }
   }
   ForRanges(pool_, n, grain, [&](size_t b, size_t e) {
@@ -200,8 +204,8 @@ void Springs::AddJacobianProduct(const ParticleState&, const Vec3* x, const Vec3
   });
 }
 
-void Springs::AddJacobianDiagonal(const ParticleState&, const Vec3* x, const Vec3*, double cx, double cv,
-                                  Vec3* diag) const {
+void Springs::AddJacobianDiagonal(const ParticleState&, const Vec3* x, const Vec3*, double cx,
+                                  double cv, Vec3* diag) const {
   const bool cached = x == preparedX_ && linear_.size() == springs_.size();
   ForColours([&](size_t j, const Spring& sp) {
     double len;
@@ -215,7 +219,9 @@ void Springs::AddJacobianDiagonal(const ParticleState&, const Vec3* x, const Vec
 
 // --- system ---
 
-System::System(int threads) { SetThreads(threads); }
+System::System(int threads) {
+  SetThreads(threads);
+}
 System::~System() = default;
 
 void System::SetThreads(int threads) {
@@ -224,7 +230,9 @@ void System::SetThreads(int threads) {
   for (auto& f : forces_) f->set_pool(pool_.get());
 }
 
-int System::threads() const { return threads_; }
+int System::threads() const {
+  return threads_;
+}
 
 void System::AddForce(std::shared_ptr<Force> f) {
   f->set_pool(pool_.get());
@@ -252,7 +260,8 @@ void System::NonLocalForces(const Vec3* x, const Vec3* v) const {
   if (!hasNonLocal_) return;
   const size_t n = state.size();
   f_.resize(n);
-  ForChunks(n, [&](size_t b, size_t e) { std::fill(f_.begin() + b, f_.begin() + e, Vec3::Zero()); });
+  ForChunks(n,
+            [&](size_t b, size_t e) { std::fill(f_.begin() + b, f_.begin() + e, Vec3::Zero()); });
   for (const auto& force : forces_) {
     if (!force->local()) force->Accumulate(state, x, v, f_.data());
   }
@@ -265,7 +274,8 @@ void System::LocalForcesInto(size_t b, size_t e, const Vec3* x, const Vec3* v, V
     std::fill(fc, fc + (e - b), Vec3::Zero());
   }
   for (const auto& force : forces_) {
-    if (force->local()) static_cast<const LocalForce&>(*force).AccumulateRange(state, x, v, fc, b, e);
+    if (force->local())
+      static_cast<const LocalForce&>(*force).AccumulateRange(state, x, v, fc, b, e);
   }
 }
 
@@ -319,7 +329,8 @@ uint64_t System::Hash() const {
   }
 }
 
-[[gnu::always_inline]] inline void System::Finish(size_t i, const Vec3& x0, const Vec3& v0, Vec3 x1, Vec3 v1, double h) {
+[[gnu::always_inline]] inline void System::Finish(size_t i, const Vec3& x0, const Vec3& v0, Vec3 x1,
+                                                  Vec3 v1, double h) {
   if (state.invMass[i] == 0) {  // immovable
     x1 = x0;
     v1 = Vec3::Zero();
@@ -338,8 +349,8 @@ uint64_t System::Hash() const {
   state.velocity[i] = v1;
 }
 
-Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id, const Vec3& x,
-                               const Vec3& v, double limit) {
+Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
+                               const Vec3& x, const Vec3& v, double limit) {
   const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
   std::ostringstream o;
   o << "particles: " << what << " step " << step << " (from t = " << t << " s): particle id " << id
@@ -482,7 +493,8 @@ void System::ImplicitEuler(double h) {
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
   for (auto& c : cg_) c.resize(n);
-  Vec3 *b = cg_[0].data(), *r = cg_[1].data(), *p = cg_[2].data(), *q = cg_[3].data(), *dv = cg_[4].data();
+  Vec3 *b = cg_[0].data(), *r = cg_[1].data(), *p = cg_[2].data(), *q = cg_[3].data(),
+       *dv = cg_[4].data();
   Vec3* inv = cg_[5].data();
   k_[0].resize(n);
   Vec3* a0 = k_[0].data();
@@ -497,7 +509,8 @@ void System::ImplicitEuler(double h) {
       inv[i] = Vec3::Constant(m[i]);
     }
   });
-  for (const auto& f : forces_) f->AddJacobianProduct(state, X.data(), V.data(), h * h, 0, V.data(), b);
+  for (const auto& f : forces_)
+    f->AddJacobianProduct(state, X.data(), V.data(), h * h, 0, V.data(), b);
   // Jacobi preconditioner: the inverse of the operator's diagonal.
   for (const auto& f : forces_) f->AddJacobianDiagonal(state, X.data(), V.data(), -h * h, -h, inv);
   // dv = 0, r = b (filtered), p = M^-1 r, q = A p's mass term.
@@ -534,7 +547,8 @@ void System::ImplicitEuler(double h) {
     double rnorm = bnorm;
     int it = 0;
     while (it < cgMaxIterations && rnorm > cgTolerance * bnorm) {
-      for (const auto& f : forces_) f->AddJacobianProduct(state, X.data(), V.data(), -h * h, -h, p, q);
+      for (const auto& f : forces_)
+        f->AddJacobianProduct(state, X.data(), V.data(), -h * h, -h, p, q);
       for (size_t i : pinned_) q[i] = Vec3::Zero();
       const double pq = SumChunks<1>(n3, [&](size_t bb, size_t e) {
         return std::array<double, 1>{kernels::Dot(kernel_, pf, qf, bb, e)};
@@ -550,12 +564,13 @@ void System::ImplicitEuler(double h) {
       rnorm = std::sqrt(sums[1]);
       ++it;
       if (it < cgMaxIterations && rnorm > cgTolerance * bnorm) {
-        ForRanges(pool_.get(), n3, BalancedGrain(pool_.get(), n3, 1536, 3 * kChunk), [&](size_t bb, size_t e) {
-          for (size_t k = bb; k < e; ++k) {
-            pf[k] = rf[k] * zf[k] + beta * pf[k];
-            qf[k] = m3[k] * pf[k];
-          }
-        });
+        ForRanges(pool_.get(), n3, BalancedGrain(pool_.get(), n3, 1536, 3 * kChunk),
+                  [&](size_t bb, size_t e) {
+                    for (size_t k = bb; k < e; ++k) {
+                      pf[k] = rf[k] * zf[k] + beta * pf[k];
+                      qf[k] = m3[k] * pf[k];
+                    }
+                  });
       }
     }
     solve_ = {it, rnorm / bnorm};
@@ -610,9 +625,10 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
       {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
       {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
       {35.0 / 384, 0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}};
-  static constexpr double B5[7] = {35.0 / 384, 0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84, 0};
-  static constexpr double B4[7] = {5179.0 / 57600,    0, 7571.0 / 16695, 393.0 / 640,
-                                   -92097.0 / 339200, 187.0 / 2100,   1.0 / 40};
+  static constexpr double B5[7] = {35.0 / 384, 0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784,
+                                   11.0 / 84,  0};
+  static constexpr double B4[7] = {
+      5179.0 / 57600, 0, 7571.0 / 16695, 393.0 / 640, -92097.0 / 339200, 187.0 / 2100, 1.0 / 40};
   AdaptiveStats local;
   AdaptiveStats& st = stats ? *stats : local;
   const size_t n = state.size();
@@ -632,8 +648,9 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
   int calls = 0;
   while (time < tEnd && tEnd - time > 1e-14 * std::max(1.0, std::abs(tEnd))) {
     if (++calls > opt.maxSteps) {
-      Diagnostic d = MakeError({}, "particles: adaptive RK45 needed more than " + std::to_string(opt.maxSteps) +
-                                       " steps for " + std::to_string(dt) + " s");
+      Diagnostic d = MakeError({}, "particles: adaptive RK45 needed more than " +
+                                       std::to_string(opt.maxSteps) + " steps for " +
+                                       std::to_string(dt) + " s");
       d.kind = ErrorKind::kRuntime;
       return d;
     }

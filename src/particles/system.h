@@ -74,11 +74,12 @@ class Force {
   // Matrix-free Jacobian product for the implicit solver:
   //   y += cx (df/dx) p + cv (df/dv) p.
   // Forces that do not override it are treated explicitly by that solver.
-  virtual void AddJacobianProduct(const ParticleState&, const Vec3* /*x*/, const Vec3* /*v*/, double /*cx*/,
-                                  double /*cv*/, const Vec3* /*p*/, Vec3* /*y*/) const {}
+  virtual void AddJacobianProduct(const ParticleState&, const Vec3* /*x*/, const Vec3* /*v*/,
+                                  double /*cx*/, double /*cv*/, const Vec3* /*p*/,
+                                  Vec3* /*y*/) const {}
   // The diagonal of the same operator, per axis (the CG preconditioner).
-  virtual void AddJacobianDiagonal(const ParticleState&, const Vec3* /*x*/, const Vec3* /*v*/, double /*cx*/,
-                                   double /*cv*/, Vec3* /*diag*/) const {}
+  virtual void AddJacobianDiagonal(const ParticleState&, const Vec3* /*x*/, const Vec3* /*v*/,
+                                   double /*cx*/, double /*cv*/, Vec3* /*diag*/) const {}
   // The system hands its thread pool to every force it owns.
   void set_pool(ThreadPool* pool) { pool_ = pool; }
 
@@ -95,8 +96,8 @@ class LocalForce : public Force {
     AccumulateRange(s, x, v, f, 0, s.size());
   }
   bool local() const final { return true; }
-  virtual void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
-                               size_t end) const = 0;
+  virtual void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f,
+                               size_t begin, size_t end) const = 0;
 };
 
 // Constant acceleration g for every movable particle (f = m g).
@@ -116,8 +117,8 @@ class Drag : public LocalForce {
   Drag(double linear, double quadratic = 0) : k1_(linear), k2_(quadratic) {}
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
-  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
-                          const Vec3* p, Vec3* y) const override;
+  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx,
+                          double cv, const Vec3* p, Vec3* y) const override;
 
  private:
   double k1_, k2_;
@@ -137,7 +138,9 @@ class Springs : public Force {
     uint32_t a, b;
     double rest, ks, kd;
   };
-  void Add(uint32_t a, uint32_t b, double rest, double ks, double kd) { springs_.push_back({a, b, rest, ks, kd}); }
+  void Add(uint32_t a, uint32_t b, double rest, double ks, double kd) {
+    springs_.push_back({a, b, rest, ks, kd});
+  }
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
   // Baraff & Witkin's spring Jacobian, with the transverse term clamped at
   // zero for compressed springs so the system matrix stays positive definite:
@@ -148,10 +151,10 @@ class Springs : public Force {
   // other array they linearise themselves), and so does the one Accumulate
   // that follows it.
   void PrepareJacobian(const ParticleState& s, const Vec3* x, const Vec3* v) override;
-  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
-                          const Vec3* p, Vec3* y) const override;
-  void AddJacobianDiagonal(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,
-                           Vec3* diag) const override;
+  void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx,
+                          double cv, const Vec3* p, Vec3* y) const override;
+  void AddJacobianDiagonal(const ParticleState& s, const Vec3* x, const Vec3* v, double cx,
+                           double cv, Vec3* diag) const override;
   const std::vector<Spring>& springs() const { return springs_; }
   // Colour groups of the last pass (the serial group counts as one).
   size_t colourCount() const { return colourStart_.empty() ? 0 : colourStart_.size() - 1; }
@@ -166,8 +169,8 @@ class Springs : public Force {
   void ForColours(Fn&& fn) const;
   static Linear Linearise(const Spring& sp, const Vec3* x, double* length);
   std::vector<Spring> springs_;
-  std::vector<Linear> linear_;           // from PrepareJacobian at preparedX_, colour order
-  std::vector<double> length_;           // and the springs' lengths
+  std::vector<Linear> linear_;  // from PrepareJacobian at preparedX_, colour order
+  std::vector<double> length_;  // and the springs' lengths
   const Vec3* preparedX_ = nullptr;
   // The next Accumulate at preparedX_ (the implicit solver's, right after
   // PrepareJacobian) takes lengths and directions from linear_; only that
@@ -179,7 +182,7 @@ class Springs : public Force {
   mutable std::vector<size_t> colourStart_;
   mutable bool serialGroup_ = false;
   mutable size_t colouredSprings_ = SIZE_MAX;
-  mutable size_t particles_ = 0;         // 1 + the largest particle index of a spring
+  mutable size_t particles_ = 0;                  // 1 + the largest particle index of a spring
   mutable std::vector<kernels::Point4> p4_, y4_;  // the product's padded operands
   kernels::Kernel kernel_ = kernels::Best();
 };
@@ -223,14 +226,14 @@ struct AdaptiveOptions {
 };
 struct AdaptiveStats {
   int accepted = 0, rejected = 0;
-  double lastStep = 0;     // the step the controller would try next
-  double maxError = 0;     // largest accepted error norm (<= 1)
+  double lastStep = 0;  // the step the controller would try next
+  double maxError = 0;  // largest accepted error norm (<= 1)
 };
 
 // Implicit Euler's conjugate-gradient solve.
 struct SolveStats {
   int iterations = 0;
-  double residual = 0;     // |r| / |b| at the end
+  double residual = 0;  // |r| / |b| at the end
 };
 
 class System {
@@ -265,7 +268,8 @@ class System {
   // One step of length h: forces, integration, collisions, ageing.
   [[nodiscard]] Status Step(double h, Integrator integrator);
   // Advances by dt with adaptive Dormand-Prince RK45 substeps.
-  [[nodiscard]] Status StepAdaptive(double dt, const AdaptiveOptions& options, AdaptiveStats* stats = nullptr);
+  [[nodiscard]] Status StepAdaptive(double dt, const AdaptiveOptions& options,
+                                    AdaptiveStats* stats = nullptr);
   const SolveStats& lastSolve() const { return solve_; }
   // Kinetic energy, sum of m |v|^2 / 2 over movable particles.
   double KineticEnergy() const;
@@ -311,7 +315,7 @@ class System {
 // The report of a particle whose position or velocity left the limit (or is
 // not finite), for both particle systems: the step, its start time and the
 // particle's id, position and velocity.
-Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id, const Vec3& x,
-                               const Vec3& v, double limit);
+Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
+                               const Vec3& x, const Vec3& v, double limit);
 
 }  // namespace sylva::particles

@@ -91,8 +91,8 @@ DiagnosticList Validate(const PlantSpec& spec) {
   }
   if (spec.limits.maxTriangles < 1) list.Add(SpecError("max triangles 0 is outside 1.."));
   if (spec.limits.maxModules < 1 || spec.limits.maxModules > lsys::kMaxModulesCap) {
-    list.Add(SpecError("max modules " + std::to_string(spec.limits.maxModules) +
-                       " is outside 1.." + std::to_string(lsys::kMaxModulesCap)));
+    list.Add(SpecError("max modules " + std::to_string(spec.limits.maxModules) + " is outside 1.." +
+                       std::to_string(lsys::kMaxModulesCap)));
   }
   return list;
 }
@@ -174,8 +174,12 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
   return g;
 }
 
-int Grower::step() const { return derivation_ ? derivation_->step() : 0; }
-int Grower::steps() const { return derivation_ ? steps_ : 0; }
+int Grower::step() const {
+  return derivation_ ? derivation_->step() : 0;
+}
+int Grower::steps() const {
+  return derivation_ ? steps_ : 0;
+}
 const lsys::Word& Grower::word() const {
   SYLVA_ASSERT(derivation_.has_value());  // not with Stage::kGrammar
   return derivation_->word();

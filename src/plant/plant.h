@@ -94,14 +94,14 @@ struct Timings {
 
 struct Plant {
   lsys::Grammar grammar;
-  lsys::Word word;                       // the derived word
-  std::vector<lsys::StepStats> steps;    // steps[0] is the axiom
+  lsys::Word word;                     // the derived word
+  std::vector<lsys::StepStats> steps;  // steps[0] is the axiom
   // The word through the interpretation rules (what the turtle read); empty
   // when the grammar has no interpretation section: use DrawnWord().
   lsys::Word interpreted;
-  mesh::PlantGeometry geometry;          // Stage::kGeometry and later
-  mesh::TriangleMesh mesh;               // Stage::kMesh
-  mesh::Palette palette;                 // the grammar's, or the default one (linear RGB)
+  mesh::PlantGeometry geometry;  // Stage::kGeometry and later
+  mesh::TriangleMesh mesh;       // Stage::kMesh
+  mesh::Palette palette;         // the grammar's, or the default one (linear RGB)
   Timings time;
 
   // The word the turtle reads (from Stage::kInterpreted on).
@@ -111,8 +111,8 @@ struct Plant {
 };
 
 struct PlantResult {
-  std::optional<Plant> plant;   // set when there is no error
-  DiagnosticList diagnostics;   // errors and warnings of every stage, in order
+  std::optional<Plant> plant;  // set when there is no error
+  DiagnosticList diagnostics;  // errors and warnings of every stage, in order
 };
 
 // Builds the plant `spec` describes, up to spec.until.

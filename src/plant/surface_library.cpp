@@ -43,8 +43,8 @@ static std::string ParentOf(const std::string& path) {
   return slash == 0 ? "/" : path.substr(0, slash);
 }
 
-SurfaceLibrary::SurfaceLibrary(const std::string& grammarPath, const std::vector<std::string>& extra,
-                               FileReader readFile)
+SurfaceLibrary::SurfaceLibrary(const std::string& grammarPath,
+                               const std::vector<std::string>& extra, FileReader readFile)
     : searchPath_(extra), readFile_(std::move(readFile)) {
   const std::string dir = ParentOf(grammarPath);
   searchPath_.push_back(dir);

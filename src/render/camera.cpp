@@ -7,7 +7,8 @@ namespace sylva::render {
 
 Vec3 Camera::Eye() const {
   const double az = azimuth * kDegToRad, el = elevation * kDegToRad;
-  return target + distance * Vec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+  return target +
+         distance * Vec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
 }
 
 Mat4 Camera::View() const {

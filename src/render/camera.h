@@ -13,10 +13,10 @@ namespace sylva::render {
 
 struct Camera {
   Vec3 target{0, 0, 0};
-  double azimuth = 30;      // degrees
-  double elevation = 15;    // degrees, -89..89
+  double azimuth = 30;    // degrees
+  double elevation = 15;  // degrees, -89..89
   double distance = 10;
-  double fovY = 35;         // degrees (perspective)
+  double fovY = 35;  // degrees (perspective)
   bool orthographic = false;
   double orthoHeight = 10;  // world units shown vertically (orthographic)
 

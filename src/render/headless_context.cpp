@@ -29,10 +29,15 @@ Expected<std::unique_ptr<HeadlessContext>> HeadlessContext::Create() {
   EGLConfig config = nullptr;
   EGLint count = 0;
   eglChooseConfig(display, configAttribs, &config, 1, &count);
-  const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
+  const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                   4,
+                                   EGL_CONTEXT_MINOR_VERSION,
+                                   5,
                                    EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                                   EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-  EGLContext context = eglCreateContext(display, count ? config : nullptr, EGL_NO_CONTEXT, contextAttribs);
+                                   EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                   EGL_NONE};
+  EGLContext context =
+      eglCreateContext(display, count ? config : nullptr, EGL_NO_CONTEXT, contextAttribs);
   if (context == EGL_NO_CONTEXT) {
     eglTerminate(display);
     return GlError("cannot create an OpenGL 4.5 core context");

@@ -5,8 +5,8 @@
 #include <unistd.h>
 
 #include <array>
-#include <cstdlib>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 
 #include "core/atomic_file.h"
@@ -247,7 +247,8 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
     glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
   }
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.meshIndex);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(), GL_STATIC_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
+               GL_STATIC_DRAW);
   g.meshIndexCount = GLsizei(m.indices.size());
   glBindVertexArray(0);
   g.lo = g.hi = Vec3::Zero();
@@ -405,7 +406,9 @@ void Renderer::Draw(const Camera& camera) {
   glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
 }
 
-void Renderer::Finish() { glFinish(); }
+void Renderer::Finish() {
+  glFinish();
+}
 
 void Renderer::PresentToWindow(int width, int height) {
   glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->resolveFbo);
@@ -482,7 +485,9 @@ Status EncodeAndWrite(const Image& image, const std::string& path, bool jpeg) {
 
 }  // namespace
 
-Status WritePng(const Image& image, const std::string& path) { return EncodeAndWrite(image, path, false); }
+Status WritePng(const Image& image, const std::string& path) {
+  return EncodeAndWrite(image, path, false);
+}
 
 bool IsImagePath(const std::string& path) {
   const std::string ext = LowerExtension(path);

@@ -26,7 +26,9 @@ namespace sylva::render {
 struct Image {
   int width = 0, height = 0;
   std::vector<uint8_t> rgba;  // rows top to bottom, 4 bytes a pixel
-  const uint8_t* Pixel(int x, int y) const { return &rgba[4 * (size_t(y) * size_t(width) + size_t(x))]; }
+  const uint8_t* Pixel(int x, int y) const {
+    return &rgba[4 * (size_t(y) * size_t(width) + size_t(x))];
+  }
 };
 
 struct LineBatch {

@@ -12,34 +12,73 @@ namespace sylva::turtle {
 namespace {
 
 enum class Op : uint8_t {
-  kNone, kForwardDraw, kForwardMove, kForwardDrawNoVertex, kForwardMoveNoVertex,
-  kTurnLeft, kTurnRight, kPitchDown, kPitchUp, kRollLeft, kRollRight, kTurnAround, kLevel,
-  kPush, kPop, kWidth, kColor, kPolygonBegin, kVertex, kPolygonEnd, kSurface, kSphere,
+  kNone,
+  kForwardDraw,
+  kForwardMove,
+  kForwardDrawNoVertex,
+  kForwardMoveNoVertex,
+  kTurnLeft,
+  kTurnRight,
+  kPitchDown,
+  kPitchUp,
+  kRollLeft,
+  kRollRight,
+  kTurnAround,
+  kLevel,
+  kPush,
+  kPop,
+  kWidth,
+  kColor,
+  kPolygonBegin,
+  kVertex,
+  kPolygonEnd,
+  kSurface,
+  kSphere,
 };
 
 Op OpFor(const std::string& name) {
   if (name.size() == 1) {
     switch (name[0]) {
-      case 'F': return Op::kForwardDraw;
-      case 'f': return Op::kForwardMove;
-      case 'G': return Op::kForwardDrawNoVertex;
-      case 'g': return Op::kForwardMoveNoVertex;
-      case '+': return Op::kTurnLeft;
-      case '-': return Op::kTurnRight;
-      case '&': return Op::kPitchDown;
-      case '^': return Op::kPitchUp;
-      case '/': return Op::kRollRight;
-      case '\\': return Op::kRollLeft;
-      case '|': return Op::kTurnAround;
-      case '$': return Op::kLevel;
-      case '[': return Op::kPush;
-      case ']': return Op::kPop;
-      case '!': return Op::kWidth;
-      case '\'': return Op::kColor;
-      case '{': return Op::kPolygonBegin;
-      case '.': return Op::kVertex;
-      case '}': return Op::kPolygonEnd;
-      default: return Op::kNone;
+      case 'F':
+        return Op::kForwardDraw;
+      case 'f':
+        return Op::kForwardMove;
+      case 'G':
+        return Op::kForwardDrawNoVertex;
+      case 'g':
+        return Op::kForwardMoveNoVertex;
+      case '+':
+        return Op::kTurnLeft;
+      case '-':
+        return Op::kTurnRight;
+      case '&':
+        return Op::kPitchDown;
+      case '^':
+        return Op::kPitchUp;
+      case '/':
+        return Op::kRollRight;
+      case '\\':
+        return Op::kRollLeft;
+      case '|':
+        return Op::kTurnAround;
+      case '$':
+        return Op::kLevel;
+      case '[':
+        return Op::kPush;
+      case ']':
+        return Op::kPop;
+      case '!':
+        return Op::kWidth;
+      case '\'':
+        return Op::kColor;
+      case '{':
+        return Op::kPolygonBegin;
+      case '.':
+        return Op::kVertex;
+      case '}':
+        return Op::kPolygonEnd;
+      default:
+        return Op::kNone;
     }
   }
   if (name[0] == '~') return Op::kSurface;
@@ -84,7 +123,7 @@ inline void SinCosSmall(double r, double* s, double* c) {
     return;
   }
   const double x2 = r * r;
-  double ps = 1.0 / 355687428096000.0;  // 1/17!
+  double ps = 1.0 / 355687428096000.0;   // 1/17!
   ps = 1.0 / 1307674368000.0 - x2 * ps;  // 1/15!
   ps = 1.0 / 6227020800.0 - x2 * ps;     // 1/13!
   ps = 1.0 / 39916800.0 - x2 * ps;       // 1/11!
@@ -93,7 +132,7 @@ inline void SinCosSmall(double r, double* s, double* c) {
   ps = 1.0 / 120.0 - x2 * ps;
   ps = 1.0 / 6.0 - x2 * ps;
   *s = r - r * x2 * ps;
-  double pc = 1.0 / 6402373705728000.0;  // 1/18!
+  double pc = 1.0 / 6402373705728000.0;   // 1/18!
   pc = 1.0 / 20922789888000.0 - x2 * pc;  // 1/16!
   pc = 1.0 / 87178291200.0 - x2 * pc;     // 1/14!
   pc = 1.0 / 479001600.0 - x2 * pc;       // 1/12!
@@ -178,7 +217,8 @@ static std::string ModuleText(const lsys::Word& word, const lsys::SymbolTable& s
 // and small enough that float arithmetic on it stays finite (squared
 // lengths included): each component of every point, every radius and
 // scale. NaN is caught in any component (no max(|x|), which drops NaN).
-static Status CheckRange(const PlantGeometry& g, const lsys::Word& word, const lsys::SymbolTable& symbols) {
+static Status CheckRange(const PlantGeometry& g, const lsys::Word& word,
+                         const lsys::SymbolTable& symbols) {
   auto ok = [](double v) { return v >= -kMaxCoordinate && v <= kMaxCoordinate; };  // false for NaN
   auto okPoint = [&](const Vec3& p) { return ok(p.x()) && ok(p.y()) && ok(p.z()); };
   auto fail = [&](uint32_t module, const char* what) -> Status {
@@ -187,8 +227,8 @@ static Status CheckRange(const PlantGeometry& g, const lsys::Word& word, const l
     std::string where = module < word.size() ? "module " + std::to_string(module + 1) + " (" +
                                                    ModuleText(word, symbols, module) + ")"
                                              : "a module";
-    return MakeError({}, where + " gives " + what + " that is not a finite number within +-" +
-                             limit + " units");
+    return MakeError(
+        {}, where + " gives " + what + " that is not a finite number within +-" + limit + " units");
   };
   for (const Segment& sg : g.segments) {
     if (!okPoint(sg.start) || !okPoint(sg.end)) return fail(sg.module, "a segment end");
@@ -208,11 +248,11 @@ static Status CheckRange(const PlantGeometry& g, const lsys::Word& word, const l
   return {};
 }
 
-Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
-                     const TurtleDef& def, const DrawOptions& options, PlantGeometry& g) {
-  std::vector<Op> ops(symbols.size());
-  for (size_t s = 0; s < symbols.size(); ++s) ops[s] = OpFor(symbols.name(lsys::SymbolId(s)));
-
+// Empties `g` and sizes its arrays for what `word` draws (counted first,
+// so they are allocated once); an error when that is more than
+// options.maxPrimitives.
+static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops,
+                              const DrawOptions& options, PlantGeometry& g) {
   g.segments.clear();
   g.polygons.clear();
   g.surfaces.clear();
@@ -220,32 +260,77 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
   g.warnings.clear();
   g.modulePosition.clear();
   g.moduleFrame.clear();
-  {
-    // Count what will be drawn, so the arrays are allocated once.
-    size_t draws = 0, spheres = 0, surfaces = 0;
-    for (size_t i = 0; i < word.size(); ++i) {
-      const Op op = ops[word.symbols[i]];
-      draws += op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex;
-      spheres += op == Op::kSphere;
-      surfaces += op == Op::kSurface;
-    }
-    if (draws + spheres + surfaces > options.maxPrimitives) {
-      Diagnostic d;
-      d.kind = ErrorKind::kRuntime;
-      d.message = "the word draws " + std::to_string(draws + spheres + surfaces) +
-                  " primitives (segments, polygon vertices, spheres, surfaces), more than the "
-                  "limit of " + std::to_string(options.maxPrimitives) +
-                  "; lower the derivation length (-n) or raise --max-triangles";
-      return d;
-    }
-    if (g.segments.capacity() < draws) {
-      g.segments = std::vector<Segment>();
-      g.segments.reserve(draws);
-      AdviseHugePages(g.segments.data(), draws * sizeof(Segment));
-    }
-    g.spheres.reserve(spheres);
-    g.surfaces.reserve(surfaces);
+  size_t draws = 0, spheres = 0, surfaces = 0;
+  for (size_t i = 0; i < word.size(); ++i) {
+    const Op op = ops[word.symbols[i]];
+    draws += op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex;
+    spheres += op == Op::kSphere;
+    surfaces += op == Op::kSurface;
   }
+  if (draws + spheres + surfaces > options.maxPrimitives) {
+    Diagnostic d;
+    d.kind = ErrorKind::kRuntime;
+    d.message = "the word draws " + std::to_string(draws + spheres + surfaces) +
+                " primitives (segments, polygon vertices, spheres, surfaces), more than the "
+                "limit of " +
+                std::to_string(options.maxPrimitives) +
+                "; lower the derivation length (-n) or raise --max-triangles";
+    return d;
+  }
+  if (g.segments.capacity() < draws) {
+    g.segments = std::vector<Segment>();
+    g.segments.reserve(draws);
+    AdviseHugePages(g.segments.data(), draws * sizeof(Segment));
+  }
+  g.spheres.reserve(spheres);
+  g.surfaces.reserve(surfaces);
+  return {};
+}
+
+// ABOP eq. 2.3: after a move, the frame turns about H x T by e |H x T|
+// (Rodrigues' rotation). True when it turned.
+static inline bool ApplyTropism(const TurtleDef& def, Frame& f) {
+  const Vec3 axis = f.heading.cross(def.tropism);
+  const double norm = axis.norm();
+  if (!(norm > 1e-12)) return false;
+  // v' = v cos a + (k x v) sin a + k (k.v)(1 - cos a).
+  const double a = def.susceptibility * norm;
+  const Vec3 k = axis / norm;
+  double sa, ca;
+  SinCosSmall(a, &sa, &ca);
+  auto turn = [&](Vec3& v) { v = v * ca + k.cross(v) * sa + k * (k.dot(v) * (1 - ca)); };
+  turn(f.heading);
+  turn(f.left);
+  turn(f.up);
+  return true;
+}
+
+// `}`: closes the innermost open polygon into g.polygons, dropping a closing
+// vertex that repeats the first; warns about an unmatched `}` or a polygon
+// of fewer than 3 vertices (module i).
+static void ClosePolygon(std::vector<Polygon>& open, size_t i, PlantGeometry& g) {
+  if (open.empty()) {
+    g.warnings.push_back("unmatched '}' at module " + std::to_string(i + 1) + " ignored");
+    return;
+  }
+  Polygon poly = std::move(open.back());
+  open.pop_back();
+  if (poly.vertices.size() > 1 && (poly.vertices.front() - poly.vertices.back()).norm() < 1e-9)
+    poly.vertices.pop_back();
+  if (poly.vertices.size() < 3) {
+    g.warnings.push_back("polygon at module " + std::to_string(poly.module + 1) + " has " +
+                         std::to_string(poly.vertices.size()) + " vertices; skipped");
+    return;
+  }
+  g.polygons.push_back(std::move(poly));
+}
+
+Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, const TurtleDef& def,
+                     const DrawOptions& options, PlantGeometry& g) {
+  std::vector<Op> ops(symbols.size());
+  for (size_t s = 0; s < symbols.size(); ++s) ops[s] = OpFor(symbols.name(lsys::SymbolId(s)));
+
+  if (Status st = ClearAndReserve(word, ops, options, g); !st.ok()) return st;
   std::vector<uint32_t> branchParent{0};
   std::vector<State> stack;
   std::vector<Polygon> openPolygons;
@@ -317,31 +402,33 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
           sg.module = uint32_t(i);
           g.segments.push_back(sg);
         }
-        if (tropism) {
-          // ABOP eq. 2.3: turn about H x T by e |H x T|.
-          const Vec3 axis = t.frame.heading.cross(def.tropism);
-          const double norm = axis.norm();
-          if (norm > 1e-12) {
-            // Rodrigues: v' = v cos a + (k x v) sin a + k (k.v)(1 - cos a).
-            const double a = def.susceptibility * norm;
-            const Vec3 k = axis / norm;
-            double sa, ca;
-            SinCosSmall(a, &sa, &ca);
-            auto turn = [&](Vec3& v) { v = v * ca + k.cross(v) * sa + k * (k.dot(v) * (1 - ca)); };
-            turn(t.frame.heading);
-            turn(t.frame.left);
-            turn(t.frame.up);
-            ++turnsSinceOrtho;
-          }
-        }
+        if (tropism && ApplyTropism(def, t.frame)) ++turnsSinceOrtho;
         break;
       }
-      case Op::kTurnLeft: angle(); Rotate(t.frame.heading, t.frame.left, c, s); break;
-      case Op::kTurnRight: angle(); Rotate(t.frame.heading, t.frame.left, c, -s); break;
-      case Op::kPitchDown: angle(); Rotate(t.frame.heading, t.frame.up, c, s); break;
-      case Op::kPitchUp: angle(); Rotate(t.frame.heading, t.frame.up, c, -s); break;
-      case Op::kRollRight: angle(); Rotate(t.frame.left, t.frame.up, c, s); break;
-      case Op::kRollLeft: angle(); Rotate(t.frame.left, t.frame.up, c, -s); break;
+      case Op::kTurnLeft:
+        angle();
+        Rotate(t.frame.heading, t.frame.left, c, s);
+        break;
+      case Op::kTurnRight:
+        angle();
+        Rotate(t.frame.heading, t.frame.left, c, -s);
+        break;
+      case Op::kPitchDown:
+        angle();
+        Rotate(t.frame.heading, t.frame.up, c, s);
+        break;
+      case Op::kPitchUp:
+        angle();
+        Rotate(t.frame.heading, t.frame.up, c, -s);
+        break;
+      case Op::kRollRight:
+        angle();
+        Rotate(t.frame.left, t.frame.up, c, s);
+        break;
+      case Op::kRollLeft:
+        angle();
+        Rotate(t.frame.left, t.frame.up, c, -s);
+        break;
       case Op::kTurnAround:
         t.frame.heading = -t.frame.heading;
         t.frame.left = -t.frame.left;
@@ -385,26 +472,9 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
       case Op::kVertex:
         if (!openPolygons.empty()) openPolygons.back().vertices.push_back(t.pos);
         break;
-      case Op::kPolygonEnd: {
-        if (openPolygons.empty()) {
-          g.warnings.push_back("unmatched '}' at module " + std::to_string(i + 1) + " ignored");
-          break;
-        }
-        Polygon poly = std::move(openPolygons.back());
-        openPolygons.pop_back();
-        // Drop a closing vertex that repeats the first.
-        if (poly.vertices.size() > 1 &&
-            (poly.vertices.front() - poly.vertices.back()).norm() < 1e-9)
-          poly.vertices.pop_back();
-        if (poly.vertices.size() < 3) {
-          g.warnings.push_back("polygon at module " + std::to_string(poly.module + 1) + " has " +
-                               std::to_string(poly.vertices.size()) +
-                               " vertices; skipped");
-          break;
-        }
-        g.polygons.push_back(std::move(poly));
+      case Op::kPolygonEnd:
+        ClosePolygon(openPolygons, i, g);
         break;
-      }
       case Op::kSurface: {
         SurfaceInstance si;
         si.name = symbols.name(sym).substr(1);
@@ -425,7 +495,8 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
         g.spheres.push_back(sp);
         break;
       }
-      case Op::kNone: break;
+      case Op::kNone:
+        break;
     }
     if (turnsSinceOrtho >= 64) {
       Orthonormalise(t.frame);

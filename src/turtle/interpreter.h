@@ -38,11 +38,11 @@ using mesh::SurfaceInstance;
 // What the turtle needs of a grammar; TurtleDefFrom fills it from the
 // grammar's header (angle:, step:, width:, width factor:, tropism:).
 struct TurtleDef {
-  double angle = 90;       // degrees, for rotations with no parameter
-  double step = 1;         // for F f G g with no parameter
-  double width = 1;        // initial width (diameter)
+  double angle = 90;  // degrees, for rotations with no parameter
+  double step = 1;    // for F f G g with no parameter
+  double width = 1;   // initial width (diameter)
   double widthFactor = 0.7;
-  double widthScale = 1;   // drawn diameter = width x widthScale
+  double widthScale = 1;  // drawn diameter = width x widthScale
   Vec3 tropism{0, -1, 0};
   double susceptibility = 0;  // 0: no tropism
 };
@@ -70,7 +70,7 @@ Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTabl
 // The same, drawing into `out` and reusing its arrays' memory: the viewer
 // redraws a plant many times, and fresh memory costs the kernel a page
 // clear per 4 KiB. On error `out` is left empty.
-Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols,
-                     const TurtleDef& def, const DrawOptions& options, PlantGeometry& out);
+Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, const TurtleDef& def,
+                     const DrawOptions& options, PlantGeometry& out);
 
 }  // namespace sylva::turtle

@@ -15,12 +15,14 @@ using testing::WriteFile;
 
 struct BadCase {
   const char* name;
-  std::string text;  // "%SELF%" is replaced by the file's own name
-  const char* where;  // "line:col" (or "line" when the whole file is at fault)
+  std::string text;     // "%SELF%" is replaced by the file's own name
+  const char* where;    // "line:col" (or "line" when the whole file is at fault)
   const char* message;  // part of the first error message
 };
 
-std::string Many(char c, int n) { return std::string(size_t(n), c); }
+std::string Many(char c, int n) {
+  return std::string(size_t(n), c);
+}
 
 std::vector<BadCase> Cases() {
   std::string ones = "1";
@@ -33,7 +35,8 @@ std::vector<BadCase> Cases() {
       {"function_arity", "axiom: F(min(1))\n", "1:10", "takes 2 arguments, given 1"},
       {"bad_number", "axiom: F(1.2.3)\n", "1:10", "malformed number '1.2.3'"},
       {"bad_exponent", "axiom: F(1e)\n", "1:10", "exponent has no digits"},
-      {"unterminated_comment", "axiom: F /* never closed\nF --> FF\n", "1:10", "unterminated comment"},
+      {"unterminated_comment", "axiom: F /* never closed\nF --> FF\n", "1:10",
+       "unterminated comment"},
       {"empty_axiom", "axiom:   \n", "1:1", "'axiom:' needs a value"},
       {"missing_axiom", "F --> FF\n", "1", "no 'axiom:'"},
       {"constant_division_by_zero", "#define a 1/0\naxiom: F(a)\n", "1:12", "division by zero"},
@@ -42,8 +45,10 @@ std::vector<BadCase> Cases() {
       {"runtime_sqrt_negative", "axiom: A(-1)\nA(x) --> B(sqrt(x))\nderivation length: 1\n", "2:12",
        "sqrt of a negative number"},
       {"include_recursion", "#include \"%SELF%\"\naxiom: F\n", "1:10", "#include recursion"},
-      {"include_missing", "#include \"nothere.lsys\"\naxiom: F\n", "1:10", "cannot read included file"},
-      {"binary_garbage", "axiom: F\n\x01\x02\xff\xfe --> \x80\n", "2:1", "unexpected character '\\x01'"},
+      {"include_missing", "#include \"nothere.lsys\"\naxiom: F\n", "1:10",
+       "cannot read included file"},
+      {"binary_garbage", "axiom: F\n\x01\x02\xff\xfe --> \x80\n", "2:1",
+       "unexpected character '\\x01'"},
       {"nul_byte", std::string("axiom: F\0F\n", 11), "1:9", "unexpected character '\\x00'"},
       {"two_module_predecessor", "axiom: F\nAB --> C\n", "2:1", "exactly one module"},
       {"no_predecessor", "axiom: F\n --> C\n", "2:2", "no predecessor"},
@@ -58,7 +63,8 @@ std::vector<BadCase> Cases() {
       {"huge_length", "derivation length: 1e9\naxiom: F\n", "1:20", "whole number"},
       {"unknown_directive", "#ifdef X\naxiom: F\n", "1:1", "unknown directive '#ifdef'"},
       {"redefinition", "#define a 1\n#define a 2\naxiom: F(a)\n", "2:9", "redefinition of 'a'"},
-      {"bracket_in_left_context", "axiom: F\n[ < F --> G\n", "2:1", "not allowed in a left context"},
+      {"bracket_in_left_context", "axiom: F\n[ < F --> G\n", "2:1",
+       "not allowed in a left context"},
       {"rewriting_a_bracket", "axiom: F\n] --> F\n", "2:1", "cannot be rewritten"},
       {"unbalanced_right_context", "axiom: AB\nA > [B --> C\n", "2:5", "unbalanced '['"},
       {"second_axiom", "axiom: F\naxiom: G\n", "2:1", "second axiom"},
@@ -71,9 +77,11 @@ std::vector<BadCase> Cases() {
       {"tilde_without_name", "axiom: ~(2)\n", "1:8", "surface name after '~'"},
       {"too_many_parameters", "axiom: F(" + ones + ")\n", "1:8", "more than 64 parameters"},
       {"empty_condition", "axiom: F\nF : --> G\n", "2:3", "empty condition"},
-      {"depth_in_main_section", "maximum depth: 2\naxiom: F\n", "1:1", "decomposition or interpretation"},
+      {"depth_in_main_section", "maximum depth: 2\naxiom: F\n", "1:1",
+       "decomposition or interpretation"},
       {"negative_seed", "seed: -4\naxiom: F\n", "1:7", "whole number"},
-      {"deep_parentheses", "axiom: F(" + Many('(', 200) + "1" + Many(')', 200) + ")\n", "1:", "nested deeper than 48"},
+      {"deep_parentheses", "axiom: F(" + Many('(', 200) + "1" + Many(')', 200) + ")\n",
+       "1:", "nested deeper than 48"},
       {"stray_close_paren", "axiom: F)\n", "1:9", "unbalanced ')'"},
       {"zero_tropism", "tropism: 0 0 0 1\naxiom: F\n", "1:10", "tropism vector is zero"},
       {"override_unknown_in_condition", "axiom: A\nA : q --> B\n", "2:5", "unknown name 'q'"},
@@ -91,8 +99,9 @@ TEST(BadInput, EachMalformedGrammarIsExitTwoWithItsLocation) {
     auto r = RunSylva({"derive", path});
     EXPECT_EQ(r.code, 2) << c.name << "\n" << r.err;
     std::string prefix = path + ":" + c.where;
-    EXPECT_EQ(r.err.rfind(prefix, 0), 0u) << c.name << ": expected the first diagnostic at "
-                                          << c.where << ", got:\n" << r.err;
+    EXPECT_EQ(r.err.rfind(prefix, 0), 0u)
+        << c.name << ": expected the first diagnostic at " << c.where << ", got:\n"
+        << r.err;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.name << ":\n" << r.err;
     EXPECT_NE(r.err.find("error:"), std::string::npos) << c.name;
     EXPECT_EQ(r.out, "") << c.name;
@@ -100,12 +109,14 @@ TEST(BadInput, EachMalformedGrammarIsExitTwoWithItsLocation) {
 }
 
 TEST(BadInput, DiagnosticShowsTheLineAndACaret) {
-  std::string path = WriteFile("caret.lsys", "axiom: A(1,10)\nA(l,w) --> !(w)F(l)[&(45)B(l*r3,w)]\n");
+  std::string path =
+      WriteFile("caret.lsys", "axiom: A(1,10)\nA(l,w) --> !(w)F(l)[&(45)B(l*r3,w)]\n");
   auto r = RunSylva({"check", path});
   EXPECT_EQ(r.code, 2);
-  EXPECT_EQ(r.err, path + ":2:30: error: unknown name 'r3' in expression\n"
-                          "    2 | A(l,w) --> !(w)F(l)[&(45)B(l*r3,w)]\n"
-                          "      |                              ^~\n");
+  EXPECT_EQ(r.err, path +
+                       ":2:30: error: unknown name 'r3' in expression\n"
+                       "    2 | A(l,w) --> !(w)F(l)[&(45)B(l*r3,w)]\n"
+                       "      |                              ^~\n");
 }
 
 TEST(BadInput, MaxErrorsCapsThePrintedErrorsAndCountsTheRest) {
@@ -117,8 +128,10 @@ TEST(BadInput, MaxErrorsCapsThePrintedErrorsAndCountsTheRest) {
     if (std::string(cmd) == "render") continue;  // built without the renderer
 #endif
     std::vector<std::string> args = {cmd, path};
-    if (std::string(cmd) == "mesh") args.insert(args.end(), {"-o", (testing::Scratch() / "unused.obj").string()});
-    if (std::string(cmd) == "render") args.insert(args.end(), {"-o", (testing::Scratch() / "unused.png").string()});
+    if (std::string(cmd) == "mesh")
+      args.insert(args.end(), {"-o", (testing::Scratch() / "unused.obj").string()});
+    if (std::string(cmd) == "render")
+      args.insert(args.end(), {"-o", (testing::Scratch() / "unused.png").string()});
     auto r = RunSylva(args);
     EXPECT_EQ(r.code, 2) << cmd;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 20 * 3 + 1) << cmd << "\n" << r.err;
@@ -126,7 +139,8 @@ TEST(BadInput, MaxErrorsCapsThePrintedErrorsAndCountsTheRest) {
   }
   auto five = RunSylva({"check", "--max-errors", "5", path});
   EXPECT_EQ(five.code, 2);
-  EXPECT_NE(five.err.find("sylva: note: 25 more errors not shown\n"), std::string::npos) << five.err;
+  EXPECT_NE(five.err.find("sylva: note: 25 more errors not shown\n"), std::string::npos)
+      << five.err;
   auto all = RunSylva({"derive", "--max-errors", "0", path});
   EXPECT_EQ(all.code, 2);
   EXPECT_EQ(std::count(all.err.begin(), all.err.end(), '\n'), 30 * 3) << all.err;

@@ -22,7 +22,8 @@ TEST(Cli, DerivePrintsTheCanonicalWord) {
 }
 
 TEST(Cli, DefinesSeedsAndSteps) {
-  std::string f = WriteFile("d.lsys", "#define x 1\nseed: 3\naxiom: A(x)\nA(a) --> A(a+ran(1)*0+1)\n");
+  std::string f =
+      WriteFile("d.lsys", "#define x 1\nseed: 3\naxiom: A(x)\nA(a) --> A(a+ran(1)*0+1)\n");
   auto r = RunSylva({"derive", f, "-D", "x=5", "-n", "2", "--seed", "9", "--threads", "1"});
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.out, "A(7)\n");
@@ -38,22 +39,23 @@ TEST(Cli, StatsReportCountsPerStepAndSymbol) {
 }
 
 TEST(Cli, InterpretAppliesInterpretationRules) {
-  auto r = RunSylva({"derive", Source("grammars/abop/fig1_10a_dragon_curve.lsys"), "-n", "1",
-                "--interpret"});
+  auto r = RunSylva(
+      {"derive", Source("grammars/abop/fig1_10a_dragon_curve.lsys"), "-n", "1", "--interpret"});
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.out, "F+F+\n");
 }
 
 TEST(Cli, OutputFileIsWrittenWhole) {
   std::string out = (Scratch() / "word.txt").string();
-  auto r = RunSylva({"derive", Source("grammars/abop/fig1_24a_bracketed_plant.lsys"), "-n", "1", "-o", out});
+  auto r = RunSylva(
+      {"derive", Source("grammars/abop/fig1_24a_bracketed_plant.lsys"), "-n", "1", "-o", out});
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(*ReadFile(out), "F[+F]F[-F]F\n");
 }
 
 TEST(Cli, UnwritableOutputIsExitOneAndLeavesNothing) {
   auto r = RunSylva({"derive", Source("grammars/abop/fig1_24a_bracketed_plant.lsys"), "-o",
-                "/nonexistent-dir/word.txt"});
+                     "/nonexistent-dir/word.txt"});
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("/nonexistent-dir/word.txt: error: cannot create output file"),
             std::string::npos)
@@ -62,17 +64,22 @@ TEST(Cli, UnwritableOutputIsExitOneAndLeavesNothing) {
 
 TEST(Cli, FailedDerivationKeepsThePreviousOutputFile) {
   std::string out = (Scratch() / "keep.txt").string();
-  ASSERT_EQ(RunSylva({"derive", Source("grammars/abop/fig1_24a_bracketed_plant.lsys"), "-n", "0", "-o", out}).code, 0);
-  auto r = RunSylva({"derive", Source("grammars/abop/fig1_06_koch_island.lsys"), "--max-modules", "100",
-                "-o", out});
+  ASSERT_EQ(RunSylva({"derive", Source("grammars/abop/fig1_24a_bracketed_plant.lsys"), "-n", "0",
+                      "-o", out})
+                .code,
+            0);
+  auto r = RunSylva({"derive", Source("grammars/abop/fig1_06_koch_island.lsys"), "--max-modules",
+                     "100", "-o", out});
   EXPECT_EQ(r.code, 1);
   EXPECT_EQ(*ReadFile(out), "F\n");
 }
 
 TEST(Cli, LimitReachedIsExitOne) {
-  auto r = RunSylva({"derive", Source("grammars/abop/fig1_06_koch_island.lsys"), "--max-modules", "1000"});
+  auto r = RunSylva(
+      {"derive", Source("grammars/abop/fig1_06_koch_island.lsys"), "--max-modules", "1000"});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("derivation step 3 would make the word 3803 modules long"), std::string::npos)
+  EXPECT_NE(r.err.find("derivation step 3 would make the word 3803 modules long"),
+            std::string::npos)
       << r.err;
   EXPECT_EQ(r.out, "");
 }
@@ -82,7 +89,8 @@ TEST(Cli, CheckPrintsWarningsAndSucceeds) {
   auto r = RunSylva({"check", f});
   EXPECT_EQ(r.code, 0);
   EXPECT_EQ(r.out, "");
-  EXPECT_NE(r.err.find("warn.lsys:1:9: warning: constant 'unused' is never used"), std::string::npos)
+  EXPECT_NE(r.err.find("warn.lsys:1:9: warning: constant 'unused' is never used"),
+            std::string::npos)
       << r.err;
 }
 
@@ -99,13 +107,15 @@ TEST(Cli, BadUsageIsExitTwo) {
   EXPECT_EQ(RunSylva({"frobnicate"}).code, 2);
   EXPECT_EQ(RunSylva({"derive"}).code, 2);
   EXPECT_EQ(RunSylva({"derive", Source("grammars/abop/fig1_25_bush.lsys"), "-n", "-3"}).code, 2);
-  EXPECT_EQ(RunSylva({"derive", Source("grammars/abop/fig1_25_bush.lsys"), "--threads", "x"}).code, 2);
+  EXPECT_EQ(RunSylva({"derive", Source("grammars/abop/fig1_25_bush.lsys"), "--threads", "x"}).code,
+            2);
   auto d = RunSylva({"derive", Source("grammars/abop/fig1_25_bush.lsys"), "-D", "novalue"});
   EXPECT_EQ(d.code, 2);
   EXPECT_NE(d.err.find("-D expects NAME=VALUE"), std::string::npos) << d.err;
   auto m = RunSylva({"derive", "/no/such/grammar.lsys"});
   EXPECT_EQ(m.code, 2);
-  EXPECT_NE(m.err.find("/no/such/grammar.lsys: error: cannot read file"), std::string::npos) << m.err;
+  EXPECT_NE(m.err.find("/no/such/grammar.lsys: error: cannot read file"), std::string::npos)
+      << m.err;
 }
 
 TEST(Cli, HelpIsExitZero) {
@@ -122,7 +132,8 @@ namespace {
 
 TEST(CliMesh, WritesTheMeshAndASummary) {
   std::string out = (Scratch() / "tree.ply").string();
-  auto r = RunSylva({"mesh", Source("grammars/abop/fig2_06a_monopodial.lsys"), "-n", "3", "--sides", "4", "-o", out});
+  auto r = RunSylva({"mesh", Source("grammars/abop/fig2_06a_monopodial.lsys"), "-n", "3", "--sides",
+                     "4", "-o", out});
   EXPECT_EQ(r.code, 0) << r.err;
   auto text = ReadFile(out);
   ASSERT_TRUE(text.ok());
@@ -132,15 +143,19 @@ TEST(CliMesh, WritesTheMeshAndASummary) {
 }
 
 TEST(CliMesh, UnknownExtensionIsExitTwo) {
-  auto r = RunSylva({"mesh", Source("grammars/abop/fig1_25_bush.lsys"), "-o", (Scratch() / "x.stl").string()});
+  auto r = RunSylva(
+      {"mesh", Source("grammars/abop/fig1_25_bush.lsys"), "-o", (Scratch() / "x.stl").string()});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("unknown mesh format"), std::string::npos) << r.err;
 }
 
 TEST(CliMesh, UnwritableOutputIsExitOneWithNoPartialFile) {
-  auto r = RunSylva({"mesh", Source("grammars/abop/fig1_25_bush.lsys"), "-o", "/nonexistent-dir/bush.glb"});
+  auto r = RunSylva(
+      {"mesh", Source("grammars/abop/fig1_25_bush.lsys"), "-o", "/nonexistent-dir/bush.glb"});
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.err.find("/nonexistent-dir/bush.glb: error: cannot create output file"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("/nonexistent-dir/bush.glb: error: cannot create output file"),
+            std::string::npos)
+      << r.err;
 }
 
 TEST(CliMesh, UnknownSurfacePointsAtTheTilde) {

@@ -47,6 +47,8 @@ inline std::string WriteFile(const std::string& name, const std::string& text) {
   return p.string();
 }
 
-inline std::string Source(const std::string& rel) { return std::string(SYLVA_SOURCE_DIR) + "/" + rel; }
+inline std::string Source(const std::string& rel) {
+  return std::string(SYLVA_SOURCE_DIR) + "/" + rel;
+}
 
 }  // namespace sylva::app::testing

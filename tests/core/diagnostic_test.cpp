@@ -9,8 +9,9 @@
 namespace sylva {
 
 TEST(Diagnostic, FormatsGccStyleWithExcerptAndCaret) {
-  Diagnostic d = MakeError(SourceLoc{"grammars/tree.lsys", 14, 31}, "unknown name 'r3' in expression",
-                           2, "A(l,w) --> !(w)F(l)[&(a0)B(l*r3,w*wr)]");
+  Diagnostic d =
+      MakeError(SourceLoc{"grammars/tree.lsys", 14, 31}, "unknown name 'r3' in expression", 2,
+                "A(l,w) --> !(w)F(l)[&(a0)B(l*r3,w*wr)]");
   std::string s = d.Format();
   EXPECT_EQ(s,
             "grammars/tree.lsys:14:31: error: unknown name 'r3' in expression\n"
@@ -27,7 +28,10 @@ TEST(Diagnostic, WarningAndNoLocation) {
 }
 
 TEST(Diagnostic, ControlBytesInExcerptBecomeSpaces) {
-  Diagnostic d = MakeError(SourceLoc{"f", 1, 2}, "bad", 1, std::string("a\x01" "b", 3));
+  Diagnostic d = MakeError(SourceLoc{"f", 1, 2}, "bad", 1,
+                           std::string("a\x01"
+                                       "b",
+                                       3));
   EXPECT_NE(d.Format().find("a b"), std::string::npos) << d.Format();
 }
 
@@ -78,7 +82,8 @@ TEST(Diagnostic, InvalidUtf8IsEscapedAndTheCaretStaysAligned) {
 
 TEST(DiagnosticList, FormatAllStopsAfterMaxErrors) {
   DiagnosticList list;
-  for (int i = 0; i < 50; ++i) list.Add(MakeError(SourceLoc{"f", i + 1, 1}, std::string("e").append(std::to_string(i))));
+  for (int i = 0; i < 50; ++i)
+    list.Add(MakeError(SourceLoc{"f", i + 1, 1}, std::string("e").append(std::to_string(i))));
   std::string s = list.FormatAll(20);
   size_t lines = size_t(std::count(s.begin(), s.end(), '\n'));
   EXPECT_EQ(lines, 21u) << s;

@@ -58,7 +58,9 @@ TEST(Context, MultiModuleContexts) {
   EXPECT_EQ(Step("ABCDE", "BB < C --> X"), "ABCDE");
 }
 
-TEST(Context, StarMeansNoContext) { EXPECT_EQ(Step("+A-", "* < + > * --> -\n* < - > * --> +"), "-A+"); }
+TEST(Context, StarMeansNoContext) {
+  EXPECT_EQ(Step("+A-", "* < + > * --> -\n* < - > * --> +"), "-A+");
+}
 
 TEST(Context, NoContextAtTheWordsEnds) {
   EXPECT_EQ(Step("A", "B < A --> X\nA > B --> Y"), "A");

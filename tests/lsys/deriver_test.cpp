@@ -60,8 +60,8 @@ TEST(Deriver, RecursiveDecompositionIsBoundedByDepth) {
 }
 
 TEST(Deriver, InterpretationLeavesTheDerivedWordAlone) {
-  Grammar g = MustParse(
-      "axiom: A\nA --> AB\ninterpretation:\nmaximum depth: 2\nB --> [G]\nG --> F(2)\n");
+  Grammar g =
+      MustParse("axiom: A\nA --> AB\ninterpretation:\nmaximum depth: 2\nB --> [G]\nG --> F(2)\n");
   DeriveOptions opt;
   opt.steps = 2;
   auto r = MustDerive(g, opt);
@@ -112,10 +112,10 @@ TEST(Deriver, RuntimeDivisionByZeroPointsIntoTheProduction) {
 }
 
 TEST(Deriver, SameWordForAnyThreadCount) {
-  for (const char* file : {"grammars/abop/fig2_06a_monopodial.lsys",
-                           "grammars/abop/fig1_27_stochastic_plant.lsys",
-                           "grammars/abop/fig1_31b_hogeweg_hesper.lsys",
-                           "grammars/abop/fig1_24d_bracketed_plant.lsys"}) {
+  for (const char* file :
+       {"grammars/abop/fig2_06a_monopodial.lsys", "grammars/abop/fig1_27_stochastic_plant.lsys",
+        "grammars/abop/fig1_31b_hogeweg_hesper.lsys",
+        "grammars/abop/fig1_24d_bracketed_plant.lsys"}) {
     Grammar g = MustParse(*ReadFile(SourcePath(file)));
     uint64_t reference = 0;
     size_t size = 0;
@@ -137,7 +137,9 @@ TEST(Deriver, SameWordForAnyThreadCount) {
   }
 }
 
-TEST(Deriver, ZeroStepsGivesTheAxiom) { EXPECT_EQ(DeriveText("axiom: A(2*3)B\nA(x) --> B\n", 0), "A(6)B"); }
+TEST(Deriver, ZeroStepsGivesTheAxiom) {
+  EXPECT_EQ(DeriveText("axiom: A(2*3)B\nA(x) --> B\n", 0), "A(6)B");
+}
 
 TEST(Deriver, LongDerivationOfAFixedPointFinishes) {
   Grammar g = MustParse("derivation length: 100000\naxiom: AB\nB --> B\n");

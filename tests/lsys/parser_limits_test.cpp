@@ -26,8 +26,12 @@ void* operator new(size_t n) {
   if (void* p = std::malloc(n ? n : 1)) return p;
   throw std::bad_alloc();
 }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, size_t) noexcept { std::free(p); }
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, size_t) noexcept {
+  std::free(p);
+}
 
 namespace sylva::lsys {
 namespace {
@@ -82,8 +86,8 @@ TEST(ParserLimits, DeepParenthesesAreALocatedError) {
 }
 
 TEST(ParserLimits, BracketsNested100000DeepDerive) {
-  std::string text = "axiom: A\nA --> " + std::string(100000, '[') + "F" +
-                     std::string(100000, ']') + "\n";
+  std::string text =
+      "axiom: A\nA --> " + std::string(100000, '[') + "F" + std::string(100000, ']') + "\n";
   Grammar g = testing::MustParse(text);
   DeriveOptions opt;
   opt.steps = 1;
@@ -96,8 +100,7 @@ TEST(ParserLimits, ParsingALongLineAllocatesInProportionToIt) {
   // diagnostics): 320,000 bracket pairs in one successor took half a minute.
   std::string succ;
   for (int i = 0; i < 100000; ++i) succ += "[F~s" + std::to_string(i % 500) + "]";
-  std::string text = "axiom: A\nA --> " + succ + " : 1\nA --> " + succ + "\nB --> " + succ +
-                     " $\n";
+  std::string text = "axiom: A\nA --> " + succ + " : 1\nA --> " + succ + "\nB --> " + succ + " $\n";
   size_t before = gAllocatedBytes.load();
   ParseResult r = ParseGrammarText(text, "long.lsys");
   size_t used = gAllocatedBytes.load() - before;
@@ -115,14 +118,16 @@ TEST(ParserLimits, ParsingALongLineAllocatesInProportionToIt) {
 
 TEST(ParserLimits, MessagesQuotingAHugeTokenStaySmall) {
   // "malformed number '<the whole token>'" used to quote a megabyte.
-  for (const std::string& token : {std::string(1000000, '7') + "x", "q" + std::string(1000000, 'z')}) {
+  for (const std::string& token :
+       {std::string(1000000, '7') + "x", "q" + std::string(1000000, 'z')}) {
     ParseResult r = ParseGrammarText("axiom: F(" + token + ")\n", "token.lsys");
     ASSERT_EQ(r.diagnostics.ErrorCount(), 1u);
     const Diagnostic& d = r.diagnostics.items[0];
     EXPECT_LT(d.message.size(), 600u) << d.message.substr(0, 40);
     EXPECT_LT(d.Format().size(), 1000u) << d.message.substr(0, 40);
     EXPECT_NE(d.message.find("..."), std::string::npos) << d.message;
-    EXPECT_TRUE(d.message.rfind("'", d.message.size()) > d.message.size() - 20) << "keeps the end: " << d.message;
+    EXPECT_TRUE(d.message.rfind("'", d.message.size()) > d.message.size() - 20)
+        << "keeps the end: " << d.message;
   }
 }
 
@@ -163,7 +168,10 @@ TEST(ParserLimits, ByteOrderMarkIsSkippedInMainAndIncludedFiles) {
   ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
   EXPECT_EQ(FormatWord(testing::MustDerive(*r.grammar).word, r.grammar->symbols), "F(3)");
   // Columns do not count the mark.
-  ParseResult bad = ParseGrammarText("\xEF\xBB\xBF" "axiom: F(q)\n", "bom.lsys");
+  ParseResult bad = ParseGrammarText(
+      "\xEF\xBB\xBF"
+      "axiom: F(q)\n",
+      "bom.lsys");
   ASSERT_FALSE(bad.grammar);
   EXPECT_EQ(bad.diagnostics.items[0].loc.column, 10) << bad.diagnostics.FormatAll();
 }
@@ -189,8 +197,8 @@ TEST(ParserLimits, IncludeOfADeviceFifoOrDirectoryIsALocatedError) {
     EXPECT_NE(d.message.find(why[i]), std::string::npos) << d.message;
   }
   // The main file gets the same checks.
-  for (const std::string& p : {std::string("/dev/zero"), fifo.string(),
-                               (Scratch() / "dir.lsys").string()}) {
+  for (const std::string& p :
+       {std::string("/dev/zero"), fifo.string(), (Scratch() / "dir.lsys").string()}) {
     ParseResult m = ParseGrammarFile(p);
     ASSERT_EQ(m.diagnostics.ErrorCount(), 1u) << p;
     EXPECT_EQ(m.diagnostics.items[0].loc.file, p);
@@ -229,8 +237,8 @@ TEST(ParserLimits, IncludedBytesHaveATotalBudgetAndAPerFileLimit) {
   };
   opt.maxFileBytes = 150;
   opt.maxTotalBytes = 200;  // the main text counts too
-  ParseResult r = ParseGrammarText(
-      "#include \"a\"\n#include \"b\"\n#include \"big\"\naxiom: F\n", "budget.lsys", opt);
+  ParseResult r = ParseGrammarText("#include \"a\"\n#include \"b\"\n#include \"big\"\naxiom: F\n",
+                                   "budget.lsys", opt);
   ASSERT_EQ(r.diagnostics.ErrorCount(), 2u) << r.diagnostics.FormatAll();
   EXPECT_EQ(r.diagnostics.items[0].loc.line, 2);
   EXPECT_EQ(r.diagnostics.items[0].message,
@@ -249,8 +257,7 @@ TEST(ParserLimits, ManyDeclaredModuleNamesLexInTimeLinearInTheWord) {
   for (int i = 0; i < 400000; ++i) word += "m49999m1m12F";
   auto start = std::chrono::steady_clock::now();
   ParseResult r = ParseGrammarText(decl + "\naxiom: A\nA --> " + word + "\n", "decl.lsys");
-  double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll(3);
   EXPECT_LT(seconds, 30.0);
   const Successor& succ = r.grammar->main.productions[0].successor;
@@ -264,7 +271,9 @@ TEST(ParserLimits, ManyDeclaredModuleNamesLexInTimeLinearInTheWord) {
 TEST(ParserLimits, RightContextNestedDeeperThan64IsAnError) {
   // The matcher gave up past 64 levels without a word: such a production
   // silently never matched.
-  auto context = [](int n) { return std::string(size_t(n), '[') + "B" + std::string(size_t(n), ']'); };
+  auto context = [](int n) {
+    return std::string(size_t(n), '[') + "B" + std::string(size_t(n), ']');
+  };
   EXPECT_TRUE(ParseGrammarText("axiom: A\nA > " + context(64) + " --> C\n", "ok.lsys").grammar);
   ParseResult r = ParseGrammarText("axiom: A\nA > " + context(65) + " --> C\n", "deep.lsys");
   ASSERT_EQ(r.diagnostics.ErrorCount(), 1u);
@@ -280,7 +289,8 @@ TEST(ParserLimits, ShadowWarningsNameTheFirstProductionThatAlwaysApplies) {
   ASSERT_TRUE(r.grammar);
   ASSERT_EQ(r.diagnostics.items.size(), 1001u);
   for (const Diagnostic& d : r.diagnostics.items) {
-    EXPECT_EQ(d.message, "production never applies: the production at line 3 always matches 'A' first")
+    EXPECT_EQ(d.message,
+              "production never applies: the production at line 3 always matches 'A' first")
         << d.loc.line;
   }
   EXPECT_EQ(r.diagnostics.items.back().loc.line, 1004);

@@ -59,8 +59,9 @@ TEST(Parser, DefaultsAndFileNameAsLabel) {
 }
 
 TEST(Parser, CpfgCapitalisedKeywordsAndArrowForms) {
-  EXPECT_EQ(DeriveText("Lsystem: 1\nDerivation length: 2\nAxiom: A\nA -> AB\nB --> A\nendlsystem\n"),
-            "ABA");
+  EXPECT_EQ(
+      DeriveText("Lsystem: 1\nDerivation length: 2\nAxiom: A\nA -> AB\nB --> A\nendlsystem\n"),
+      "ABA");
 }
 
 TEST(Parser, WhitespaceSeparatesNothingInWords) {
@@ -69,11 +70,15 @@ TEST(Parser, WhitespaceSeparatesNothingInWords) {
 }
 
 TEST(Parser, CommentsOfBothKinds) {
-  EXPECT_EQ(DeriveText("/* a block\n spanning lines */\naxiom: A /* inline */ B // line\nA --> C // x\n", 1),
-            "CB");
+  EXPECT_EQ(
+      DeriveText("/* a block\n spanning lines */\naxiom: A /* inline */ B // line\nA --> C // x\n",
+                 1),
+      "CB");
 }
 
-TEST(Parser, EmptySuccessorIsStar) { EXPECT_EQ(DeriveText("axiom: ABA\nB --> *\n", 1), "AA"); }
+TEST(Parser, EmptySuccessorIsStar) {
+  EXPECT_EQ(DeriveText("axiom: ABA\nB --> *\n", 1), "AA");
+}
 
 TEST(Parser, ModuleDeclarationLongestMatchWins) {
   Grammar g = MustParse("module: Fl Flw\naxiom: FlwFlF\n");
@@ -162,7 +167,8 @@ TEST(Parser, WarnsAboutProductionsThatCannotMatch) {
 TEST(Parser, WarnsAboutShadowedProduction) {
   auto w = Warnings("axiom: A\nA --> B\nA --> C\n");
   ASSERT_EQ(w.size(), 1u);
-  EXPECT_EQ(w[0], "3:1 production never applies: the production at line 2 always matches 'A' first");
+  EXPECT_EQ(w[0],
+            "3:1 production never applies: the production at line 2 always matches 'A' first");
 }
 
 TEST(Parser, WarnsAboutUnusedConstant) {
@@ -217,8 +223,9 @@ namespace sylva::lsys {
 namespace {
 
 TEST(WordFormat, NumbersPrintAsPrintfG6) {
-  const double values[] = {0, -0.0, 1, -1, 0.5, 1.0 / 3, 2.0 / 3, 123456, 1234567, 1e-5, 1e-4,
-                           0.0001234567, 1e100, -2.5e-300, 7.07, 4.99849, 99999.95, 999999.5};
+  const double values[] = {0,       -0.0,      1,       -1,      0.5,      1.0 / 3,
+                           2.0 / 3, 123456,    1234567, 1e-5,    1e-4,     0.0001234567,
+                           1e100,   -2.5e-300, 7.07,    4.99849, 99999.95, 999999.5};
   for (double v : values) {
     std::string a;
     AppendNumber(a, v);
@@ -257,7 +264,8 @@ namespace {
 
 TEST(Parser, DoubleSlashIsACommentOnlyAfterSpaceOrAtLineStart) {
   // ABOP writes rolls as `/////`; a comment needs a space before `//`.
-  EXPECT_EQ(testing::DeriveText("// a comment line\naxiom: A\nA --> S/////F  // the stem\n", 1), "S/////F");
+  EXPECT_EQ(testing::DeriveText("// a comment line\naxiom: A\nA --> S/////F  // the stem\n", 1),
+            "S/////F");
   EXPECT_EQ(testing::DeriveText("axiom: F//F\n", 0), "F//F");
   EXPECT_EQ(testing::DeriveText("axiom: F //F\n", 0), "F");
 }

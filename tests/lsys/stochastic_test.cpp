@@ -96,7 +96,8 @@ TEST(Stochastic, SameSeedSameWordOtherSeedOtherWord) {
 }
 
 TEST(Stochastic, RandomParametersAreReproducibleAndInRange) {
-  Grammar g = MustParse("axiom: A(10)\nA(n) : n > 0 --> A(n-1)A(n-1)\nA(n) : n == 0 --> F(uniform(1, 2))F(ran(3))\n");
+  Grammar g = MustParse(
+      "axiom: A(10)\nA(n) : n > 0 --> A(n-1)A(n-1)\nA(n) : n == 0 --> F(uniform(1, 2))F(ran(3))\n");
   DeriveOptions opt;
   opt.steps = 11;
   auto r1 = MustDerive(g, opt);
@@ -126,8 +127,8 @@ namespace {
 std::string HundredChoices(const std::vector<int>& weights) {
   std::string g = "axiom: A(17)\nA(n) : n > 0 --> A(n-1)A(n-1)\n";
   for (size_t k = 0; k < weights.size(); ++k) {
-    g += "A(n) : n == 0 --> B(" + std::to_string(k + 1) + ") : " + std::to_string(weights[k]) +
-         "\n";
+    g +=
+        "A(n) : n == 0 --> B(" + std::to_string(k + 1) + ") : " + std::to_string(weights[k]) + "\n";
   }
   return g;
 }

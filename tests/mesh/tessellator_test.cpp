@@ -75,8 +75,8 @@ TEST(Tessellator, TriangleCountsFollowTheDetailExactly) {
 }
 
 TEST(Tessellator, EachTubeIsAClosedTwoManifold) {
-  for (const char* text : {"axiom: FFF\n", "angle: 30\naxiom: F+F-F&F/F^F\n",
-                           "axiom: !(2)F!(1)F\n"}) {
+  for (const char* text :
+       {"axiom: FFF\n", "angle: 30\naxiom: F+F-F&F/F^F\n", "axiom: !(2)F!(1)F\n"}) {
     TriangleMesh m = Mesh(Draw(text), 8);
     std::string why;
     EXPECT_EQ(EulerCharacteristic(m, &why), 2) << text << why;
@@ -116,7 +116,9 @@ std::vector<long> ComponentEulerCharacteristics(const TriangleMesh& m) {
   const size_t nt = m.triangleCount();
   std::vector<size_t> parent(nt);
   for (size_t t = 0; t < nt; ++t) parent[t] = t;
-  std::function<size_t(size_t)> find = [&](size_t x) { return parent[x] == x ? x : parent[x] = find(parent[x]); };
+  std::function<size_t(size_t)> find = [&](size_t x) {
+    return parent[x] == x ? x : parent[x] = find(parent[x]);
+  };
   std::map<std::pair<uint32_t, uint32_t>, size_t> edgeOwner;
   for (size_t t = 0; t < nt; ++t) {
     for (int e = 0; e < 3; ++e) {
@@ -225,7 +227,8 @@ TEST(Tessellator, DegeneratePolygonsAreSkippedWithAWarning) {
   EXPECT_EQ(m.triangleCount(), 0u);
   ASSERT_EQ(stats.warnings.size(), 1u);
   EXPECT_EQ(stats.warnings[0],
-            "polygon at module 5 is degenerate, crosses itself or is too complex to triangulate; skipped");
+            "polygon at module 5 is degenerate, crosses itself or is too complex to triangulate; "
+            "skipped");
 }
 
 TEST(Tessellator, LeafPolygonsOfTheBush) {
@@ -351,8 +354,9 @@ TEST(Export, AMeshWithANonFiniteNumberIsNeverWritten) {
   m.indices = {0, 1, 2};
   m.material = {0};
   EXPECT_EQ(FindNonFinite(m), "the normal of vertex 1 is not finite");
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("sylva_nan_" + std::to_string(::getpid()) + ".glb")).string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("sylva_nan_" + std::to_string(::getpid()) + ".glb"))
+                               .string();
   Status s = WriteMesh(m, DefaultPalette(), path);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message.find("not finite"), std::string::npos) << s.error().message;

@@ -72,8 +72,8 @@ double ShoelaceArea(const std::vector<Vec3>& v) {
 void ExpectValid(const std::vector<Vec3>& v, const std::string& what) {
   Vec3 normal;
   const std::vector<uint32_t> t = TriangulatePolygon(v, &normal);
-  ASSERT_EQ(t.size(), 3 * (v.size() - 2)) << what << ": " << t.size() / 3 << " triangles for "
-                                          << v.size() << " vertices";
+  ASSERT_EQ(t.size(), 3 * (v.size() - 2))
+      << what << ": " << t.size() / 3 << " triangles for " << v.size() << " vertices";
   double sum = 0;
   for (size_t k = 0; k < t.size(); k += 3) {
     const Vec3 c = (v[t[k + 1]] - v[t[k]]).cross(v[t[k + 2]] - v[t[k]]);
@@ -85,11 +85,13 @@ void ExpectValid(const std::vector<Vec3>& v, const std::string& what) {
 }
 
 TEST(Triangulate, StarShapedPolygonsOfManySizes) {
-  for (size_t n : {10u, 100u, 1000u, 10000u, 100000u}) ExpectValid(Star(n, uint32_t(n)), "star " + std::to_string(n));
+  for (size_t n : {10u, 100u, 1000u, 10000u, 100000u})
+    ExpectValid(Star(n, uint32_t(n)), "star " + std::to_string(n));
 }
 
 TEST(Triangulate, SpiralsAndCombs) {
-  for (size_t n : {40u, 400u, 4000u, 40000u, 130000u}) ExpectValid(Spiral(n, 3), "spiral " + std::to_string(n));
+  for (size_t n : {40u, 400u, 4000u, 40000u, 130000u})
+    ExpectValid(Spiral(n, 3), "spiral " + std::to_string(n));
   for (size_t teeth : {3u, 300u, 30000u}) ExpectValid(Comb(teeth), "comb " + std::to_string(teeth));
 }
 
@@ -110,7 +112,8 @@ TEST(Triangulate, ClockwiseOutlinesAndTiltedPlanes) {
 TEST(Triangulate, DegenerateOutlinesGiveNothing) {
   Vec3 n;
   EXPECT_TRUE(TriangulatePolygon({Vec3(0, 0, 0), Vec3(1, 0, 0)}, &n).empty());
-  EXPECT_TRUE(TriangulatePolygon({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(3, 0, 0)}, &n).empty());
+  EXPECT_TRUE(
+      TriangulatePolygon({Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(3, 0, 0)}, &n).empty());
 }
 
 }  // namespace

@@ -54,7 +54,8 @@ TEST(Cloth, UnpinnedClothInFreeFallDoesNotDeform) {
   for (int i = 0; i < 60; ++i) cloth.Step(t / 60, Vec3(0, -9.81, 0));
   double worst = 0;
   for (const auto& c : cloth.constraints())
-    worst = std::max(worst, std::abs((cloth.positions()[c.a] - cloth.positions()[c.b]).norm() - c.rest));
+    worst = std::max(worst,
+                     std::abs((cloth.positions()[c.a] - cloth.positions()[c.b]).norm() - c.rest));
   EXPECT_LT(worst, 1e-9) << "largest change of a constraint length: " << worst;
   // And it falls as a rigid body: 1/2 g t^2 (symplectic substeps: within h g t).
   const double drop = start[0].y() - cloth.positions()[0].y();
@@ -72,7 +73,8 @@ TEST(Cloth, PinsDoNotMoveUnderGravityAndWind) {
   EXPECT_EQ(cloth.positions()[0], a);
   EXPECT_EQ(cloth.positions()[9], b);
   // The wind pushed the free cloth along +z.
-  EXPECT_GT(cloth.positions()[cloth.Index(5, 7)].z(), 0.05) << cloth.positions()[cloth.Index(5, 7)].transpose();
+  EXPECT_GT(cloth.positions()[cloth.Index(5, 7)].z(), 0.05)
+      << cloth.positions()[cloth.Index(5, 7)].transpose();
   EXPECT_EQ(cloth.triangles().size(), size_t(2 * 9 * 7));
 }
 
@@ -126,7 +128,8 @@ TEST(ClothImplicit, ConjugateGradientsConvergeWhenGivenTheIterations) {
   def.cgIterations = 1000;
   Cloth cloth(def);
   cloth.Step(1.0 / 30, Vec3(0, -9.81, 0));  // the first frame has the largest right-hand side
-  EXPECT_LT(cloth.lastSolve().residual, 1e-9) << "after " << cloth.lastSolve().iterations << " iterations";
+  EXPECT_LT(cloth.lastSolve().residual, 1e-9)
+      << "after " << cloth.lastSolve().iterations << " iterations";
   EXPECT_LT(cloth.lastSolve().iterations, 1000);
 }
 
@@ -145,9 +148,12 @@ TEST(Xpbd, AvxKernelMatchesTheScalarKernelBitForBit) {
   x0[11] = x0[10];  // constraint 5 has no direction
   std::vector<xpbd::Projection> ps(m);
   for (size_t k = 0; k < m; ++k) {
-    const double wa = k == 17 ? 0 : 1 + 0.5 * u(rng), wb = 1 + 0.5 * u(rng), alphaT = k % 3 ? 0 : 0.01 * (1 + u(rng));
+    const double wa = k == 17 ? 0 : 1 + 0.5 * u(rng), wb = 1 + 0.5 * u(rng),
+                 alphaT = k % 3 ? 0 : 0.01 * (1 + u(rng));
     const double scale = 1 / (wa + wb + alphaT);
-    ps[k] = {uint32_t(2 * k), uint32_t(2 * k + 1), 0.5 + 0.2 * u(rng), scale, wa * scale, wb * scale, alphaT};
+    ps[k] = {uint32_t(2 * k), uint32_t(2 * k + 1), 0.5 + 0.2 * u(rng),
+             scale,           wa * scale,          wb * scale,
+             alphaT};
   }
   std::vector<double> lambda0(m);
   for (double& l : lambda0) l = 0.1 * u(rng);
@@ -156,13 +162,16 @@ TEST(Xpbd, AvxKernelMatchesTheScalarKernelBitForBit) {
       std::vector<xpbd::Point4> xs = x0, xa = x0;
       std::vector<double> ls = lambda0, la = lambda0;
       for (int pass = 0; pass < 3; ++pass) {
-        xpbd::ProjectRange(xpbd::Kernel::kScalar, first, keep, ps.data(), ls.data(), xs.data(), 0, m);
+        xpbd::ProjectRange(xpbd::Kernel::kScalar, first, keep, ps.data(), ls.data(), xs.data(), 0,
+                           m);
         xpbd::ProjectRange(xpbd::Kernel::kAvx, first, keep, ps.data(), la.data(), xa.data(), 0, m);
       }
       EXPECT_EQ(0, std::memcmp(xs.data(), xa.data(), xs.size() * sizeof(xpbd::Point4)))
-          << "first " << first << " keep " << keep << ": x[0] scalar " << xs[0].p[0] << " avx " << xa[0].p[0];
+          << "first " << first << " keep " << keep << ": x[0] scalar " << xs[0].p[0] << " avx "
+          << xa[0].p[0];
       EXPECT_EQ(0, std::memcmp(ls.data(), la.data(), ls.size() * sizeof(double)))
-          << "first " << first << " keep " << keep << ": lambda[0] scalar " << ls[0] << " avx " << la[0];
+          << "first " << first << " keep " << keep << ": lambda[0] scalar " << ls[0] << " avx "
+          << la[0];
       // The projection did something: the pass moved the positions.
       EXPECT_NE(0, std::memcmp(xs.data(), x0.data(), xs.size() * sizeof(xpbd::Point4)));
       EXPECT_EQ(x0[34].p[0], xa[34].p[0]) << "the pinned end moved";
@@ -208,8 +217,8 @@ TEST(Xpbd, AvxParticlePassMatchesTheScalarPassBitForBit) {
   EXPECT_GT(taut, 100) << "too few taut tethers to test the clamp";
   for (bool predictNext : {true, false}) {
     std::vector<xpbd::Point4> xs = x0, vs = v0, ps = prev0, xa = x0, va = v0, pa = prev0;
-    const xpbd::Particles s{xs.data(), vs.data(), ps.data(), fext.data(), w.data(), tethers.data(),
-                            {0.1, -9.81, 0.3}, 1e-3, 1e3, 0.999};
+    const xpbd::Particles s{xs.data(),      vs.data(),         ps.data(), fext.data(), w.data(),
+                            tethers.data(), {0.1, -9.81, 0.3}, 1e-3,      1e3,         0.999};
     xpbd::Particles a = s;
     a.x = xa.data();
     a.v = va.data();
@@ -221,7 +230,8 @@ TEST(Xpbd, AvxParticlePassMatchesTheScalarPassBitForBit) {
     EXPECT_EQ(0, std::memcmp(vs.data(), va.data(), n * sizeof(xpbd::Point4)))
         << "predictNext " << predictNext << ": v[1] scalar " << vs[1].p[0] << " avx " << va[1].p[0];
     EXPECT_EQ(0, std::memcmp(ps.data(), pa.data(), n * sizeof(xpbd::Point4)))
-        << "predictNext " << predictNext << ": prev[1] scalar " << ps[1].p[0] << " avx " << pa[1].p[0];
+        << "predictNext " << predictNext << ": prev[1] scalar " << ps[1].p[0] << " avx "
+        << pa[1].p[0];
     EXPECT_EQ(0, std::memcmp(&x0[3], &xa[3], sizeof(xpbd::Point4))) << "a pin moved";
   }
 }
@@ -261,9 +271,9 @@ TEST(Cloth, WindDragLiftAndFrictionMatchTheirClosedForms) {
   for (ClothSolver solver : {ClothSolver::kXPBD, ClothSolver::kImplicit}) {
     for (double deg : {0.0, 30.0, 60.0, 85.0}) {
       const double th = deg * M_PI / 180, c = std::cos(th), s = std::sin(th);
-      const Vec3 along(s, 0, c);            // the wind's direction
-      const Vec3 across(c, 0, -s);          // perpendicular to it, in the plane of n and the wind
-      const Vec3 n(0, 0, 1), t(1, 0, 0);    // normal and the tangential direction of the wind
+      const Vec3 along(s, 0, c);          // the wind's direction
+      const Vec3 across(c, 0, -s);        // perpendicular to it, in the plane of n and the wind
+      const Vec3 n(0, 0, 1), t(1, 0, 0);  // normal and the tangential direction of the wind
       struct Case {
         double cd, cl, cf;
         Vec3 want;
@@ -294,9 +304,9 @@ TEST(Cloth, WindDragLiftAndFrictionMatchTheirClosedForms) {
         for (const Vec3& v : cloth.velocities()) momentum += (def.mass / 4) * v;
         const Vec3 force = momentum / dt;
         EXPECT_LT((force - k.want).norm(), 1e-9 * (1 + k.want.norm()))
-            << (solver == ClothSolver::kXPBD ? "XPBD" : "implicit") << ", th = " << deg << " deg, c_d " << k.cd
-            << " c_l " << k.cl << " c_f " << k.cf << ": force " << force.transpose() << ", want "
-            << k.want.transpose();
+            << (solver == ClothSolver::kXPBD ? "XPBD" : "implicit") << ", th = " << deg
+            << " deg, c_d " << k.cd << " c_l " << k.cl << " c_f " << k.cf << ": force "
+            << force.transpose() << ", want " << k.want.transpose();
       }
     }
   }
@@ -316,7 +326,8 @@ TEST(Cloth, TethersKeepAHangingClothFromStretching) {
     stretch[tethers] = cloth.MaxStretch();
   }
   EXPECT_LT(stretch[1], 0.05) << "with tethers";
-  EXPECT_GT(stretch[0], 4 * stretch[1]) << "without tethers " << stretch[0] << ", with " << stretch[1];
+  EXPECT_GT(stretch[0], 4 * stretch[1])
+      << "without tethers " << stretch[0] << ", with " << stretch[1];
 }
 
 }  // namespace

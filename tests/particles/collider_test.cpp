@@ -27,7 +27,8 @@ TEST(Contact, SlidingDistanceIsV0SquaredOver2MuG) {
     s.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0)).Restitution(0.5).Friction(mu));
     for (int i = 0; i < 20000; ++i) STEP_OK(s, 1e-3, Integrator::kSymplecticEuler);
     const double want = v0 * v0 / (2 * mu * kG), got = s.state.position[0].x();
-    EXPECT_NEAR(got / want, 1, 0.02) << "mu " << mu << ": slid " << got << " m, v0^2/(2 mu g) = " << want;
+    EXPECT_NEAR(got / want, 1, 0.02)
+        << "mu " << mu << ": slid " << got << " m, v0^2/(2 mu g) = " << want;
     EXPECT_LT(s.state.velocity[0].norm(), 1e-12) << "mu " << mu << ": still moving";
     EXPECT_GE(s.state.position[0].y(), 0) << "sank";
   }
@@ -37,7 +38,7 @@ TEST(Contact, OnAnInclineItSlidesIffTanThetaExceedsMu) {
   const double mu = 0.5;  // threshold at 26.57 degrees
   for (double deg : {10.0, 20.0, 26.0, 27.5, 35.0, 50.0}) {
     const double th = deg * kPi / 180;
-    const Vec3 n(-std::sin(th), std::cos(th), 0);   // plane through the origin, rising to -x
+    const Vec3 n(-std::sin(th), std::cos(th), 0);    // plane through the origin, rising to -x
     const Vec3 down(std::cos(th), std::sin(th), 0);  // down the slope is +x... sign below
     System s;
     s.state.Add(Vec3::Zero(), Vec3::Zero(), 1);
@@ -49,10 +50,12 @@ TEST(Contact, OnAnInclineItSlidesIffTanThetaExceedsMu) {
     const bool slides = std::tan(th) > mu;
     if (slides) {
       const double a = kG * (std::sin(th) - mu * std::cos(th));
-      EXPECT_NEAR(moved / (0.5 * a * T * T), 1, 0.02) << deg << " deg: moved " << moved << ", want " << 0.5 * a * T * T;
+      EXPECT_NEAR(moved / (0.5 * a * T * T), 1, 0.02)
+          << deg << " deg: moved " << moved << ", want " << 0.5 * a * T * T;
       EXPECT_LT(s.state.position[0].dot(down), 0) << "slides downhill (-x, -y)";
     } else {
-      EXPECT_LT(moved, 1e-12) << deg << " deg: tan " << std::tan(th) << " <= mu " << mu << " but it moved " << moved;
+      EXPECT_LT(moved, 1e-12) << deg << " deg: tan " << std::tan(th) << " <= mu " << mu
+                              << " but it moved " << moved;
     }
     EXPECT_GE(n.dot(s.state.position[0]), -1e-12) << deg << " deg: sank";
   }
@@ -87,9 +90,11 @@ TEST(Contact, RestingParticleNeitherSinksNorJitters) {
 TEST(Colliders, NoShapeIsTunnelledThrough) {
   auto cube = [] {
     std::vector<Vec3> v;
-    for (int i = 0; i < 8; ++i) v.emplace_back(i & 1 ? 0.05 : -0.05, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
-    std::vector<std::array<uint32_t, 3>> t = {{0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}, {0, 1, 3}, {0, 3, 2},
-                                             {4, 6, 7}, {4, 7, 5}, {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6}};
+    for (int i = 0; i < 8; ++i)
+      v.emplace_back(i & 1 ? 0.05 : -0.05, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+    std::vector<std::array<uint32_t, 3>> t = {{0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3},
+                                              {0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5},
+                                              {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6}};
     return std::make_shared<TriangleBvh>(v, t);
   }();
   const Collider shapes[] = {
@@ -109,7 +114,8 @@ TEST(Colliders, NoShapeIsTunnelledThrough) {
       STEP_OK(s, 0.01, Integrator::kSymplecticEuler);
       ASSERT_LT(s.state.position[0].x(), 0) << names[k] << ": crossed at step " << i;
     }
-    EXPECT_NEAR(s.state.velocity[0].norm(), 100, 1e-9) << names[k] << ": elastic bounces keep the speed";
+    EXPECT_NEAR(s.state.velocity[0].norm(), 100, 1e-9)
+        << names[k] << ": elastic bounces keep the speed";
   }
 }
 
@@ -132,17 +138,20 @@ TEST(Colliders, ParticlesStayInsideABoxAndABowl) {
   std::uniform_real_distribution<double> u(-1, 1);
   for (bool bowl : {false, true}) {
     System s(2);
-    for (int i = 0; i < 5000; ++i) s.state.Add(Vec3(u(rng), u(rng), u(rng)) * 0.5, Vec3(u(rng), u(rng), u(rng)) * 40);
+    for (int i = 0; i < 5000; ++i)
+      s.state.Add(Vec3(u(rng), u(rng), u(rng)) * 0.5, Vec3(u(rng), u(rng), u(rng)) * 40);
     s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
     if (bowl) {
       s.AddCollider(Collider::Sphere(Vec3::Zero(), 1, true).Restitution(0.9).Friction(0.1));
     } else {
-      s.AddCollider(Collider::Box(Vec3(-1, -1, -1), Vec3(1, 1, 1), true).Restitution(0.9).Friction(0.1));
+      s.AddCollider(
+          Collider::Box(Vec3(-1, -1, -1), Vec3(1, 1, 1), true).Restitution(0.9).Friction(0.1));
     }
     double worst = 0;
     for (int i = 0; i < 400; ++i) {
       STEP_OK(s, 1.0 / 60, Integrator::kRK4);
-      for (const Vec3& p : s.state.position) worst = std::max(worst, bowl ? p.norm() : p.cwiseAbs().maxCoeff());
+      for (const Vec3& p : s.state.position)
+        worst = std::max(worst, bowl ? p.norm() : p.cwiseAbs().maxCoeff());
     }
     EXPECT_LE(worst, 1 + 1e-12) << (bowl ? "bowl" : "box") << ": a particle reached " << worst;
   }
@@ -150,10 +159,11 @@ TEST(Colliders, ParticlesStayInsideABoxAndABowl) {
 
 TEST(Colliders, PolygonStopsOnlyWhatFallsOnIt) {
   System s;
-  s.state.Add(Vec3(0.5, 1, 0.5), Vec3::Zero(), 1);   // above the square
-  s.state.Add(Vec3(1.5, 1, 0.5), Vec3::Zero(), 1);   // beside it
+  s.state.Add(Vec3(0.5, 1, 0.5), Vec3::Zero(), 1);  // above the square
+  s.state.Add(Vec3(1.5, 1, 0.5), Vec3::Zero(), 1);  // beside it
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
-  s.AddCollider(Collider::Polygon({Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(1, 0, 0)}).Restitution(0));
+  s.AddCollider(Collider::Polygon({Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(1, 0, 0)})
+                    .Restitution(0));
   for (int i = 0; i < 1000; ++i) STEP_OK(s, 1e-3, Integrator::kSymplecticEuler);
   EXPECT_NEAR(s.state.position[0].y(), 0, 1e-6) << "rests on the square";
   EXPECT_LT(s.state.velocity[0].norm(), 1e-6);
@@ -166,7 +176,8 @@ TEST(Colliders, BvhAgreesWithBruteForce) {
   std::vector<std::array<uint32_t, 3>> t;
   const int N = 41;
   for (int j = 0; j < N; ++j)
-    for (int i = 0; i < N; ++i) v.emplace_back(i * 0.1, 0.2 * std::sin(i * 0.7) * std::cos(j * 0.5), j * 0.1);
+    for (int i = 0; i < N; ++i)
+      v.emplace_back(i * 0.1, 0.2 * std::sin(i * 0.7) * std::cos(j * 0.5), j * 0.1);
   for (int j = 0; j + 1 < N; ++j)
     for (int i = 0; i + 1 < N; ++i) {
       const uint32_t a = j * N + i, b = a + 1, c = a + N, d = c + 1;
@@ -201,8 +212,9 @@ TEST(Colliders, MeshKeepsRainOff) {
   // Particles rain on a closed cube mesh; none ends up inside it.
   std::vector<Vec3> v;
   for (int i = 0; i < 8; ++i) v.emplace_back(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
-  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}, {0, 1, 3}, {0, 3, 2},
-                                           {4, 6, 7}, {4, 7, 5}, {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6}};
+  std::vector<std::array<uint32_t, 3>> t = {{0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3},
+                                            {0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5},
+                                            {0, 4, 5}, {0, 5, 1}, {2, 3, 7}, {2, 7, 6}};
   System s;
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1.5, 1.5);
@@ -216,7 +228,8 @@ TEST(Colliders, MeshKeepsRainOff) {
   }
   EXPECT_EQ(inside, 0) << "particle-steps inside the cube";
   int onTop = 0;
-  for (const Vec3& p : s.state.position) onTop += std::abs(p.y() - 1) < 1e-6 && p.cwiseAbs().maxCoeff() <= 1 + 1e-6;
+  for (const Vec3& p : s.state.position)
+    onTop += std::abs(p.y() - 1) < 1e-6 && p.cwiseAbs().maxCoeff() <= 1 + 1e-6;
   EXPECT_GT(onTop, 500) << "particles resting on the top face";
 }
 
@@ -225,8 +238,10 @@ TEST(Responses, StickAndKill) {
   s.state.Add(Vec3(0, 1, 0), Vec3(1, 0, 0), 1, 100);
   s.state.Add(Vec3(5, 1, 0), Vec3(1, 0, 0), 1, 100);
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
-  s.AddCollider(Collider::Polygon({Vec3(-1, 0, -1), Vec3(-1, 0, 1), Vec3(2, 0, 1), Vec3(2, 0, -1)}).Respond(Response::kStick));
-  s.AddCollider(Collider::Polygon({Vec3(4, 0, -1), Vec3(4, 0, 1), Vec3(7, 0, 1), Vec3(7, 0, -1)}).Respond(Response::kKill));
+  s.AddCollider(Collider::Polygon({Vec3(-1, 0, -1), Vec3(-1, 0, 1), Vec3(2, 0, 1), Vec3(2, 0, -1)})
+                    .Respond(Response::kStick));
+  s.AddCollider(Collider::Polygon({Vec3(4, 0, -1), Vec3(4, 0, 1), Vec3(7, 0, 1), Vec3(7, 0, -1)})
+                    .Respond(Response::kKill));
   for (int i = 0; i < 1000; ++i) STEP_OK(s, 1e-3, Integrator::kSymplecticEuler);
   // Lands at x0 + v t with t = sqrt(2 / g).
   const double land = std::sqrt(2 / kG);
@@ -252,7 +267,8 @@ TEST(ParticleCollisions, GasConservesMomentumAndElasticEnergy) {
   System s;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (int i = 0; i < 2000; ++i) s.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), 1 + 0.5 * u(rng));
+  for (int i = 0; i < 2000; ++i)
+    s.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), 1 + 0.5 * u(rng));
   s.EnableParticleCollisions(0.03, 1.0);
   auto momentum = [&] {
     Vec3 p = Vec3::Zero();
@@ -286,7 +302,8 @@ TEST(AdaptiveRK45, MeetsItsToleranceWithFewerStepsWhenLooser) {
     // Local error control: the global error over ~1.6 periods stays within
     // a small multiple of the tolerance.
     EXPECT_LT(err, 10 * tol) << "tol " << tol << ": error " << err << " in " << steps << " steps";
-    EXPECT_LT(steps, prevSteps) << "tol " << tol << ": " << steps << " steps, tighter took " << prevSteps;
+    EXPECT_LT(steps, prevSteps) << "tol " << tol << ": " << steps << " steps, tighter took "
+                                << prevSteps;
     prevSteps = steps;
   }
 }

@@ -17,7 +17,8 @@ TEST(Emitter, CountIsRateTimesTimeWithinOne) {
     const double h = 1.0 / 60;
     const int steps = 150;  // 2.5 s
     for (int i = 0; i < steps; ++i) e.Emit(s, h);
-    EXPECT_NEAR(double(s.size()), rate * steps * h, 1.0) << "rate " << rate << ": emitted " << s.size();
+    EXPECT_NEAR(double(s.size()), rate * steps * h, 1.0)
+        << "rate " << rate << ": emitted " << s.size();
   }
 }
 

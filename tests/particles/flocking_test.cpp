@@ -37,7 +37,8 @@ TEST(Flocking, AlignmentAloneOrdersTheFlock) {
 double MinDistance(const ParticleState& s) {
   double best = 1e300;
   for (size_t i = 0; i < s.size(); ++i)
-    for (size_t j = i + 1; j < s.size(); ++j) best = std::min(best, (s.position[i] - s.position[j]).squaredNorm());
+    for (size_t j = i + 1; j < s.size(); ++j)
+      best = std::min(best, (s.position[i] - s.position[j]).squaredNorm());
   return std::sqrt(best);
 }
 

@@ -39,7 +39,8 @@ TEST(NoiseWind, IsDivergenceFreeSmoothAndHasItsSpeed) {
     ms += wind.Velocity(x, t).squaredNorm();
   }
   // Central differences are exact to O(e^2 |u'''|): far below the gradient.
-  EXPECT_LT(worstDiv, 1e-6 * gradScale) << "divergence up to " << worstDiv << " against gradients of " << gradScale;
+  EXPECT_LT(worstDiv, 1e-6 * gradScale)
+      << "divergence up to " << worstDiv << " against gradients of " << gradScale;
   EXPECT_GT(gradScale, 1) << "the field must vary";
   EXPECT_NEAR(std::sqrt(ms / N), 2, 0.4) << "RMS speed";
 }
@@ -79,7 +80,9 @@ TEST(RandomDrift, HasItsVarianceZeroMeanAndRepeats) {
 }
 
 TEST(FieldGrid, TrilinearReproducesALinearFieldAndIsZeroOutside) {
-  auto linear = [](const Vec3& x) { return Vec3(1 + 2 * x.x() - x.y(), 3 * x.z(), x.x() + x.y() + x.z()); };
+  auto linear = [](const Vec3& x) {
+    return Vec3(1 + 2 * x.x() - x.y(), 3 * x.z(), x.x() + x.y() + x.z());
+  };
   const Vec3 lo(-1, 0, 2), hi(3, 1, 5);
   const std::array<int, 3> n = {5, 3, 4};
   std::vector<Vec3> samples;
@@ -169,7 +172,8 @@ TEST(Flocking, AvoidKeepsTheFlockOutOfAnObstacle) {
   }
   Vec3 centre = Vec3::Zero();
   for (const Vec3& p : s.state.position) centre += p / 200.0;
-  EXPECT_GT(closest, 1.5) << "a boid came within " << closest << " of the obstacle's centre (radius 1.5)";
+  EXPECT_GT(closest, 1.5) << "a boid came within " << closest
+                          << " of the obstacle's centre (radius 1.5)";
   EXPECT_GT(centre.x(), 3) << "the flock got past it to the target; centre " << centre.transpose();
 }
 

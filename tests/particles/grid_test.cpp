@@ -23,7 +23,8 @@ TEST(NeighbourGrid, EqualsBruteForceOn10kRandomPoints) {
       grid.ForEachNeighbour(x.data(), i, r, [&](size_t j) { fromGrid.push_back(j); });
       if (copy) {
         grid.ForEachInSlotOrder(x[i], r, [&](size_t k) {
-          EXPECT_EQ(grid.sortedPositions()[k], x[grid.order()[k]]) << "slot-order copy, place " << k;
+          EXPECT_EQ(grid.sortedPositions()[k], x[grid.order()[k]])
+              << "slot-order copy, place " << k;
           if (grid.order()[k] != i) inSlotOrder.push_back(grid.order()[k]);
         });
         // Both queries visit in the same order.
@@ -33,8 +34,9 @@ TEST(NeighbourGrid, EqualsBruteForceOn10kRandomPoints) {
         if (j != i && (x[j] - x[i]).squaredNorm() <= r * r) brute.push_back(j);
       }
       std::sort(fromGrid.begin(), fromGrid.end());
-      ASSERT_EQ(fromGrid, brute) << (copy ? "with" : "without") << " copied positions, particle " << i << ": grid "
-                                 << fromGrid.size() << ", brute force " << brute.size();
+      ASSERT_EQ(fromGrid, brute) << (copy ? "with" : "without") << " copied positions, particle "
+                                 << i << ": grid " << fromGrid.size() << ", brute force "
+                                 << brute.size();
       total += brute.size();
     }
     EXPECT_GT(total, 1000u) << "the test should see many neighbours";
@@ -50,7 +52,8 @@ TEST(NeighbourGrid, SlotOrderIsTheSameForOneAndTwoThreads) {
   for (bool clustered : {false, true}) {
     std::vector<Vec3> x(200000);
     for (size_t i = 0; i < x.size(); ++i) {
-      x[i] = clustered && i % 4 != 0 ? Vec3(0.01 * (i % 3), 0.5, -0.2) : Vec3(u(rng), u(rng), u(rng));
+      x[i] =
+          clustered && i % 4 != 0 ? Vec3(0.01 * (i % 3), 0.5, -0.2) : Vec3(u(rng), u(rng), u(rng));
     }
     NeighbourGrid one, two;
     ThreadPool pool(2);
@@ -73,7 +76,8 @@ TEST(InverseSquare, GridForcesEqualAllPairsWithinTheCutoff) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-2, 2);
   ParticleState s;
-  for (int i = 0; i < 2000; ++i) s.Add(Vec3(u(rng), u(rng), u(rng)), Vec3::Zero(), 0.5 + 0.25 * (u(rng) + 2));
+  for (int i = 0; i < 2000; ++i)
+    s.Add(Vec3(u(rng), u(rng), u(rng)), Vec3::Zero(), 0.5 + 0.25 * (u(rng) + 2));
   for (double strength : {1.0, -2.0}) {
     InverseSquare force(strength, 0.5, 0.05);
     std::vector<Vec3> a(s.size(), Vec3::Zero()), b(s.size(), Vec3::Zero());
@@ -84,7 +88,8 @@ TEST(InverseSquare, GridForcesEqualAllPairsWithinTheCutoff) {
       worst = std::max(worst, (a[i] - b[i]).norm());
       scale = std::max(scale, b[i].norm());
     }
-    EXPECT_LT(worst, 1e-5 * std::max(scale, 1.0)) << "strength " << strength << ": worst difference " << worst;
+    EXPECT_LT(worst, 1e-5 * std::max(scale, 1.0))
+        << "strength " << strength << ": worst difference " << worst;
   }
 }
 
@@ -92,7 +97,9 @@ TEST(InverseSquare, PairForcesConserveMomentum) {
   System sys;
   std::mt19937 rng(2);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (int i = 0; i < 300; ++i) sys.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)) * 0.1, 1 + 0.5 * u(rng));
+  for (int i = 0; i < 300; ++i)
+    sys.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)) * 0.1,
+                  1 + 0.5 * u(rng));
   sys.AddForce(std::make_shared<InverseSquare>(-0.01, 0.6, 0.05));
   auto momentum = [&] {
     Vec3 p = Vec3::Zero();

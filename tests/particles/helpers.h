@@ -9,10 +9,10 @@
 
 // STEP_OK(system, h, integrator): one step that must succeed, with the
 // fault's message in the failure.
-#define STEP_OK(sys, h, in)                         \
-  do {                                              \
-    ::sylva::Status st_ = (sys).Step((h), (in));    \
-    ASSERT_TRUE(st_.ok()) << st_.error().message;   \
+#define STEP_OK(sys, h, in)                       \
+  do {                                            \
+    ::sylva::Status st_ = (sys).Step((h), (in));  \
+    ASSERT_TRUE(st_.ok()) << st_.error().message; \
   } while (0)
 
 namespace sylva::particles::testing {

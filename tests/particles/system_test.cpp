@@ -40,8 +40,10 @@ TEST(Integrators, HalvingTheStepDividesTheErrorByTheOrder) {
     const double h = c.in == Integrator::kRK4 ? 0.05 : 0.01;
     const double e1 = OscillatorError(c.in, h), e2 = OscillatorError(c.in, h / 2);
     const double r = e1 / e2;
-    EXPECT_GT(r, c.lo) << c.name << ": error " << e1 << " -> " << e2 << ", ratio " << r << " (want ~" << c.ratio << ")";
-    EXPECT_LT(r, c.hi) << c.name << ": error " << e1 << " -> " << e2 << ", ratio " << r << " (want ~" << c.ratio << ")";
+    EXPECT_GT(r, c.lo) << c.name << ": error " << e1 << " -> " << e2 << ", ratio " << r
+                       << " (want ~" << c.ratio << ")";
+    EXPECT_LT(r, c.hi) << c.name << ": error " << e1 << " -> " << e2 << ", ratio " << r
+                       << " (want ~" << c.ratio << ")";
   }
 }
 
@@ -67,7 +69,8 @@ TEST(Integrators, SymplecticEulerKeepsEnergyWhereExplicitEulerDiverges) {
     if (in == Integrator::kSymplecticEuler) {
       EXPECT_LT(worst, 0.05) << "symplectic Euler: worst |E/E0 - 1| = " << worst;
     } else {
-      EXPECT_GT(Energy(s, 1) / e0, 2.0) << "explicit Euler should gain energy; E/E0 = " << Energy(s, 1) / e0;
+      EXPECT_GT(Energy(s, 1) / e0, 2.0)
+          << "explicit Euler should gain energy; E/E0 = " << Energy(s, 1) / e0;
     }
   }
 }
@@ -109,7 +112,8 @@ TEST(Forces, SpringsConserveMomentum) {
   System s;
   std::mt19937 rng(4);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (int i = 0; i < 20; ++i) s.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), 1 + u(rng) * 0.5);
+  for (int i = 0; i < 20; ++i)
+    s.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), 1 + u(rng) * 0.5);
   auto springs = std::make_shared<Springs>();
   for (uint32_t i = 0; i < 20; ++i) springs->Add(i, (i * 7 + 3) % 20, 0.5, 50, 0.3);
   s.AddForce(springs);
@@ -157,7 +161,8 @@ TEST(Collisions, SuccessiveApexesShrinkByRestitutionSquared) {
   ASSERT_EQ(apex.size(), 4u);
   EXPECT_NEAR(apex[0], e * e, 2e-4) << "first apex " << apex[0];
   for (size_t k = 1; k < apex.size(); ++k) {
-    EXPECT_NEAR(apex[k] / apex[k - 1], e * e, 2e-3) << "ratio " << apex[k] / apex[k - 1] << " at bounce " << k;
+    EXPECT_NEAR(apex[k] / apex[k - 1], e * e, 2e-3)
+        << "ratio " << apex[k] / apex[k - 1] << " at bounce " << k;
   }
 }
 

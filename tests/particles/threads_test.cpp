@@ -21,7 +21,8 @@ uint64_t Simulate(int threads, Integrator in, int steps) {
   System s(threads);
   std::mt19937 rng(42);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (int i = 0; i < 9000; ++i) s.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), 1 + 0.1 * u(rng));
+  for (int i = 0; i < 9000; ++i)
+    s.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), 1 + 0.1 * u(rng));
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
   s.AddForce(std::make_shared<Drag>(0.1, 0.02));
   auto springs = std::make_shared<Springs>();
@@ -33,7 +34,9 @@ uint64_t Simulate(int threads, Integrator in, int steps) {
   flock.separationRadius = 0.03;
   flock.cohesion = 0;  // no clumping: keeps neighbour counts small
   s.AddForce(std::make_shared<Flocking>(flock));
-  s.AddCollider(Collider::Box(Vec3(-1.2, -1.2, -1.2), Vec3(1.2, 1.2, 1.2), true).Restitution(0.7).Friction(0.3));
+  s.AddCollider(Collider::Box(Vec3(-1.2, -1.2, -1.2), Vec3(1.2, 1.2, 1.2), true)
+                    .Restitution(0.7)
+                    .Friction(0.3));
   s.AddCollider(Collider::Sphere(Vec3(0, -0.8, 0), 0.4).Restitution(0.5).Friction(0.2));
   s.EnableParticleCollisions(0.01, 0.8);
   for (int i = 0; i < steps; ++i) {
@@ -46,10 +49,14 @@ uint64_t Simulate(int threads, Integrator in, int steps) {
 }
 
 TEST(Determinism, OneAndTwoThreadsAreBitIdentical) {
-  for (Integrator in : {Integrator::kSymplecticEuler, Integrator::kRK4, Integrator::kImplicitEuler}) {
-    const uint64_t one = Simulate(1, in, 24), two = Simulate(2, in, 24), three = Simulate(3, in, 24);
-    EXPECT_EQ(one, two) << "integrator " << int(in) << ": 1 thread " << std::hex << one << ", 2 threads " << two;
-    EXPECT_EQ(one, three) << "integrator " << int(in) << ": 1 thread " << std::hex << one << ", 3 threads " << three;
+  for (Integrator in :
+       {Integrator::kSymplecticEuler, Integrator::kRK4, Integrator::kImplicitEuler}) {
+    const uint64_t one = Simulate(1, in, 24), two = Simulate(2, in, 24),
+                   three = Simulate(3, in, 24);
+    EXPECT_EQ(one, two) << "integrator " << int(in) << ": 1 thread " << std::hex << one
+                        << ", 2 threads " << two;
+    EXPECT_EQ(one, three) << "integrator " << int(in) << ": 1 thread " << std::hex << one
+                          << ", 3 threads " << three;
     EXPECT_NE(one, Simulate(1, in, 25)) << "the hash must see one more step";
   }
 }
@@ -57,10 +64,12 @@ TEST(Determinism, OneAndTwoThreadsAreBitIdentical) {
 TEST(Faults, NonFiniteForceIsReportedWithStepAndId) {
   System s;
   for (int i = 0; i < 10; ++i) s.state.Add(Vec3(i, 0, 0), Vec3::Zero());
-  s.AddForce(std::make_shared<ForceFunction>([](const ParticleState& st, const Vec3*, const Vec3*, Vec3* f) {
-    if (st.step == 3) f[7] = Vec3(std::nan(""), 0, 0);
-  }));
-  for (int i = 0; i < 3; ++i) ASSERT_TRUE(s.Step(0.01, Integrator::kSymplecticEuler).ok()) << "step " << i;
+  s.AddForce(std::make_shared<ForceFunction>(
+      [](const ParticleState& st, const Vec3*, const Vec3*, Vec3* f) {
+        if (st.step == 3) f[7] = Vec3(std::nan(""), 0, 0);
+      }));
+  for (int i = 0; i < 3; ++i)
+    ASSERT_TRUE(s.Step(0.01, Integrator::kSymplecticEuler).ok()) << "step " << i;
   Status st = s.Step(0.01, Integrator::kSymplecticEuler);
   ASSERT_FALSE(st.ok()) << "a NaN force must not pass silently";
   const std::string& m = st.error().message;
@@ -80,7 +89,8 @@ TEST(Faults, ExplodingStiffSpringIsReported) {
   Status st;
   int i = 0;
   for (; i < 100000 && st.ok(); ++i) st = s.Step(0.05, Integrator::kExplicitEuler);
-  ASSERT_FALSE(st.ok()) << "no explosion reported after " << i << " steps, x = " << s.state.position[1].x();
+  ASSERT_FALSE(st.ok()) << "no explosion reported after " << i
+                        << " steps, x = " << s.state.position[1].x();
   EXPECT_NE(st.error().message.find("particle id 1"), std::string::npos) << st.error().message;
   EXPECT_NE(st.error().message.find("exploded"), std::string::npos) << st.error().message;
 }
@@ -88,7 +98,8 @@ TEST(Faults, ExplodingStiffSpringIsReported) {
 TEST(Faults, ImplicitEulerIsStableWhereExplicitExplodes) {
   System s;
   testing::AddAnchoredSpring(s, 1.5, 1, 1e4);
-  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(s.Step(0.05, Integrator::kImplicitEuler).ok()) << "step " << i;
+  for (int i = 0; i < 1000; ++i)
+    ASSERT_TRUE(s.Step(0.05, Integrator::kImplicitEuler).ok()) << "step " << i;
   // Backward Euler damps: the spring settles at its rest length.
   EXPECT_NEAR(s.state.position[1].x(), 1.0, 1e-6) << "x " << s.state.position[1].x();
   EXPECT_LT(s.lastSolve().residual, 1e-9) << "CG residual " << s.lastSolve().residual;
@@ -109,7 +120,8 @@ struct HubNetwork {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1, 1);
     state.Add(Vec3::Zero(), Vec3::Zero());
-    for (int i = 0; i < 100; ++i) state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)));
+    for (int i = 0; i < 100; ++i)
+      state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)));
     for (uint32_t i = 1; i <= 100; ++i) {
       springs->Add(0, i, 0.5, 10 + i, 0.1 * i);
       springs->Add(i, i % 100 + 1, 0.2, 30, 0.3);
@@ -139,10 +151,11 @@ TEST(Springs, ColouredPassesEqualTheSerialSumAndIgnoreTheThreadCount) {
     ref[sp.b] -= fa;
   }
   for (size_t i = 0; i < ref.size(); ++i) {
-    ASSERT_EQ(one[i], two[i]) << "particle " << i << ": 1 thread " << one[i].transpose() << ", 2 threads "
-                              << two[i].transpose();
+    ASSERT_EQ(one[i], two[i]) << "particle " << i << ": 1 thread " << one[i].transpose()
+                              << ", 2 threads " << two[i].transpose();
     ASSERT_LT((one[i] - ref[i]).norm(), 1e-12 * (1 + ref[i].norm()))
-        << "particle " << i << ": coloured " << one[i].transpose() << ", serial " << ref[i].transpose();
+        << "particle " << i << ": coloured " << one[i].transpose() << ", serial "
+        << ref[i].transpose();
   }
 }
 
@@ -161,7 +174,8 @@ TEST(Springs, CachedJacobianProductEqualsTheDirectOne) {
   net.springs->AddJacobianProduct(net.state, x, v, -0.01, -0.1, p.data(), cached.data());
   for (size_t i = 0; i < p.size(); ++i) {
     ASSERT_LT((cached[i] - direct[i]).norm(), 1e-12 * (1 + direct[i].norm()))
-        << "particle " << i << ": cached " << cached[i].transpose() << ", direct " << direct[i].transpose();
+        << "particle " << i << ": cached " << cached[i].transpose() << ", direct "
+        << direct[i].transpose();
   }
 }
 
@@ -180,15 +194,22 @@ TEST(Springs, AvxProductKernelMatchesTheScalarKernelBitForBit) {
   std::vector<kernels::SpringLinear> lin(m);
   for (size_t k = 0; k < m; ++k) {
     const Vec3 dir = k == 5 ? Vec3::Zero() : Vec3(u(rng), u(rng), u(rng)).normalized();
-    lin[k] = {{dir.x(), dir.y(), dir.z(), 0}, uint32_t(2 * k + 1), uint32_t(2 * k), 10 * (1 + u(rng)),
-              20 * (1 + u(rng)), 0.5 * (1 + u(rng))};
+    lin[k] = {{dir.x(), dir.y(), dir.z(), 0},
+              uint32_t(2 * k + 1),
+              uint32_t(2 * k),
+              10 * (1 + u(rng)),
+              20 * (1 + u(rng)),
+              0.5 * (1 + u(rng))};
   }
   std::vector<kernels::Point4> ys = y0, ya = y0;
-  kernels::SpringProductRange(kernels::Kernel::kScalar, lin.data(), 0, m, -1e-4, -1e-2, p.data(), ys.data());
-  kernels::SpringProductRange(kernels::Kernel::kAvx, lin.data(), 0, m, -1e-4, -1e-2, p.data(), ya.data());
+  kernels::SpringProductRange(kernels::Kernel::kScalar, lin.data(), 0, m, -1e-4, -1e-2, p.data(),
+                              ys.data());
+  kernels::SpringProductRange(kernels::Kernel::kAvx, lin.data(), 0, m, -1e-4, -1e-2, p.data(),
+                              ya.data());
   EXPECT_EQ(0, std::memcmp(ys.data(), ya.data(), ys.size() * sizeof(kernels::Point4)))
       << "y[1] scalar " << ys[1].p[0] << " avx " << ya[1].p[0];
-  EXPECT_NE(0, std::memcmp(ys.data(), y0.data(), ys.size() * sizeof(kernels::Point4))) << "the product added nothing";
+  EXPECT_NE(0, std::memcmp(ys.data(), y0.data(), ys.size() * sizeof(kernels::Point4)))
+      << "the product added nothing";
 }
 
 // The conjugate-gradient reductions: AVX and scalar kernels give the same
@@ -216,10 +237,10 @@ TEST(ImplicitEuler, AvxReductionKernelsMatchTheScalarKernelsBitForBit) {
     for (size_t i = begin; i < n; ++i) ref += p[i] * q[i];
     ASSERT_NEAR(ds, ref, 1e-14) << "trial " << trial << ": dot";
     std::vector<double> dvs = dv0, rs = r0, dva = dv0, ra = r0;
-    const auto cs = kernels::CgStep(kernels::Kernel::kScalar, 0.3, p.data(), q.data(), z.data(), dvs.data(), rs.data(),
-                                    begin, n);
-    const auto ca = kernels::CgStep(kernels::Kernel::kAvx, 0.3, p.data(), q.data(), z.data(), dva.data(), ra.data(),
-                                    begin, n);
+    const auto cs = kernels::CgStep(kernels::Kernel::kScalar, 0.3, p.data(), q.data(), z.data(),
+                                    dvs.data(), rs.data(), begin, n);
+    const auto ca = kernels::CgStep(kernels::Kernel::kAvx, 0.3, p.data(), q.data(), z.data(),
+                                    dva.data(), ra.data(), begin, n);
     ASSERT_EQ(cs.rz, ca.rz) << "trial " << trial << ": r.z";
     ASSERT_EQ(cs.rr, ca.rr) << "trial " << trial << ": r.r";
     ASSERT_EQ(dvs, dva) << "trial " << trial;

@@ -16,17 +16,22 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Source(const std::string& rel) { return std::string(SYLVA_SOURCE_DIR) + "/" + rel; }
+std::string Source(const std::string& rel) {
+  return std::string(SYLVA_SOURCE_DIR) + "/" + rel;
+}
 
-std::string Text(const Plant& p, const lsys::Word& w) { return lsys::FormatWord(w, p.grammar.symbols); }
+std::string Text(const Plant& p, const lsys::Word& w) {
+  return lsys::FormatWord(w, p.grammar.symbols);
+}
 
 // A folder of its own under the temp directory, removed at the end.
 struct TempDir {
   fs::path path;
   TempDir() {
-    path = fs::temp_directory_path() /
-           ("sylva_plant_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    path =
+        fs::temp_directory_path() /
+        ("sylva_plant_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(path);
     fs::create_directories(path);
   }
@@ -215,7 +220,8 @@ namespace {
 
 TEST(Plant, PixelWidthsWithoutWidthScaleGetAWarningNamingTheFix) {
   // ABOP Fig. 2.6a without its `width scale:` line: a brown cone.
-  std::string text = *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys");
+  std::string text =
+      *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys");
   const size_t at = text.find("width scale:");
   ASSERT_NE(at, std::string::npos);
   text.erase(at, text.find('\n', at) - at);
@@ -251,7 +257,8 @@ TEST(Plant, MeshAndTurtleAreBoundedBeforeTheyAllocate) {
   PlantResult r = BuildPlant(spec);
   ASSERT_FALSE(r.plant);
   std::string all = r.diagnostics.FormatAll();
-  EXPECT_NE(all.find("ff.lsys: error: the word draws 33554432 primitives"), std::string::npos) << all;
+  EXPECT_NE(all.find("ff.lsys: error: the word draws 33554432 primitives"), std::string::npos)
+      << all;
   EXPECT_EQ(r.diagnostics.items.back().kind, ErrorKind::kRuntime);
 
   spec.steps = 10;  // 1024 segments at 8 sides: 16,400 triangles

@@ -11,11 +11,11 @@
 #include <filesystem>
 #include <random>
 
-#include "plant/plant_test_util.h"
 #include "mesh/tessellator.h"
+#include "plant/plant_test_util.h"
 #include "render/headless_context.h"
-#include "render/renderer.h"
 #include "render/render_fixture.h"
+#include "render/renderer.h"
 
 namespace sylva::render {
 namespace {
@@ -47,7 +47,8 @@ class Golden : public testing::RenderFixture {
     size_t differing = 0;
     for (size_t i = 0; i < size_t(w) * size_t(h); ++i) {
       bool off = false;
-      for (int k = 0; k < 3; ++k) off |= std::abs(int(img.rgba[4 * i + k]) - int(want[4 * i + k])) > 24;
+      for (int k = 0; k < 3; ++k)
+        off |= std::abs(int(img.rgba[4 * i + k]) - int(want[4 * i + k])) > 24;
       differing += off;
       diff.rgba[4 * i] = off ? 255 : img.rgba[4 * i] / 3;
       diff.rgba[4 * i + 1] = off ? 0 : img.rgba[4 * i + 1] / 3;
@@ -66,8 +67,8 @@ class Golden : public testing::RenderFixture {
 
   void DrawPlant(const std::string& file, int steps, bool lines) {
     // Through the plant library, interpretation rules included.
-    auto p = sylva::testing::PlantFromFile("abop/" + file + ".lsys", steps,
-                                    lines ? plant::Stage::kGeometry : plant::Stage::kMesh, 8);
+    auto p = sylva::testing::PlantFromFile(
+        "abop/" + file + ".lsys", steps, lines ? plant::Stage::kGeometry : plant::Stage::kMesh, 8);
     ASSERT_TRUE(p);
     const mesh::PlantGeometry* g = &p->geometry;
     renderer_->SetMesh({}, {});

@@ -17,12 +17,12 @@
 
 #include "app/graphics.h"
 #include "core/atomic_file.h"
-#include "plant/plant_test_util.h"
 #include "mesh/tessellator.h"
+#include "plant/plant_test_util.h"
 #include "render/camera.h"
 #include "render/headless_context.h"
-#include "render/renderer.h"
 #include "render/render_fixture.h"
+#include "render/renderer.h"
 
 namespace sylva::render {
 namespace {
@@ -97,7 +97,8 @@ TEST_F(Render, EmptySceneIsTheBackgroundColour) {
 }
 
 TEST_F(Render, PlantSilhouetteMatchesItsProjectedBounds) {
-  auto p = sylva::testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 6, plant::Stage::kMesh, 16);
+  auto p =
+      sylva::testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 6, plant::Stage::kMesh, 16);
   ASSERT_TRUE(p);
   const mesh::TriangleMesh& m = p->mesh;
   Vec3 lo = m.positions[0].cast<double>(), hi = lo;
@@ -111,7 +112,8 @@ TEST_F(Render, PlantSilhouetteMatchesItsProjectedBounds) {
   renderer_->SetMesh(m, mesh::DefaultPalette());
   renderer_->Draw(cam);
   Image img = renderer_->ReadPixels();
-  const uint8_t bg[3] = {uint8_t(0.94f * 255 + 0.5f), uint8_t(0.95f * 255 + 0.5f), uint8_t(0.96f * 255 + 0.5f)};
+  const uint8_t bg[3] = {uint8_t(0.94f * 255 + 0.5f), uint8_t(0.95f * 255 + 0.5f),
+                         uint8_t(0.96f * 255 + 0.5f)};
   auto s = Silhouette(img, bg);
   ASSERT_GE(s[2], 0) << "nothing drawn";
   const Mat4 vp = cam.ViewProjection(double(W) / H);
@@ -164,13 +166,17 @@ TEST(RenderShaders, MissingOrBrokenShaderNamesTheFile) {
   fs::path dir = fs::temp_directory_path() / ("sylva_bad_shaders_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   for (const char* f : {"mesh.vert", "line.vert", "line.frag"})
-    fs::copy_file(fs::path(SYLVA_SOURCE_DIR) / "shaders" / f, dir / f, fs::copy_options::overwrite_existing);
-  std::ofstream(dir / "mesh.frag") << "#version 450 core\nout vec4 c;\nvoid main() { c = vec4(undefined_name); }\n";
+    fs::copy_file(fs::path(SYLVA_SOURCE_DIR) / "shaders" / f, dir / f,
+                  fs::copy_options::overwrite_existing);
+  std::ofstream(dir / "mesh.frag")
+      << "#version 450 core\nout vec4 c;\nvoid main() { c = vec4(undefined_name); }\n";
   auto broken = Renderer::Create(dir.string());
   ASSERT_FALSE(broken.ok());
   EXPECT_EQ(broken.error().loc.file, (dir / "mesh.frag").string());
-  EXPECT_NE(broken.error().message.find("GLSL compilation failed"), std::string::npos) << broken.error().message;
-  EXPECT_NE(broken.error().message.find("undefined_name"), std::string::npos) << broken.error().message;
+  EXPECT_NE(broken.error().message.find("GLSL compilation failed"), std::string::npos)
+      << broken.error().message;
+  EXPECT_NE(broken.error().message.find("undefined_name"), std::string::npos)
+      << broken.error().message;
 }
 
 int RunCli(std::vector<std::string> args, std::string* err) {
@@ -181,10 +187,16 @@ int RunCli(std::vector<std::string> args, std::string* err) {
 }
 
 TEST(RenderCli, WritesAPngOfTheRequestedSize) {
-  std::string out = (fs::temp_directory_path() / ("sylva_render_" + std::to_string(::getpid()) + ".png")).string();
+  std::string out =
+      (fs::temp_directory_path() / ("sylva_render_" + std::to_string(::getpid()) + ".png"))
+          .string();
   std::string err;
-  ASSERT_EQ(RunCli({"render", std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig1_24a_bracketed_plant.lsys",
-                    "-n", "3", "--size", "120x80", "-o", out}, &err), 0) << err;
+  ASSERT_EQ(RunCli({"render",
+                    std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig1_24a_bracketed_plant.lsys",
+                    "-n", "3", "--size", "120x80", "-o", out},
+                   &err),
+            0)
+      << err;
   auto png = ReadFile(out);
   ASSERT_TRUE(png.ok());
   ASSERT_GT(png->size(), 24u);
@@ -211,7 +223,9 @@ TEST(RenderCli, BadInputIsExitTwoWithAClearMessage) {
   setenv("SYLVA_SHADER_DIR", "/nonexistent-shaders", 1);
   EXPECT_EQ(RunCli({"render", grammar, "-o", out}, &err), 2);
   unsetenv("SYLVA_SHADER_DIR");
-  EXPECT_NE(err.find("/nonexistent-shaders/mesh.vert: error: cannot read shader"), std::string::npos) << err;
+  EXPECT_NE(err.find("/nonexistent-shaders/mesh.vert: error: cannot read shader"),
+            std::string::npos)
+      << err;
   EXPECT_FALSE(fs::exists(out));
 }
 
@@ -316,17 +330,17 @@ namespace {
 TEST(Camera, FramingNonFiniteBoundsGivesAFiniteCamera) {
   const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
   const std::pair<Vec3, Vec3> boxes[] = {
-      {Vec3(0, nan, 0), Vec3(1, 1, 1)},  // NaN in y
-      {Vec3(0, 0, 0), Vec3(1, 1, nan)},  // NaN in z
-      {Vec3(-inf, 0, 0), Vec3(1, 1, 1)},
-      {Vec3(2, 2, 2), Vec3(1, 1, 1)},    // inverted
+      {Vec3(0, nan, 0), Vec3(1, 1, 1)},                                         // NaN in y
+      {Vec3(0, 0, 0), Vec3(1, 1, nan)},                                         // NaN in z
+      {Vec3(-inf, 0, 0), Vec3(1, 1, 1)},       {Vec3(2, 2, 2), Vec3(1, 1, 1)},  // inverted
       {Vec3(-1e300, 0, 0), Vec3(1e300, 1, 1)},  // its extent overflows
   };
   for (bool ortho : {false, true}) {
     for (const auto& [lo, hi] : boxes) {
       Camera c = Camera::Frame(lo, hi, 16.0 / 9, 30, 12, ortho);
       const Mat4 vp = c.ViewProjection(16.0 / 9);
-      EXPECT_TRUE(vp.allFinite()) << "lo " << lo.transpose() << " hi " << hi.transpose() << " ortho " << ortho;
+      EXPECT_TRUE(vp.allFinite()) << "lo " << lo.transpose() << " hi " << hi.transpose()
+                                  << " ortho " << ortho;
       EXPECT_TRUE(c.Eye().allFinite()) << "lo " << lo.transpose() << " hi " << hi.transpose();
     }
   }

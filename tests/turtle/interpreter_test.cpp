@@ -109,7 +109,8 @@ TEST(Turtle, TropismBendsTowardTheVectorByTheAbopFormula) {
 }
 
 TEST(Turtle, KochIslandClosesOnItself) {
-  std::string text = *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig1_06_koch_island.lsys");
+  std::string text =
+      *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig1_06_koch_island.lsys");
   DrawOptions opt;
   opt.recordModules = true;
   Drawn d = Draw(text, 2, opt);
@@ -119,7 +120,8 @@ TEST(Turtle, KochIslandClosesOnItself) {
 }
 
 TEST(Turtle, DragonCurveEndsAtDistanceTwoToTheHalfN) {
-  std::string text = *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig1_10a_dragon_curve.lsys");
+  std::string text =
+      *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig1_10a_dragon_curve.lsys");
   DrawOptions opt;
   opt.recordModules = true;
   Drawn d = Draw(text, 10, opt);
@@ -196,7 +198,8 @@ TEST(Turtle, StepAngleAndBounds) {
 }
 
 TEST(Turtle, MonopodialTreeIsThreeDimensionalAndBounded) {
-  std::string text = *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys");
+  std::string text =
+      *ReadFile(std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys");
   Drawn d = Draw(text);
   // 2^10 - 1 internodes of lengths r1^k..., all F's of the derived word.
   EXPECT_EQ(d.geometry.segments.size(), 1023u);
@@ -280,7 +283,8 @@ TEST(Turtle, OutOfRangeGeometryIsAnErrorNamingTheModule) {
       {"&(90)F(1e16)", "module 2 (F(1e+16)) gives a segment end"},  // the bad component is z
   };
   for (const Case& c : cases) {
-    auto p = testing::PlantFromText(std::string("axiom: ") + c.axiom + "\n", -1, plant::Stage::kInterpreted);
+    auto p = testing::PlantFromText(std::string("axiom: ") + c.axiom + "\n", -1,
+                                    plant::Stage::kInterpreted);
     ASSERT_TRUE(p);
     auto g = Interpret(p->DrawnWord(), p->grammar.symbols, TurtleDefFrom(p->grammar));
     ASSERT_FALSE(g.ok()) << c.axiom << " was accepted";
