@@ -36,7 +36,10 @@ int main(int argc, char** argv) {
       p.normal = Vec3::Zero();
       p.normal[axis] = -side;
       p.restitution = 0.85;
-      sys.AddPlane(p);
+      if (Status st = sys.AddPlane(p); !st.ok()) {
+        std::fputs(st.error().Format().c_str(), stderr);
+        return 1;
+      }
     }
   }
   const double h = 1.0 / 240;

@@ -44,7 +44,12 @@ int main(int argc, char** argv) {
   def.avoid = 10;
   def.avoidDistance = 1.0;
   def.obstacles = {{obstacle, radius}};
-  auto flock = std::make_shared<particles::Flocking>(def);
+  auto made = particles::Flocking::Create(def);
+  if (!made) {
+    std::fputs(made.error().Format().c_str(), stderr);
+    return 1;
+  }
+  std::shared_ptr<particles::Flocking> flock = *made;
   sys.AddForce(flock);
   sys.AddForce(std::make_shared<particles::Drag>(0.4));
   const double h = 1.0 / 120;
