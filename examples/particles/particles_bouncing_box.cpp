@@ -89,7 +89,10 @@ int main(int argc, char** argv) {
     }
   }
   (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
-  (*renderer)->SetPoints(batch);
+  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->SetLines(edges);
   (*renderer)->Draw(render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 480.0 / 360, 30, 20, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {

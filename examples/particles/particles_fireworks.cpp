@@ -124,7 +124,10 @@ int main(int argc, char** argv) {
     hi = hi.cwiseMax(sys.state.position[i]);
   }
   (*renderer)->SetBackground(mesh::Srgb(0.03f, 0.03f, 0.07f));
-  (*renderer)->SetPoints(batch);
+  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 0, 5, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
     std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default

@@ -98,7 +98,10 @@ int main(int argc, char** argv) {
   }
   Vec3 lo = Vec3::Constant(-4.5), hi = Vec3::Constant(4.5);
   (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
-  (*renderer)->SetPoints(batch);
+  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 30, 25, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
     std::filesystem::create_directories(std::filesystem::path(out).parent_path(), ec);  // out/ by default

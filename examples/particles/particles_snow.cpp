@@ -141,7 +141,10 @@ int main(int argc, char** argv) {
     for (int c = 0; c < 4; ++c) lines.colors.push_back(mesh::Srgb(0.5f, 0.55f, 0.6f));
   }
   (*renderer)->SetBackground(mesh::Srgb(0.12f, 0.14f, 0.2f));
-  (*renderer)->SetPoints(batch);
+  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->SetLines(lines);
   (*renderer)->Draw(
       render::Camera::Frame(Vec3(-2, 0, -2), Vec3(2, 3, 2), 480.0 / 360, 25, 15, false));
