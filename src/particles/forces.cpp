@@ -152,6 +152,10 @@ void Penalty::OnSphere(uint32_t i, const Vec3& centre, double radius, double ks,
   terms_.push_back({Kind::kSphere, i, i, centre, Vec3::Zero(), radius, ks, kd});
 }
 
+Status RandomDrift::Check(const ParticleState&) const {
+  return check::Range("RandomDrift sigma", sigma_, 0, 1e12, "N");
+}
+
 Status Penalty::Check(const ParticleState& s) const {
   if (terms_.empty() || maxIndex_ < s.size()) return {};
   return check::Error("Penalty: a term names particle " + std::to_string(maxIndex_) + ", but the system has " +

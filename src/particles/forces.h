@@ -14,9 +14,11 @@ namespace sylva::particles {
 // axis, drawn afresh every step from the counter-based generator keyed by
 // (seed, particle id, step), so it is the same whatever the thread count or
 // the integrator's stages (all stages of a step see one draw).
+// sigma 0..1e12 N (Check, on every step, says otherwise).
 class RandomDrift : public LocalForce {
  public:
   RandomDrift(double sigma, uint64_t seed) : sigma_(sigma), seed_(seed) {}
+  Status Check(const ParticleState& s) const override;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
 

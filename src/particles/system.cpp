@@ -67,6 +67,13 @@ void Drag::AddJacobianProduct(const ParticleState& s, const Vec3*, const Vec3* v
   }
 }
 
+Status Gravity::Check(const ParticleState&) const { return check::Finite("Gravity g", g_, 1e12, "m/s^2"); }
+
+Status Drag::Check(const ParticleState&) const {
+  SYLVA_CHECK_OK(check::Range("Drag linear", k1_, 0, 1e12, "N s/m"));
+  return check::Range("Drag quadratic", k2_, 0, 1e12, "N s^2/m^2");
+}
+
 Status Springs::Add(uint32_t a, uint32_t b, double rest, double ks, double kd) {
   using namespace check;
   if (a == b) return Error("Springs.Add joins particle " + std::to_string(a) + " to itself");

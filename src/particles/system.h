@@ -104,10 +104,12 @@ class LocalForce : public Force {
                                size_t end) const = 0;
 };
 
-// Constant acceleration g for every movable particle (f = m g).
+// Constant acceleration g for every movable particle (f = m g); each
+// component within +-1e12 m/s^2 (Check, on every step, says otherwise).
 class Gravity : public LocalForce {
  public:
   explicit Gravity(const Vec3& g) : g_(g) {}
+  Status Check(const ParticleState& s) const override;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
 
@@ -115,10 +117,12 @@ class Gravity : public LocalForce {
   Vec3 g_;
 };
 
-// Drag: f = -k1 v - k2 |v| v (linear and quadratic).
+// Drag: f = -k1 v - k2 |v| v (linear and quadratic); k1, k2 0..1e12
+// (Check, on every step, says otherwise).
 class Drag : public LocalForce {
  public:
   Drag(double linear, double quadratic = 0) : k1_(linear), k2_(quadratic) {}
+  Status Check(const ParticleState& s) const override;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
   void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx, double cv,

@@ -175,6 +175,20 @@ TEST(Penalty, StepRejectsIndicesOutOfRange) {
   ExpectRejected(s.Step(0.01, Integrator::kSymplecticEuler), "particle 7", "1 particles");
 }
 
+TEST(Forces, GravityDragAndDriftWithBadNumbersStopTheStep) {
+  auto run = [](std::shared_ptr<Force> f) {
+    System s;
+    s.state.Add(Vec3::Zero(), Vec3(1, 0, 0));
+    s.AddForce(std::move(f));
+    return s.Step(0.01, Integrator::kSymplecticEuler);
+  };
+  ExpectRejected(run(std::make_shared<Gravity>(Vec3(0, 0, kNaN))), "Gravity g", "nan");
+  ExpectRejected(run(std::make_shared<Drag>(-0.5)), "Drag linear", "-0.5");
+  ExpectRejected(run(std::make_shared<Drag>(0.1, kNaN)), "Drag quadratic", "nan");
+  ExpectRejected(run(std::make_shared<RandomDrift>(-1, 7)), "RandomDrift sigma", "-1");
+  EXPECT_OK(run(std::make_shared<Drag>(0.1, 0.01)));
+}
+
 TEST(System, StepRejectsZeroNegativeAndNaNSteps) {
   for (double h : {0.0, -0.01, kNaN, kInf, 1e7}) {
     System s;
