@@ -53,7 +53,12 @@ void BM_SylvaCloth(benchmark::State& state) {
   def.pinned = {0, k - 1};  // corners (0, 0) and (k-1, 0)
   def.windDrag = 0;
   def.threads = int(state.range(1));
-  particles::Cloth cloth(def);
+  auto made = particles::Cloth::Create(def);
+  if (!made) {
+    state.SkipWithError(made.error().message.c_str());
+    return;
+  }
+  particles::Cloth& cloth = **made;
   const Vec3 g(0, -kG, 0);
   double peak = 0;
   for (int i = 0; i < kSettleFrames; ++i) {

@@ -38,7 +38,10 @@ void BM_Step(benchmark::State& state, particles::Integrator in) {
   }
   sys.AddForce(std::make_shared<particles::Gravity>(Vec3(0, -9.81, 0)));
   sys.AddForce(std::make_shared<particles::Drag>(0.1, 0.01));
-  sys.AddPlane(particles::Plane{Vec3(0, -1, 0), Vec3(0, 1, 0), 0.8, 0.1});
+  if (!sys.AddPlane(particles::Plane{Vec3(0, -1, 0), Vec3(0, 1, 0), 0.8, 0.1}).ok()) {
+    state.SkipWithError("bad plane");
+    return;
+  }
   const std::vector<Vec3> x0 = s.position, v0 = s.velocity;
   for (auto _ : state) {
     state.PauseTiming();
@@ -76,8 +79,13 @@ void BM_BulkStep(benchmark::State& state) {
   sys.fields.gravity = Vec3(0, -9.81, 0);
   sys.fields.linearDrag = 0.1;
   sys.fields.quadraticDrag = 0.01;
-  sys.AddCollider(
-      particles::Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.8).Friction(0.1));
+  if (!sys.AddCollider(particles::Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0))
+                           .Restitution(0.8)
+                           .Friction(0.1))
+           .ok()) {
+    state.SkipWithError("bad plane");
+    return;
+  }
   const particles::BulkState s0 = s;
   for (auto _ : state) {
     state.PauseTiming();
@@ -133,7 +141,12 @@ void BM_Flocking(benchmark::State& state) {
   particles::FlockingDef def;
   def.radius = 0.6;
   def.separationRadius = 0.2;
-  sys.AddForce(std::make_shared<particles::Flocking>(def));
+  auto flock = particles::Flocking::Create(def);
+  if (!flock) {
+    state.SkipWithError(flock.error().message.c_str());
+    return;
+  }
+  sys.AddForce(*flock);
   sys.AddForce(std::make_shared<particles::Drag>(0.1));
   for (auto _ : state) {
     if (!sys.Step(1.0 / 60, particles::Integrator::kSymplecticEuler).ok())
@@ -158,7 +171,12 @@ void BM_Cloth(benchmark::State& state, particles::ClothSolver solver) {
   def.cgIterations = 20;
   def.pinned = {0, k - 1};
   def.threads = int(state.range(1));
-  particles::Cloth cloth(def);
+  auto made = particles::Cloth::Create(def);
+  if (!made) {
+    state.SkipWithError(made.error().message.c_str());
+    return;
+  }
+  particles::Cloth& cloth = **made;
   for (int i = 0; i < 30; ++i)
     cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2));  // settle a little
   for (auto _ : state) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2));

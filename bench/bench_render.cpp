@@ -47,7 +47,7 @@ void BM_FrameMillionTrianglePlant(benchmark::State& state) {
     hi = hi.cwiseMax(p.cast<double>());
   }
   Gl& gl = Context();
-  gl.renderer->SetPoints({});
+  (void)gl.renderer->SetPoints({});  // an empty batch is always valid
   gl.renderer->SetLines({});
   gl.renderer->SetMesh(m, mesh::DefaultPalette());
   const render::Camera cam = render::Camera::Frame(lo, hi, 16.0 / 9, 30, 12, false);
@@ -73,14 +73,17 @@ void BM_FrameMillionPoints(benchmark::State& state) {
   }
   Gl& gl = Context();
   gl.renderer->SetMesh({}, {});
-  gl.renderer->SetPoints(pts);
+  if (Status st = gl.renderer->SetPoints(pts); !st.ok()) {
+    state.SkipWithError(st.error().message.c_str());
+    return;
+  }
   const render::Camera cam =
       render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 16.0 / 9, 30, 20, false);
   for (auto _ : state) {
     gl.renderer->Draw(cam);
     gl.renderer->Finish();
   }
-  gl.renderer->SetPoints({});
+  (void)gl.renderer->SetPoints({});
   state.counters["points"] = 1e6;
   state.counters["fps"] =
       benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);

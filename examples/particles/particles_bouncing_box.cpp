@@ -37,7 +37,10 @@ int main(int argc, char** argv) {
       p.normal = Vec3::Zero();
       p.normal[axis] = -side;
       p.restitution = 0.85;
-      sys.AddPlane(p);
+      if (Status st = sys.AddPlane(p); !st.ok()) {
+        std::fputs(st.error().Format().c_str(), stderr);
+        return 1;
+      }
     }
   }
   const double h = 1.0 / 240;
@@ -90,7 +93,10 @@ int main(int argc, char** argv) {
     }
   }
   (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
-  (*renderer)->SetPoints(batch);
+  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->SetLines(edges);
   (*renderer)->Draw(
       render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 480.0 / 360, 30, 20, false));

@@ -44,9 +44,15 @@ int main(int argc, char** argv) {
   rockets.lifetimeJitter = 0.2;
   rockets.colorStart = rockets.colorEnd = mesh::Srgb(1, 0.9f, 0.7f);
   rockets.seed = 2026;
-  particles::Emitter launcher(rockets);
+  auto made = particles::Emitter::Create(rockets);
+  if (!made) {
+    std::fputs(made.error().Format().c_str(), stderr);
+    return 1;
+  }
+  particles::Emitter& launcher = *made;
   int bursts = 0, sparks = 0;
   uint32_t stream = 1;
+  bool failed = false;
   auto burst = [&](const Vec3& at, const Vec3& v, int n, double speed, bool again) {
     EmitterDef d;
     d.position = at;
@@ -59,12 +65,17 @@ int main(int argc, char** argv) {
     d.colorEnd = mesh::Srgb(0.25f, 0.05f, 0.05f);
     d.seed = 2026;
     d.stream = stream++;
-    particles::Emitter e(d);
+    auto e = particles::Emitter::Create(d);
+    if (!e) {  // every def here is in range; a bad one is reported and ends the run
+      std::fputs(e.error().Format().c_str(), stderr);
+      failed = true;
+      return;
+    }
     const uint32_t first = sys.state.nextId;
-    e.Burst(sys.state, n);
+    e->Burst(sys.state, n);
     for (uint32_t id = first; id < sys.state.nextId; ++id) {
       kind[id] = again && id % 9 == 0 ? kBursting : kSpark;
-      emitterOf.emplace(id, e);
+      emitterOf.emplace(id, *e);
     }
     ++bursts;
     sparks += n;
@@ -94,6 +105,7 @@ int main(int argc, char** argv) {
       }
     }
     particles::RemoveDead(sys.state);
+    if (failed) return 1;
   }
   std::printf("%.2f s: %d bursts, %d sparks made, %zu particles alive\n", sys.time, bursts, sparks,
               sys.state.size());
@@ -115,7 +127,10 @@ int main(int argc, char** argv) {
     hi = hi.cwiseMax(sys.state.position[i]);
   }
   (*renderer)->SetBackground(mesh::Srgb(0.03f, 0.03f, 0.07f));
-  (*renderer)->SetPoints(batch);
+  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 0, 5, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
     std::filesystem::create_directories(std::filesystem::path(out).parent_path(),

@@ -39,7 +39,12 @@ int main(int argc, char** argv) {
   def.substeps = 40;
   def.iterations = 4;
   for (int r = 0; r < def.rows; ++r) def.pinned.push_back(r * def.columns);  // the pole side
-  particles::Cloth flag(def);
+  auto made = particles::Cloth::Create(def);
+  if (!made) {
+    std::fputs(made.error().Format().c_str(), stderr);
+    return 1;
+  }
+  particles::Cloth& flag = **made;
   const double h = 1.0 / 60;
   for (int i = 0; i * h < seconds; ++i) {
     const double gust = 1 + 0.4 * std::sin(2.1 * i * h) + 0.2 * std::sin(5.3 * i * h);

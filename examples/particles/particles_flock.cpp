@@ -44,7 +44,12 @@ int main(int argc, char** argv) {
   def.avoid = 10;
   def.avoidDistance = 1.0;
   def.obstacles = {{obstacle, radius}};
-  auto flock = std::make_shared<particles::Flocking>(def);
+  auto made = particles::Flocking::Create(def);
+  if (!made) {
+    std::fputs(made.error().Format().c_str(), stderr);
+    return 1;
+  }
+  std::shared_ptr<particles::Flocking> flock = *made;
   sys.AddForce(flock);
   sys.AddForce(std::make_shared<particles::Drag>(0.4));
   const double h = 1.0 / 120;
@@ -97,7 +102,10 @@ int main(int argc, char** argv) {
   }
   Vec3 lo = Vec3::Constant(-4.5), hi = Vec3::Constant(4.5);
   (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
-  (*renderer)->SetPoints(batch);
+  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 30, 25, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
     std::filesystem::create_directories(std::filesystem::path(out).parent_path(),

@@ -35,7 +35,12 @@ int main(int argc, char** argv) {
   def.velocitySpread = 0.3;
   def.mass = 0.002;
   def.lifetime = 1e6;
-  particles::Emitter emitter(def);
+  auto made = particles::Emitter::Create(def);
+  if (!made) {
+    std::fputs(made.error().Format().c_str(), stderr);
+    return 1;
+  }
+  particles::Emitter& emitter = *made;
   particles::ParticleState born;
 
   particles::BulkSystem snow(0);
@@ -44,9 +49,14 @@ int main(int argc, char** argv) {
   snow.fields.linearDrag = 0.02;  // terminal speed m g / k = 0.98 m/s
   const Vec3 ballCentre(0.3, 0.4, 0), ground(0, 0, 0);
   const double ballRadius = 0.4;
-  snow.AddCollider(particles::Collider::Plane(ground, Vec3(0, 1, 0)).Restitution(0).Friction(0.8));
-  snow.AddCollider(
-      particles::Collider::Sphere(ballCentre, ballRadius).Respond(particles::Response::kStick));
+  for (const particles::Collider& c :
+       {particles::Collider::Plane(ground, Vec3(0, 1, 0)).Restitution(0).Friction(0.8),
+        particles::Collider::Sphere(ballCentre, ballRadius).Respond(particles::Response::kStick)}) {
+    if (Status st = snow.AddCollider(c); !st.ok()) {
+      std::fputs(st.error().Format().c_str(), stderr);
+      return 1;
+    }
+  }
 
   const double h = 1.0 / 120;
   double stepSeconds = 0;
@@ -131,7 +141,10 @@ int main(int argc, char** argv) {
     for (int c = 0; c < 4; ++c) lines.colors.push_back(mesh::Srgb(0.5f, 0.55f, 0.6f));
   }
   (*renderer)->SetBackground(mesh::Srgb(0.12f, 0.14f, 0.2f));
-  (*renderer)->SetPoints(batch);
+  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->SetLines(lines);
   (*renderer)->Draw(
       render::Camera::Frame(Vec3(-2, 0, -2), Vec3(2, 3, 2), 480.0 / 360, 25, 15, false));

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "particles/def_check.h"
 #include "particles/system.h"
 
 namespace sylva::particles {
@@ -144,8 +145,27 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
   }
 }
 
+Status Validate(const BulkFields& f) {
+  using namespace check;
+  SYLVA_CHECK_OK(Finite("BulkFields.gravity", f.gravity, 1e12, "m/s^2"));
+  SYLVA_CHECK_OK(Range("BulkFields.linearDrag", f.linearDrag, 0, 1e12, "N s/m"));
+  SYLVA_CHECK_OK(Range("BulkFields.quadraticDrag", f.quadraticDrag, 0, 1e12, "N s^2/m^2"));
+  SYLVA_CHECK_OK(Finite("BulkFields.wind", f.wind, 1e12, "m/s"));
+  return {};
+}
+
+Status BulkSystem::AddCollider(Collider c) {
+  SYLVA_CHECK_OK(Validate(c));
+  colliders_.push_back(std::move(c));
+  return {};
+}
+
 Status BulkSystem::Step(double h) {
   if (fault_) return *fault_;
+  if (!(h > 0 && h <= 1e6))
+    return check::Error("BulkSystem.Step h " + check::Num(h) + " is outside (0, 1e+06] s");
+  SYLVA_CHECK_OK(check::Range("BulkSystem.maxMagnitude", maxMagnitude, 1e-30, 1e300));
+  SYLVA_CHECK_OK(Validate(fields));
   const Vec3& g = fields.gravity;
   const Vec3& w = fields.wind;
   const float limit = float(std::min(maxMagnitude, double(FLT_MAX)));

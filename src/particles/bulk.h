@@ -77,13 +77,17 @@ struct BulkState {
   }
 };
 
-// The uniform fields acting on every movable particle.
+// The uniform fields acting on every movable particle. Ranges (checked by
+// Validate, which BulkSystem::Step calls first):
 struct BulkFields {
-  Vec3 gravity{0, 0, 0};  // acceleration, m/s^2
-  // Drag force -(linear + quadratic |u|) u, with u = v - wind (N).
+  Vec3 gravity{0, 0, 0};  // acceleration, m/s^2, each component within +-1e12
+  // Drag force -(linear + quadratic |u|) u, with u = v - wind (N); each 0..1e12.
   double linearDrag = 0, quadraticDrag = 0;
-  Vec3 wind{0, 0, 0};  // m/s
+  Vec3 wind{0, 0, 0};  // m/s, each component within +-1e12
 };
+
+// The first field of `fields` outside its range, or ok.
+Status Validate(const BulkFields& fields);
 
 class BulkSystem {
  public:
@@ -96,16 +100,18 @@ class BulkSystem {
   BulkFields fields;
   uint64_t steps = 0;
   double time() const { return state.time; }
-  double maxMagnitude = 1e12;  // a coordinate or speed beyond this is an explosion
+  double maxMagnitude = 1e12;  // a coordinate or speed beyond this is an explosion, 1e-30..1e300
 
   // 0 = every hardware thread.
   void SetThreads(int threads);
   int threads() const;
-  void AddCollider(Collider c) { colliders_.push_back(std::move(c)); }
+  // Adds a collider that passes Validate(Collider), else its Diagnostic.
+  [[nodiscard]] Status AddCollider(Collider c);
   const std::vector<Collider>& colliders() const { return colliders_; }
 
   // One symplectic Euler step of length h: fields, integration, collisions,
-  // ageing. A coordinate or speed beyond maxMagnitude (or not finite) is
+  // ageing. h in (0, 1e6] s; `fields` and maxMagnitude are checked first
+  // (a Diagnostic, nothing moves). A coordinate or speed beyond maxMagnitude (or not finite) is
   // reported with the step and the particle's id, and the system then
   // refuses to step again.
   [[nodiscard]] Status Step(double h);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "particles/def_check.h"
+
 namespace sylva::particles {
 
 // Gravity, damping and wind at the current frame's values, on the implicit
@@ -25,9 +27,46 @@ class Cloth::ExternalForce : public Force {
   Cloth* cloth_;
 };
 
+Status Validate(const ClothDef& d) {
+  using namespace check;
+  SYLVA_CHECK_OK(Range("ClothDef.columns", d.columns, 2, 10000));
+  SYLVA_CHECK_OK(Range("ClothDef.rows", d.rows, 2, 10000));
+  const double n = double(d.columns) * double(d.rows);
+  SYLVA_CHECK_OK(Range("ClothDef.columns * rows", n, 4, 1e7, "particles"));
+  SYLVA_CHECK_OK(Finite("ClothDef.origin", d.origin, 1e12, "m"));
+  SYLVA_CHECK_OK(Finite("ClothDef.u", d.u, 1e12, "m"));
+  SYLVA_CHECK_OK(Finite("ClothDef.v", d.v, 1e12, "m"));
+  if (!(d.u.cross(d.v).squaredNorm() > 0)) {
+    return Error("ClothDef.u " + Vec(d.u) + " and v " + Vec(d.v) +
+                 " are parallel or zero: the cloth has no area");
+  }
+  SYLVA_CHECK_OK(Range("ClothDef.mass", d.mass, 1e-12, 1e12, "kg"));
+  SYLVA_CHECK_OK(Range("ClothDef.stretchCompliance", d.stretchCompliance, 0, 1e12, "m/N"));
+  SYLVA_CHECK_OK(Range("ClothDef.shearCompliance", d.shearCompliance, 0, 1e12, "m/N"));
+  SYLVA_CHECK_OK(Range("ClothDef.bendCompliance", d.bendCompliance, 0, 1e12, "m/N"));
+  SYLVA_CHECK_OK(Range("ClothDef.substeps", d.substeps, 1, 10000));
+  SYLVA_CHECK_OK(Range("ClothDef.iterations", d.iterations, 1, 10000));
+  SYLVA_CHECK_OK(Range("ClothDef.damping", d.damping, 0, 1e6, "1/s"));
+  SYLVA_CHECK_OK(Range("ClothDef.windDrag", d.windDrag, 0, 1e6));
+  SYLVA_CHECK_OK(Range("ClothDef.windLift", d.windLift, -1e6, 1e6));
+  SYLVA_CHECK_OK(Range("ClothDef.windFriction", d.windFriction, 0, 1e6));
+  for (size_t k = 0; k < d.pinned.size(); ++k) {
+    SYLVA_CHECK_OK(Range("ClothDef.pinned[" + std::to_string(k) + "]", d.pinned[k], 0, n - 1));
+  }
+  SYLVA_CHECK_OK(Range("ClothDef.threads", d.threads, 0, 256));
+  SYLVA_CHECK_OK(Range("ClothDef.implicitStiffness", d.implicitStiffness, 1e-12, 1e12, "N/m"));
+  SYLVA_CHECK_OK(Range("ClothDef.implicitDamping", d.implicitDamping, 0, 1e12, "N s/m"));
+  SYLVA_CHECK_OK(Range("ClothDef.implicitSubsteps", d.implicitSubsteps, 1, 10000));
+  SYLVA_CHECK_OK(Range("ClothDef.cgIterations", d.cgIterations, 1, 100000));
+  return {};
+}
+
+Expected<std::unique_ptr<Cloth>> Cloth::Create(const ClothDef& def) {
+  if (Status st = Validate(def); !st.ok()) return st.error();
+  return std::unique_ptr<Cloth>(new Cloth(def));
+}
+
 Cloth::Cloth(const ClothDef& def) : def_(def) {
-  def_.columns = std::max(def_.columns, 2);
-  def_.rows = std::max(def_.rows, 2);
   const int nc = def_.columns, nr = def_.rows;
   const size_t n = size_t(nc) * size_t(nr);
   x_.resize(n);
@@ -37,9 +76,7 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
     for (int c = 0; c < nc; ++c)
       x_[size_t(Index(c, r))] =
           def_.origin + def_.u * (double(c) / (nc - 1)) + def_.v * (double(r) / (nr - 1));
-  for (int p : def_.pinned) {
-    if (p >= 0 && size_t(p) < n) w_[size_t(p)] = 0;
-  }
+  for (int p : def_.pinned) w_[size_t(p)] = 0;  // in range (Validate)
   auto link = [&](int c0, int r0, int c1, int r1, double compliance) {
     if (c1 < 0 || c1 >= nc || r1 < 0 || r1 >= nr) return;
     const uint32_t a = uint32_t(Index(c0, r0)), b = uint32_t(Index(c1, r1));
@@ -113,16 +150,18 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
   }
   if (def_.solver == ClothSolver::kImplicit) {
     implicit_ = std::make_unique<System>(def_.threads);
-    implicit_->cgMaxIterations = std::max(1, def_.cgIterations);
+    implicit_->cgMaxIterations = def_.cgIterations;
     implicit_->cgTolerance = 1e-12;
     for (size_t i = 0; i < n; ++i)
       implicit_->state.Add(x_[i], Vec3::Zero(), w_[i] > 0 ? 1 / w_[i] : 0);
     auto springs = std::make_shared<Springs>();
     for (const Constraint& c : constraints_) {
-      springs->Add(c.a, c.b, c.rest,
-                   c.compliance > 0 ? std::min(1 / c.compliance, def_.implicitStiffness)
-                                    : def_.implicitStiffness,
-                   def_.implicitDamping);
+      const Status added =
+          springs->Add(c.a, c.b, c.rest,
+                       c.compliance > 0 ? std::min(1 / c.compliance, def_.implicitStiffness)
+                                        : def_.implicitStiffness,
+                       def_.implicitDamping);
+      SYLVA_ASSERT(added.ok());  // in range by Validate(ClothDef)
     }
     implicit_->AddForce(springs);
     implicit_->AddForce(std::make_shared<ExternalForce>(this));
@@ -195,7 +234,7 @@ void Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
   wind_ = wind;
   implicit_->state.position = x_;  // the caller may have moved particles
   implicit_->state.velocity = v_;
-  const int subs = std::max(def_.implicitSubsteps, 1);
+  const int subs = def_.implicitSubsteps;
   for (int s = 0; s < subs; ++s) {
     // Cloth is well-behaved input; a fault here is a bug in the set-up.
     if (!implicit_->Step(dt / subs, Integrator::kImplicitEuler).ok()) break;
@@ -205,8 +244,9 @@ void Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
 }
 
 void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
+  SYLVA_ASSERT(dt > 0 && dt <= 1e6);
   if (implicit_) return StepImplicit(dt, gravity, wind);
-  const int subs = std::max(def_.substeps, 1);
+  const int subs = def_.substeps;
   const double h = dt / subs;
   const size_t n = x_.size();
   ThreadPool* pool = pool_.get();

@@ -46,40 +46,50 @@ namespace sylva::particles {
 
 enum class ClothSolver { kXPBD, kImplicit };
 
+// Ranges (Validate rejects anything outside, NaN included, naming the field
+// and the value):
 struct ClothDef {
-  int columns = 20, rows = 20;   // particles along u and v (>= 2)
-  Vec3 origin{0, 0, 0};          // corner (0, 0)
-  Vec3 u{1, 0, 0}, v{0, -1, 0};  // edges of the whole cloth
-  double mass = 1;               // total, kg
-  double stretchCompliance = 0;  // m/N: 0 = inextensible
-  double shearCompliance = 1e-4;
-  double bendCompliance = 1e-2;
+  int columns = 20, rows = 20;    // particles along u and v, each 2..10000, columns * rows <= 1e7
+  Vec3 origin{0, 0, 0};           // corner (0, 0), m, each component within +-1e12
+  Vec3 u{1, 0, 0}, v{0, -1, 0};   // edges of the whole cloth, m, within +-1e12, not parallel
+  double mass = 1;                // total, kg, 1e-12..1e12
+  double stretchCompliance = 0;   // m/N, 0..1e12: 0 = inextensible
+  double shearCompliance = 1e-4;  // m/N, 0..1e12
+  double bendCompliance = 1e-2;   // m/N, 0..1e12
   // Substeps x iterations decide how stiff "inextensible" really is: a flag
   // in a strong wind (examples/particles/particles_flag) stretches 13% at
   // 10 x 1, 1.3% at 20 x 4 and 0.5% at 40 x 4.
-  int substeps = 10;
-  int iterations = 1;  // per substep
-  double damping = 0;  // fraction of velocity removed per second
+  int substeps = 10;   // 1..10000
+  int iterations = 1;  // per substep, 1..10000
+  double damping = 0;  // fraction of velocity removed per second, 0..1e6
   // Air force coefficients, N per (m^2 * m/s); see the notes above.
-  double windDrag = 1.0;    // c_d, along the relative air speed
-  double windLift = 1.0;    // c_l, across it
-  double windFriction = 0;  // c_f, along the triangle
-  std::vector<int> pinned;  // particle indices (row * columns + column)
+  double windDrag = 1.0;    // c_d, along the relative air speed, 0..1e6
+  double windLift = 1.0;    // c_l, across it, -1e6..1e6
+  double windFriction = 0;  // c_f, along the triangle, 0..1e6
+  std::vector<int> pinned;  // particle indices (row * columns + column), each 0..columns * rows - 1
   // Long-range attachments: tethers from every particle to its two nearest
   // pins, at their rest distance (XPBD only).
   bool longRangeAttachments = true;
-  int threads = 1;  // 0 = every hardware thread
+  int threads = 1;  // 0..256, 0 = every hardware thread
   ClothSolver solver = ClothSolver::kXPBD;
   // Implicit solver only.
-  double implicitStiffness = 2000;  // N/m for constraints of compliance 0
-  double implicitDamping = 0.02;    // N s/m along each spring
-  int implicitSubsteps = 1;         // backward-Euler steps per Step
-  int cgIterations = 20;
+  double implicitStiffness = 2000;  // N/m for constraints of compliance 0, 1e-12..1e12
+  double implicitDamping = 0.02;    // N s/m along each spring, 0..1e12
+  int implicitSubsteps = 1;         // backward-Euler steps per Step, 1..10000
+  int cgIterations = 20;            // 1..100000
 };
+
+// The first field of `def` outside its range, or ok.
+Status Validate(const ClothDef& def);
 
 class Cloth {
  public:
-  explicit Cloth(const ClothDef& def);
+  // A cloth of a valid definition, or the Diagnostic of Validate. The cloth
+  // stays where it was made (its forces point back at it), hence the pointer.
+  static Expected<std::unique_ptr<Cloth>> Create(const ClothDef& def);
+  Cloth(const Cloth&) = delete;
+  Cloth& operator=(const Cloth&) = delete;
+  // One frame of dt seconds, 0 < dt <= 1e6 (asserted: the caller's clock).
   void Step(double dt, const Vec3& gravity, const Vec3& wind = Vec3::Zero());
 
   const std::vector<Vec3>& positions() const { return x_; }
@@ -99,6 +109,7 @@ class Cloth {
   double MaxStretch() const;
 
  private:
+  explicit Cloth(const ClothDef& def);
   void StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
   std::vector<xpbd::Tether> tethers_;  // xpbd::kTethers a particle
   std::vector<size_t> colorStart_;     // constraints_ sorted by colour

@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "core/assert.h"
+#include "particles/def_check.h"
 
 namespace sylva::particles {
 namespace {
@@ -168,6 +169,48 @@ bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
 
 // --- Collider ---
 
+Status Validate(const Collider& c) {
+  using namespace check;
+  switch (c.kind) {
+    case Collider::Kind::kPolygon:
+      if (c.polygon.size() < 3) {
+        return Error("Collider.polygon has " + std::to_string(c.polygon.size()) +
+                     " vertices, fewer than 3");
+      }
+      for (size_t k = 0; k < c.polygon.size(); ++k) {
+        SYLVA_CHECK_OK(
+            Finite("Collider.polygon[" + std::to_string(k) + "]", c.polygon[k], 1e12, "m"));
+      }
+      [[fallthrough]];
+    case Collider::Kind::kPlane:
+      SYLVA_CHECK_OK(Finite("Collider.point", c.point, 1e12, "m"));
+      SYLVA_CHECK_OK(Finite("Collider.normal", c.normal, 1e12));
+      if (!(std::abs(c.normal.norm() - 1) < 1e-6)) {
+        return Error(std::string("Collider.normal ") + Vec(c.normal) + " of a " +
+                     (c.kind == Collider::Kind::kPlane ? "plane" : "polygon (from its winding)") +
+                     " is not a unit direction");
+      }
+      break;
+    case Collider::Kind::kSphere:
+      SYLVA_CHECK_OK(Finite("Collider.point", c.point, 1e12, "m"));
+      SYLVA_CHECK_OK(Range("Collider.radius", c.radius, 1e-12, 1e12, "m"));
+      break;
+    case Collider::Kind::kBox:
+      SYLVA_CHECK_OK(Finite("Collider.lo", c.lo, 1e12, "m"));
+      SYLVA_CHECK_OK(Finite("Collider.hi", c.hi, 1e12, "m"));
+      if (!(c.lo.array() <= c.hi.array()).all()) {
+        return Error("Collider.lo " + Vec(c.lo) + " is above hi " + Vec(c.hi) + " in some axis");
+      }
+      break;
+    case Collider::Kind::kMesh:
+      if (!c.mesh) return Error("Collider.mesh is null");
+      break;
+  }
+  SYLVA_CHECK_OK(Range("Collider.restitution", c.restitution, 0, 1));
+  SYLVA_CHECK_OK(Range("Collider.friction", c.friction, 0, 1e3));
+  return {};
+}
+
 Collider Collider::Plane(const Vec3& point, const Vec3& normal) {
   Collider c;
   c.kind = Kind::kPlane;
@@ -195,7 +238,6 @@ Collider Collider::Box(const Vec3& lo, const Vec3& hi, bool inside) {
 }
 
 Collider Collider::Polygon(std::vector<Vec3> vertices) {
-  SYLVA_ASSERT(vertices.size() >= 3);
   Collider c;
   c.kind = Kind::kPolygon;
   Vec3 n = Vec3::Zero();  // Newell's normal

@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "core/status.h"
 
 namespace sylva::particles {
 
@@ -70,22 +71,28 @@ class TriangleBvh {
   int depth_ = 0;
 };
 
+// A collider is a plain description; the factories below fill it, and
+// System::AddCollider / BulkSystem::AddCollider run Validate on it, so a bad
+// number (a zero or NaN normal, a negative radius) is a Diagnostic there,
+// never a collider that silently does nothing. Ranges (m unless said):
 struct Collider {
   enum class Kind { kPlane, kSphere, kBox, kPolygon, kMesh };
   Kind kind = Kind::kPlane;
   // plane / polygon: point and unit normal; sphere: centre = point, radius;
-  // box: lo, hi.
-  Vec3 point{0, 0, 0}, normal{0, 1, 0};
-  double radius = 1;
-  Vec3 lo{0, 0, 0}, hi{0, 0, 0};
-  bool inside = false;        // sphere and box: keep particles inside
-  std::vector<Vec3> polygon;  // convex, counter-clockwise about normal
-  std::shared_ptr<const TriangleBvh> mesh;
+  // box: lo, hi. Every coordinate within +-1e12.
+  Vec3 point{0, 0, 0}, normal{0, 1, 0};     // normal: unit length (within 1e-6)
+  double radius = 1;                        // 1e-12..1e12
+  Vec3 lo{0, 0, 0}, hi{0, 0, 0};            // lo <= hi in every axis
+  bool inside = false;                      // sphere and box: keep particles inside
+  std::vector<Vec3> polygon;                // convex, counter-clockwise about normal, >= 3 vertices
+  std::shared_ptr<const TriangleBvh> mesh;  // not null for kMesh
   // Material.
-  double restitution = 1;  // e: normal speed out / in
-  double friction = 0;     // Coulomb mu: tangential impulse <= mu * normal impulse
+  double restitution = 1;  // e: normal speed out / in, 0..1
+  double friction = 0;     // Coulomb mu, 0..1e3: tangential impulse <= mu * normal impulse
   Response response = Response::kBounce;
 
+  // Plane's normal need not be unit (it is normalised); a zero or NaN
+  // normal stays so and fails Validate.
   static Collider Plane(const Vec3& point, const Vec3& normal);
   static Collider Sphere(const Vec3& centre, double radius, bool inside = false);
   static Collider Box(const Vec3& lo, const Vec3& hi, bool inside = false);
@@ -120,6 +127,9 @@ struct Collider {
   bool IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const;
   bool ProjectAny(const Vec3& x, Vec3* surface, Vec3* normal) const;
 };
+
+// The first field of `c` outside its range (for its kind), or ok.
+Status Validate(const Collider& c);
 
 // What RespondToContacts did to a particle.
 enum class ContactOutcome {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/rng.h"
+#include "particles/def_check.h"
 
 namespace sylva::particles {
 
@@ -12,6 +13,36 @@ static Vec3 InBall(RandomStream& r) {
     const Vec3 p(2 * r.Uniform() - 1, 2 * r.Uniform() - 1, 2 * r.Uniform() - 1);
     if (p.squaredNorm() <= 1) return p;
   }
+}
+
+Status Validate(const EmitterDef& d) {
+  using namespace check;
+  SYLVA_CHECK_OK(Range("EmitterDef.rate", d.rate, 0, 1e9, "particles/s"));
+  SYLVA_CHECK_OK(Finite("EmitterDef.position", d.position, 1e12, "m"));
+  SYLVA_CHECK_OK(Range("EmitterDef.positionRadius", d.positionRadius, 0, 1e6, "m"));
+  SYLVA_CHECK_OK(Finite("EmitterDef.velocity", d.velocity, 1e12, "m/s"));
+  SYLVA_CHECK_OK(Range("EmitterDef.velocitySpread", d.velocitySpread, 0, 1e6, "m/s"));
+  SYLVA_CHECK_OK(Range("EmitterDef.lifetime", d.lifetime, 1e-9, 1e300, "s"));
+  SYLVA_CHECK_OK(
+      Range("EmitterDef.lifetimeJitter", d.lifetimeJitter, 0, d.lifetime, "s (0..lifetime)"));
+  SYLVA_CHECK_OK(Range("EmitterDef.mass", d.mass, 0, 1e30, "kg"));
+  for (const Vec3f* c : {&d.colorStart, &d.colorEnd}) {
+    const char* name = c == &d.colorStart ? "EmitterDef.colorStart" : "EmitterDef.colorEnd";
+    for (int k = 0; k < 3; ++k) {
+      if (!((*c)[k] >= 0 && (*c)[k] <= 1e6)) {
+        return Error(std::string(name) + " " + Vec(c->cast<double>()) +
+                     " has a component outside 0..1e+06");
+      }
+    }
+  }
+  SYLVA_CHECK_OK(Range("EmitterDef.radiusStart", d.radiusStart, 0, 1e6, "m"));
+  SYLVA_CHECK_OK(Range("EmitterDef.radiusEnd", d.radiusEnd, 0, 1e6, "m"));
+  return {};
+}
+
+Expected<Emitter> Emitter::Create(const EmitterDef& def) {
+  if (Status st = Validate(def); !st.ok()) return st.error();
+  return Emitter(def);
 }
 
 void Emitter::Spawn(ParticleState& s) {
@@ -25,6 +56,7 @@ void Emitter::Spawn(ParticleState& s) {
 }
 
 int Emitter::Emit(ParticleState& s, double h) {
+  SYLVA_ASSERT(h >= 0 && h <= 1e6 && def_.rate * h < 2147483647.0);
   carry_ += def_.rate * h;
   const int n = int(std::floor(carry_ + 1e-9));
   carry_ -= n;

@@ -3,7 +3,33 @@
 #include <algorithm>
 #include <cmath>
 
+#include "particles/def_check.h"
+
 namespace sylva::particles {
+
+Status Validate(const FlockingDef& d) {
+  using namespace check;
+  SYLVA_CHECK_OK(Range("FlockingDef.radius", d.radius, 1e-9, 1e6, "m"));
+  SYLVA_CHECK_OK(Range("FlockingDef.cohesion", d.cohesion, 0, 1e6));
+  SYLVA_CHECK_OK(Range("FlockingDef.separation", d.separation, 0, 1e6));
+  SYLVA_CHECK_OK(Range("FlockingDef.separationRadius", d.separationRadius, 0, 1e6, "m"));
+  SYLVA_CHECK_OK(Range("FlockingDef.alignment", d.alignment, 0, 1e6));
+  SYLVA_CHECK_OK(Range("FlockingDef.seek", d.seek, 0, 1e6));
+  SYLVA_CHECK_OK(Finite("FlockingDef.target", d.target, 1e12, "m"));
+  SYLVA_CHECK_OK(Range("FlockingDef.avoid", d.avoid, 0, 1e6));
+  SYLVA_CHECK_OK(Range("FlockingDef.avoidDistance", d.avoidDistance, 1e-9, 1e6, "m"));
+  for (size_t k = 0; k < d.obstacles.size(); ++k) {
+    const std::string name = "FlockingDef.obstacles[" + std::to_string(k) + "]";
+    SYLVA_CHECK_OK(Finite(name + ".centre", d.obstacles[k].first, 1e12, "m"));
+    SYLVA_CHECK_OK(Range(name + ".radius", d.obstacles[k].second, 0, 1e6, "m"));
+  }
+  return {};
+}
+
+Expected<std::shared_ptr<Flocking>> Flocking::Create(const FlockingDef& def) {
+  if (Status st = Validate(def); !st.ok()) return st.error();
+  return std::shared_ptr<Flocking>(new Flocking(def));
+}
 
 void Flocking::Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const {
   const size_t n = s.size();

@@ -5,6 +5,7 @@
 
 #include "core/assert.h"
 #include "core/rng.h"
+#include "particles/def_check.h"
 
 namespace sylva::particles {
 
@@ -17,9 +18,25 @@ void RandomDrift::AccumulateRange(const ParticleState& s, const Vec3*, const Vec
   }
 }
 
+Status Validate(const NoiseWindDef& d) {
+  using namespace check;
+  SYLVA_CHECK_OK(Finite("NoiseWindDef.mean", d.mean, 1e12, "m/s"));
+  SYLVA_CHECK_OK(Range("NoiseWindDef.speed", d.speed, 0, 1e6, "m/s"));
+  SYLVA_CHECK_OK(Range("NoiseWindDef.scale", d.scale, 1e-9, 1e12, "m"));
+  SYLVA_CHECK_OK(Range("NoiseWindDef.frequency", d.frequency, 0, 1e9, "rad/s"));
+  SYLVA_CHECK_OK(Range("NoiseWindDef.drag", d.drag, 0, 1e12, "N s/m"));
+  SYLVA_CHECK_OK(Range("NoiseWindDef.modes", d.modes, 1, 65536));
+  return {};
+}
+
+Expected<std::shared_ptr<NoiseWind>> NoiseWind::Create(const NoiseWindDef& def) {
+  if (Status st = Validate(def); !st.ok()) return st.error();
+  return std::shared_ptr<NoiseWind>(new NoiseWind(def));
+}
+
 NoiseWind::NoiseWind(const NoiseWindDef& def) : def_(def) {
   RandomStream r{def.seed, 0xc0e1, 0, 0, 0};
-  const int m = std::max(1, def.modes);
+  const int m = def.modes;
   for (int j = 0; j < m; ++j) {
     // Direction uniform on the sphere, wavenumber around 2 pi / scale.
     Vec3 dir;
@@ -61,11 +78,37 @@ void NoiseWind::AddJacobianProduct(const ParticleState& s, const Vec3*, const Ve
   for (size_t i = 0; i < s.size(); ++i) y[i] -= cv * def_.drag * p[i];  // df/dv = -drag I
 }
 
+Expected<std::shared_ptr<FieldGrid>> FieldGrid::Create(const Vec3& lo, const Vec3& hi,
+                                                       std::array<int, 3> n,
+                                                       std::vector<Vec3> samples, bool clamp) {
+  using namespace check;
+  for (int k = 0; k < 3; ++k) {
+    if (Status st = Range("FieldGrid n[" + std::to_string(k) + "]", n[k], 2, 4096); !st.ok())
+      return st.error();
+  }
+  const size_t want = size_t(n[0]) * size_t(n[1]) * size_t(n[2]);
+  if (samples.size() != want) {
+    return Error("FieldGrid has " + std::to_string(samples.size()) +
+                 " samples, not n0 n1 n2 = " + std::to_string(want));
+  }
+  for (const auto& [name, v] : {std::pair{"FieldGrid lo", &lo}, std::pair{"FieldGrid hi", &hi}}) {
+    if (Status st = Finite(name, *v, 1e12, "m"); !st.ok()) return st.error();
+  }
+  if (!(lo.array() < hi.array()).all())
+    return Error("FieldGrid lo " + Vec(lo) + " is not below hi " + Vec(hi));
+  for (size_t k = 0; k < samples.size(); ++k) {
+    if (Status st =
+            Finite("FieldGrid samples[" + std::to_string(k) + "]", samples[k], 1e12, "m/s^2");
+        !st.ok()) {
+      return st.error();
+    }
+  }
+  return std::shared_ptr<FieldGrid>(new FieldGrid(lo, hi, n, std::move(samples), clamp));
+}
+
 FieldGrid::FieldGrid(const Vec3& lo, const Vec3& hi, std::array<int, 3> n,
                      std::vector<Vec3> samples, bool clamp)
     : lo_(lo), hi_(hi), n_(n), samples_(std::move(samples)), clamp_(clamp) {
-  SYLVA_ASSERT(n[0] >= 2 && n[1] >= 2 && n[2] >= 2);
-  SYLVA_ASSERT(samples_.size() == size_t(n[0]) * n[1] * n[2]);
   for (int k = 0; k < 3; ++k) inv_[k] = (n[k] - 1) / (hi[k] - lo[k]);
 }
 
@@ -99,16 +142,30 @@ void FieldGrid::AccumulateRange(const ParticleState& s, const Vec3* x, const Vec
 }
 
 void Penalty::Anchor(uint32_t i, const Vec3& point, double ks, double kd) {
+  maxIndex_ = std::max(maxIndex_, i);
   terms_.push_back({Kind::kAnchor, i, i, point, Vec3::Zero(), 0, ks, kd});
 }
 void Penalty::Distance(uint32_t i, uint32_t j, double distance, double ks, double kd) {
+  maxIndex_ = std::max({maxIndex_, i, j});
   terms_.push_back({Kind::kDistance, i, j, Vec3::Zero(), Vec3::Zero(), distance, ks, kd});
 }
 void Penalty::OnPlane(uint32_t i, const Vec3& point, const Vec3& normal, double ks, double kd) {
+  maxIndex_ = std::max(maxIndex_, i);
   terms_.push_back({Kind::kPlane, i, i, point, normal.normalized(), 0, ks, kd});
 }
 void Penalty::OnSphere(uint32_t i, const Vec3& centre, double radius, double ks, double kd) {
+  maxIndex_ = std::max(maxIndex_, i);
   terms_.push_back({Kind::kSphere, i, i, centre, Vec3::Zero(), radius, ks, kd});
+}
+
+Status RandomDrift::Check(const ParticleState&) const {
+  return check::Range("RandomDrift sigma", sigma_, 0, 1e12, "N");
+}
+
+Status Penalty::Check(const ParticleState& s) const {
+  if (terms_.empty() || maxIndex_ < s.size()) return {};
+  return check::Error("Penalty: a term names particle " + std::to_string(maxIndex_) +
+                      ", but the system has " + std::to_string(s.size()) + " particles");
 }
 
 void Penalty::Accumulate(const ParticleState&, const Vec3* x, const Vec3* v, Vec3* f) const {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <vector>
 
 #include "particles/system.h"
@@ -13,9 +14,11 @@ namespace sylva::particles {
 // axis, drawn afresh every step from the counter-based generator keyed by
 // (seed, particle id, step), so it is the same whatever the thread count or
 // the integrator's stages (all stages of a step see one draw).
+// sigma 0..1e12 N (Check, on every step, says otherwise).
 class RandomDrift : public LocalForce {
  public:
   RandomDrift(double sigma, uint64_t seed) : sigma_(sigma), seed_(seed) {}
+  Status Check(const ParticleState& s) const override;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
 
@@ -31,19 +34,24 @@ class RandomDrift : public LocalForce {
 // exactly (k . (k x a) = 0), smooth, and tileless. Wavelengths are drawn
 // around `scale`; the field's RMS speed is `speed`; `mean` is added.
 // The force pulls each particle's velocity toward the wind: f = drag (u - v).
+// Ranges (Validate rejects anything outside, NaN included):
 struct NoiseWindDef {
-  Vec3 mean{0, 0, 0};
-  double speed = 1;      // RMS of the fluctuation, m/s
-  double scale = 1;      // typical eddy size, m
-  double frequency = 0;  // how fast the pattern changes, rad/s
-  double drag = 1;       // N per (m/s) of relative speed
-  int modes = 16;
+  Vec3 mean{0, 0, 0};    // m/s, each component within +-1e12
+  double speed = 1;      // RMS of the fluctuation, m/s, 0..1e6
+  double scale = 1;      // typical eddy size, m, 1e-9..1e12
+  double frequency = 0;  // how fast the pattern changes, rad/s, 0..1e9
+  double drag = 1;       // N per (m/s) of relative speed, 0..1e12
+  int modes = 16;        // 1..65536
   uint64_t seed = 1;
 };
 
+// The first field of `def` outside its range, or ok.
+Status Validate(const NoiseWindDef& def);
+
 class NoiseWind : public LocalForce {
  public:
-  explicit NoiseWind(const NoiseWindDef& def);
+  // A wind of a valid definition, or the Diagnostic of Validate.
+  static Expected<std::shared_ptr<NoiseWind>> Create(const NoiseWindDef& def);
   Vec3 Velocity(const Vec3& x, double t) const;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
@@ -51,6 +59,7 @@ class NoiseWind : public LocalForce {
                           double cv, const Vec3* p, Vec3* y) const override;
 
  private:
+  explicit NoiseWind(const NoiseWindDef& def);
   struct Mode {
     Vec3 k, curlAmp;  // k and k x a
     double omega, phase;
@@ -62,15 +71,21 @@ class NoiseWind : public LocalForce {
 // An acceleration field (m/s^2, so f = m a) sampled on a regular grid of
 // nx x ny x nz points spanning [lo, hi], interpolated trilinearly. Outside
 // the box the field is zero, or the nearest border value with `clamp`.
+// Create checks n (each 2..4096), samples (n0 n1 n2 of them, each
+// component within +-1e12 m/s^2) and the box (finite, lo < hi in every
+// axis).
 class FieldGrid : public LocalForce {
  public:
-  FieldGrid(const Vec3& lo, const Vec3& hi, std::array<int, 3> n, std::vector<Vec3> samples,
-            bool clamp = false);
+  static Expected<std::shared_ptr<FieldGrid>> Create(const Vec3& lo, const Vec3& hi,
+                                                     std::array<int, 3> n,
+                                                     std::vector<Vec3> samples, bool clamp = false);
   Vec3 At(const Vec3& x) const;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
 
  private:
+  FieldGrid(const Vec3& lo, const Vec3& hi, std::array<int, 3> n, std::vector<Vec3> samples,
+            bool clamp);
   Vec3 lo_, hi_, inv_;
   std::array<int, 3> n_;
   std::vector<Vec3> samples_;  // x fastest
@@ -90,6 +105,8 @@ class Penalty : public Force {
   void Distance(uint32_t i, uint32_t j, double distance, double ks, double kd);
   void OnPlane(uint32_t i, const Vec3& point, const Vec3& normal, double ks, double kd);
   void OnSphere(uint32_t i, const Vec3& centre, double radius, double ks, double kd);
+  // Every particle index named is below s.size() (System::Step asks).
+  Status Check(const ParticleState& s) const override;
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
   // The implicit solver's Jacobian, for anchors and distances (the stiff
   // ones); plane and sphere terms are treated explicitly.
@@ -107,6 +124,7 @@ class Penalty : public Force {
     double value, ks, kd;
   };
   std::vector<Term> terms_;
+  uint32_t maxIndex_ = 0;
 };
 
 }  // namespace sylva::particles

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <utility>
 
+#include "particles/def_check.h"
 #include "particles/grid.h"
 
 namespace sylva::particles {
@@ -64,6 +65,32 @@ void Drag::AddJacobianProduct(const ParticleState& s, const Vec3*, const Vec3* v
     if (k2_ != 0 && speed > 0) j -= k2_ * v[i] * (v[i].dot(p[i]) / speed);
     y[i] += cv * j;
   }
+}
+
+Status Gravity::Check(const ParticleState&) const {
+  return check::Finite("Gravity g", g_, 1e12, "m/s^2");
+}
+
+Status Drag::Check(const ParticleState&) const {
+  SYLVA_CHECK_OK(check::Range("Drag linear", k1_, 0, 1e12, "N s/m"));
+  return check::Range("Drag quadratic", k2_, 0, 1e12, "N s^2/m^2");
+}
+
+Status Springs::Add(uint32_t a, uint32_t b, double rest, double ks, double kd) {
+  using namespace check;
+  if (a == b) return Error("Springs.Add joins particle " + std::to_string(a) + " to itself");
+  SYLVA_CHECK_OK(Range("Springs.Add rest", rest, 0, 1e12, "m"));
+  SYLVA_CHECK_OK(Range("Springs.Add ks", ks, 0, 1e12, "N/m"));
+  SYLVA_CHECK_OK(Range("Springs.Add kd", kd, 0, 1e12, "N s/m"));
+  springs_.push_back({a, b, rest, ks, kd});
+  maxIndex_ = std::max({maxIndex_, a, b});
+  return {};
+}
+
+Status Springs::Check(const ParticleState& s) const {
+  if (springs_.empty() || maxIndex_ < s.size()) return {};
+  return check::Error("Springs: a spring joins particle " + std::to_string(maxIndex_) +
+                      ", but the system has " + std::to_string(s.size()) + " particles");
 }
 
 void Springs::Colour() const {
@@ -240,10 +267,19 @@ void System::AddForce(std::shared_ptr<Force> f) {
   forces_.push_back(std::move(f));
 }
 
-void System::EnableParticleCollisions(double radius, double restitution) {
+Status System::AddCollider(Collider c) {
+  SYLVA_CHECK_OK(Validate(c));
+  colliders_.push_back(std::move(c));
+  return {};
+}
+
+Status System::EnableParticleCollisions(double radius, double restitution) {
+  SYLVA_CHECK_OK(check::Range("System.EnableParticleCollisions radius", radius, 1e-12, 1e12, "m"));
+  SYLVA_CHECK_OK(check::Range("System.EnableParticleCollisions restitution", restitution, 0, 1));
   pairRadius_ = radius;
   pairRestitution_ = restitution;
   if (!pairGrid_) pairGrid_ = std::make_unique<NeighbourGrid>();
+  return {};
 }
 
 template <typename Fn>
@@ -388,8 +424,20 @@ void System::StagePoint(double c, const Vec3* dx, const Vec3* dv, Vec3* out) con
   });
 }
 
+Status System::CheckStep(const char* what, double h) const {
+  using namespace check;
+  if (!(h > 0 && h <= 1e6))
+    return Error(std::string(what) + " " + Num(h) + " is outside (0, 1e+06] s");
+  SYLVA_CHECK_OK(Range("System.maxMagnitude", maxMagnitude, 1e-300, 1e300));
+  SYLVA_CHECK_OK(Range("System.cgTolerance", cgTolerance, 0, 1));
+  SYLVA_CHECK_OK(Range("System.cgMaxIterations", cgMaxIterations, 1, 1e7));
+  for (const auto& f : forces_) SYLVA_CHECK_OK(f->Check(state));
+  return {};
+}
+
 Status System::Step(double h, Integrator integrator) {
   if (fault_) return *fault_;
+  SYLVA_CHECK_OK(CheckStep("System.Step h", h));
   const size_t n = state.size();
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
@@ -616,6 +664,13 @@ void System::ParticleCollisions() {
 // Dormand & Prince (1980) RK5(4)7M.
 Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats* stats) {
   if (fault_) return *fault_;
+  SYLVA_CHECK_OK(CheckStep("System.StepAdaptive dt", dt));
+  SYLVA_CHECK_OK(check::Range("AdaptiveOptions.rtol", opt.rtol, 0, 1));
+  SYLVA_CHECK_OK(check::Range("AdaptiveOptions.atol", opt.atol, 0, 1e12));
+  if (!(opt.rtol > 0 || opt.atol > 0))
+    return check::Error("AdaptiveOptions.rtol and atol are both 0");
+  SYLVA_CHECK_OK(check::Range("AdaptiveOptions.minStep", opt.minStep, 1e-300, dt, "s (up to dt)"));
+  SYLVA_CHECK_OK(check::Range("AdaptiveOptions.maxSteps", opt.maxSteps, 1, 1e9));
   static constexpr double c[7] = {0, 1.0 / 5, 3.0 / 10, 4.0 / 5, 8.0 / 9, 1, 1};
   static constexpr double A[7][6] = {
       {},

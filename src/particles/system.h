@@ -80,6 +80,11 @@ class Force {
   // The diagonal of the same operator, per axis (the CG preconditioner).
   virtual void AddJacobianDiagonal(const ParticleState&, const Vec3* /*x*/, const Vec3* /*v*/,
                                    double /*cx*/, double /*cv*/, Vec3* /*diag*/) const {}
+  // Whether the force fits state `s`: every particle index it holds is below
+  // s.size(). System::Step asks once a step (O(1) for the library's forces),
+  // before any work, so an index out of range is a Diagnostic, never a
+  // write past the end.
+  virtual Status Check(const ParticleState& /*s*/) const { return {}; }
   // The system hands its thread pool to every force it owns.
   void set_pool(ThreadPool* pool) { pool_ = pool; }
 
@@ -100,10 +105,12 @@ class LocalForce : public Force {
                                size_t begin, size_t end) const = 0;
 };
 
-// Constant acceleration g for every movable particle (f = m g).
+// Constant acceleration g for every movable particle (f = m g); each
+// component within +-1e12 m/s^2 (Check, on every step, says otherwise).
 class Gravity : public LocalForce {
  public:
   explicit Gravity(const Vec3& g) : g_(g) {}
+  Status Check(const ParticleState& s) const override;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
 
@@ -111,10 +118,12 @@ class Gravity : public LocalForce {
   Vec3 g_;
 };
 
-// Drag: f = -k1 v - k2 |v| v (linear and quadratic).
+// Drag: f = -k1 v - k2 |v| v (linear and quadratic); k1, k2 0..1e12
+// (Check, on every step, says otherwise).
 class Drag : public LocalForce {
  public:
   Drag(double linear, double quadratic = 0) : k1_(linear), k2_(quadratic) {}
+  Status Check(const ParticleState& s) const override;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
   void AddJacobianProduct(const ParticleState& s, const Vec3* x, const Vec3* v, double cx,
@@ -138,9 +147,12 @@ class Springs : public Force {
     uint32_t a, b;
     double rest, ks, kd;
   };
-  void Add(uint32_t a, uint32_t b, double rest, double ks, double kd) {
-    springs_.push_back({a, b, rest, ks, kd});
-  }
+  // A spring between particles a != b, rest length 0..1e12 m, stiffness ks
+  // 0..1e12 N/m, damping kd 0..1e12 N s/m; anything else (NaN included) is
+  // a Diagnostic and adds nothing. The indices are checked against the
+  // state by Check, on every System::Step.
+  [[nodiscard]] Status Add(uint32_t a, uint32_t b, double rest, double ks, double kd);
+  Status Check(const ParticleState& s) const override;
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
   // Baraff & Witkin's spring Jacobian, with the transverse term clamped at
   // zero for compressed springs so the system matrix stays positive definite:
@@ -169,6 +181,7 @@ class Springs : public Force {
   void ForColours(Fn&& fn) const;
   static Linear Linearise(const Spring& sp, const Vec3* x, double* length);
   std::vector<Spring> springs_;
+  uint32_t maxIndex_ = 0;       // the largest particle index of a spring
   std::vector<Linear> linear_;  // from PrepareJacobian at preparedX_, colour order
   std::vector<double> length_;  // and the springs' lengths
   const Vec3* preparedX_ = nullptr;
@@ -246,7 +259,7 @@ class System {
   ParticleState state;
   double time = 0;
   uint64_t steps = 0;
-  double maxMagnitude = 1e12;  // a coordinate or speed beyond this is an explosion
+  double maxMagnitude = 1e12;  // a coordinate or speed beyond this is an explosion, 1e-300..1e300
   // Implicit Euler's CG: stop at this relative residual or iteration count.
   double cgTolerance = 1e-10;
   int cgMaxIterations = 200;
@@ -255,19 +268,28 @@ class System {
   void SetThreads(int threads);
   int threads() const;
   void AddForce(std::shared_ptr<Force> f);
-  void AddCollider(Collider c) { colliders_.push_back(std::move(c)); }
-  void AddPlane(const Plane& p) {
-    AddCollider(Collider::Plane(p.point, p.normal).Restitution(p.restitution).Friction(p.friction));
+  // Adds a collider that passes Validate(Collider), else its Diagnostic.
+  [[nodiscard]] Status AddCollider(Collider c);
+  const std::vector<Collider>& colliders() const { return colliders_; }
+  [[nodiscard]] Status AddPlane(const Plane& p) {
+    return AddCollider(
+        Collider::Plane(p.point, p.normal).Restitution(p.restitution).Friction(p.friction));
   }
   // Particles as spheres of this radius that collide with each other (found
   // on a grid), with the given restitution; resolved after every step.
-  void EnableParticleCollisions(double radius, double restitution);
+  // radius 1e-12..1e12 m, restitution 0..1, else a Diagnostic.
+  [[nodiscard]] Status EnableParticleCollisions(double radius, double restitution);
 
   // Accelerations for positions x and velocities v (all particles).
   void Accelerations(const Vec3* x, const Vec3* v, Vec3* a) const;
   // One step of length h: forces, integration, collisions, ageing.
+  // h in (0, 1e6] s (NaN, 0, negative: a Diagnostic, nothing moves); the
+  // settings above (maxMagnitude 1e-300..1e300, cgTolerance 0..1,
+  // cgMaxIterations 1..1e7) and every force's Check are verified first.
   [[nodiscard]] Status Step(double h, Integrator integrator);
-  // Advances by dt with adaptive Dormand-Prince RK45 substeps.
+  // Advances by dt with adaptive Dormand-Prince RK45 substeps: dt as h
+  // above; options rtol 0..1, atol 0..1e12 (not both 0), minStep
+  // 1e-300..dt s, maxSteps 1..1e9.
   [[nodiscard]] Status StepAdaptive(double dt, const AdaptiveOptions& options,
                                     AdaptiveStats* stats = nullptr);
   const SolveStats& lastSolve() const { return solve_; }
@@ -293,6 +315,7 @@ class System {
   std::array<double, K> SumChunks(size_t n, Fn&& fn) const;
   void ParticleCollisions();
   Status CheckFaults(const char* what);
+  Status CheckStep(const char* what, double h) const;
 
   std::vector<std::shared_ptr<Force>> forces_;
   std::vector<Collider> colliders_;

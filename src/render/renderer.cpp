@@ -334,7 +334,15 @@ void Renderer::SetLines(const LineBatch& lines) {
   glBindVertexArray(0);
 }
 
-void Renderer::SetPoints(const PointBatch& points) {
+Status Renderer::SetPoints(const PointBatch& points) {
+  if (points.sizes.size() != points.positions.size() ||
+      points.colors.size() != points.positions.size()) {
+    Diagnostic d;
+    d.message = "PointBatch has " + std::to_string(points.positions.size()) + " positions but " +
+                std::to_string(points.sizes.size()) + " sizes and " +
+                std::to_string(points.colors.size()) + " colors (one of each a point)";
+    return d;
+  }
   Gl& g = *gl_;
   glBindVertexArray(g.pointVao);
   const size_t n = points.positions.size();
@@ -352,6 +360,7 @@ void Renderer::SetPoints(const PointBatch& points) {
   glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 12, nullptr);
   g.pointCount = GLsizei(n);
   glBindVertexArray(0);
+  return {};
 }
 
 void Renderer::Draw(const Camera& camera) {

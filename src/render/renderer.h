@@ -70,7 +70,10 @@ class Renderer {
   void SetGround(bool on) { ground_ = on; }
   void SetShadows(bool on) { shadows_ = on; }
   void SetLines(const LineBatch& lines);
-  void SetPoints(const PointBatch& points);
+  // Replaces the points. sizes and colors must have one entry per position
+  // (else a Diagnostic naming the lengths, and the points are unchanged: a
+  // shorter array used to be read past its end).
+  [[nodiscard]] Status SetPoints(const PointBatch& points);
   // Draws the current mesh, points and lines: no allocation and no upload;
   // one draw call for the mesh, one for the points, one for the lines.
   void Draw(const Camera& camera);

@@ -11,6 +11,8 @@
 #include "particles/emitter.h"
 #include "particles/system.h"
 
+#include "particles/helpers.h"
+
 namespace sylva::particles {
 namespace {
 
@@ -39,9 +41,11 @@ void Scene(BulkSystem& b) {
   b.fields.gravity = Vec3(0, -kG, 0);
   b.fields.linearDrag = 0.1;
   b.fields.quadraticDrag = 0.02;
-  b.AddCollider(Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.6).Friction(0.3));
-  b.AddCollider(Collider::Sphere(Vec3(0.3, -0.6, 0.2), 0.3).Restitution(0.9));
-  b.AddCollider(Collider::Box(Vec3(-1.5, -1.5, -1.5), Vec3(1.5, 3, 1.5), true).Restitution(0.8));
+  EXPECT_OK(
+      b.AddCollider(Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.6).Friction(0.3)));
+  EXPECT_OK(b.AddCollider(Collider::Sphere(Vec3(0.3, -0.6, 0.2), 0.3).Restitution(0.9)));
+  EXPECT_OK(b.AddCollider(
+      Collider::Box(Vec3(-1.5, -1.5, -1.5), Vec3(1.5, 3, 1.5), true).Restitution(0.8)));
 }
 
 TEST(Bulk, FollowsTheDoublePrecisionSystemWithinSinglePrecision) {
@@ -55,7 +59,7 @@ TEST(Bulk, FollowsTheDoublePrecisionSystemWithinSinglePrecision) {
   bulk.fields.quadraticDrag = 0.02;
   const Collider floor =
       Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.6).Friction(0.3);
-  bulk.AddCollider(floor);
+  EXPECT_OK(bulk.AddCollider(floor));
   System sys;
   for (size_t i = 0; i < bulk.state.size(); ++i) {
     sys.state.Add(bulk.state.position(i), bulk.state.velocity(i),
@@ -63,7 +67,7 @@ TEST(Bulk, FollowsTheDoublePrecisionSystemWithinSinglePrecision) {
   }
   sys.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
   sys.AddForce(std::make_shared<Drag>(0.1, 0.02));
-  sys.AddCollider(floor);
+  EXPECT_OK(sys.AddCollider(floor));
   double worstX = 0, worstV = 0;
   for (int k = 0; k < 240; ++k) {
     BULK_STEP_OK(bulk, 1.0 / 240);
@@ -160,11 +164,11 @@ TEST(Bulk, ElasticBallReturnsToItsHeightAsTheDoubleSystemDoes) {
   BulkSystem b;
   b.state.Add(Vec3(0, 1, 0), Vec3::Zero());
   b.fields.gravity = Vec3(0, -kG, 0);
-  b.AddCollider(floor);
+  EXPECT_OK(b.AddCollider(floor));
   System s;
   s.state.Add(Vec3(0, 1, 0), Vec3::Zero(), 1);
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
-  s.AddCollider(floor);
+  EXPECT_OK(s.AddCollider(floor));
   const auto bulk = Apexes([&] { return b.Step(h).ok(); }, [&] { return double(b.state.vy[0]); },
                            [&] { return double(b.state.py[0]); });
   const auto exact =
@@ -190,7 +194,7 @@ TEST(Bulk, RestingParticleNeitherSinksNorJitters) {
     const Vec3 point(0.1, 0.3, 0.7);
     b.state.Add(point + 0.2 * n, Vec3::Zero());
     b.fields.gravity = Vec3(0, -kG, 0);
-    b.AddCollider(Collider::Plane(point, n).Restitution(0.5).Friction(0.5));
+    EXPECT_OK(b.AddCollider(Collider::Plane(point, n).Restitution(0.5).Friction(0.5)));
     double lowest = 1;
     for (int i = 0; i < 12000; ++i) {
       BULK_STEP_OK(b, 1e-3);
@@ -220,8 +224,9 @@ TEST(Bulk, RoundingNeverPutsAParticleThroughAThinPanel) {
   const double y = 0.7;  // float(0.7) is below 0.7
   for (int i = 0; i < 2000; ++i) b.state.Add(Vec3(u(rng), y + 0.1 + u(rng), u(rng)), Vec3::Zero());
   b.fields.gravity = Vec3(0, -kG, 0);
-  b.AddCollider(Collider::Polygon({Vec3(0, y, 0), Vec3(0, y, 1), Vec3(1, y, 1), Vec3(1, y, 0)})
-                    .Restitution(0.2));
+  EXPECT_OK(
+      b.AddCollider(Collider::Polygon({Vec3(0, y, 0), Vec3(0, y, 1), Vec3(1, y, 1), Vec3(1, y, 0)})
+                        .Restitution(0.2)));
   for (int i = 0; i < 2000; ++i) BULK_STEP_OK(b, 1e-3);
   int below = 0;
   double worstV = 0;
@@ -263,10 +268,12 @@ TEST(Bulk, StickAndKill) {
   b.state.Add(Vec3(0, 1, 0), Vec3(1, 0, 0), 1, 100);
   b.state.Add(Vec3(5, 1, 0), Vec3(1, 0, 0), 1, 100);
   b.fields.gravity = Vec3(0, -kG, 0);
-  b.AddCollider(Collider::Polygon({Vec3(-1, 0, -1), Vec3(-1, 0, 1), Vec3(2, 0, 1), Vec3(2, 0, -1)})
-                    .Respond(Response::kStick));
-  b.AddCollider(Collider::Polygon({Vec3(4, 0, -1), Vec3(4, 0, 1), Vec3(7, 0, 1), Vec3(7, 0, -1)})
-                    .Respond(Response::kKill));
+  EXPECT_OK(b.AddCollider(
+      Collider::Polygon({Vec3(-1, 0, -1), Vec3(-1, 0, 1), Vec3(2, 0, 1), Vec3(2, 0, -1)})
+          .Respond(Response::kStick)));
+  EXPECT_OK(b.AddCollider(
+      Collider::Polygon({Vec3(4, 0, -1), Vec3(4, 0, 1), Vec3(7, 0, 1), Vec3(7, 0, -1)})
+          .Respond(Response::kKill)));
   for (int i = 0; i < 1000; ++i) BULK_STEP_OK(b, 1e-3);
   EXPECT_NEAR(b.state.px[0], std::sqrt(2 / kG), 2e-3) << "stuck where it landed";
   EXPECT_NEAR(b.state.py[0], 0, 1e-6);
@@ -283,7 +290,7 @@ TEST(Bulk, EmittedParticlesKeepTheirIdsAndTheLivingTheirOrder) {
   def.velocitySpread = 0.5;
   def.lifetime = 0.5;
   def.lifetimeJitter = 0.2;
-  Emitter emitter(def);
+  Emitter emitter = testing::Made(Emitter::Create(def));
   ParticleState born;
   BulkSystem b;
   b.fields.gravity = Vec3(0, -kG, 0);

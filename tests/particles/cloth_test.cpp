@@ -8,6 +8,8 @@
 
 #include "particles/xpbd.h"
 
+#include "particles/helpers.h"
+
 namespace sylva::particles {
 namespace {
 
@@ -32,7 +34,8 @@ TEST(Cloth, HangingMassSettlesAtTheExtensionOfItsCompliance) {
     def.damping = 2.0;
     def.longRangeAttachments = false;  // tethers would cap the extension at rest
     def.pinned = {0, 1};
-    Cloth cloth(def);
+    auto clothOwner = testing::Made(Cloth::Create(def));
+    Cloth& cloth = *clothOwner;
     for (int i = 0; i < 2000; ++i) cloth.Step(1.0 / 60, Vec3(0, -g, 0));
     // Each hanging particle carries its own weight on its vertical link; the
     // horizontal link between them is slack-free and carries nothing.
@@ -48,7 +51,8 @@ TEST(Cloth, UnpinnedClothInFreeFallDoesNotDeform) {
   def.columns = 12;
   def.rows = 9;
   def.windDrag = 0;
-  Cloth cloth(def);
+  auto clothOwner = testing::Made(Cloth::Create(def));
+  Cloth& cloth = *clothOwner;
   const std::vector<Vec3> start = cloth.positions();
   const double t = 1.0;
   for (int i = 0; i < 60; ++i) cloth.Step(t / 60, Vec3(0, -9.81, 0));
@@ -67,7 +71,8 @@ TEST(Cloth, PinsDoNotMoveUnderGravityAndWind) {
   def.columns = 10;
   def.rows = 8;
   def.pinned = {0, 9};
-  Cloth cloth(def);
+  auto clothOwner = testing::Made(Cloth::Create(def));
+  Cloth& cloth = *clothOwner;
   const Vec3 a = cloth.positions()[0], b = cloth.positions()[9];
   for (int i = 0; i < 120; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 6));
   EXPECT_EQ(cloth.positions()[0], a);
@@ -92,7 +97,8 @@ TEST(ClothImplicit, HangingMassSettlesAtTheExtensionOfItsCompliance) {
   def.solver = ClothSolver::kImplicit;
   def.cgIterations = 50;
   def.pinned = {0, 1};
-  Cloth cloth(def);
+  auto clothOwner = testing::Made(Cloth::Create(def));
+  Cloth& cloth = *clothOwner;
   for (int i = 0; i < 600; ++i) cloth.Step(1.0 / 60, Vec3(0, -g, 0));
   const double extension = -cloth.positions()[2].y() - 1.0;
   EXPECT_NEAR(extension, g * alpha, 0.001 * g * alpha) << "extension " << extension;
@@ -104,7 +110,8 @@ TEST(ClothImplicit, LargeStepsStayStableWithPinsFixed) {
   def.rows = 40;
   def.solver = ClothSolver::kImplicit;
   def.pinned = {0, 39};
-  Cloth cloth(def);
+  auto clothOwner = testing::Made(Cloth::Create(def));
+  Cloth& cloth = *clothOwner;
   const Vec3 pin0 = cloth.positions()[0], pin1 = cloth.positions()[39];
   for (int i = 0; i < 120; ++i) {
     cloth.Step(1.0 / 30, Vec3(0, -9.81, 0), Vec3(0, 0, 1));
@@ -126,7 +133,8 @@ TEST(ClothImplicit, ConjugateGradientsConvergeWhenGivenTheIterations) {
   def.solver = ClothSolver::kImplicit;
   def.pinned = {0, 29};
   def.cgIterations = 1000;
-  Cloth cloth(def);
+  auto clothOwner = testing::Made(Cloth::Create(def));
+  Cloth& cloth = *clothOwner;
   cloth.Step(1.0 / 30, Vec3(0, -9.81, 0));  // the first frame has the largest right-hand side
   EXPECT_LT(cloth.lastSolve().residual, 1e-9)
       << "after " << cloth.lastSolve().iterations << " iterations";
@@ -248,7 +256,8 @@ TEST(Cloth, OneAndTwoThreadsAreBitIdentical) {
       def.windLift = 0.6;
       def.windFriction = 0.1;
       def.solver = solver;
-      Cloth cloth(def);
+      auto clothOwner = testing::Made(Cloth::Create(def));
+      Cloth& cloth = *clothOwner;
       for (int i = 0; i < 20; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(1, 0, 3));
       return cloth.positions();
     };
@@ -298,7 +307,8 @@ TEST(Cloth, WindDragLiftAndFrictionMatchTheirClosedForms) {
         def.windFriction = k.cf;
         def.solver = solver;
         def.substeps = 5;
-        Cloth cloth(def);
+        auto clothOwner = testing::Made(Cloth::Create(def));
+        Cloth& cloth = *clothOwner;
         cloth.Step(dt, Vec3::Zero(), U * along);
         Vec3 momentum = Vec3::Zero();
         for (const Vec3& v : cloth.velocities()) momentum += (def.mass / 4) * v;
@@ -321,7 +331,8 @@ TEST(Cloth, TethersKeepAHangingClothFromStretching) {
     def.substeps = 10;
     def.longRangeAttachments = tethers;
     def.pinned = {0, 59};
-    Cloth cloth(def);
+    auto clothOwner = testing::Made(Cloth::Create(def));
+    Cloth& cloth = *clothOwner;
     for (int i = 0; i < 60; ++i) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0));
     stretch[tethers] = cloth.MaxStretch();
   }

@@ -24,7 +24,8 @@ TEST(Contact, SlidingDistanceIsV0SquaredOver2MuG) {
     const double v0 = 5;
     s.state.Add(Vec3(0, 0, 0), Vec3(v0, 0, 0), 2);
     s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
-    s.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0)).Restitution(0.5).Friction(mu));
+    EXPECT_OK(
+        s.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0)).Restitution(0.5).Friction(mu)));
     for (int i = 0; i < 20000; ++i) STEP_OK(s, 1e-3, Integrator::kSymplecticEuler);
     const double want = v0 * v0 / (2 * mu * kG), got = s.state.position[0].x();
     EXPECT_NEAR(got / want, 1, 0.02)
@@ -43,7 +44,7 @@ TEST(Contact, OnAnInclineItSlidesIffTanThetaExceedsMu) {
     System s;
     s.state.Add(Vec3::Zero(), Vec3::Zero(), 1);
     s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
-    s.AddCollider(Collider::Plane(Vec3::Zero(), n).Restitution(0.3).Friction(mu));
+    EXPECT_OK(s.AddCollider(Collider::Plane(Vec3::Zero(), n).Restitution(0.3).Friction(mu)));
     const double T = 1;
     for (int i = 0; i < 1000; ++i) STEP_OK(s, T / 1000, Integrator::kSymplecticEuler);
     const double moved = s.state.position[0].norm();
@@ -68,7 +69,8 @@ TEST(Contact, RestingParticleNeitherSinksNorJitters) {
       System s;
       s.state.Add(Vec3(0, 0.3, 0), Vec3(0, 0, 0), 1);  // dropped, bounces, comes to rest
       s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
-      s.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0)).Restitution(e).Friction(0.4));
+      EXPECT_OK(
+          s.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0)).Restitution(e).Friction(0.4)));
       double lowest = 1;
       for (int i = 0; i < 12000; ++i) {
         STEP_OK(s, 1e-3, in);
@@ -108,8 +110,8 @@ TEST(Colliders, NoShapeIsTunnelledThrough) {
     System s;
     s.state.Add(Vec3(-0.7, 0, 0), Vec3(100, 0, 0), 1);  // 1 unit a step at h = 0.01, head on
     // (through the mesh's face diagonal: a shared edge must not let it through)
-    s.AddCollider(shapes[k]);
-    s.AddCollider(Collider::Box(Vec3(-3, -3, -3), Vec3(3, 3, 3), true));
+    EXPECT_OK(s.AddCollider(shapes[k]));
+    EXPECT_OK(s.AddCollider(Collider::Box(Vec3(-3, -3, -3), Vec3(3, 3, 3), true)));
     for (int i = 0; i < 500; ++i) {
       STEP_OK(s, 0.01, Integrator::kSymplecticEuler);
       ASSERT_LT(s.state.position[0].x(), 0) << names[k] << ": crossed at step " << i;
@@ -124,7 +126,7 @@ TEST(Colliders, SphereBounceIsAReflectionAboutTheNormal) {
   // one reflected about the surface normal at the contact point.
   System s;
   s.state.Add(Vec3(0.3, 2, 0), Vec3(0, -3, 0), 1);
-  s.AddCollider(Collider::Sphere(Vec3::Zero(), 1));
+  EXPECT_OK(s.AddCollider(Collider::Sphere(Vec3::Zero(), 1)));
   for (int i = 0; i < 600; ++i) STEP_OK(s, 1e-3, Integrator::kSymplecticEuler);
   const Vec3 n(0.3, std::sqrt(1 - 0.09), 0);
   const Vec3 in(0, -3, 0);
@@ -142,10 +144,11 @@ TEST(Colliders, ParticlesStayInsideABoxAndABowl) {
       s.state.Add(Vec3(u(rng), u(rng), u(rng)) * 0.5, Vec3(u(rng), u(rng), u(rng)) * 40);
     s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
     if (bowl) {
-      s.AddCollider(Collider::Sphere(Vec3::Zero(), 1, true).Restitution(0.9).Friction(0.1));
+      EXPECT_OK(
+          s.AddCollider(Collider::Sphere(Vec3::Zero(), 1, true).Restitution(0.9).Friction(0.1)));
     } else {
-      s.AddCollider(
-          Collider::Box(Vec3(-1, -1, -1), Vec3(1, 1, 1), true).Restitution(0.9).Friction(0.1));
+      EXPECT_OK(s.AddCollider(
+          Collider::Box(Vec3(-1, -1, -1), Vec3(1, 1, 1), true).Restitution(0.9).Friction(0.1)));
     }
     double worst = 0;
     for (int i = 0; i < 400; ++i) {
@@ -162,8 +165,9 @@ TEST(Colliders, PolygonStopsOnlyWhatFallsOnIt) {
   s.state.Add(Vec3(0.5, 1, 0.5), Vec3::Zero(), 1);  // above the square
   s.state.Add(Vec3(1.5, 1, 0.5), Vec3::Zero(), 1);  // beside it
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
-  s.AddCollider(Collider::Polygon({Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(1, 0, 0)})
-                    .Restitution(0));
+  EXPECT_OK(
+      s.AddCollider(Collider::Polygon({Vec3(0, 0, 0), Vec3(0, 0, 1), Vec3(1, 0, 1), Vec3(1, 0, 0)})
+                        .Restitution(0)));
   for (int i = 0; i < 1000; ++i) STEP_OK(s, 1e-3, Integrator::kSymplecticEuler);
   EXPECT_NEAR(s.state.position[0].y(), 0, 1e-6) << "rests on the square";
   EXPECT_LT(s.state.velocity[0].norm(), 1e-6);
@@ -220,7 +224,8 @@ TEST(Colliders, MeshKeepsRainOff) {
   std::uniform_real_distribution<double> u(-1.5, 1.5);
   for (int i = 0; i < 2000; ++i) s.state.Add(Vec3(u(rng), 3 + u(rng), u(rng)), Vec3(0, -5, 0));
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
-  s.AddCollider(Collider::Mesh(std::make_shared<TriangleBvh>(v, t)).Restitution(0.2).Friction(0.5));
+  EXPECT_OK(s.AddCollider(
+      Collider::Mesh(std::make_shared<TriangleBvh>(v, t)).Restitution(0.2).Friction(0.5)));
   int inside = 0;
   for (int i = 0; i < 300; ++i) {
     STEP_OK(s, 1.0 / 100, Integrator::kSymplecticEuler);
@@ -238,10 +243,12 @@ TEST(Responses, StickAndKill) {
   s.state.Add(Vec3(0, 1, 0), Vec3(1, 0, 0), 1, 100);
   s.state.Add(Vec3(5, 1, 0), Vec3(1, 0, 0), 1, 100);
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -kG, 0)));
-  s.AddCollider(Collider::Polygon({Vec3(-1, 0, -1), Vec3(-1, 0, 1), Vec3(2, 0, 1), Vec3(2, 0, -1)})
-                    .Respond(Response::kStick));
-  s.AddCollider(Collider::Polygon({Vec3(4, 0, -1), Vec3(4, 0, 1), Vec3(7, 0, 1), Vec3(7, 0, -1)})
-                    .Respond(Response::kKill));
+  EXPECT_OK(s.AddCollider(
+      Collider::Polygon({Vec3(-1, 0, -1), Vec3(-1, 0, 1), Vec3(2, 0, 1), Vec3(2, 0, -1)})
+          .Respond(Response::kStick)));
+  EXPECT_OK(s.AddCollider(
+      Collider::Polygon({Vec3(4, 0, -1), Vec3(4, 0, 1), Vec3(7, 0, 1), Vec3(7, 0, -1)})
+          .Respond(Response::kKill)));
   for (int i = 0; i < 1000; ++i) STEP_OK(s, 1e-3, Integrator::kSymplecticEuler);
   // Lands at x0 + v t with t = sqrt(2 / g).
   const double land = std::sqrt(2 / kG);
@@ -257,7 +264,7 @@ TEST(ParticleCollisions, HeadOnEqualMassesSwapVelocities) {
   System s;
   s.state.Add(Vec3(-1, 0, 0), Vec3(2, 0, 0), 1);
   s.state.Add(Vec3(1, 0, 0), Vec3(-1, 0, 0), 1);
-  s.EnableParticleCollisions(0.1, 1.0);
+  EXPECT_OK(s.EnableParticleCollisions(0.1, 1.0));
   for (int i = 0; i < 100; ++i) STEP_OK(s, 0.01, Integrator::kSymplecticEuler);
   EXPECT_NEAR(s.state.velocity[0].x(), -1, 1e-12);
   EXPECT_NEAR(s.state.velocity[1].x(), 2, 1e-12);
@@ -269,7 +276,7 @@ TEST(ParticleCollisions, GasConservesMomentumAndElasticEnergy) {
   std::uniform_real_distribution<double> u(-1, 1);
   for (int i = 0; i < 2000; ++i)
     s.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), 1 + 0.5 * u(rng));
-  s.EnableParticleCollisions(0.03, 1.0);
+  EXPECT_OK(s.EnableParticleCollisions(0.03, 1.0));
   auto momentum = [&] {
     Vec3 p = Vec3::Zero();
     for (size_t i = 0; i < s.state.size(); ++i) p += s.state.mass[i] * s.state.velocity[i];

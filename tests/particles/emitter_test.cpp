@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "particles/helpers.h"
+
 namespace sylva::particles {
 namespace {
 
@@ -12,7 +14,7 @@ TEST(Emitter, CountIsRateTimesTimeWithinOne) {
     EmitterDef def;
     def.rate = rate;
     def.lifetime = 1e9;
-    Emitter e(def);
+    Emitter e = testing::Made(Emitter::Create(def));
     ParticleState s;
     const double h = 1.0 / 60;
     const int steps = 150;  // 2.5 s
@@ -28,7 +30,7 @@ TEST(Emitter, EveryAgeStaysWithinItsLifetime) {
   def.lifetime = 0.5;
   def.lifetimeJitter = 0.3;
   def.velocitySpread = 2;
-  Emitter e(def);
+  Emitter e = testing::Made(Emitter::Create(def));
   System sys;
   size_t removed = 0;
   for (int i = 0; i < 240; ++i) {
@@ -48,7 +50,7 @@ TEST(Emitter, ColourOverAgeIsExactAtBothEnds) {
   EmitterDef def;
   def.colorStart = Vec3f(1, 0.5f, 0);
   def.colorEnd = Vec3f(0.2f, 0.1f, 0.9f);
-  Emitter e(def);
+  Emitter e = testing::Made(Emitter::Create(def));
   EXPECT_EQ(e.ColorAt(0, 2), def.colorStart);
   EXPECT_EQ(e.ColorAt(2, 2), def.colorEnd);
   EXPECT_EQ(e.ColorAt(5, 2), def.colorEnd);  // clamped
@@ -78,8 +80,8 @@ TEST(Emitter, SameSeedSameParticlesAndPositionsInTheirBall) {
   def.position = Vec3(1, 2, 3);
   def.seed = 9;
   ParticleState a, b;
-  Emitter(def).Burst(a, 200);
-  Emitter(def).Burst(b, 200);
+  testing::Made(Emitter::Create(def)).Burst(a, 200);
+  testing::Made(Emitter::Create(def)).Burst(b, 200);
   for (size_t i = 0; i < 200; ++i) {
     EXPECT_EQ(a.position[i], b.position[i]);
     EXPECT_LE((a.position[i] - def.position).norm(), 0.5 + 1e-12);

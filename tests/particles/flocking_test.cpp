@@ -4,6 +4,8 @@
 
 #include <random>
 
+#include "particles/helpers.h"
+
 namespace sylva::particles {
 namespace {
 
@@ -27,7 +29,7 @@ TEST(Flocking, AlignmentAloneOrdersTheFlock) {
   def.cohesion = 0;
   def.separation = 0;
   def.alignment = 3;
-  s.AddForce(std::make_shared<Flocking>(def));
+  s.AddForce(testing::Made(Flocking::Create(def)));
   for (int i = 0; i < 600; ++i) ASSERT_TRUE(s.Step(1.0 / 120, Integrator::kSymplecticEuler).ok());
   const double after = OrderParameter(s.state);
   EXPECT_LT(before, 0.2) << "random start";
@@ -53,7 +55,7 @@ double MinDistanceAfter(bool separation) {
   def.alignment = 0;
   def.separation = separation ? 1.0 : 0;
   def.separationRadius = 0.15;
-  s.AddForce(std::make_shared<Flocking>(def));
+  s.AddForce(testing::Made(Flocking::Create(def)));
   s.AddForce(std::make_shared<Drag>(2.0));
   double worst = 1e300;
   for (int i = 0; i < 600; ++i) {
@@ -81,7 +83,7 @@ TEST(Flocking, SeekGoesToTheTarget) {
   def.cohesion = def.separation = def.alignment = 0;
   def.seek = 4;
   def.target = Vec3(3, 1, 0);
-  s.AddForce(std::make_shared<Flocking>(def));
+  s.AddForce(testing::Made(Flocking::Create(def)));
   s.AddForce(std::make_shared<Drag>(4.0));  // critically damped: no overshoot
   for (int i = 0; i < 2400; ++i) ASSERT_TRUE(s.Step(1.0 / 240, Integrator::kSymplecticEuler).ok());
   for (const Vec3& p : s.state.position) EXPECT_LT((p - def.target).norm(), 1e-3) << p.transpose();

@@ -18,7 +18,8 @@ TEST(NoiseWind, IsDivergenceFreeSmoothAndHasItsSpeed) {
   def.speed = 2;
   def.scale = 0.5;
   def.frequency = 1;
-  NoiseWind wind(def);
+  const auto windOwner = testing::Made(NoiseWind::Create(def));
+  const NoiseWind& wind = *windOwner;
   std::mt19937 rng(1);
   std::uniform_real_distribution<double> u(-3, 3);
   const double e = 1e-5;
@@ -52,7 +53,7 @@ TEST(NoiseWind, CarriesParticlesAtTheWindSpeed) {
   def.drag = 2;
   System s;
   s.state.Add(Vec3::Zero(), Vec3::Zero(), 1);
-  s.AddForce(std::make_shared<NoiseWind>(def));
+  s.AddForce(testing::Made(NoiseWind::Create(def)));
   for (int i = 0; i < 2000; ++i) STEP_OK(s, 1e-3, Integrator::kRK4);
   // v(t) = 3 (1 - e^{-2t}).
   EXPECT_NEAR(s.state.velocity[0].x(), 3 * (1 - std::exp(-4.0)), 1e-9);
@@ -92,7 +93,9 @@ TEST(FieldGrid, TrilinearReproducesALinearFieldAndIsZeroOutside) {
         const Vec3 t(double(i) / (n[0] - 1), double(j) / (n[1] - 1), double(k) / (n[2] - 1));
         samples.push_back(linear(lo + t.cwiseProduct(hi - lo)));
       }
-  FieldGrid field(lo, hi, n, samples), clamped(lo, hi, n, samples, true);
+  const auto fieldOwner = testing::Made(FieldGrid::Create(lo, hi, n, samples));
+  const auto clampedOwner = testing::Made(FieldGrid::Create(lo, hi, n, samples, true));
+  const FieldGrid &field = *fieldOwner, &clamped = *clampedOwner;
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(0, 1);
   double worst = 0;
@@ -163,7 +166,7 @@ TEST(Flocking, AvoidKeepsTheFlockOutOfAnObstacle) {
   def.avoid = 8;
   def.avoidDistance = 1;
   def.obstacles = {{Vec3::Zero(), 1.5}};
-  s.AddForce(std::make_shared<Flocking>(def));
+  s.AddForce(testing::Made(Flocking::Create(def)));
   s.AddForce(std::make_shared<Drag>(0.5));
   double closest = 1e9;
   for (int i = 0; i < 3000; ++i) {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <memory>
 
 #include "particles/system.h"
@@ -15,7 +16,33 @@
     ASSERT_TRUE(st_.ok()) << st_.error().message; \
   } while (0)
 
+// ASSERT_OK(status): a Status that must be ok, with its message in the
+// failure.
+#define ASSERT_OK(expr)                           \
+  do {                                            \
+    ::sylva::Status st_ = (expr);                 \
+    ASSERT_TRUE(st_.ok()) << st_.error().message; \
+  } while (0)
+
+// EXPECT_OK(status): the same, not fatal (usable in any function).
+#define EXPECT_OK(expr)                           \
+  do {                                            \
+    ::sylva::Status st_ = (expr);                 \
+    EXPECT_TRUE(st_.ok()) << st_.error().message; \
+  } while (0)
+
 namespace sylva::particles::testing {
+
+// The value of an Expected that the test's own (valid) input must give; a
+// Diagnostic fails the test with its message and stops it.
+template <typename T>
+T Made(Expected<T> e) {
+  if (!e.ok()) {
+    ADD_FAILURE() << "unexpected diagnostic: " << e.error().message;
+    std::abort();
+  }
+  return std::move(e).value();
+}
 
 // An immovable anchor at the origin (particle 0) and a unit mass at x0 on
 // the x axis (particle 1), joined by an undamped spring.
@@ -23,7 +50,8 @@ inline void AddAnchoredSpring(System& s, double x0, double rest, double ks) {
   s.state.Add(Vec3::Zero(), Vec3::Zero(), 0);
   s.state.Add(Vec3(x0, 0, 0), Vec3::Zero(), 1);
   auto springs = std::make_shared<Springs>();
-  springs->Add(1, 0, rest, ks, 0.0);
+  const Status added = springs->Add(1, 0, rest, ks, 0.0);
+  EXPECT_TRUE(added.ok()) << added.error().message;
   s.AddForce(springs);
 }
 

@@ -58,7 +58,7 @@ TEST(Integrators, SymplecticEulerKeepsEnergyWhereExplicitEulerDiverges) {
     s.state.Add(Vec3(0, 0, 0), Vec3::Zero(), 0);
     s.state.Add(Vec3(1, 0, 0), Vec3::Zero(), 1);
     auto springs = std::make_shared<Springs>();
-    springs->Add(1, 0, 0.0, 1.0, 0.0);
+    EXPECT_OK(springs->Add(1, 0, 0.0, 1.0, 0.0));
     s.AddForce(springs);
     const double e0 = Energy(s, 1);
     double worst = 0;
@@ -91,7 +91,7 @@ TEST(Forces, DampedSpringOscillatesAtItsDampedFrequency) {
   s.state.Add(Vec3(0, 0, 0), Vec3::Zero(), 0);
   s.state.Add(Vec3(1, 0, 0), Vec3::Zero(), m);
   auto springs = std::make_shared<Springs>();
-  springs->Add(1, 0, 0.0, ks, kd);
+  EXPECT_OK(springs->Add(1, 0, 0.0, ks, kd));
   s.AddForce(springs);
   std::vector<double> crossings;
   double prev = 1;
@@ -115,7 +115,7 @@ TEST(Forces, SpringsConserveMomentum) {
   for (int i = 0; i < 20; ++i)
     s.state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)), 1 + u(rng) * 0.5);
   auto springs = std::make_shared<Springs>();
-  for (uint32_t i = 0; i < 20; ++i) springs->Add(i, (i * 7 + 3) % 20, 0.5, 50, 0.3);
+  for (uint32_t i = 0; i < 20; ++i) EXPECT_OK(springs->Add(i, (i * 7 + 3) % 20, 0.5, 50, 0.3));
   s.AddForce(springs);
   auto momentum = [&] {
     Vec3 p = Vec3::Zero();
@@ -134,7 +134,7 @@ std::vector<double> Apexes(double restitution, int bounces) {
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
   Plane floor;
   floor.restitution = restitution;
-  s.AddPlane(floor);
+  EXPECT_OK(s.AddPlane(floor));
   std::vector<double> apex;
   double prevVy = 0;
   for (int i = 0; i < 2000000 && int(apex.size()) < bounces; ++i) {
@@ -172,8 +172,8 @@ TEST(Collisions, FastParticlesNeverPassThroughAWall) {
   s.state.Add(Vec3(5, 0, 0), Vec3(-1000, 0, 0), 1);
   Plane left{Vec3(0, 0, 0), Vec3(1, 0, 0), 1, 0};
   Plane right{Vec3(37, 0, 0), Vec3(-1, 0, 0), 1, 0};
-  s.AddPlane(left);
-  s.AddPlane(right);
+  EXPECT_OK(s.AddPlane(left));
+  EXPECT_OK(s.AddPlane(right));
   for (int i = 0; i < 10000; ++i) {
     ASSERT_TRUE(s.Step(0.01, Integrator::kSymplecticEuler).ok());
     const double x = s.state.position[0].x();
@@ -186,7 +186,7 @@ TEST(Collisions, FastParticlesNeverPassThroughAWall) {
 TEST(Collisions, FrictionKeepsTheNormalBounceAndSlowsTheTangent) {
   System s;
   s.state.Add(Vec3(0, 0.05, 0), Vec3(2, -1, 0), 1);
-  s.AddPlane(Plane{Vec3::Zero(), Vec3(0, 1, 0), 0.5, 0.25});
+  EXPECT_OK(s.AddPlane(Plane{Vec3::Zero(), Vec3(0, 1, 0), 0.5, 0.25}));
   ASSERT_TRUE(s.Step(0.1, Integrator::kExplicitEuler).ok());
   // Coulomb: the normal impulse is (1 + e) * 1 = 1.5, so friction takes 0.25 * 1.5.
   EXPECT_NEAR(s.state.velocity[0].x(), 2 - 0.25 * 1.5, 1e-12);

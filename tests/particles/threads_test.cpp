@@ -26,19 +26,19 @@ uint64_t Simulate(int threads, Integrator in, int steps) {
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
   s.AddForce(std::make_shared<Drag>(0.1, 0.02));
   auto springs = std::make_shared<Springs>();
-  for (uint32_t i = 0; i + 1 < 2000; i += 2) springs->Add(i, i + 1, 0.05, 50, 0.5);
+  for (uint32_t i = 0; i + 1 < 2000; i += 2) EXPECT_OK(springs->Add(i, i + 1, 0.05, 50, 0.5));
   s.AddForce(springs);
   s.AddForce(std::make_shared<InverseSquare>(0.001, 0.1, 0.01));
   FlockingDef flock;
   flock.radius = 0.1;
   flock.separationRadius = 0.03;
   flock.cohesion = 0;  // no clumping: keeps neighbour counts small
-  s.AddForce(std::make_shared<Flocking>(flock));
-  s.AddCollider(Collider::Box(Vec3(-1.2, -1.2, -1.2), Vec3(1.2, 1.2, 1.2), true)
-                    .Restitution(0.7)
-                    .Friction(0.3));
-  s.AddCollider(Collider::Sphere(Vec3(0, -0.8, 0), 0.4).Restitution(0.5).Friction(0.2));
-  s.EnableParticleCollisions(0.01, 0.8);
+  s.AddForce(testing::Made(Flocking::Create(flock)));
+  EXPECT_OK(s.AddCollider(Collider::Box(Vec3(-1.2, -1.2, -1.2), Vec3(1.2, 1.2, 1.2), true)
+                              .Restitution(0.7)
+                              .Friction(0.3)));
+  EXPECT_OK(s.AddCollider(Collider::Sphere(Vec3(0, -0.8, 0), 0.4).Restitution(0.5).Friction(0.2)));
+  EXPECT_OK(s.EnableParticleCollisions(0.01, 0.8));
   for (int i = 0; i < steps; ++i) {
     if (Status st = s.Step(1.0 / 240, in); !st.ok()) {
       ADD_FAILURE() << st.error().message;
@@ -123,8 +123,8 @@ struct HubNetwork {
     for (int i = 0; i < 100; ++i)
       state.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)));
     for (uint32_t i = 1; i <= 100; ++i) {
-      springs->Add(0, i, 0.5, 10 + i, 0.1 * i);
-      springs->Add(i, i % 100 + 1, 0.2, 30, 0.3);
+      EXPECT_OK(springs->Add(0, i, 0.5, 10 + i, 0.1 * i));
+      EXPECT_OK(springs->Add(i, i % 100 + 1, 0.2, 30, 0.3));
     }
   }
   std::vector<Vec3> Forces(ThreadPool* pool) {

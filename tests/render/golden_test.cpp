@@ -73,7 +73,7 @@ class Golden : public testing::RenderFixture {
     const mesh::PlantGeometry* g = &p->geometry;
     renderer_->SetMesh({}, {});
     renderer_->SetLines({});
-    renderer_->SetPoints({});
+    ASSERT_TRUE(renderer_->SetPoints({}).ok());
     if (lines) {
       LineBatch b;
       for (const auto& s : g->segments) {
@@ -123,7 +123,7 @@ TEST_F(Golden, PointBatch) {
   renderer_->SetMesh({}, {});
   renderer_->SetLines({});
   renderer_->SetBackground(mesh::Srgb(0.1f, 0.1f, 0.15f));
-  renderer_->SetPoints(pts);
+  ASSERT_TRUE(renderer_->SetPoints(pts).ok());
   renderer_->Draw(Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), double(kW) / kH, 30, 20, false));
   Compare("points");
 }

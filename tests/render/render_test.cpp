@@ -235,6 +235,20 @@ TEST(RenderCli, BadInputIsExitTwoWithAClearMessage) {
 namespace sylva::render {
 namespace {
 
+TEST_F(Render, PointBatchOfUnequalLengthsIsADiagnosticNotAnOverRead) {
+  PointBatch pts;
+  pts.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  pts.sizes = {1.0f};  // before: glBufferData read 12 bytes from a 4-byte array
+  pts.colors = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  const Status st = renderer_->SetPoints(pts);
+  ASSERT_FALSE(st.ok()) << "3 positions, 1 size accepted";
+  EXPECT_NE(st.error().message.find("3 positions but 1 sizes and 3 colors"), std::string::npos)
+      << st.error().message;
+  pts.sizes = {1.0f, 1.0f, 1.0f};
+  pts.colors.pop_back();
+  EXPECT_FALSE(renderer_->SetPoints(pts).ok()) << "3 positions, 2 colours accepted";
+}
+
 TEST_F(Render, PointBatchDrawsRoundSpritesOfTheirWorldSize) {
   PointBatch pts;
   pts.positions = {{-2, 0, 0}, {2, 0, 0}};
@@ -249,7 +263,7 @@ TEST_F(Render, PointBatchDrawsRoundSpritesOfTheirWorldSize) {
   cam.distance = 10;
   ASSERT_TRUE(renderer_->Resize(W, H).ok());
   renderer_->SetBackground(mesh::Vec3f(1, 1, 1));
-  renderer_->SetPoints(pts);
+  ASSERT_TRUE(renderer_->SetPoints(pts).ok());
   renderer_->Draw(cam);
   Image img = renderer_->ReadPixels();
   // Red sprite centred at x = 50: about 25 px across; blue at x = 150: about 12 px.
