@@ -32,12 +32,4 @@ std::optional<SymbolId> SymbolTable::Find(std::string_view name, int arity) cons
   return it->second;
 }
 
-std::vector<SymbolId> SymbolTable::AllWithName(std::string_view name) const {
-  std::vector<SymbolId> out;
-  for (size_t i = 0; i < names_.size(); ++i) {
-    if (names_[i] == name) out.push_back(SymbolId(i));
-  }
-  return out;
-}
-
 }  // namespace sylva::lsys

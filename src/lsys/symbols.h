@@ -36,8 +36,6 @@ class SymbolTable {
   int arity(SymbolId id) const { return arities_[id]; }
   // Arity of every symbol, indexed by id (hot: used per module).
   const std::vector<uint8_t>& arities() const { return arities_; }
-  // Every id whose name is `name`, whatever its arity.
-  std::vector<SymbolId> AllWithName(std::string_view name) const;
 
  private:
   std::vector<std::string> names_;

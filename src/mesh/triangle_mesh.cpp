@@ -22,16 +22,6 @@ void TriangleMesh::Append(const TriangleMesh& o) {
   material.insert(material.end(), o.material.begin(), o.material.end());
 }
 
-std::pair<uint16_t, uint16_t> TriangleMesh::MaterialRange() const {
-  if (material.empty()) return {0, 0};
-  uint16_t lo = material[0], hi = material[0];
-  for (uint16_t m : material) {
-    lo = std::min(lo, m);
-    hi = std::max(hi, m);
-  }
-  return {lo, hi};
-}
-
 std::string FindNonFinite(const TriangleMesh& m) {
   // allFinite() is false for NaN and infinity in any component.
   auto bad = [&](const auto& array, const char* what) -> std::string {

@@ -26,8 +26,6 @@ struct TriangleMesh {
   size_t triangleCount() const { return indices.size() / 3; }
   void Clear();
   void Append(const TriangleMesh& other);
-  // Smallest and largest material id; {0, 0} when empty.
-  std::pair<uint16_t, uint16_t> MaterialRange() const;
 };
 
 // The first vertex whose position, normal or UV has a component that is not
