@@ -12,6 +12,7 @@
 #include "app/cli.h"
 #ifdef SYLVA_TESTS_WITH_GRAPHICS
 #include "app/graphics.h"
+#include "scratch_dir.h"
 #endif
 
 namespace sylva::app::testing {
@@ -36,9 +37,7 @@ inline CliResult RunSylva(std::vector<std::string> args) {
 
 // A scratch folder per test program.
 inline std::filesystem::path Scratch() {
-  auto d = std::filesystem::temp_directory_path() / ("sylva_cli_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(d);
-  return d;
+  return sylva::testing::ScratchDir("sylva_cli_");
 }
 
 inline std::string WriteFile(const std::string& name, const std::string& text) {

@@ -9,15 +9,14 @@
 
 #include <sys/stat.h>
 #include <unistd.h>
+#include "scratch_dir.h"
 
 namespace fs = std::filesystem;
 
 namespace sylva {
 
 static fs::path TempDir() {
-  fs::path d = fs::temp_directory_path() / ("sylva_atomic_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
+  return sylva::testing::ScratchDir("sylva_atomic_");
 }
 
 static int CountEntries(const fs::path& d) {

@@ -16,6 +16,7 @@
 
 #include "lsys/parser.h"
 #include "lsys_test_util.h"
+#include "scratch_dir.h"
 
 // Bytes allocated by this test program, to check that parsing allocates in
 // proportion to its input (not to input x modules).
@@ -39,9 +40,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path Scratch() {
-  fs::path d = fs::temp_directory_path() / ("sylva_parser_limits_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
+  return sylva::testing::ScratchDir("sylva_parser_limits_");
 }
 
 std::string Write(const std::string& name, const std::string& text) {
