@@ -10,9 +10,9 @@
 #include <vector>
 
 #include "app/cli.h"
+#include "scratch_dir.h"
 #ifdef SYLVA_TESTS_WITH_GRAPHICS
 #include "app/graphics.h"
-#include "scratch_dir.h"
 #endif
 
 namespace sylva::app::testing {
