@@ -3,9 +3,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cstring>
 #include <filesystem>
+#include <set>
+#include <string_view>
+#include <utility>
 
 #include "core/atomic_file.h"
 #include "mesh/color.h"
@@ -69,32 +73,88 @@ static inline void UInt(std::string& out, uint32_t v) {
   out.append(buf, size_t(r.ptr - buf));
 }
 
+// The .obj/.mtl pair is two files and two renames, so a crash between them
+// could leave an .obj beside an .mtl it does not match. Two rules make every
+// pair that can be seen consistent:
+// - a material's name is its colour (`kd_0.42_0.3_0.19`: the Kd values, the
+//   shortest text that reads back as the same floats), so a name means one
+//   definition in every .mtl Sylva writes;
+// - the .mtl is committed first as the union of the new materials and those
+//   the existing .mtl defines, then the .obj, then (only when the union
+//   added anything) the .mtl again with the new materials alone.
+// After every rename the .mtl on disk defines every material of the .obj on
+// disk, old or new, with the colour that .obj was written with.
+static std::string MaterialName(const Vec3f& srgb) {
+  std::string name = "kd";
+  for (int k = 0; k < 3; ++k) {
+    name += '_';
+    Num(name, srgb[k]);
+  }
+  return name;
+}
+
+// The `newmtl` blocks of an .mtl file, each with its lines up to the next.
+static std::vector<std::pair<std::string, std::string>> MaterialBlocks(const std::string& text) {
+  std::vector<std::pair<std::string, std::string>> blocks;
+  size_t at = 0;
+  while (at < text.size()) {
+    size_t end = text.find('\n', at);
+    end = end == std::string::npos ? text.size() : end + 1;
+    std::string_view line(text.data() + at, end - at);
+    if (line.rfind("newmtl ", 0) == 0) {
+      std::string_view name = line.substr(7);
+      while (!name.empty() && std::isspace(static_cast<unsigned char>(name.back())))
+        name.remove_suffix(1);
+      blocks.emplace_back(std::string(name), std::string());
+    }
+    if (!blocks.empty()) blocks.back().second.append(line);
+    at = end;
+  }
+  return blocks;
+}
+
+static Status WriteText(const std::string& path, const std::string& text) {
+  AtomicFile f;
+  if (Status s = f.Open(path); !s.ok()) return s;
+  if (Status s = f.Write(text); !s.ok()) return s;
+  return f.Commit();
+}
+
 Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string& path) {
   const MaterialGroups groups = GroupByMaterial(m);
   const std::filesystem::path p(path);
   const std::string mtlName = p.stem().string() + ".mtl";
   const std::string mtlPath = (p.parent_path() / mtlName).string();
 
+  // Material names, and the .mtl text that defines them.
+  std::vector<std::string> names;
+  std::set<std::string> defined;
+  std::string text = "# Sylva materials\n";
+  for (uint16_t mat : groups.materials) {
+    // Kd in sRGB: the values a `palette:` entry was written with.
+    const Vec3f c = ToSrgb(PaletteColor(palette, mat));
+    names.push_back(MaterialName(c));
+    if (!defined.insert(names.back()).second) continue;
+    text += "newmtl " + names.back() + "\nKd ";
+    Num(text, c.x());
+    text += ' ';
+    Num(text, c.y());
+    text += ' ';
+    Num(text, c.z());
+    text += "\nKa 0 0 0\nKs 0 0 0\nd 1\nillum 1\n\n";
+  }
   AtomicFile obj;
   if (Status s = obj.Open(path); !s.ok()) return s;
   // Written to a device or FIFO (/dev/stdout): no .mtl beside it.
   const bool withMtl = !obj.direct();
-  AtomicFile mtl;
+  std::string old;  // materials only the existing .mtl defines
   if (withMtl) {
-    if (Status s = mtl.Open(mtlPath); !s.ok()) return s;
-    std::string text = "# Sylva materials\n";
-    for (uint16_t mat : groups.materials) {
-      // Kd in sRGB: the values a `palette:` entry was written with.
-      Vec3f c = ToSrgb(PaletteColor(palette, mat));
-      text += "newmtl color" + std::to_string(mat) + "\nKd ";
-      Num(text, c.x());
-      text += ' ';
-      Num(text, c.y());
-      text += ' ';
-      Num(text, c.z());
-      text += "\nKa 0 0 0\nKs 0 0 0\nd 1\nillum 1\n\n";
+    if (auto existing = ReadFile(mtlPath); existing.ok()) {
+      for (auto& [name, block] : MaterialBlocks(*existing)) {
+        if (defined.insert(name).second) old += block;
+      }
     }
-    if (Status s = mtl.Write(text); !s.ok()) return s;
+    if (Status s = WriteText(mtlPath, text + old); !s.ok()) return s;
   }
   static constexpr size_t kFlush = 1 << 20;
   std::string out;
@@ -128,7 +188,7 @@ Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string
   if (Status s = attribute("vn", floats(m.normals), m.vertexCount(), 3); !s.ok()) return s;
   if (Status s = attribute("vt", floats(m.uvs), m.vertexCount(), 2); !s.ok()) return s;
   for (size_t k = 0; k < groups.materials.size(); ++k) {
-    out += "usemtl color" + std::to_string(groups.materials[k]) + "\n";
+    out += "usemtl " + names[k] + "\n";
     for (uint32_t o = groups.starts[k]; o < groups.starts[k + 1]; ++o) {
       const uint32_t t = groups.order[o];
       out += 'f';
@@ -146,17 +206,10 @@ Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string
     }
   }
   if (Status s = flush(true); !s.ok()) return s;
-  // Both files complete (every write and flush checked) before either is
-  // renamed: the two renames back to back are the only window in which a
-  // crash could leave a new .mtl beside an old .obj.
-  if (withMtl) {
-    if (Status s = mtl.Finish(); !s.ok()) return s;
-  }
-  if (Status s = obj.Finish(); !s.ok()) return s;
-  if (withMtl) {
-    if (Status s = mtl.Commit(); !s.ok()) return s;
-  }
-  return obj.Commit();
+  if (Status s = obj.Commit(); !s.ok()) return s;
+  // The .mtl holds the old materials too until the .obj is in place; then
+  // only the new ones.
+  return withMtl && !old.empty() ? WriteText(mtlPath, text) : Status();
 }
 
 Status WritePly(const TriangleMesh& m, const Palette& palette, const std::string& path) {

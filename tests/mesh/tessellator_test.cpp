@@ -368,3 +368,41 @@ TEST(Export, AMeshWithANonFiniteNumberIsNeverWritten) {
 
 }  // namespace
 }  // namespace sylva::mesh
+
+namespace sylva::mesh {
+namespace {
+
+// Materials are named by their colour, so one name means one definition in
+// every .mtl, and an .obj never points at a material its .mtl lacks.
+TEST(Export, ObjMaterialsAreNamedByColourAndAllDefinedInTheMtl) {
+  auto p =
+      testing::PlantFromText("palette: #808080 #ff0000\naxiom: F'F\n", -1, plant::Stage::kMesh);
+  ASSERT_TRUE(p);
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("sylva_mtl_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string obj = (dir / "two.obj").string();
+  ASSERT_TRUE(WriteMesh(p->mesh, p->palette, obj).ok());
+  const std::string objText = *ReadFile(obj), mtlText = *ReadFile((dir / "two.mtl").string());
+  size_t uses = 0;
+  for (size_t at = objText.find("usemtl "); at != std::string::npos;
+       at = objText.find("usemtl ", at + 1)) {
+    const std::string name = objText.substr(at + 7, objText.find('\n', at) - at - 7);
+    EXPECT_NE(mtlText.find("newmtl " + name + "\n"), std::string::npos) << name << " not in:\n"
+                                                                        << mtlText;
+    ++uses;
+  }
+  EXPECT_EQ(uses, 2u);
+  EXPECT_NE(mtlText.find("newmtl kd_0.5019608_0.5019608_0.5019608\n"), std::string::npos)
+      << mtlText;
+  // A second export leaves only its own materials.
+  auto grey = testing::PlantFromText("palette: #808080\naxiom: F\n", -1, plant::Stage::kMesh);
+  ASSERT_TRUE(grey);
+  ASSERT_TRUE(WriteMesh(grey->mesh, grey->palette, obj).ok());
+  const std::string after = *ReadFile((dir / "two.mtl").string());
+  EXPECT_EQ(after.find("kd_0.99999994"), std::string::npos) << after;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace sylva::mesh
