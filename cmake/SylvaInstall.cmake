@@ -8,7 +8,7 @@
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(_sylva_libs core lsys mesh turtle plant particles terrain scene)
+set(_sylva_libs core lsys mesh turtle plant particles terrain draw scene)
 if(SYLVA_BUILD_RENDER)
   list(APPEND _sylva_libs render)
 endif()

@@ -122,6 +122,9 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   AddDeriveFlags(re, render.derive);
   re->add_option("-o,--output", render.output, "image file (.png, .jpg or .jpeg)")->required();
   re->add_option("--size", render.size, "image size WxH (default 960x540)");
+  re->add_option("--time", render.time,
+                 "scenes: simulate this many seconds before the picture (default 0)")
+      ->check(CLI::Range(0.0, 1e6));
   re->add_option("--camera", render.camera,
                  "azimuth,elevation,distance in degrees and units (distance 0: frame the plant)");
   AddMaxTrianglesFlag(re, render.derive);

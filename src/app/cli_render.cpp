@@ -12,13 +12,13 @@
 
 namespace sylva::app {
 
-static bool ParseSize(const std::string& s, int* w, int* h) {
+bool ParseSize(const std::string& s, int* w, int* h) {
   int n = 0;
   if (std::sscanf(s.c_str(), "%dx%d%n", w, h, &n) != 2 || size_t(n) != s.size()) return false;
   return *w >= 1 && *h >= 1 && *w <= 8192 && *h <= 8192;
 }
 
-static bool ParseCamera(const std::string& s, double v[3]) {
+bool ParseCamera(const std::string& s, double v[3]) {
   int n = 0;
   if (std::sscanf(s.c_str(), "%lf,%lf,%lf%n", &v[0], &v[1], &v[2], &n) != 3 ||
       size_t(n) != s.size())
@@ -28,6 +28,7 @@ static bool ParseCamera(const std::string& s, double v[3]) {
 }
 
 int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
+  if (IsSceneFile(cmd.derive.file)) return RunRenderScene(cmd, out, err);
   if (!render::IsImagePath(cmd.output)) {
     err << "sylva: error: " << cmd.output << ": unknown image format; use .png, .jpg or .jpeg\n";
     return kExitBadInput;

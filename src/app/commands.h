@@ -45,10 +45,17 @@ struct RenderCommand {
   std::string size = "960x540";
   std::string camera;  // "azimuth,elevation,distance"; empty or distance 0: framed
   int sides = 12;
+  double time = 0;  // scenes: simulated seconds before the picture
 };
 
 int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err);
 int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err);
+// `sylva render scene.xml` (cli_render_scene.cpp).
+int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& err);
+// "WxH", 1x1..8192x8192.
+bool ParseSize(const std::string& s, int* w, int* h);
+// "azimuth,elevation,distance": finite, elevation in (-90, 90), distance >= 0.
+bool ParseCamera(const std::string& s, double v[3]);
 int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 
 // The plant spec the flags describe (steps, seed, -D, threads, limits);

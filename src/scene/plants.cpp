@@ -36,11 +36,19 @@ plant::PlantSpec SpecFor(const PlantDef& p) {
   return s;
 }
 
-plant::PlantSpec SpecFor(const ForestDef& f, int variant) {
+uint64_t ElementSeed(uint64_t sceneSeed, const std::string& id, const char* kind, size_t index) {
+  // FNV-1a of the key: stable across compilers, unlike std::hash.
+  const std::string key = id.empty() ? std::string(kind) + "#" + std::to_string(index) : id;
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (unsigned char c : key) h = (h ^ c) * 0x100000001b3ull;
+  return CounterHash(sceneSeed, h) >> 11;  // 53 bits, as the CLI allows
+}
+
+plant::PlantSpec SpecFor(const ForestDef& f, uint64_t forestSeed, int variant) {
   plant::PlantSpec s;
   s.path = f.grammar;
   s.steps = f.steps;
-  s.seed = CounterHash(f.seed, uint64_t(variant)) >> 11;  // 53 bits, as the CLI allows
+  s.seed = CounterHash(forestSeed, uint64_t(variant)) >> 11;  // 53 bits, as the CLI allows
   s.defines = Defines(f.defines);
   return s;
 }
@@ -52,7 +60,11 @@ DiagnosticList CheckGrammars(const Scene& scene) {
     if (seen.emplace(s.path, s.defines).second) Check(s, where, element, out);
   };
   for (const PlantDef& p : scene.plants) once(SpecFor(p), p.grammarLoc, "plant");
-  for (const ForestDef& f : scene.forests) once(SpecFor(f, 0), f.grammarLoc, "forest");
+  for (size_t i = 0; i < scene.forests.size(); ++i) {
+    const ForestDef& f = scene.forests[i];
+    const uint64_t seed = f.seed.value_or(ElementSeed(scene.seed, f.id, "forest", i));
+    once(SpecFor(f, seed, 0), f.grammarLoc, "forest");
+  }
   return out;
 }
 

@@ -8,11 +8,16 @@
 
 namespace sylva::scene {
 
+// The seed of an element that sets none: the scene's seed hashed with the
+// element's id (or, without one, its kind and its index among its kind), so
+// adding an element does not change another's randomness.
+uint64_t ElementSeed(uint64_t sceneSeed, const std::string& id, const char* kind, size_t index);
+
 // The spec of a <plant> (its grammar, steps, seed, <define>s).
 plant::PlantSpec SpecFor(const PlantDef& p);
-// The spec of a forest's variant `variant` (its seed drawn from the
-// forest's seed and the variant index).
-plant::PlantSpec SpecFor(const ForestDef& f, int variant);
+// The spec of a forest's variant `variant`: its grammar seed drawn from
+// `forestSeed` (the forest's seed, or its ElementSeed) and the index.
+plant::PlantSpec SpecFor(const ForestDef& f, uint64_t forestSeed, int variant);
 
 // Parses every grammar the scene names (each file once per set of defines).
 // A grammar's diagnostics are followed by a note at the scene element that

@@ -74,13 +74,16 @@ Range Between(double a, double b) {
 
 // Largest count any attribute takes: beyond it sizes overflow estimates.
 constexpr uint64_t kMaxCount = uint64_t(1) << 40;
+// The renderer's shaders take this many lights (draw::kMaxLights).
+constexpr size_t kMaxLights = 8;
 
 class Reader;
 
 // Reads one element's attributes; see the file comment.
 class Attrs {
  public:
-  Attrs(Reader& r, Elem e);
+  // takesId: the element may carry an `id` (not <scene> or <include>).
+  Attrs(Reader& r, Elem e, bool takesId = true);
   ~Attrs() { Finish(); }
 
   bool Has(std::string_view name) {
@@ -192,8 +195,8 @@ class Reader {
 // ---------------------------------------------------------------------------
 // Attrs
 
-Attrs::Attrs(Reader& r, Elem e) : r_(r), e_(e) {
-  Know("id");
+Attrs::Attrs(Reader& r, Elem e, bool takesId) : r_(r), e_(e) {
+  if (takesId) Know("id");
 }
 
 void Attrs::Error(std::string_view attr, std::string message) {
@@ -500,7 +503,7 @@ bool Reader::Load(const std::string& path, int depth, std::vector<std::string>& 
   if (!from) root_ = rootElem;
   if (from) {
     // An included file's <scene> may carry only its version.
-    Attrs a(*this, rootElem);
+    Attrs a(*this, rootElem, false);
     int version = 1;
     if (a.Count("version", version, 1, 1000) && version != 1)
       a.Error("version", "this Sylva reads scene version 1, found " + std::to_string(version));
@@ -522,7 +525,7 @@ bool Reader::Load(const std::string& path, int depth, std::vector<std::string>& 
       out.push_back(e);
       continue;
     }
-    Attrs a(*this, e);
+    Attrs a(*this, e, false);
     std::string file;
     if (!a.Has("file")) {
       Add(f.AtElement(n, "<include> needs a 'file' attribute"));
@@ -554,7 +557,7 @@ bool Reader::Load(const std::string& path, int depth, std::vector<std::string>& 
 }
 
 void Reader::ReadRootAttributes(const Elem& root) {
-  Attrs a(*this, root);
+  Attrs a(*this, root, false);
   int version = 1;
   if (!a.Has("version"))
     Add(root.file->AtElement(root.node, "<scene> needs version=\"1\""));
@@ -569,9 +572,16 @@ void Reader::CollectDefaults() {
   for (const Elem& e : top_) {
     if (e.name() != "default") continue;
     Attrs a(*this, e);
+    const bool named = a.Has("name"), valued = a.Has("value");
+    if (std::string_view(e.node.attribute("value").value()).find('$') != std::string_view::npos ||
+        std::string_view(e.node.attribute("name").value()).find('$') != std::string_view::npos) {
+      Add(e.file->AtElement(e.node, "a <default> is literal: its name and value cannot use "
+                                    "$parameters"));
+      continue;
+    }
     const std::optional<std::string> name = a.Text("name");
     const std::optional<std::string> value = a.Text("value");
-    if (!a.Has("name") || !a.Has("value")) {
+    if (!named || !valued) {
       Add(e.file->AtElement(e.node, "<default> needs 'name' and 'value'"));
       continue;
     }
@@ -633,9 +643,15 @@ void Reader::CollectIds(const Elem& top) {
 }
 
 void Reader::CollectId(const Elem& e) {
-  if (e.name() == "ref" || e.name() == "default") return;
+  if (e.name() == "ref") return;
   const pugi::xml_attribute a = e.node.attribute("id");
   if (!a) return;
+  if (e.name() == "default" || e.name() == "define") {
+    Add(e.file->AtAttribute(e.node, "id",
+                            "<" + std::string(e.name()) +
+                                "> has no 'id': nothing can refer to it (it has a 'name')"));
+    return;
+  }
   const std::string id = a.value();
   bool valid = !id.empty() && (std::isalpha(static_cast<unsigned char>(id[0])) || id[0] == '_');
   for (char c : id)
@@ -802,7 +818,7 @@ TerrainDef Reader::ReadTerrain(const Elem& e) {
     else
       a.Error("size", "'size' is 'x z' in metres, both above 0");
   }
-  a.Count("resolution", t.resolution, 2, 65537);
+  a.Count("resolution", t.resolution, 2, 8193);
   a.Number("height", t.height, kNonNegative);
   a.Enum("noise", t.noise,
          {{"fbm", NoiseKind::kFbm},
@@ -812,7 +828,8 @@ TerrainDef Reader::ReadTerrain(const Elem& e) {
   a.Count("octaves", t.octaves, 1, 16);
   a.Number("lacunarity", t.lacunarity, Range{1, 8});
   a.Number("gain", t.gain, Range{0, 1, true, false});
-  a.Count("seed", t.seed, 0, uint64_t(1) << 53);
+  uint64_t seed = 0;
+  if (a.Count("seed", seed, 0, uint64_t(1) << 53)) t.seed = seed;
   a.Color("color", t.color);
   if (t.noise == NoiseKind::kDiamondSquare && ((t.resolution - 1) & (t.resolution - 2)) != 0)
     a.Error("resolution",
@@ -867,6 +884,8 @@ PlantDef Reader::ReadPlant(const Elem& e) {
   }
   a.Number("rotate", p.rotateDegrees);
   a.Number("scale", p.scale, kPositive);
+  double height = 0;
+  if (a.Number("height", height, kPositive)) p.height = height;
   p.defines = ReadDefines(e);
   return p;
 }
@@ -880,7 +899,7 @@ ForestDef Reader::ReadForest(const Elem& e) {
   a.Path("grammar", f.grammar, &f.grammarLoc);
   if (!a.Has("count")) Add(e.file->AtElement(e.node, "<forest> needs a 'count'"));
   a.Count("count", f.count, 0, 10000000);
-  a.Ref("on", f.on, {"terrain"});
+  a.Ref("on", f.on, {"terrain"}, true);
   std::vector<double> area;
   if (a.Numbers("area", area, 4)) {
     if (area[2] > area[0] && area[3] > area[1])
@@ -897,9 +916,12 @@ ForestDef Reader::ReadForest(const Elem& e) {
     else
       a.Error("scale", "'scale' is 'min max' with 0 < min <= max");
   }
+  double height = 0;
+  if (a.Number("height", height, kPositive)) f.height = height;
   int steps = 0;
   if (a.Count("steps", steps, 0, 1000)) f.steps = steps;
-  a.Count("seed", f.seed, 0, uint64_t(1) << 53);
+  uint64_t seed = 0;
+  if (a.Count("seed", seed, 0, uint64_t(1) << 53)) f.seed = seed;
   f.defines = ReadDefines(e);
   // An instance is a transform and a variant index; the variants' meshes
   // are counted when they are built.
@@ -1077,7 +1099,10 @@ DrawDef Reader::ReadDraw(const Elem& e) {
   if (d.as != DrawAs::kMesh && a.Has("mesh")) a.Error("mesh", "'mesh' is for as=\"mesh\"");
   a.Number("size", d.size, kPositive);
   // color: one colour, or two (start and end of life).
-  if (const std::optional<std::string> t = a.Text("color")) {
+  if (std::optional<std::string> t = a.Text("color")) {
+    const size_t first = t->find_first_not_of(" \t\r\n");
+    const size_t last = t->find_last_not_of(" \t\r\n");
+    *t = first == std::string::npos ? std::string() : t->substr(first, last - first + 1);
     const Parsed<Vec3> one = ParseColor(*t);
     const Parsed<std::vector<double>> six = ParseNumbers(*t, 6);
     const size_t space = t->find_first_of(" \t");
@@ -1106,7 +1131,7 @@ DrawDef Reader::ReadDraw(const Elem& e) {
   }
   a.Number("alpha", d.alpha, Between(0, 1));
   a.Enum("blend", d.blend, {{"alpha", Blend::kAlpha}, {"additive", Blend::kAdditive}});
-  a.Number("spin", d.spin);
+  a.Number("spin", d.spinDegrees);
   NoChildren(e);
   return d;
 }
@@ -1138,6 +1163,8 @@ ParticlesDef Reader::ReadParticles(const Elem& e) {
              for (const auto& [n, k] : kForceNames)
                if (c.name() == n) p.forces.push_back(ReadForce(c));
              if (c.name() == "self-collide") {
+               if (p.selfCollideRestitution)
+                 Add(c.file->AtElement(c.node, "a second <self-collide> in one system"));
                Attrs sa(*this, c);
                double r = 0.5;
                sa.Number("restitution", r, Between(0, 1));
@@ -1301,8 +1328,13 @@ void Reader::ReadTop(const Elem& e) {
   if (name == "default") return;  // read with the parameters
   if (name == "camera")
     scene_.camera = ReadCamera(e);
-  else if (name == "light")
+  else if (name == "light") {
+    if (scene_.lights.size() == kMaxLights)
+      Add(e.file->AtElement(e.node, "more than " + std::to_string(kMaxLights) +
+                                        " lights; the renderer takes at most " +
+                                        std::to_string(kMaxLights)));
     scene_.lights.push_back(ReadLight(e));
+  }
   else if (name == "sky")
     scene_.sky = ReadSky(e);
   else if (name == "terrain")

@@ -62,7 +62,7 @@ struct TerrainDef {
   int octaves = 6;
   double lacunarity = 2;
   double gain = 0.5;
-  uint64_t seed = 1;
+  std::optional<uint64_t> seed;  // absent: from the scene's seed and the element's id
   Vec3 color = Vec3(0.19, 0.26, 0.11);  // linear
 };
 
@@ -83,6 +83,9 @@ struct PlantDef {
   bool positionHasY = false;  // false: y is the terrain's surface at x, z
   double rotateDegrees = 0;   // about Y
   double scale = 1;
+  // Grammar units vary (ABOP's trees are hundreds of units tall): when set,
+  // the plant is first scaled to this height in metres, then by `scale`.
+  std::optional<double> height;
   std::vector<Define> defines;
 };
 
@@ -97,8 +100,9 @@ struct ForestDef {
   double minDistance = 0;              // 0: chosen from count and area
   int variants = 8;
   Vec2 scale = Vec2(0.8, 1.2);  // uniform scale drawn in this range
+  std::optional<double> height;  // each variant scaled to this height (metres) first
   std::optional<int> steps;
-  uint64_t seed = 1;
+  std::optional<uint64_t> seed;  // absent: from the scene's seed and the element's id
   std::vector<Define> defines;
 };
 
@@ -180,7 +184,7 @@ struct DrawDef {
   std::optional<Vec3> colorEnd;  // colour over age: color -> colorEnd
   double alpha = 1;
   Blend blend = Blend::kAlpha;
-  double spin = 0;  // tumbling, radians per second
+  double spinDegrees = 0;  // tumbling, degrees per second
 };
 
 enum class Integrator { kSymplectic, kEuler, kRk2, kRk4, kRk45, kImplicit };
