@@ -65,8 +65,8 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
     return kExitBadInput;
   }
   int exit = kExitOk;
-  const auto scene = LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err,
-                               &exit);
+  const auto scene =
+      LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err, &exit);
   if (!scene) return exit;
   if (cmd.time > 0) {
     err << "sylva: error: --time " << cmd.time
@@ -95,8 +95,8 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
   char line[320];
   std::snprintf(line, sizeof line,
                 "%s: %dx%d, %zu meshes, %zu triangles drawn, build %.2f s, render %.2f s (%s)\n",
-                cmd.output.c_str(), width, height, list.meshes.size(),
-                built.scene->trianglesDrawn, std::chrono::duration<double>(t1 - t0).count(),
+                cmd.output.c_str(), width, height, list.meshes.size(), built.scene->trianglesDrawn,
+                std::chrono::duration<double>(t1 - t0).count(),
                 std::chrono::duration<double>(t2 - t1).count(), (*context)->Renderer().c_str());
   err << line;
   (void)out;

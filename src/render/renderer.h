@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "core/status.h"
+#include "draw/draw_list.h"
 #include "mesh/color.h"
 #include "mesh/export.h"
 #include "mesh/triangle_mesh.h"
-#include "draw/draw_list.h"
 #include "render/camera.h"
 
 namespace sylva::render {

@@ -57,8 +57,8 @@ static_assert(sizeof(GpuInstance) == 76, "instance layout");
 
 struct Renderer::ScenePass {
   GLuint meshProgram = 0, shadowProgram = 0, skyProgram = 0, spriteProgram = 0, lineProgram = 0;
-  GLint viewProj = -1, eye = -1, lightCount = -1, lightType = -1, lightVector = -1,
-        lightColor = -1, shadowLight = -1, lightViewProj = -1, shadowMap = -1;
+  GLint viewProj = -1, eye = -1, lightCount = -1, lightType = -1, lightVector = -1, lightColor = -1,
+        shadowLight = -1, lightViewProj = -1, shadowMap = -1;
   GLint shadowViewProj = -1;
   GLint skyInverse = -1, skyTop = -1, skyHorizon = -1;
   GLint spriteViewProj = -1, spriteScale = -1, lineViewProj = -1;
@@ -295,8 +295,11 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     float vectors[3 * draw::kMaxLights], colors[3 * draw::kMaxLights];
     for (size_t i = 0; i < lights.size(); ++i) {
       const draw::Light& l = lights[i];
-      types[i] = l.type == draw::Light::Type::kSun ? 0 : l.type == draw::Light::Type::kAmbient ? 1 : 2;
-      const mesh::Vec3f v = l.type == draw::Light::Type::kPoint ? l.position : mesh::Vec3f(-l.direction.normalized());
+      types[i] = l.type == draw::Light::Type::kSun       ? 0
+                 : l.type == draw::Light::Type::kAmbient ? 1
+                                                         : 2;
+      const mesh::Vec3f v =
+          l.type == draw::Light::Type::kPoint ? l.position : mesh::Vec3f(-l.direction.normalized());
       const mesh::Vec3f c = l.color * l.intensity;
       for (int k = 0; k < 3; ++k) {
         vectors[3 * i + size_t(k)] = v[k];

@@ -35,8 +35,7 @@ std::optional<plant::Plant> Grow(plant::PlantSpec spec, const BuildOptions& opti
 }
 
 // Box of a mesh through a transform.
-void GrowBounds(const mesh::TriangleMesh& m, const draw::Mat4f& t, Vec3& lo, Vec3& hi,
-                bool& any) {
+void GrowBounds(const mesh::TriangleMesh& m, const draw::Mat4f& t, Vec3& lo, Vec3& hi, bool& any) {
   for (const mesh::Vec3f& p : m.positions) {
     const Vec3 w = (t.cast<double>() * p.cast<double>().homogeneous()).head<3>();
     lo = any ? lo.cwiseMin(w) : w;
@@ -52,7 +51,8 @@ std::shared_ptr<mesh::TriangleMesh> TerrainMeshOf(const terrain::TerrainMesh& t)
   m->normals.resize(n);
   m->uvs.resize(n);
   for (size_t i = 0; i < n; ++i) {
-    m->positions[i] = mesh::Vec3f(t.positions[3 * i], t.positions[3 * i + 1], t.positions[3 * i + 2]);
+    m->positions[i] =
+        mesh::Vec3f(t.positions[3 * i], t.positions[3 * i + 1], t.positions[3 * i + 2]);
     m->normals[i] = mesh::Vec3f(t.normals[3 * i], t.normals[3 * i + 1], t.normals[3 * i + 2]);
     m->uvs[i] = mesh::Vec2f(t.positions[3 * i], t.positions[3 * i + 2]);
   }
@@ -85,10 +85,10 @@ terrain::TerrainDef TerrainDefOf(const TerrainDef& t, uint64_t seed) {
   d.sizeZ = t.size.y();
   d.resolution = t.resolution;
   d.height = t.noise == NoiseKind::kFlat ? 0 : t.height;
-  d.noise = t.noise == NoiseKind::kFbm              ? terrain::NoiseKind::kFbm
-            : t.noise == NoiseKind::kRidged         ? terrain::NoiseKind::kRidged
+  d.noise = t.noise == NoiseKind::kFbm             ? terrain::NoiseKind::kFbm
+            : t.noise == NoiseKind::kRidged        ? terrain::NoiseKind::kRidged
             : t.noise == NoiseKind::kDiamondSquare ? terrain::NoiseKind::kDiamondSquare
-                                                    : terrain::NoiseKind::kFlat;
+                                                   : terrain::NoiseKind::kFlat;
   d.octaves = t.octaves;
   d.lacunarity = t.lacunarity;
   d.gain = t.gain;
@@ -226,7 +226,8 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
                                                ToUnit(CounterHash(forestSeed, 0xf0e57, k, 2)));
       const double y = on ? on->Height(spots[k].x(), spots[k].y()) : 0;
       BuiltMesh& m = built.meshes[first + size_t(v)];
-      m.instances.push_back({draw::Transform(Vec3(spots[k].x(), y, spots[k].y()), yaw, s), {1, 1, 1}});
+      m.instances.push_back(
+          {draw::Transform(Vec3(spots[k].x(), y, spots[k].y()), yaw, s), {1, 1, 1}});
       GrowBounds(*m.mesh, m.instances.back().transform, built.lo, built.hi, any);
       built.trianglesDrawn += m.mesh->triangleCount();
     }
@@ -234,8 +235,9 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
 
   // Read, checked, not yet simulated: say so where the scene asks for it.
   for (const ParticlesDef& p : scene.particles)
-    diags.Add(AtElement(p.loc, "<particles> is not simulated or drawn yet (this Sylva builds "
-                               "terrain, plants, forests, lights, sky and camera of a scene)",
+    diags.Add(AtElement(p.loc,
+                        "<particles> is not simulated or drawn yet (this Sylva builds "
+                        "terrain, plants, forests, lights, sky and camera of a scene)",
                         Severity::kWarning));
   for (const ClothDef& c : scene.cloths)
     diags.Add(AtElement(c.loc, "<cloth> is not simulated or drawn yet", Severity::kWarning));

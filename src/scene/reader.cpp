@@ -575,8 +575,9 @@ void Reader::CollectDefaults() {
     const bool named = a.Has("name"), valued = a.Has("value");
     if (std::string_view(e.node.attribute("value").value()).find('$') != std::string_view::npos ||
         std::string_view(e.node.attribute("name").value()).find('$') != std::string_view::npos) {
-      Add(e.file->AtElement(e.node, "a <default> is literal: its name and value cannot use "
-                                    "$parameters"));
+      Add(e.file->AtElement(e.node,
+                            "a <default> is literal: its name and value cannot use "
+                            "$parameters"));
       continue;
     }
     const std::optional<std::string> name = a.Text("name");
@@ -646,10 +647,10 @@ void Reader::CollectId(const Elem& e) {
   if (e.name() == "ref") return;
   const pugi::xml_attribute a = e.node.attribute("id");
   if (!a) return;
-  if (e.name() == "default" || e.name() == "define") {
-    Add(e.file->AtAttribute(e.node, "id",
-                            "<" + std::string(e.name()) +
-                                "> has no 'id': nothing can refer to it (it has a 'name')"));
+  if (e.name() == "default") {
+    Add(e.file->AtAttribute(
+        e.node, "id",
+        "<" + std::string(e.name()) + "> has no 'id': nothing can refer to it (it has a 'name')"));
     return;
   }
   const std::string id = a.value();
@@ -1334,8 +1335,7 @@ void Reader::ReadTop(const Elem& e) {
                                         " lights; the renderer takes at most " +
                                         std::to_string(kMaxLights)));
     scene_.lights.push_back(ReadLight(e));
-  }
-  else if (name == "sky")
+  } else if (name == "sky")
     scene_.sky = ReadSky(e);
   else if (name == "terrain")
     scene_.terrains.push_back(ReadTerrain(e));

@@ -62,7 +62,7 @@ struct TerrainDef {
   int octaves = 6;
   double lacunarity = 2;
   double gain = 0.5;
-  std::optional<uint64_t> seed;  // absent: from the scene's seed and the element's id
+  std::optional<uint64_t> seed;         // absent: from the scene's seed and the element's id
   Vec3 color = Vec3(0.19, 0.26, 0.11);  // linear
 };
 
@@ -99,7 +99,7 @@ struct ForestDef {
   Vec4 area = Vec4(-10, -10, 10, 10);  // x0 z0 x1 z1
   double minDistance = 0;              // 0: chosen from count and area
   int variants = 8;
-  Vec2 scale = Vec2(0.8, 1.2);  // uniform scale drawn in this range
+  Vec2 scale = Vec2(0.8, 1.2);   // uniform scale drawn in this range
   std::optional<double> height;  // each variant scaled to this height (metres) first
   std::optional<int> steps;
   std::optional<uint64_t> seed;  // absent: from the scene's seed and the element's id
