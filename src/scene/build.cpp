@@ -77,6 +77,33 @@ double HeightScale(const mesh::TriangleMesh& m, double height, const SourceLoc& 
   return height / double(hi - lo);
 }
 
+// Tips, segment points and leaves of `g` through the transform `t`.
+void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t, PlantPoints& out) {
+  const Eigen::Matrix4d m = t.cast<double>();
+  auto world = [&](const Vec3& p) { return Vec3((m * p.homogeneous()).head<3>()); };
+  struct Hash {
+    size_t operator()(const Vec3& v) const {
+      return std::hash<double>()(v.x()) ^ (std::hash<double>()(v.y()) << 1) ^
+             (std::hash<double>()(v.z()) << 2);
+    }
+  };
+  std::unordered_map<Vec3, int, Hash> starts;
+  for (const mesh::Segment& s : g.segments) starts[s.start] = 1;
+  const double scale = m.block<3, 1>(0, 0).norm();
+  for (const mesh::Segment& s : g.segments) {
+    if (!starts.count(s.end)) out.tips.push_back(world(s.end));
+    out.segmentPoints.push_back(world((s.start + s.end) / 2));
+    out.segmentLengths.push_back((s.end - s.start).norm() * scale);
+  }
+  for (const mesh::Polygon& p : g.polygons) {
+    if (p.vertices.empty()) continue;
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& v : p.vertices) c += v;
+    out.leaves.push_back(world(c / double(p.vertices.size())));
+  }
+  for (const mesh::SurfaceInstance& s : g.surfaces) out.leaves.push_back(world(s.position));
+}
+
 }  // namespace
 
 terrain::TerrainDef TerrainDefOf(const TerrainDef& t, uint64_t seed) {
@@ -165,6 +192,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     m.loc = t.loc;
     GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
     built.trianglesDrawn += m.mesh->triangleCount();
+    if (!t.id.empty()) built.meshesOf[t.id].push_back(built.meshes.size());
     built.meshes.push_back(std::move(m));
     built.terrains.push_back(std::move(*field));
   }
@@ -186,6 +214,10 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     m.loc = p.loc;
     GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
     built.trianglesDrawn += m.mesh->triangleCount();
+    if (!p.id.empty()) {
+      AddPoints(grown->geometry, m.instances[0].transform, built.points[p.id]);
+      built.meshesOf[p.id].push_back(built.meshes.size());
+    }
     built.meshes.push_back(std::move(m));
   }
 
@@ -205,6 +237,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     const int variants = std::min<int>(f.variants, std::max<int>(1, int(spots.size())));
     const size_t first = built.meshes.size();
     std::vector<double> unit;
+    std::vector<mesh::PlantGeometry> geometry;
     for (int v = 0; v < variants; ++v) {
       std::optional<plant::Plant> grown =
           Grow(SpecFor(f, forestSeed, v), options, f.grammarLoc, "forest", diags);
@@ -214,6 +247,10 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       m.palette = grown->palette;
       m.loc = f.loc;
       unit.push_back(f.height ? HeightScale(*m.mesh, *f.height, f.loc, diags) : 1);
+      if (!f.id.empty()) {
+        geometry.push_back(std::move(grown->geometry));
+        built.meshesOf[f.id].push_back(built.meshes.size());
+      }
       built.meshes.push_back(std::move(m));
     }
     if (int(built.meshes.size() - first) != variants) continue;
@@ -230,22 +267,10 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
           {draw::Transform(Vec3(spots[k].x(), y, spots[k].y()), yaw, s), {1, 1, 1}});
       GrowBounds(*m.mesh, m.instances.back().transform, built.lo, built.hi, any);
       built.trianglesDrawn += m.mesh->triangleCount();
+      if (!f.id.empty())
+        AddPoints(geometry[size_t(v)], m.instances.back().transform, built.points[f.id]);
     }
   }
-
-  // Read, checked, not yet simulated: say so where the scene asks for it.
-  for (const ParticlesDef& p : scene.particles)
-    diags.Add(AtElement(p.loc,
-                        "<particles> is not simulated or drawn yet (this Sylva builds "
-                        "terrain, plants, forests, lights, sky and camera of a scene)",
-                        Severity::kWarning));
-  for (const ClothDef& c : scene.cloths)
-    diags.Add(AtElement(c.loc, "<cloth> is not simulated or drawn yet", Severity::kWarning));
-  for (const FlockDef& f : scene.flocks)
-    diags.Add(AtElement(f.loc, "<flock> is not simulated or drawn yet", Severity::kWarning));
-  if (scene.wind)
-    diags.Add(AtElement(scene.wind->loc, "<wind> has no effect yet: nothing is simulated",
-                        Severity::kWarning));
 
   if (!diags.HasErrors()) result.scene = std::move(built);
   return result;

@@ -7,10 +7,11 @@
 //   scene::BuildResult b = scene::Build(*r.scene, {});
 //   draw::DrawList list = scene::MakeDrawList(*b.scene);
 //
-// Particles, cloth and flocks are read (reader.h) but not simulated yet:
-// Build warns, at each such element, that it is not drawn.
+// Particles, cloth and flocks live in the Simulation (simulation.h), which
+// reads the built world (colliders, emitters on plants and terrain).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -37,11 +38,24 @@ struct BuiltMesh {
   SourceLoc loc;  // the element it comes from
 };
 
+// Points of a plant (or of every tree of a forest) in world space, where
+// emitters place particles: branch tips, points along the segments (their
+// midpoints, with the segments' lengths as weights), leaves (polygon and
+// surface centres).
+struct PlantPoints {
+  std::vector<Vec3> tips, segmentPoints, leaves;
+  std::vector<double> segmentLengths;
+};
+
 struct BuiltScene {
   std::vector<terrain::HeightField> terrains;  // in the order of scene.terrains
   std::vector<BuiltMesh> meshes;               // terrains, plants, forest variants
-  size_t trianglesDrawn = 0;                   // over every instance
-  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();   // bounds of everything drawn
+  // By element id: the meshes of a terrain, plant or forest (indices into
+  // `meshes`) and the emission points of a plant or forest.
+  std::map<std::string, std::vector<size_t>> meshesOf;
+  std::map<std::string, PlantPoints> points;
+  size_t trianglesDrawn = 0;                  // over every instance
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // bounds of everything drawn
   // The surface height under (x, z): the first terrain containing the
   // point, else 0 (the ground plane).
   double GroundHeight(double x, double z) const;
