@@ -26,6 +26,10 @@
 //   flat            0 everywhere
 // fbm and ridged sample at (x, z) / featureSize: the first octave's
 // lattice spacing is featureSize metres (0 = half the larger extent).
+//
+// A HeightField is immutable once made: its const queries may run on any
+// number of threads at once. To draw it, turn MakeMesh()'s arrays into a
+// mesh::TriangleMesh (examples/terrain/terrain_kinds.cpp does).
 #pragma once
 
 #include <cstdint>
