@@ -36,6 +36,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/assert.h"
 #include "core/math.h"
 #include "core/status.h"
 
@@ -98,6 +99,7 @@ class HeightField {
   double VertexX(int i) const { return x0_ + double(i) * dx_; }
   double VertexZ(int j) const { return z0_ + double(j) * dz_; }
   float HeightAt(int i, int j) const {
+    SYLVA_DCHECK(i >= 0 && i < def_.resolution && j >= 0 && j < def_.resolution);
     return heights_[size_t(j) * size_t(def_.resolution) + size_t(i)];
   }
   // resolution^2 heights, row-major by z: [j resolution + i].
