@@ -114,6 +114,22 @@ void BM_Fbm2Grid(benchmark::State& state) {
 }
 BENCHMARK(BM_Fbm2Grid)->Args({0, 0})->Args({1, 0})->Args({1, 1});
 
+// Six octaves of 3D fBm at arrays of points (wind, gusts, clouds), 1 thread.
+void BM_Fbm3Points(benchmark::State& state) {
+  Kernel kernel;
+  if (!PickKernel(state, &kernel)) return;
+  const size_t n = size_t(1) << 16;
+  const std::vector<float> x = Coordinates(n, 1), y = Coordinates(n, 2), z = Coordinates(n, 3);
+  std::vector<float> out(n);
+  for (auto _ : state) {
+    Fbm3(1, FractalDef{}, x.data(), y.data(), z.data(), n, out.data(), kernel);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(n));
+}
+BENCHMARK(BM_Fbm3Points)->Arg(0)->Arg(1);
+
 // Diamond-square on a (2^k + 1)^2 grid; argument: size, threads.
 void BM_DiamondSquare(benchmark::State& state) {
   DiamondSquareDef def;

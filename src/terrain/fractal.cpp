@@ -55,20 +55,65 @@ inline float NextWeight(float s) {
   return std::min(std::max(s * kRidgeWeight, 0.0f), 1.0f);
 }
 
+// One octave's contribution folded into (sum, weight), the same in every
+// path: the point calls, the arrays and the grids.
+template <bool kRidged>
+inline void Accumulate(float a, float n, float& sum, float& weight) {
+  if constexpr (kRidged) {
+    const float s = RidgeSignal(n, weight);
+    sum += a * s;
+    weight = NextWeight(s);
+  } else {
+    sum += a * n;
+  }
+}
+
 template <bool kRidged>
 float PointSum(const Octaves& o, float x, float y) {
   float sum = 0.0f, weight = 1.0f;
   for (int k = 0; k < o.count; ++k) {
-    const float n = kernels::Noise2(o.key[k], x * o.freq[k], y * o.freq[k]);
-    if constexpr (kRidged) {
-      const float s = RidgeSignal(n, weight);
-      sum += o.amp[k] * s;
-      weight = NextWeight(s);
-    } else {
-      sum += o.amp[k] * n;
-    }
+    Accumulate<kRidged>(o.amp[k], kernels::Noise2(o.key[k], x * o.freq[k], y * o.freq[k]), sum,
+                        weight);
   }
   return sum / o.total;
+}
+
+template <bool kRidged>
+float PointSum(const Octaves& o, float x, float y, float z) {
+  float sum = 0.0f, weight = 1.0f;
+  for (int k = 0; k < o.count; ++k) {
+    const float f = o.freq[k];
+    Accumulate<kRidged>(o.amp[k], kernels::Noise3(o.key[k], x * f, y * f, z * f), sum, weight);
+  }
+  return sum / o.total;
+}
+
+// Arrays of points (z null: 2D), in chunks of kChunk on the pool.
+constexpr size_t kChunk = 1024;
+
+template <bool kRidged>
+void ArraySum(uint64_t seed, const FractalDef& def, const float* x, const float* y, const float* z,
+              size_t count, float* out, Kernel kernel, ThreadPool* pool) {
+  const Octaves o = MakeOctaves(seed, def);
+  const size_t chunks = (count + kChunk - 1) / kChunk;
+  ForRanges(pool, chunks, BalancedGrain(pool, chunks, 1), [&](size_t begin, size_t end) {
+    float n[kChunk], weight[kChunk];
+    for (size_t c = begin; c < end; ++c) {
+      const size_t first = c * kChunk, m = std::min(kChunk, count - first);
+      float* sum = out + first;
+      std::fill(sum, sum + m, 0.0f);
+      std::fill(weight, weight + m, 1.0f);
+      for (int k = 0; k < o.count; ++k) {
+        if (z) {
+          kernels::Noise3Points(kernel, o.key[k], x + first, y + first, z + first, o.freq[k], m, n);
+        } else {
+          kernels::Noise2Points(kernel, o.key[k], x + first, y + first, o.freq[k], m, n);
+        }
+        for (size_t i = 0; i < m; ++i) Accumulate<kRidged>(o.amp[k], n[i], sum[i], weight[i]);
+      }
+      for (size_t i = 0; i < m; ++i) sum[i] /= o.total;
+    }
+  });
 }
 
 template <bool kRidged>
@@ -78,24 +123,15 @@ void GridSum(uint64_t seed, const FractalDef& def, const Grid2& grid, float* out
   const Octaves o = MakeOctaves(seed, def);
   const size_t grain = BalancedGrain(pool, grid.ny, 4);
   ForRanges(pool, grid.ny, grain, [&](size_t begin, size_t end) {
-    std::vector<float> n(grid.nx), weight(kRidged ? grid.nx : 0);
+    std::vector<float> n(grid.nx), weight(grid.nx);  // weight: ridged only
     for (size_t j = begin; j < end; ++j) {
       float* row = out + j * grid.nx;
       const float y = grid.y0 + float(int32_t(j)) * grid.dy;
       std::fill(row, row + grid.nx, 0.0f);
-      if constexpr (kRidged) std::fill(weight.begin(), weight.end(), 1.0f);
+      std::fill(weight.begin(), weight.end(), 1.0f);
       for (int k = 0; k < o.count; ++k) {
         kernels::Noise2Row(kernel, o.key[k], grid.x0, grid.dx, y, o.freq[k], grid.nx, n.data());
-        const float a = o.amp[k];
-        if constexpr (kRidged) {
-          for (size_t i = 0; i < grid.nx; ++i) {
-            const float s = RidgeSignal(n[i], weight[i]);
-            row[i] += a * s;
-            weight[i] = NextWeight(s);
-          }
-        } else {
-          for (size_t i = 0; i < grid.nx; ++i) row[i] += a * n[i];
-        }
+        for (size_t i = 0; i < grid.nx; ++i) Accumulate<kRidged>(o.amp[k], n[i], row[i], weight[i]);
       }
       for (size_t i = 0; i < grid.nx; ++i) row[i] /= o.total;
     }
@@ -130,6 +166,36 @@ float Fbm2(uint64_t seed, const FractalDef& def, float x, float y) {
 
 float Ridged2(uint64_t seed, const FractalDef& def, float x, float y) {
   return PointSum<true>(MakeOctaves(seed, def), x, y);
+}
+
+float Fbm3(uint64_t seed, const FractalDef& def, float x, float y, float z) {
+  return PointSum<false>(MakeOctaves(seed, def), x, y, z);
+}
+
+float Ridged3(uint64_t seed, const FractalDef& def, float x, float y, float z) {
+  return PointSum<true>(MakeOctaves(seed, def), x, y, z);
+}
+
+void Fbm2(uint64_t seed, const FractalDef& def, const float* x, const float* y, size_t n,
+          float* out, Kernel kernel, ThreadPool* pool) {
+  ArraySum<false>(seed, def, x, y, nullptr, n, out, kernel, pool);
+}
+
+void Ridged2(uint64_t seed, const FractalDef& def, const float* x, const float* y, size_t n,
+             float* out, Kernel kernel, ThreadPool* pool) {
+  ArraySum<true>(seed, def, x, y, nullptr, n, out, kernel, pool);
+}
+
+void Fbm3(uint64_t seed, const FractalDef& def, const float* x, const float* y, const float* z,
+          size_t n, float* out, Kernel kernel, ThreadPool* pool) {
+  SYLVA_ASSERT(z != nullptr);
+  ArraySum<false>(seed, def, x, y, z, n, out, kernel, pool);
+}
+
+void Ridged3(uint64_t seed, const FractalDef& def, const float* x, const float* y, const float* z,
+             size_t n, float* out, Kernel kernel, ThreadPool* pool) {
+  SYLVA_ASSERT(z != nullptr);
+  ArraySum<true>(seed, def, x, y, z, n, out, kernel, pool);
 }
 
 void Fbm2Grid(uint64_t seed, const FractalDef& def, const Grid2& grid, float* out, Kernel kernel,

@@ -1,4 +1,4 @@
-// Fractal sums of gradient noise (noise.h) in 2D: fractional Brownian
+// Fractal sums of gradient noise (noise.h) in 2D and 3D: fractional Brownian
 // motion and Musgrave's ridged multifractal (Musgrave, in Ebert et al.,
 // "Texturing and Modeling: A Procedural Approach", 3rd ed. 2003, ch. 16:
 // fBm and RidgedMultifractal).
@@ -37,6 +37,20 @@ Status Validate(const FractalDef& def);
 // One sample. The def must be valid (asserted: octaves in 1..16).
 float Fbm2(uint64_t seed, const FractalDef& def, float x, float y);
 float Ridged2(uint64_t seed, const FractalDef& def, float x, float y);
+float Fbm3(uint64_t seed, const FractalDef& def, float x, float y, float z);
+float Ridged3(uint64_t seed, const FractalDef& def, float x, float y, float z);
+
+// Arrays of points: out[i] = Fbm2(seed, def, x[i], y[i]) and so on, bit
+// for bit; chunks of 1024 points on `pool` when given. The caller
+// allocates out (n floats).
+void Fbm2(uint64_t seed, const FractalDef& def, const float* x, const float* y, size_t n,
+          float* out, Kernel kernel = BestKernel(), ThreadPool* pool = nullptr);
+void Ridged2(uint64_t seed, const FractalDef& def, const float* x, const float* y, size_t n,
+             float* out, Kernel kernel = BestKernel(), ThreadPool* pool = nullptr);
+void Fbm3(uint64_t seed, const FractalDef& def, const float* x, const float* y, const float* z,
+          size_t n, float* out, Kernel kernel = BestKernel(), ThreadPool* pool = nullptr);
+void Ridged3(uint64_t seed, const FractalDef& def, const float* x, const float* y, const float* z,
+             size_t n, float* out, Kernel kernel = BestKernel(), ThreadPool* pool = nullptr);
 
 // The grid's samples (noise.h's Grid2, out[j nx + i]); rows on `pool` when
 // given. The def must be valid.

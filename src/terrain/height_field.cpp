@@ -155,7 +155,7 @@ Expected<HeightField> HeightField::Create(const TerrainDef& def, ThreadPool* poo
   f.z0_ = -def.sizeZ / 2;
   f.dx_ = def.sizeX / double(n - 1);
   f.dz_ = def.sizeZ / double(n - 1);
-  f.heights_.assign(n * n, 0.0f);
+  if (def.noise != NoiseKind::kDiamondSquare) f.heights_.assign(n * n, 0.0f);
   float* h = f.heights_.data();
   double scale = def.height;
   switch (def.noise) {

@@ -26,12 +26,17 @@
 //   flat            0 everywhere
 // fbm and ridged sample at (x, z) / featureSize: the first octave's
 // lattice spacing is featureSize metres (0 = half the larger extent).
+//
+// A HeightField is immutable once made: its const queries may run on any
+// number of threads at once. To draw it, turn MakeMesh()'s arrays into a
+// mesh::TriangleMesh (examples/terrain/terrain_kinds.cpp does).
 #pragma once
 
 #include <cstdint>
 #include <string_view>
 #include <vector>
 
+#include "core/assert.h"
 #include "core/math.h"
 #include "core/status.h"
 
@@ -94,6 +99,7 @@ class HeightField {
   double VertexX(int i) const { return x0_ + double(i) * dx_; }
   double VertexZ(int j) const { return z0_ + double(j) * dz_; }
   float HeightAt(int i, int j) const {
+    SYLVA_DCHECK(i >= 0 && i < def_.resolution && j >= 0 && j < def_.resolution);
     return heights_[size_t(j) * size_t(def_.resolution) + size_t(i)];
   }
   // resolution^2 heights, row-major by z: [j resolution + i].

@@ -28,7 +28,7 @@ void GradientNoise2(uint64_t seed, const float* x, const float* y, size_t n, flo
 
 void GradientNoise3(uint64_t seed, const float* x, const float* y, const float* z, size_t n,
                     float* out, Kernel kernel) {
-  kernels::Noise3Points(kernel, kernels::KeyOf(seed), x, y, z, n, out);
+  kernels::Noise3Points(kernel, kernels::KeyOf(seed), x, y, z, 1.0f, n, out);
 }
 
 void GradientNoise2Grid(uint64_t seed, const Grid2& grid, float* out, Kernel kernel,

@@ -26,7 +26,7 @@
 // not depend on thread count, batch size or alignment.
 //
 // The batch calls are the hot path: on the 2-core VM, about 910 M 2D
-// samples/s on one core with AVX2, 130 M/s with the scalar twin
+// samples/s on one core with AVX2, 134 M/s with the scalar twin
 // (bench/bench_terrain.cpp; docs/terrain.md has the figures).
 #pragma once
 

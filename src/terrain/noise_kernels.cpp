@@ -137,15 +137,18 @@ SYLVA_AVX2 size_t Noise2PointsAvx2(uint32_t key, const float* x, const float* y,
 }
 
 SYLVA_AVX2 size_t Noise3PointsAvx2(uint32_t key, const float* x, const float* y, const float* z,
-                                   size_t n, float* out) {
+                                   float f, size_t n, float* out) {
   const __m256i k = _mm256_set1_epi32(int32_t(key));
   const Tables3 t{_mm256_loadu_ps(kGrad3X), _mm256_loadu_ps(kGrad3X + 8),
                   _mm256_loadu_ps(kGrad3Y), _mm256_loadu_ps(kGrad3Y + 8),
                   _mm256_loadu_ps(kGrad3Z), _mm256_loadu_ps(kGrad3Z + 8)};
+  const __m256 vf = _mm256_set1_ps(f);
   size_t i = 0;
   for (; i + 8 <= n; i += 8) {
-    _mm256_storeu_ps(out + i, Noise3V(k, _mm256_loadu_ps(x + i), _mm256_loadu_ps(y + i),
-                                      _mm256_loadu_ps(z + i), t));
+    const __m256 px = _mm256_mul_ps(_mm256_loadu_ps(x + i), vf);
+    const __m256 py = _mm256_mul_ps(_mm256_loadu_ps(y + i), vf);
+    const __m256 pz = _mm256_mul_ps(_mm256_loadu_ps(z + i), vf);
+    _mm256_storeu_ps(out + i, Noise3V(k, px, py, pz, t));
   }
   return i;
 }
@@ -166,9 +169,9 @@ void Noise2Points(Kernel kernel, uint32_t key, const float* x, const float* y, f
 }
 
 void Noise3Points(Kernel kernel, uint32_t key, const float* x, const float* y, const float* z,
-                  size_t n, float* out) {
-  size_t i = kernel == Kernel::kAvx2 ? Noise3PointsAvx2(key, x, y, z, n, out) : 0;
-  for (; i < n; ++i) out[i] = Noise3(key, x[i], y[i], z[i]);
+                  float f, size_t n, float* out) {
+  size_t i = kernel == Kernel::kAvx2 ? Noise3PointsAvx2(key, x, y, z, f, n, out) : 0;
+  for (; i < n; ++i) out[i] = Noise3(key, x[i] * f, y[i] * f, z[i] * f);
 }
 
 }  // namespace sylva::terrain::kernels

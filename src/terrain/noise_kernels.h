@@ -116,8 +116,8 @@ void Noise2Row(Kernel kernel, uint32_t key, float x0, float dx, float y, float f
 // out[i] = Noise2(key, x[i] f, y[i] f).
 void Noise2Points(Kernel kernel, uint32_t key, const float* x, const float* y, float f, size_t n,
                   float* out);
-// out[i] = Noise3(key, x[i], y[i], z[i]).
+// out[i] = Noise3(key, x[i] f, y[i] f, z[i] f).
 void Noise3Points(Kernel kernel, uint32_t key, const float* x, const float* y, const float* z,
-                  size_t n, float* out);
+                  float f, size_t n, float* out);
 
 }  // namespace sylva::terrain::kernels

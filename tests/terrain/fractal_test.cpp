@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include "core/parallel.h"
@@ -92,6 +93,66 @@ TEST(Fractal, GridGivesThePointValuesOnEitherKernelAndAnyThreadCount) {
       }
     }
   }
+}
+
+std::vector<float> Uniform(size_t n, uint64_t seed, float lo, float hi) {
+  std::vector<float> v(n);
+  for (size_t i = 0; i < n; ++i) v[i] = lo + (hi - lo) * float(ToUnit(CounterHash(seed, i)));
+  return v;
+}
+
+TEST(Fractal, ArraysGiveThePointValuesOnEitherKernelAndAnyThreadCount) {
+  const size_t n = 5000 + 3;  // chunks of 1024 and a tail of 8 and of 1
+  const std::vector<float> x = Uniform(n, 1, -30, 30), y = Uniform(n, 2, -30, 30);
+  const std::vector<float> z = Uniform(n, 3, -30, 30);
+  const FractalDef def{6, 1.9f, 0.55f};
+  using Point2 = float (*)(uint64_t, const FractalDef&, float, float);
+  using Point3 = float (*)(uint64_t, const FractalDef&, float, float, float);
+  using Array2 = void (*)(uint64_t, const FractalDef&, const float*, const float*, size_t, float*,
+                          Kernel, ThreadPool*);
+  using Array3 = void (*)(uint64_t, const FractalDef&, const float*, const float*, const float*,
+                          size_t, float*, Kernel, ThreadPool*);
+  const Point2 p2[2] = {Fbm2, Ridged2};
+  const Point3 p3[2] = {Fbm3, Ridged3};
+  const Array2 a2[2] = {Fbm2, Ridged2};
+  const Array3 a3[2] = {Fbm3, Ridged3};
+  for (int ridged = 0; ridged < 2; ++ridged) {
+    std::vector<float> ref2(n), ref3(n);
+    for (size_t i = 0; i < n; ++i) {
+      ref2[i] = p2[ridged](8, def, x[i], y[i]);
+      ref3[i] = p3[ridged](8, def, x[i], y[i], z[i]);
+    }
+    for (Kernel kernel : {Kernel::kScalar, BestKernel()}) {
+      for (int threads : {0, 1, 3}) {
+        std::unique_ptr<ThreadPool> pool =
+            threads ? std::make_unique<ThreadPool>(threads) : nullptr;
+        std::vector<float> v2(n), v3(n);
+        a2[ridged](8, def, x.data(), y.data(), n, v2.data(), kernel, pool.get());
+        a3[ridged](8, def, x.data(), y.data(), z.data(), n, v3.data(), kernel, pool.get());
+        EXPECT_EQ(HashBits(v2), HashBits(ref2))
+            << (ridged ? "ridged" : "fbm") << " 2D, kernel " << int(kernel) << ", " << threads;
+        EXPECT_EQ(HashBits(v3), HashBits(ref3))
+            << (ridged ? "ridged" : "fbm") << " 3D, kernel " << int(kernel) << ", " << threads;
+      }
+    }
+  }
+}
+
+TEST(Fractal, ThreeDimensionalSumsStayInTheirRanges) {
+  const size_t n = 400000;
+  const std::vector<float> x = Uniform(n, 4, -300, 300), y = Uniform(n, 5, -300, 300);
+  const std::vector<float> z = Uniform(n, 6, -300, 300);
+  std::vector<float> v(n);
+  Fbm3(2, FractalDef{}, x.data(), y.data(), z.data(), n, v.data());
+  const Range f = Measure(v);
+  EXPECT_GE(f.lo, -1.0f);
+  EXPECT_LE(f.hi, 1.0f);
+  EXPECT_GT(f.hi - f.lo, 0.8f) << "fbm 3D measured [" << f.lo << ", " << f.hi << "]";
+  Ridged3(2, FractalDef{}, x.data(), y.data(), z.data(), n, v.data());
+  const Range r = Measure(v);
+  EXPECT_GE(r.lo, 0.0f);
+  EXPECT_LE(r.hi, 1.0f);
+  EXPECT_GT(r.hi - r.lo, 0.5f) << "ridged 3D measured [" << r.lo << ", " << r.hi << "]";
 }
 
 TEST(Fractal, BadDefsAreRejectedWithTheFieldAndValue) {
