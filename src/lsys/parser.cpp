@@ -18,6 +18,7 @@
 
 #include "core/atomic_file.h"
 #include "lsys/expr_parser.h"
+#include "lsys/unsupported.h"
 
 namespace sylva::lsys {
 namespace {
@@ -130,7 +131,15 @@ class GrammarParser {
   bool ParseConstExpr(const Line& l, size_t pos, size_t end, double* out, Expr* expr = nullptr);
   bool CheckBrackets(const Line& l, const std::vector<SymbolId>& syms, const std::vector<int>& cols,
                      const char* what);
+  // opt_.isSurface, asked once per name; false without it.
+  bool IsSurface(const std::string& name) {
+    if (!opt_.isSurface) return false;
+    auto it = isSurface_.find(name);
+    if (it == isSurface_.end()) it = isSurface_.emplace(name, opt_.isSurface(name)).first;
+    return it->second;
+  }
   std::optional<SymbolId> Intern(const Line& l, int col, const std::string& name, int arity);
+  void WarnAfterEnd(const Line& l);
   void Finish();
   void WarnUnmatchable();
 
@@ -143,6 +152,7 @@ class GrammarParser {
   Section* section_ = &g_.main;
   bool haveAxiom_ = false;
   bool ended_ = false;
+  bool warnedAfterEnd_ = false;
   Successor axiom_;
   SourceLoc axiomLoc_;
   std::vector<int> axiomCols_;
@@ -156,6 +166,8 @@ class GrammarParser {
   std::unordered_set<std::string> usedConstants_;
   std::set<std::string> usedOverrides_;
   std::unordered_map<std::string, ArityUse> arityUse_;
+  std::unordered_set<std::string> unsupportedWarned_;  // name + reason
+  std::unordered_map<std::string, bool> isSurface_;
   std::set<std::string> ignoreNames_, considerNames_;
   bool haveIgnore_ = false, haveConsider_ = false;
   size_t bytesRead_ = 0;  // all files, for kMaxGrammarBytes
@@ -329,6 +341,9 @@ bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string*
     size_t q = pos + 1;
     if (q < end && IsIdentStart(t[q])) {
       while (q < end && IsIdentChar(t[q])) ++q;
+      if (q - pos > 2 && !IsSurface(t.substr(pos + 1, q - pos - 1)) &&
+          IsSurface(t.substr(pos + 1, 1)))
+        q = pos + 2;  // cpfg: a one-letter surface, then the next module
       *name = t.substr(pos, q - pos);
       pos = q;
       return true;
@@ -392,6 +407,11 @@ std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std:
   if (!id) {
     Error(l, col, "too many distinct modules (the limit is 65535)");
     return std::nullopt;
+  }
+  // What Sylva does not act on is said once, at its first use.
+  if (auto why = UnsupportedModule(name, arity)) {
+    if (unsupportedWarned_.insert(name + '\x01' + *why).second)
+      Warn(Loc(l, col), l.original, *why, int(name.size()));
   }
   auto it = arityUse_.find(name);
   if (it == arityUse_.end()) {
@@ -1100,6 +1120,29 @@ void GrammarParser::ParseLine(const Line& l) {
 // ---------------------------------------------------------------------------
 // After all lines
 
+// The first line with text after `endlsystem`: Sylva reads one L-system a
+// file, so what follows is said to be ignored, where it starts.
+void GrammarParser::WarnAfterEnd(const Line& l) {
+  const std::string& t = l.text;
+  size_t pos = 0;
+  while (pos < t.size() && IsSpace(t[pos])) ++pos;
+  if (pos >= t.size()) return;
+  warnedAfterEnd_ = true;
+  size_t e = pos;
+  while (e < t.size() && IsIdentChar(t[e])) ++e;
+  size_t c = e;
+  while (c < t.size() && IsSpace(t[c])) ++c;
+  if (Lower(t.substr(pos, e - pos)) == "lsystem" && c < t.size() && t[c] == ':') {
+    Warn(Loc(l, int(pos) + 1), l.original,
+         "a second 'lsystem:' block (a cpfg sub-L-system) is not supported: it and everything "
+         "after it are ignored",
+         int(e - pos));
+    return;
+  }
+  Warn(Loc(l, int(pos) + 1), l.original,
+       "text after 'endlsystem' is ignored (Sylva reads one L-system a file)", 1);
+}
+
 void GrammarParser::WarnUnmatchable() {
   // Symbols that can occur in a derived word: the axiom and every successor
   // of the main and decomposition sections; interpretation successors only
@@ -1236,7 +1279,11 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   declaredLengths_.erase(std::unique(declaredLengths_.begin(), declaredLengths_.end()),
                          declaredLengths_.end());
   for (const Line& l : lines_) {
-    if (ended_) break;
+    if (ended_) {
+      WarnAfterEnd(l);
+      if (warnedAfterEnd_) break;
+      continue;
+    }
     ParseLine(l);
   }
   Finish();

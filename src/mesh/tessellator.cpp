@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <type_traits>
 
 #include "core/memory.h"
@@ -315,11 +316,17 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   for (const SurfaceInstance& si : g.surfaces) {
     const TriangleMesh& s = options.surfaces->at(si.name);
     const uint32_t base = uint32_t(out.positions.size());
+    std::optional<Vec3> inverseScale;
+    if (si.scale.x() != 0 && si.scale.y() != 0 && si.scale.z() != 0)
+      inverseScale = si.scale.cwiseInverse();
     for (size_t i = 0; i < s.positions.size(); ++i) {
       const Vec3 p = s.positions[i].cast<double>(), n = s.normals[i].cast<double>();
-      const Vec3 wp = si.position + si.scale * (p.x() * si.frame.left + p.y() * si.frame.heading +
-                                                p.z() * si.frame.up);
-      const Vec3 wn = n.x() * si.frame.left + n.y() * si.frame.heading + n.z() * si.frame.up;
+      const Vec3 sp = p.cwiseProduct(si.scale);
+      const Vec3 wp =
+          si.position + sp.x() * si.frame.left + sp.y() * si.frame.heading + sp.z() * si.frame.up;
+      // Normals scale by the inverse (a flat scale leaves them as they are).
+      const Vec3 sn = inverseScale ? Vec3(n.cwiseProduct(*inverseScale)) : n;
+      const Vec3 wn = sn.x() * si.frame.left + sn.y() * si.frame.heading + sn.z() * si.frame.up;
       out.positions.push_back(F(wp));
       out.normals.push_back(F(wn.normalized()));
       out.uvs.push_back(s.uvs[i]);

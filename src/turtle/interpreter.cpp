@@ -34,6 +34,7 @@ enum class Op : uint8_t {
   kPolygonEnd,
   kSurface,
   kSphere,
+  kMoveTo,
 };
 
 Op OpFor(const std::string& name) {
@@ -83,6 +84,7 @@ Op OpFor(const std::string& name) {
   }
   if (name[0] == '~') return Op::kSurface;
   if (name == "@O") return Op::kSphere;
+  if (name == "@M") return Op::kMoveTo;
   return Op::kNone;
 }
 
@@ -243,7 +245,7 @@ static Status CheckRange(const PlantGeometry& g, const lsys::Word& word,
     if (!okPoint(sp.center) || !ok(sp.radius)) return fail(sp.module, "a sphere");
   }
   for (const SurfaceInstance& si : g.surfaces) {
-    if (!okPoint(si.position) || !ok(si.scale)) return fail(si.module, "a surface placement");
+    if (!okPoint(si.position) || !okPoint(si.scale)) return fail(si.module, "a surface placement");
   }
   return {};
 }
@@ -480,7 +482,12 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         si.name = symbols.name(sym).substr(1);
         si.position = t.pos;
         si.frame = t.frame;
-        si.scale = np ? p[0] : 1.0;
+        // ~name(s): uniform; ~name(sx, sy, sz): along L, H, U (cpfg).
+        if (np >= 3) {
+          si.scale = Vec3(p[0], p[1], p[2]);
+        } else if (np) {
+          si.scale = Vec3(p[0], p[0], p[0]);
+        }
         si.color = t.color;
         si.module = uint32_t(i);
         g.surfaces.push_back(std::move(si));
@@ -495,6 +502,14 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         g.spheres.push_back(sp);
         break;
       }
+      case Op::kMoveTo:
+        // @M(x,y,z): cpfg's move-to, drawing nothing. Other arities are
+        // warned about by the parser and do nothing.
+        if (np >= 3) {
+          t.pos = Vec3(p[0], p[1], p[2]);
+          visit(t.pos);
+        }
+        break;
       case Op::kNone:
         break;
     }

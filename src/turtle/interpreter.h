@@ -14,7 +14,9 @@
 // current position. `[` `]` push and pop the turtle state (not the polygon).
 // !(w) sets the width (a diameter), ! multiplies it by the width factor;
 // '(c) sets the colour index, ' adds 1; ~name(s) places a surface scaled by
-// s (default 1); @O(d) a sphere of diameter d (default: the width).
+// s (default 1), ~name(sx,sy,sz) scaled along L, H, U; @O(d) a sphere of
+// diameter d (default: the width); @M(x,y,z) moves to (x,y,z) drawing
+// nothing.
 // Tropism (ABOP eq. 2.3): after every F and f, the frame turns about H x T
 // by e |H x T|.
 #pragma once

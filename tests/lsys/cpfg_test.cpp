@@ -1,0 +1,108 @@
+// Reading cpfg files (docs/cpfg.md): what Sylva does not implement is said,
+// with its location, once per symbol; the rest reads as cpfg reads it.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "lsys/parser.h"
+#include "lsys_test_util.h"
+
+namespace sylva::lsys {
+namespace {
+
+using testing::DeriveText;
+using testing::MustParse;
+
+// "line:col message" of every diagnostic (all must be warnings).
+std::vector<std::string> Warnings(const std::string& text, const ParseOptions& opt = {}) {
+  ParseResult r = ParseGrammarText(text, "c.l", opt);
+  EXPECT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  std::vector<std::string> out;
+  for (const auto& d : r.diagnostics.items) {
+    EXPECT_EQ(d.severity, Severity::kWarning) << d.Format();
+    out.push_back(std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " +
+                  d.message);
+  }
+  return out;
+}
+
+std::string Joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += x + "\n";
+  return s;
+}
+
+TEST(Cpfg, UnimplementedCommandsWarnOncePerSymbolAtTheirFirstUse) {
+  auto w = Warnings(
+      "axiom: A\n"
+      "A --> F@Gs F@Gc(1)@Gc(2)@Ge A\n"
+      "F --> @Gs F @Tf(1) @Ts(2) @o(1) @c(1) @v @M(1,2) @O(2)\n");
+  const std::string all = Joined(w);
+  ASSERT_EQ(w.size(), 9u) << all;
+  EXPECT_EQ(w[0].rfind("2:8 '@Gs' (cpfg: start of a generalized cylinder) is not implemented", 0),
+            0u)
+      << all;
+  EXPECT_EQ(w[1].rfind("2:13 '@Gc'", 0), 0u) << all;  // once for @Gc(1) and @Gc(2)
+  EXPECT_EQ(w[2].rfind("2:25 '@Ge'", 0), 0u) << all;
+  EXPECT_EQ(w[3].rfind("3:13 '@Tf'", 0), 0u) << all;
+  EXPECT_EQ(w[4].rfind("3:20 '@Ts'", 0), 0u) << all;
+  EXPECT_EQ(w[5].rfind("3:27 '@o'", 0), 0u) << all;
+  EXPECT_EQ(w[6].rfind("3:33 '@c'", 0), 0u) << all;
+  EXPECT_EQ(w[7].rfind("3:39 '@v'", 0), 0u) << all;
+  EXPECT_EQ(w[8].rfind("3:42 '@M' (move to) needs 3 parameters", 0), 0u) << all;
+}
+
+TEST(Cpfg, QueryModulesWarnThatTheyAreNotAnswered) {
+  auto w = Warnings("axiom: A ?P(0,0,0)\nA --> F ?H(0,0,0) ?P(1,1,1)\n");
+  ASSERT_EQ(w.size(), 2u) << Joined(w);
+  EXPECT_EQ(w[0].rfind("1:10 query module '?P' is not answered yet", 0), 0u) << w[0];
+  EXPECT_EQ(w[1].rfind("2:9 query module '?H' is not answered yet", 0), 0u) << w[1];
+}
+
+TEST(Cpfg, SurfaceWithTwoScalesWarns) {
+  EXPECT_TRUE(Warnings("axiom: ~leaf(1) ~petal(1,2,3) ~flower\n").empty());
+  auto w = Warnings("axiom: F ~leaf(1,2)\n");
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0].rfind("1:10 surface '~leaf' takes 1 scale or 3", 0), 0u) << w[0];
+}
+
+TEST(Cpfg, TextAfterEndlsystemWarnsWhereItStarts) {
+  auto w = Warnings("axiom: F\nendlsystem\n\n  F --> FF\nG --> GG\n");
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0], "4:3 text after 'endlsystem' is ignored (Sylva reads one L-system a file)");
+  // ... and it is ignored: F is not rewritten.
+  EXPECT_EQ(DeriveText("axiom: F\nendlsystem\nF --> FF\n", 1), "F");
+}
+
+TEST(Cpfg, SecondLsystemBlockWarnsThatSubLsystemsAreNotSupported) {
+  auto w = Warnings("Lsystem: 1\naxiom: F\nendlsystem\nLsystem: 2\naxiom: G\nendlsystem\n");
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0].rfind("4:1 a second 'lsystem:' block (a cpfg sub-L-system) is not supported", 0),
+            0u)
+      << w[0];
+}
+
+TEST(Cpfg, BlankLinesAndCommentsAfterEndlsystemAreSilent) {
+  EXPECT_TRUE(Warnings("axiom: F\nendlsystem\n\n/* done */\n// end\n").empty());
+}
+
+TEST(Cpfg, OneLetterSurfaceNameWhenOnlyItIsKnown) {
+  ParseOptions opt;
+  opt.isSurface = [](const std::string& n) { return n == "l" || n == "leaf"; };
+  Grammar g = MustParse("axiom: ~lF ~leaf(2) ~leafF ~lx\n", opt);
+  // ~lF: l is a surface and lF is not, so ~l then F (cpfg); ~leaf is whole;
+  // ~leafF: leafF is not a surface, l is, so ~l then e a f F; ~lx: ~l x.
+  std::string names;
+  for (SymbolId s : g.axiom.symbols) names += g.symbols.name(s) + " ";
+  EXPECT_EQ(names, "~l F ~leaf ~l e a f F ~l x ");
+}
+
+TEST(Cpfg, SurfaceNamesAreWholeWithoutALibrary) {
+  Grammar g = MustParse("axiom: ~lF\n");
+  ASSERT_EQ(g.axiom.symbols.size(), 1u);
+  EXPECT_EQ(g.symbols.name(g.axiom.symbols[0]), "~lF");
+}
+
+}  // namespace
+}  // namespace sylva::lsys
