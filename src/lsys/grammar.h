@@ -74,7 +74,8 @@ struct Grammar {
   double step = 1;
   double width = 1;
   double widthFactor = 0.7;
-  double widthScale = 1;  // drawing: diameter = width x widthScale (cpfg's pixel widths)
+  double widthIncrement = 0;  // `width increment:` (cpfg): ! and # subtract/add it; 0: factor
+  double widthScale = 1;      // drawing: diameter = width x widthScale (cpfg's pixel widths)
   std::optional<Tropism> tropism;
   uint64_t seed = 1;
   // `palette: #rrggbb ...`: material colour of each colour index (sRGB as

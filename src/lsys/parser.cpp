@@ -51,7 +51,7 @@ bool IsIdentChar(char c) {
 }
 
 // Single-character module names besides letters and digits.
-constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_";
+constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_;,#";
 
 // cpfg's @ commands, longest first where they share a prefix.
 constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS",
@@ -741,6 +741,12 @@ void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, si
     g_.width = v;
   } else if (k == "width factor") {
     g_.widthFactor = v;
+  } else if (k == "width increment") {
+    if (!(v > 0)) {
+      Error(l, vcol, "width increment must be positive");
+      return;
+    }
+    g_.widthIncrement = v;
   } else if (k == "width scale") {
     if (!(v > 0)) {
       Error(l, vcol, "width scale must be positive");
@@ -757,25 +763,11 @@ void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, si
 }
 
 bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
-  static const char* kKeywords[] = {"derivation length",
-                                    "width factor",
-                                    "width scale",
-                                    "maximum depth",
-                                    "lsystem",
-                                    "axiom",
-                                    "angle",
-                                    "step",
-                                    "width",
-                                    "tropism",
-                                    "seed",
-                                    "ignore",
-                                    "consider",
-                                    "module",
-                                    "decomposition",
-                                    "interpretation",
-                                    "homomorphism",
-                                    "endlsystem",
-                                    "palette"};
+  static const char* kKeywords[] = {
+      "derivation length", "width factor",   "width increment", "width scale", "maximum depth",
+      "lsystem",           "axiom",          "angle",           "step",        "width",
+      "tropism",           "seed",           "ignore",          "consider",    "module",
+      "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette"};
   const std::string& t = l.text;
   std::string lower = Lower(t.substr(pos, 20));
   const char* kw = nullptr;

@@ -32,7 +32,9 @@ constexpr Command kUndrawn[] = {
     {"@b", "bounding box"},
 };
 
-std::string Params(int n) { return std::to_string(n) + (n == 1 ? " parameter" : " parameters"); }
+std::string Params(int n) {
+  return std::to_string(n) + (n == 1 ? " parameter" : " parameters");
+}
 
 }  // namespace
 
@@ -41,8 +43,8 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
   if (name[0] == '@') {
     if (name == "@O") {
       if (arity <= 1) return std::nullopt;
-      return "'@O' (sphere) uses 1 parameter, the diameter; the other " + std::to_string(arity - 1) +
-             " are ignored";
+      return "'@O' (sphere) uses 1 parameter, the diameter; the other " +
+             std::to_string(arity - 1) + " are ignored";
     }
     if (name == "@M") {
       if (arity == 3) return std::nullopt;
@@ -64,7 +66,8 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
   if (name[0] == '~') {
     if (arity <= 1 || arity == 3) return std::nullopt;
     return "surface '" + std::string(name) + "' takes 1 scale or 3 (x, y, z); of its " +
-           Params(arity) + (arity == 2 ? " only the first (a uniform scale) is used" : " the first 3 are used");
+           Params(arity) +
+           (arity == 2 ? " only the first (a uniform scale) is used" : " the first 3 are used");
   }
   return std::nullopt;
 }

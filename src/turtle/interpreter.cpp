@@ -28,7 +28,9 @@ enum class Op : uint8_t {
   kPush,
   kPop,
   kWidth,
+  kWidthUp,
   kColor,
+  kColorDown,
   kPolygonBegin,
   kVertex,
   kPolygonEnd,
@@ -71,7 +73,12 @@ Op OpFor(const std::string& name) {
       case '!':
         return Op::kWidth;
       case '\'':
+      case ';':
         return Op::kColor;
+      case ',':
+        return Op::kColorDown;
+      case '#':
+        return Op::kWidthUp;
       case '{':
         return Op::kPolygonBegin;
       case '.':
@@ -187,6 +194,7 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   d.step = g.step;
   d.width = g.width;
   d.widthFactor = g.widthFactor;
+  d.widthIncrement = g.widthIncrement;
   d.widthScale = g.widthScale;
   if (g.tropism) {
     d.tropism = Vec3(g.tropism->x, g.tropism->y, g.tropism->z);
@@ -459,10 +467,28 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         stack.pop_back();
         break;
       case Op::kWidth:
-        t.width = np ? p[0] : t.width * def.widthFactor;
+        if (np) {
+          t.width = p[0];
+        } else if (def.widthIncrement > 0) {
+          t.width = std::max(t.width - def.widthIncrement, 0.0);
+        } else {
+          t.width *= def.widthFactor;
+        }
+        break;
+      case Op::kWidthUp:
+        if (np) {
+          t.width = p[0];
+        } else if (def.widthIncrement > 0) {
+          t.width += def.widthIncrement;
+        } else if (def.widthFactor != 0) {
+          t.width /= def.widthFactor;
+        }
         break;
       case Op::kColor:
-        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : t.color + 1);
+        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : std::min(t.color + 1, 65535));
+        break;
+      case Op::kColorDown:
+        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : std::max(t.color - 1, 0));
         break;
       case Op::kPolygonBegin: {
         Polygon poly;

@@ -104,5 +104,17 @@ TEST(Cpfg, SurfaceNamesAreWholeWithoutALibrary) {
   EXPECT_EQ(g.symbols.name(g.axiom.symbols[0]), "~lF");
 }
 
+TEST(Cpfg, ColourAndWidthSymbolsAreModules) {
+  EXPECT_EQ(DeriveText("axiom: A\nA --> ;(2)F,#!;,(1)#(3)A\n", 1), ";(2)F,#!;,(1)#(3)A");
+  EXPECT_EQ(DeriveText("axiom: A(1)\nA(x) --> F(x),A(x+1)\n", 2), "F(1),F(2),A(3)");
+}
+
+TEST(Cpfg, WidthIncrementMustBePositive) {
+  ParseResult r = ParseGrammarText("width increment: 0\naxiom: F\n", "c.l");
+  ASSERT_FALSE(r.grammar);
+  EXPECT_EQ(r.diagnostics.items[0].message, "width increment must be positive");
+  EXPECT_EQ(MustParse("width increment: 0.5\naxiom: F\n").widthIncrement, 0.5);
+}
+
 }  // namespace
 }  // namespace sylva::lsys

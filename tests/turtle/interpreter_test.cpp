@@ -332,5 +332,32 @@ TEST(Turtle, MoveToSetsThePositionWithoutDrawing) {
   EXPECT_VEC_NEAR(d.geometry.segments[1].end, Vec3(3, 5, 5), 1e-12);
 }
 
+TEST(Turtle, CpfgColourIndexUpDownAndSet) {
+  // ; up, , down (never below 0), ;(n) and ,(n) set; ' is ; as before.
+  Drawn d = Draw("axiom: ;F;(5)F,F,(2)F,,,F'F\n");
+  ASSERT_EQ(d.geometry.segments.size(), 6u);
+  const int want[] = {1, 5, 4, 2, 0, 1};
+  for (size_t i = 0; i < 6; ++i)
+    EXPECT_EQ(d.geometry.segments[i].color, want[i]) << "segment " << i;
+}
+
+TEST(Turtle, WidthDownAndUpByTheFactor) {
+  // Without `width increment:`, ! multiplies by the width factor and #
+  // divides by it; !(w) and #(w) set.
+  Drawn d = Draw("width: 2\nwidth factor: 0.5\naxiom: !F#F#F#(3)F!(4)F\n");
+  ASSERT_EQ(d.geometry.segments.size(), 5u);
+  const double want[] = {1, 2, 4, 3, 4};
+  for (size_t i = 0; i < 5; ++i)
+    EXPECT_NEAR(d.geometry.segments[i].radiusStart, want[i] / 2, 1e-6) << "segment " << i;
+}
+
+TEST(Turtle, WidthDownAndUpByTheIncrementAsCpfg) {
+  Drawn d = Draw("width: 1\nwidth increment: 0.25\naxiom: !F#F#F!(0.1)F!F#(2)F\n");
+  ASSERT_EQ(d.geometry.segments.size(), 6u);
+  const double want[] = {0.75, 1, 1.25, 0.1, 0, 2};  // never below 0
+  for (size_t i = 0; i < 6; ++i)
+    EXPECT_NEAR(d.geometry.segments[i].radiusStart, want[i] / 2, 1e-6) << "segment " << i;
+}
+
 }  // namespace
 }  // namespace sylva::turtle
