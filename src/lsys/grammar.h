@@ -50,6 +50,16 @@ struct Production {
   SourceLoc loc;  // of the predecessor (Grammar::SourceLine has its text)
   // Columns of the parts, for run-time error messages.
   int conditionColumn = 0, weightColumn = 0;
+  // A production continued over several lines (a trailing `\`, cpfg's
+  // indented continuation) is read as one line; each piece says where its
+  // columns came from: columns from `at` + 1 on are on `line`, starting at
+  // `column` there. Empty: one line.
+  struct LinePiece {
+    int at = 0, line = 0, column = 1;
+  };
+  std::vector<LinePiece> pieces;
+  // The file position of a column of the production as read.
+  SourceLoc LocOf(int column) const;
 
   bool HasContext() const { return !left.empty() || !right.empty(); }
 };

@@ -28,6 +28,22 @@ struct Line {
   int number = 0;
   std::string text;           // comments blanked, same columns
   std::string_view original;  // for excerpts: points into Grammar::sources
+  // Lines joined to this one (JoinContinuations): text from at + 1 on came
+  // from line `number` of the same file, starting at its column `column`.
+  struct Piece {
+    int at = 0, number = 0, column = 1;
+    std::string_view original;
+  };
+  std::vector<Piece> more;
+
+  // The piece that column `col` (1-based, of `text`) came from; null: the first line.
+  const Piece* PieceAt(int col) const {
+    const Piece* p = nullptr;
+    for (const Piece& q : more) {
+      if (col > q.at) p = &q;
+    }
+    return p;
+  }
 };
 
 struct Define {
@@ -79,6 +95,38 @@ std::string Printable(char c) {
   return buf;
 }
 
+// Header statements and section keywords, longest first where they share a
+// prefix ("width factor" before "width").
+constexpr const char* kKeywords[] = {
+    "derivation length", "width factor",   "width increment", "width scale", "maximum depth",
+    "lsystem",           "axiom",          "angle",           "step",        "width",
+    "tropism",           "seed",           "ignore",          "consider",    "module",
+    "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette"};
+
+// The keyword that starts `t` at `pos` ("keyword:", or a bare section
+// keyword alone on its line), case-insensitive; *after is just past it.
+const char* MatchKeyword(const std::string& t, size_t pos, size_t* after) {
+  const std::string lower = Lower(t.substr(pos, 20));
+  for (const char* k : kKeywords) {
+    const size_t n = std::strlen(k);
+    if (lower.compare(0, n, k) != 0) continue;
+    size_t q = pos + n;
+    while (q < t.size() && IsSpace(t[q])) ++q;
+    const std::string_view kv = k;
+    const bool bare = kv == "endlsystem" || kv == "decomposition" || kv == "interpretation" ||
+                      kv == "homomorphism";
+    if (q < t.size() && t[q] == ':') {
+      *after = q + 1;
+      return k;
+    }
+    if (bare && q >= t.size()) {
+      *after = q;
+      return k;
+    }
+  }
+  return nullptr;
+}
+
 class GrammarParser {
  public:
   explicit GrammarParser(const ParseOptions& options) : opt_(options) {}
@@ -87,13 +135,23 @@ class GrammarParser {
 
  private:
   // --- diagnostics ---
-  SourceLoc Loc(const Line& l, int col) const { return SourceLoc{files_[l.file], l.number, col}; }
+  // The file position of column `col` of a (possibly joined) line, and the
+  // text of the file line it is on.
+  SourceLoc Loc(const Line& l, int col) const {
+    if (const Line::Piece* p = l.PieceAt(col))
+      return SourceLoc{files_[l.file], p->number, p->column + (col - 1 - p->at)};
+    return SourceLoc{files_[l.file], l.number, col};
+  }
+  static std::string_view OriginalAt(const Line& l, int col) {
+    const Line::Piece* p = l.PieceAt(col);
+    return p ? p->original : l.original;
+  }
   void Error(const Line& l, int col, std::string msg, int len = 1) {
     if (int(diags_.ErrorCount()) >= kMaxErrors) {
       ++diags_.droppedErrors;  // counted, so the report can say how many
       return;
     }
-    diags_.Add(MakeError(Loc(l, col), std::move(msg), len, l.original));
+    diags_.Add(MakeError(Loc(l, col), std::move(msg), len, OriginalAt(l, col)));
   }
   void Warn(SourceLoc loc, std::string_view line, std::string msg, int len = 1) {
     Diagnostic d = MakeError(std::move(loc), std::move(msg), len, line);
@@ -139,6 +197,7 @@ class GrammarParser {
     return it->second;
   }
   std::optional<SymbolId> Intern(const Line& l, int col, const std::string& name, int arity);
+  void JoinContinuations();
   void WarnAfterEnd(const Line& l);
   void Finish();
   void WarnUnmatchable();
@@ -411,7 +470,7 @@ std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std:
   // What Sylva does not act on is said once, at its first use.
   if (auto why = UnsupportedModule(name, arity)) {
     if (unsupportedWarned_.insert(name + '\x01' + *why).second)
-      Warn(Loc(l, col), l.original, *why, int(name.size()));
+      Warn(Loc(l, col), OriginalAt(l, col), *why, int(name.size()));
   }
   auto it = arityUse_.find(name);
   if (it == arityUse_.end()) {
@@ -419,7 +478,7 @@ std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std:
   } else if (it->second.arity != arity && name != "[" && name != "]") {
     // One warning per name.
     if (it->second.arity >= 0) {
-      Warn(Loc(l, col), l.original,
+      Warn(Loc(l, col), OriginalAt(l, col),
            "module '" + name + "' is used with " + std::to_string(arity) + " parameter" +
                (arity == 1 ? "" : "s") + " here and with " + std::to_string(it->second.arity) +
                " at line " + std::to_string(it->second.loc.line) + "; they are different modules",
@@ -763,34 +822,9 @@ void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, si
 }
 
 bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
-  static const char* kKeywords[] = {
-      "derivation length", "width factor",   "width increment", "width scale", "maximum depth",
-      "lsystem",           "axiom",          "angle",           "step",        "width",
-      "tropism",           "seed",           "ignore",          "consider",    "module",
-      "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette"};
   const std::string& t = l.text;
-  std::string lower = Lower(t.substr(pos, 20));
-  const char* kw = nullptr;
   size_t after = 0;
-  for (const char* k : kKeywords) {
-    size_t n = std::strlen(k);
-    if (lower.compare(0, n, k) != 0) continue;
-    size_t q = pos + n;
-    while (q < t.size() && IsSpace(t[q])) ++q;
-    bool colon = q < t.size() && t[q] == ':';
-    bool bare = std::string_view(k) == "endlsystem" || std::string_view(k) == "decomposition" ||
-                std::string_view(k) == "interpretation" || std::string_view(k) == "homomorphism";
-    if (colon) {
-      kw = k;
-      after = q + 1;
-      break;
-    }
-    if (bare && (q >= t.size())) {
-      kw = k;
-      after = q;
-      break;
-    }
-  }
+  const char* kw = MatchKeyword(t, pos, &after);
   if (!kw) return false;
   std::string k = kw;
   size_t end = t.size();
@@ -877,6 +911,72 @@ static size_t FindTopLevel(const std::string& t, size_t from, size_t to, std::st
       return i;
   }
   return std::string::npos;
+}
+
+// A line continued on the next: by a `\` at its end (the `\` reads as a
+// space), or, for a production, by indented lines that are neither
+// statements nor productions themselves (cpfg's way of writing a long
+// successor, or the `-->` of a production on the line after its
+// predecessor and condition). Lines of different files are never joined.
+// Joined lines keep where each piece came from (Line::more), so errors
+// point into the right line and column.
+void GrammarParser::JoinContinuations() {
+  auto firstText = [](const std::string& t) {
+    size_t p = 0;
+    while (p < t.size() && IsSpace(t[p])) ++p;
+    return p;
+  };
+  auto hasArrow = [](const std::string& t) {
+    return FindTopLevel(t, 0, t.size(), "->") != std::string::npos;
+  };
+  auto startsWithArrow = [&](const std::string& t) {
+    const size_t p = firstText(t);
+    return t.compare(p, 2, "->") == 0 || t.compare(p, 3, "-->") == 0;
+  };
+  // Not blank, not a statement, not a directive.
+  auto isProduction = [&](const Line& l) {
+    const size_t p = firstText(l.text);
+    size_t after = 0;
+    return p < l.text.size() && l.text[p] != '#' && !MatchKeyword(l.text, p, &after);
+  };
+  // `l` ends with `\` and `next` goes on with it (text that is not a
+  // statement, directive or production of its own; otherwise the `\` is
+  // the roll module that ends a word): blanks the `\` and says so.
+  auto takeBackslash = [&](Line& l, const Line* next) {
+    if (!next || next->file != l.file || !isProduction(*next) ||
+        (hasArrow(next->text) && !startsWithArrow(next->text)))
+      return false;
+    size_t e = l.text.size();
+    while (e > 0 && IsSpace(l.text[e - 1])) --e;
+    if (e == 0 || l.text[e - 1] != '\\') return false;
+    l.text[e - 1] = ' ';
+    return true;
+  };
+  std::vector<Line> out;
+  out.reserve(lines_.size());
+  bool continued = false;  // out.back() ended with a backslash
+  for (size_t i = 0; i < lines_.size(); ++i) {
+    Line& l = lines_[i];
+    const Line* next = i + 1 < lines_.size() ? &lines_[i + 1] : nullptr;
+    const size_t p = firstText(l.text);
+    const bool blank = p >= l.text.size();
+    bool join = continued;
+    if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
+        isProduction(out.back())) {
+      const bool curArrow = hasArrow(out.back().text), lineArrow = hasArrow(l.text);
+      join = curArrow ? !lineArrow : startsWithArrow(l.text);
+    }
+    if (!join) {
+      out.push_back(std::move(l));
+      continued = takeBackslash(out.back(), next);
+      continue;
+    }
+    Line& cur = out.back();
+    cur.more.push_back(Line::Piece{int(cur.text.size()), l.number, 1, l.original});
+    cur.text += l.text;
+    continued = takeBackslash(cur, next);
+  }
+  lines_ = std::move(out);
 }
 
 void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen) {
@@ -1011,8 +1111,8 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
       }
       p.conditionColumn = int(c) + 1;
       if (cond.IsConstant() && cond.constant() == 0) {
-        Warn(Loc(l, int(c) + 1), l.original, "condition is always false: production never applies",
-             int(e - c));
+        Warn(Loc(l, int(c) + 1), OriginalAt(l, int(c) + 1),
+             "condition is always false: production never applies", int(e - c));
       }
       if (!(cond.IsConstant() && cond.constant() != 0)) p.condition = std::move(cond);
     }
@@ -1062,6 +1162,11 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     p.weight = std::move(weight);
   }
   p.loc = Loc(l, pf.column);
+  if (!l.more.empty()) {
+    p.pieces.push_back(Production::LinePiece{0, l.number, 1});
+    for (const Line::Piece& q : l.more)
+      p.pieces.push_back(Production::LinePiece{q.at, q.number, q.column});
+  }
   if (section_->productions.size() >= kMaxProductionsPerSection) {
     Error(l, pf.column,
           "more than " + std::to_string(kMaxProductionsPerSection) + " productions in one section");
@@ -1239,6 +1344,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   }
   std::vector<std::string> stack{std::filesystem::path(path).lexically_normal().string()};
   Preprocess(std::make_shared<const std::string>(text), path, 0, stack);
+  JoinContinuations();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
   // module: declarations apply to the whole file, wherever they stand.
@@ -1287,6 +1393,15 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
 }
 
 }  // namespace
+
+SourceLoc Production::LocOf(int column) const {
+  const LinePiece* piece = nullptr;
+  for (const LinePiece& q : pieces) {
+    if (column > q.at) piece = &q;
+  }
+  if (!piece) return SourceLoc{loc.file, loc.line, column};
+  return SourceLoc{loc.file, piece->line, piece->column + (column - 1 - piece->at)};
+}
 
 std::string_view Grammar::SourceLine(const SourceLoc& loc) const {
   for (const SourceFile& f : sources) {

@@ -116,5 +116,57 @@ TEST(Cpfg, WidthIncrementMustBePositive) {
   EXPECT_EQ(MustParse("width increment: 0.5\naxiom: F\n").widthIncrement, 0.5);
 }
 
+TEST(Cpfg, TrailingBackslashContinuesALine) {
+  EXPECT_EQ(DeriveText("axiom: A\nA --> B\\\n  C \\\nD\n", 1), "BCD");
+  // On any line: a #define, an axiom.
+  EXPECT_EQ(DeriveText("#define n \\\n 3\naxiom: A(n) \\\n B\n", 0), "A(3)B");
+}
+
+TEST(Cpfg, BackslashBeforeAStatementOrProductionIsTheRollModule) {
+  EXPECT_EQ(DeriveText("axiom: A\\\nA --> F\\\nB --> C\n", 1), "F\\\\");
+  EXPECT_EQ(DeriveText("axiom: A\\\n\n", 0), "A\\");  // last line, then blank
+  EXPECT_EQ(DeriveText("axiom: A\nA(n) \\\n--> B\nA --> C\n", 1), "C");
+}
+
+TEST(Cpfg, IndentedLinesContinueAProduction) {
+  EXPECT_EQ(DeriveText("axiom: A\nA --> B\n\t[+C]\n\tD\nB --> E\n", 1), "B[+C]D");
+  // The arrow on the line after the predecessor and condition.
+  EXPECT_EQ(DeriveText("axiom: A(2)\nA(n) : n > 0\n\t--> B A(n-1)\n", 3), "BBA(0)");
+  // A weight on its own line.
+  EXPECT_EQ(DeriveText("axiom: A\nA --> B\n    : 1\n", 1), "B");
+}
+
+TEST(Cpfg, IndentedProductionsAndStatementsStayLinesOfTheirOwn) {
+  EXPECT_EQ(DeriveText("axiom: A\n  A --> B\n  B --> C\n", 2), "C");
+  Grammar g = MustParse("axiom: A\nA --> B\n  derivation length: 2\n\tdecomposition\nB --> C\n");
+  EXPECT_EQ(g.derivationLength, 2);
+  EXPECT_EQ(g.decomposition.productions.size(), 1u);
+}
+
+TEST(Cpfg, ErrorsOnAContinuationLinePointAtThatLine) {
+  ParseResult r = ParseGrammarText("axiom: A\nA --> B\n\t[+C(1 +)]\n", "c.l");
+  ASSERT_FALSE(r.grammar);
+  const Diagnostic& d = r.diagnostics.items[0];
+  EXPECT_EQ(d.loc.line, 3) << d.Format();
+  EXPECT_EQ(d.loc.column, 9) << d.Format();
+  EXPECT_EQ(d.sourceLine, "\t[+C(1 +)]") << d.Format();
+
+  ParseResult b = ParseGrammarText("axiom: A\nA --> B \\\n C(2, @)\n", "c.l");
+  ASSERT_FALSE(b.grammar);
+  EXPECT_EQ(b.diagnostics.items[0].loc.line, 3) << b.diagnostics.items[0].Format();
+  EXPECT_EQ(b.diagnostics.items[0].loc.column, 7) << b.diagnostics.items[0].Format();
+}
+
+TEST(Cpfg, RunTimeErrorsOnAContinuationLinePointAtThatLine) {
+  Grammar g = MustParse("axiom: A(0)\nA(x) -->\n\tB(1/x)\n");
+  DeriveOptions opt;
+  opt.steps = 1;
+  auto r = Derive(g, opt);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().loc.line, 3) << r.error().Format();
+  EXPECT_EQ(r.error().loc.column, 5) << r.error().Format();
+  EXPECT_EQ(r.error().sourceLine, "\tB(1/x)") << r.error().Format();
+}
+
 }  // namespace
 }  // namespace sylva::lsys
