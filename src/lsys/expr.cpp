@@ -320,8 +320,12 @@ constexpr FunctionInfo kFunctions[] = {
     {"floor", OpCode::kFloor, 1},   {"ceil", OpCode::kCeil, 1},   {"min", OpCode::kMin, 2},
     {"max", OpCode::kMax, 2},       {"clamp", OpCode::kClamp, 3}, {"sign", OpCode::kSign, 1},
     {"trunc", OpCode::kTrunc, 1},   {"ran", OpCode::kRan, 1},     {"uniform", OpCode::kUniform, 2},
-    {"normal", OpCode::kNormal, 2},
+    {"normal", OpCode::kNormal, 2}, {"nran", OpCode::kNormal, 2},  // nran: cpfg's name
 };
+
+// cpfg's functions that Sylva does not have: named as such when called.
+constexpr std::string_view kCpfgFunctions[] = {"bran", "biran",  "tran", "srand",
+                                               "func", "inblob", "stop"};
 
 bool IsRandom(OpCode op) {
   return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal;
@@ -604,7 +608,13 @@ class Parser {
     for (const auto& f : kFunctions) {
       if (name == f.name) fn = &f;
     }
-    if (!fn) return Error(col, "unknown function '" + name + "'", len);
+    if (!fn) {
+      for (std::string_view c : kCpfgFunctions) {
+        if (name == c)
+          return Error(col, "cpfg function '" + name + "' is not supported by Sylva", len);
+      }
+      return Error(col, "unknown function '" + name + "'", len);
+    }
     ++p_;  // '('
     auto n = Make(fn->op, col);
     SkipSpace();

@@ -189,6 +189,12 @@ TEST(Cli, StrictMakesWarningsErrorsOnEveryCommand) {
   EXPECT_FALSE(std::filesystem::exists(out));
   auto meshPlain = RunSylva({"mesh", f, "-n", "1", "-o", out});
   EXPECT_EQ(meshPlain.code, 0) << meshPlain.err;
+#ifdef SYLVA_TESTS_WITH_GRAPHICS
+  std::string png = (Scratch() / "gc.png").string();
+  auto render = RunSylva({"render", "--strict", f, "-n", "1", "-o", png, "--size", "64x64"});
+  EXPECT_EQ(render.code, 2) << render.err;
+  EXPECT_FALSE(std::filesystem::exists(png));
+#endif
 }
 
 TEST(Cli, StrictIsQuietOnACleanGrammar) {

@@ -168,5 +168,20 @@ TEST(Cpfg, RunTimeErrorsOnAContinuationLinePointAtThatLine) {
   EXPECT_EQ(r.error().sourceLine, "\tB(1/x)") << r.error().Format();
 }
 
+TEST(Cpfg, NranIsTheNormalDistribution) {
+  const std::string a = DeriveText("seed: 3\naxiom: A(nran(5, 2), nran(0, 1))\n", 0);
+  EXPECT_EQ(a, DeriveText("seed: 3\naxiom: A(normal(5, 2), normal(0, 1))\n", 0));
+  EXPECT_NE(a, DeriveText("seed: 4\naxiom: A(nran(5, 2), nran(0, 1))\n", 0));
+}
+
+TEST(Cpfg, UnsupportedCpfgFunctionsAreNamedAsSuch) {
+  ParseResult r = ParseGrammarText("axiom: A\nA --> B(bran(1, 2))\n", "c.l");
+  ASSERT_FALSE(r.grammar);
+  const Diagnostic& d = r.diagnostics.items[0];
+  EXPECT_EQ(d.message, "cpfg function 'bran' is not supported by Sylva");
+  EXPECT_EQ(d.loc.line, 2);
+  EXPECT_EQ(d.loc.column, 9);
+}
+
 }  // namespace
 }  // namespace sylva::lsys
