@@ -175,6 +175,7 @@ class GrammarParser {
   void ParseTropism(const Line& l, size_t after, size_t end);
   void ParseNumberStatement(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseDefine(const Line& l, size_t pos);
+  void ParseMacro(const Line& l, const std::string& name, int col, size_t pos);
   void ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen);
   bool LexName(const Line& l, size_t& pos, size_t end, std::string* name);
   bool ParseActualWord(const Line& l, size_t pos, size_t end, const ExprScope& scope,
@@ -222,6 +223,7 @@ class GrammarParser {
   std::vector<size_t> declaredLengths_;
   std::unordered_set<std::string_view> declaredSet_;
   std::unordered_map<std::string, Define> defines_;
+  std::unordered_map<std::string, ExprMacro> macros_;  // #define NAME(params) body
   std::unordered_set<std::string> usedConstants_;
   std::set<std::string> usedOverrides_;
   std::unordered_map<std::string, ArityUse> arityUse_;
@@ -612,7 +614,7 @@ bool GrammarParser::ParseFormalWord(const Line& l, size_t& pos, size_t end,
 
 bool GrammarParser::ParseConstExpr(const Line& l, size_t pos, size_t end, double* out,
                                    Expr* exprOut) {
-  ExprScope scope{&g_.constants, &usedConstants_, nullptr};
+  ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   std::string_view view(l.text.data(), end);
   Expr e;
   ExprParseError err;
@@ -652,6 +654,10 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
   while (pos < t.size() && IsIdentChar(t[pos])) ++pos;
   std::string name = t.substr(s, pos - s);
   int col = int(s) + 1;
+  if (pos < t.size() && t[pos] == '(') {
+    ParseMacro(l, name, col, pos);
+    return;
+  }
   if (pos < t.size() && !IsSpace(t[pos])) {
     Error(l, int(pos) + 1, "expected a space after the name of #define '" + name + "'");
     return;
@@ -679,13 +685,84 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
   defines_[name] = Define{Loc(l, col), int(name.size())};
 }
 
+// `#define NAME(a, b) body` (the `(` right after the name, as in C): a
+// function of its parameters, the body checked now with them as its only
+// names besides constants and earlier macros.
+void GrammarParser::ParseMacro(const Line& l, const std::string& name, int col, size_t pos) {
+  const std::string& t = l.text;
+  ExprMacro m;
+  ++pos;  // '('
+  for (;;) {
+    while (pos < t.size() && IsSpace(t[pos])) ++pos;
+    if (m.params.empty() && pos < t.size() && t[pos] == ')') {
+      ++pos;
+      break;
+    }
+    if (pos >= t.size() || !IsIdentStart(t[pos])) {
+      Error(l, int(pos) + 1, "expected a parameter name in '#define " + name + "(...)'");
+      return;
+    }
+    const size_t s = pos;
+    while (pos < t.size() && IsIdentChar(t[pos])) ++pos;
+    std::string param = t.substr(s, pos - s);
+    if (std::find(m.params.begin(), m.params.end(), param) != m.params.end()) {
+      Error(l, int(s) + 1, "parameter '" + param + "' appears twice", int(param.size()));
+      return;
+    }
+    m.params.push_back(std::move(param));
+    while (pos < t.size() && IsSpace(t[pos])) ++pos;
+    if (pos < t.size() && t[pos] == ',') {
+      ++pos;
+      continue;
+    }
+    if (pos < t.size() && t[pos] == ')') {
+      ++pos;
+      break;
+    }
+    Error(l, int(pos) + 1, "expected ',' or ')' after a parameter of '#define " + name + "'");
+    return;
+  }
+  if (defines_.count(name)) {
+    Error(l, col,
+          "redefinition of '" + name + "' (first defined at line " +
+              std::to_string(defines_[name].loc.line) + ")",
+          int(name.size()));
+    return;
+  }
+  while (pos < t.size() && IsSpace(t[pos])) ++pos;
+  size_t end = t.size();
+  while (end > pos && IsSpace(t[end - 1])) --end;
+  if (pos >= end) {
+    Error(l, col, "#define '" + name + "' has no body", int(name.size()));
+    return;
+  }
+  // Check the body where it is written, its parameters standing as formals.
+  ExprScope scope{&g_.constants, &usedConstants_, &m.params, &macros_};
+  std::string_view view(t.data(), end);
+  Expr body;
+  ExprParseError err;
+  size_t q = pos;
+  if (!ParseExpr(view, &q, scope, &body, &err)) {
+    Error(l, err.column, err.message, err.length);
+    return;
+  }
+  while (q < end && IsSpace(t[q])) ++q;
+  if (q < end) {
+    Error(l, int(q) + 1, "unexpected text after the body of '#define " + name + "'");
+    return;
+  }
+  m.body = t.substr(pos, end - pos);
+  macros_.emplace(name, std::move(m));
+  defines_[name] = Define{Loc(l, col), int(name.size())};
+}
+
 // Header statements: "keyword:" at the start of a line, case-insensitive.
 void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end) {
   if (haveAxiom_) {
     Error(l, col, "second axiom (the first is at line " + std::to_string(axiomLoc_.line) + ")", 5);
     return;
   }
-  ExprScope scope{&g_.constants, &usedConstants_, nullptr};
+  ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   Successor s;
   if (!ParseActualWord(l, after, end, scope, &s)) return;
   if (s.symbols.empty()) {
@@ -1084,7 +1161,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     }
   }
   p.formalCount = uint16_t(formals.size());
-  ExprScope scope{&g_.constants, &usedConstants_, &formals};
+  ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
 
   // Condition.
   if (condAt != std::string::npos) {

@@ -183,5 +183,45 @@ TEST(Cpfg, UnsupportedCpfgFunctionsAreNamedAsSuch) {
   EXPECT_EQ(d.loc.column, 9);
 }
 
+TEST(Cpfg, DefineWithArgumentsIsAFunction) {
+  EXPECT_EQ(DeriveText("#define sq(x) ((x)*(x))\n#define k 3\n#define lin(a, b) (a*k + b)\n"
+                       "axiom: A(2)\nA(n) --> B(sq(n+1), lin(n, sq(2)))\n",
+                       1),
+            "B(9,10)");
+  // A random argument is drawn once per use, as the preprocessor would.
+  const std::string twice = DeriveText("seed: 5\n#define d(x) (x - x)\naxiom: A(d(ran(1)))\n", 0);
+  EXPECT_NE(twice, "A(0)");
+}
+
+TEST(Cpfg, DefineWithArgumentsErrorsAreLocated) {
+  auto firstError = [](const std::string& text) {
+    ParseResult r = ParseGrammarText(text, "c.l");
+    EXPECT_FALSE(r.grammar);
+    if (r.diagnostics.items.empty()) return std::string("<none>");
+    const Diagnostic& d = r.diagnostics.items[0];
+    return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " + d.message;
+  };
+  EXPECT_EQ(firstError("#define f(x) (x + y)\naxiom: A\n"), "1:19 unknown name 'y' in expression");
+  EXPECT_EQ(firstError("#define f(x, x) x\naxiom: A\n"), "1:14 parameter 'x' appears twice");
+  EXPECT_EQ(firstError("#define f(x) x\naxiom: A(f(1, 2))\n"),
+            "2:10 'f' (#define) takes 1 argument, given 2");
+  EXPECT_EQ(firstError("#define f(x) x\n#define f(y) y\naxiom: A\n"),
+            "2:9 redefinition of 'f' (first defined at line 1)");
+  // A run-time error inside the body points at the call.
+  Grammar g = MustParse("#define inv(x) (1/x)\naxiom: A(0)\nA(n) --> B(inv(n))\n");
+  DeriveOptions opt;
+  opt.steps = 1;
+  auto r = Derive(g, opt);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().loc.line, 3) << r.error().Format();
+  EXPECT_EQ(r.error().loc.column, 12) << r.error().Format();
+}
+
+TEST(Cpfg, UnusedDefineWithArgumentsWarns) {
+  auto w = Warnings("#define f(x) x\naxiom: A\n");
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0], "1:9 constant 'f' is never used");
+}
+
 }  // namespace
 }  // namespace sylva::lsys
