@@ -316,15 +316,17 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   for (const SurfaceInstance& si : g.surfaces) {
     const TriangleMesh& s = options.surfaces->at(si.name);
     const uint32_t base = uint32_t(out.positions.size());
+    // ~name(s) scales all axes alike (the common case, computed as it
+    // always was); ~name(sx,sy,sz) each its own, normals by the inverse.
+    const Vec3 sc = si.scale;
+    const bool uniform = sc.x() == sc.y() && sc.y() == sc.z();
     std::optional<Vec3> inverseScale;
-    if (si.scale.x() != 0 && si.scale.y() != 0 && si.scale.z() != 0)
-      inverseScale = si.scale.cwiseInverse();
+    if (!uniform && sc.x() != 0 && sc.y() != 0 && sc.z() != 0) inverseScale = sc.cwiseInverse();
     for (size_t i = 0; i < s.positions.size(); ++i) {
       const Vec3 p = s.positions[i].cast<double>(), n = s.normals[i].cast<double>();
-      const Vec3 sp = p.cwiseProduct(si.scale);
-      const Vec3 wp =
-          si.position + sp.x() * si.frame.left + sp.y() * si.frame.heading + sp.z() * si.frame.up;
-      // Normals scale by the inverse (a flat scale leaves them as they are).
+      const Vec3 sp = uniform ? p : Vec3(p.cwiseProduct(sc));
+      const Vec3 local = sp.x() * si.frame.left + sp.y() * si.frame.heading + sp.z() * si.frame.up;
+      const Vec3 wp = si.position + (uniform ? sc.x() * local : local);
       const Vec3 sn = inverseScale ? Vec3(n.cwiseProduct(*inverseScale)) : n;
       const Vec3 wn = sn.x() * si.frame.left + sn.y() * si.frame.heading + sn.z() * si.frame.up;
       out.positions.push_back(F(wp));
