@@ -38,11 +38,10 @@ struct Line {
 
   // The piece that column `col` (1-based, of `text`) came from; null: the first line.
   const Piece* PieceAt(int col) const {
-    const Piece* p = nullptr;
-    for (const Piece& q : more) {
-      if (col > q.at) p = &q;
-    }
-    return p;
+    // The last piece with at < col (pieces are in column order).
+    auto it = std::upper_bound(more.begin(), more.end(), col,
+                               [](int c, const Piece& q) { return c <= q.at; });
+    return it == more.begin() ? nullptr : &*(it - 1);
   }
 };
 
@@ -1032,6 +1031,7 @@ void GrammarParser::JoinContinuations() {
   std::vector<Line> out;
   out.reserve(lines_.size());
   bool continued = false;  // out.back() ended with a backslash
+  bool curArrow = false;   // out.back() has a `->` (kept, not rescanned: linear time)
   for (size_t i = 0; i < lines_.size(); ++i) {
     Line& l = lines_[i];
     const Line* next = i + 1 < lines_.size() ? &lines_[i + 1] : nullptr;
@@ -1040,14 +1040,15 @@ void GrammarParser::JoinContinuations() {
     bool join = continued;
     if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
         isProduction(out.back())) {
-      const bool curArrow = hasArrow(out.back().text), lineArrow = hasArrow(l.text);
-      join = curArrow ? !lineArrow : startsWithArrow(l.text);
+      join = curArrow ? !hasArrow(l.text) : startsWithArrow(l.text);
     }
     if (!join) {
       out.push_back(std::move(l));
+      curArrow = hasArrow(out.back().text);
       continued = takeBackslash(out.back(), next);
       continue;
     }
+    curArrow = curArrow || hasArrow(l.text);
     Line& cur = out.back();
     cur.more.push_back(Line::Piece{int(cur.text.size()), l.number, 1, l.original});
     cur.text += l.text;
