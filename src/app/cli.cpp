@@ -156,9 +156,11 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   AddStrictFlag(vi, view.strict);
 
   DeriveFlags check;
-  CLI::App* c = app.add_subcommand("check", "parse and check a grammar; print diagnostics");
-  c->add_option("file", check.file, "grammar file (.lsys)")->required();
-  c->add_option("-D,--define", check.defines, "override a #define: NAME=VALUE (repeatable)");
+  CLI::App* c = app.add_subcommand(
+      "check", "parse and check a grammar or a scene (.xml, with its grammars); print diagnostics");
+  c->add_option("file", check.file, "grammar file (.lsys) or scene file (.xml)")->required();
+  c->add_option("-D,--define", check.defines,
+                "override a grammar's #define or a scene's <default>: NAME=VALUE (repeatable)");
   AddMaxErrorsFlag(c, check);
   AddStrictFlag(c, check.strict);
 

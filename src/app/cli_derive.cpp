@@ -64,6 +64,7 @@ std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErro
 }
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err) {
+  if (IsSceneFile(flags.file)) return RunCheckScene(flags, out, err);
   int exit = kExitOk;
   auto spec = SpecFrom(flags, err, &exit);
   if (!spec) return exit;

@@ -10,6 +10,7 @@
 
 #include "core/diagnostic.h"
 #include "plant/plant.h"
+#include "scene/scene.h"
 
 namespace sylva::app {
 
@@ -62,6 +63,13 @@ std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErro
                                        std::ostream& err, int* exit, bool strict = false);
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
+
+// Scene files (.xml): read strictly, every grammar they name parsed.
+bool IsSceneFile(const std::string& path);
+std::optional<scene::Scene> LoadScene(const std::string& path,
+                                      const std::vector<std::string>& defines, int maxErrors,
+                                      std::ostream& err, int* exit);
+int RunCheckScene(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
 // Prints diagnostics; returns the exit status they call for (0 when there
 // are only warnings, 2 when there are warnings and `strict`, saying so).
