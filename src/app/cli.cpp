@@ -26,7 +26,7 @@ int Report(const DiagnosticList& list, std::ostream& err, int maxErrors, bool st
   size_t warnings = 0;
   for (const auto& d : list.items) {
     if (d.severity != Severity::kError) {
-      ++warnings;
+      warnings += d.severity == Severity::kWarning;  // not notes
       continue;
     }
     int c = d.kind == ErrorKind::kRuntime ? kExitRuntime : kExitBadInput;
@@ -34,7 +34,8 @@ int Report(const DiagnosticList& list, std::ostream& err, int maxErrors, bool st
   }
   if (strict && warnings > 0) {
     err << "sylva: error: --strict: " << warnings
-        << (warnings == 1 ? " warning is" : " warnings are") << " treated as errors\n";
+        << (warnings == 1 ? " warning is treated as an error\n"
+                          : " warnings are treated as errors\n");
     code = kExitBadInput;
   }
   return code;

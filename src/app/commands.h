@@ -64,11 +64,12 @@ std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErro
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
-// Scene files (.xml): read strictly, every grammar they name parsed.
+// Scene files (.xml): read strictly, every grammar they name parsed; with
+// `strict`, a warning (of the scene or a grammar) is an error too.
 bool IsSceneFile(const std::string& path);
 std::optional<scene::Scene> LoadScene(const std::string& path,
                                       const std::vector<std::string>& defines, int maxErrors,
-                                      std::ostream& err, int* exit);
+                                      std::ostream& err, int* exit, bool strict = false);
 int RunCheckScene(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
 // Prints diagnostics; returns the exit status they call for (0 when there

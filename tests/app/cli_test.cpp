@@ -223,5 +223,21 @@ TEST(CliMesh, UnknownLongSurfaceNameMentionsCpfgOneLetterNames) {
       << r.err;
 }
 
+TEST(Cli, StrictAppliesToTheGrammarsOfAScene) {
+  std::string g = WriteFile("scene_gc.l", "axiom: F@Gs\n");
+  std::string f = WriteFile("strict_scene.xml",
+                            "<scene version=\"1\">\n  <plant id=\"p\" grammar=\"scene_gc.l\" "
+                            "position=\"0 0 0\"/>\n</scene>\n");
+  auto plain = RunSylva({"check", f});
+  EXPECT_EQ(plain.code, 0) << plain.err;
+  EXPECT_NE(plain.err.find("scene_gc.l:1:9: warning: '@Gs'"), std::string::npos) << plain.err;
+  auto strict = RunSylva({"check", "--strict", f});
+  EXPECT_EQ(strict.code, 2) << strict.err;
+  // One warning; the note that names the <plant> is not counted.
+  EXPECT_NE(strict.err.find("sylva: error: --strict: 1 warning is treated as an error"),
+            std::string::npos)
+      << strict.err;
+}
+
 }  // namespace
 }  // namespace sylva::app
