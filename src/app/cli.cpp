@@ -20,15 +20,31 @@ int Report(const Diagnostic& d, std::ostream& err) {
   return d.kind == ErrorKind::kRuntime ? kExitRuntime : kExitBadInput;
 }
 
-int Report(const DiagnosticList& list, std::ostream& err, int maxErrors) {
+int Report(const DiagnosticList& list, std::ostream& err, int maxErrors, bool strict) {
   err << list.FormatAll(size_t(maxErrors));
   int code = list.droppedErrors > 0 ? kExitBadInput : kExitOk;
+  size_t warnings = 0;
   for (const auto& d : list.items) {
-    if (d.severity != Severity::kError) continue;
+    if (d.severity != Severity::kError) {
+      warnings += d.severity == Severity::kWarning;  // not notes
+      continue;
+    }
     int c = d.kind == ErrorKind::kRuntime ? kExitRuntime : kExitBadInput;
     if (c == kExitBadInput || code == kExitOk) code = c;
   }
+  if (strict && warnings > 0) {
+    err << "sylva: error: --strict: " << warnings
+        << (warnings == 1 ? " warning is treated as an error\n"
+                          : " warnings are treated as errors\n");
+    code = kExitBadInput;
+  }
   return code;
+}
+
+static void AddStrictFlag(CLI::App* cmd, bool& strict) {
+  cmd->add_flag("--strict", strict,
+                "treat every warning as an error (exit 2), e.g. a cpfg command Sylva does not "
+                "implement");
 }
 
 static void AddMaxErrorsFlag(CLI::App* cmd, DeriveFlags& f) {
@@ -58,6 +74,7 @@ static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
                   "(default 268435456)")
       ->check(CLI::Range(uint64_t(1), lsys::kMaxModulesCap));
   AddMaxErrorsFlag(cmd, f);
+  AddStrictFlag(cmd, f.strict);
 }
 
 static int NotBuilt(const char* command, std::ostream& err) {
@@ -140,6 +157,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   vi->add_option("--frames", view.frames, "frames to draw before the screenshot")
       ->check(CLI::Range(1, 1000000));
   vi->add_option("--size", view.size, "window size WxH (default 1280x720)");
+  AddStrictFlag(vi, view.strict);
 
   DeriveFlags check;
   CLI::App* c = app.add_subcommand(
@@ -148,6 +166,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   c->add_option("-D,--define", check.defines,
                 "override a grammar's #define or a scene's <default>: NAME=VALUE (repeatable)");
   AddMaxErrorsFlag(c, check);
+  AddStrictFlag(c, check.strict);
 
   std::vector<std::string> rev(args.rbegin(), args.rend());
   try {

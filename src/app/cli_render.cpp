@@ -51,7 +51,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (!spec) return exit;
   spec->detail.sides = cmd.sides;
   spec->until = plant::Stage::kGeometry;
-  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit);
+  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   const mesh::PlantGeometry* geometry = &plant->geometry;
   const mesh::Palette& palette = plant->palette;
@@ -76,8 +76,9 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   } else {
     DiagnosticList warnings;
     Status s = plant::Tessellate(*plant, *spec, warnings);
-    exit = Report(warnings, err, cmd.derive.maxErrors);
+    exit = Report(warnings, err, cmd.derive.maxErrors, cmd.derive.strict);
     if (!s.ok()) return Report(s.error(), err);
+    if (exit != kExitOk) return exit;
     if (m.vertexCount()) {
       lo = hi = m.positions[0].cast<double>();
       for (const auto& p : m.positions) {

@@ -15,25 +15,26 @@ bool IsSceneFile(const std::string& path) {
 
 std::optional<scene::Scene> LoadScene(const std::string& path,
                                       const std::vector<std::string>& defines, int maxErrors,
-                                      std::ostream& err, int* exit) {
+                                      std::ostream& err, int* exit, bool strict) {
   scene::ReadOptions options;
   options.defines = defines;
   scene::ReadResult r = scene::ReadScene(path, options);
   if (!r.scene) {
-    *exit = Report(r.diagnostics, err, maxErrors);
+    *exit = Report(r.diagnostics, err, maxErrors, strict);
     if (*exit == kExitOk) *exit = kExitBadInput;
     return std::nullopt;
   }
   DiagnosticList all = std::move(r.diagnostics);
   for (Diagnostic& d : scene::CheckGrammars(*r.scene).items) all.Add(std::move(d));
-  *exit = Report(all, err, maxErrors);
+  *exit = Report(all, err, maxErrors, strict);
   if (*exit != kExitOk) return std::nullopt;
   return std::move(r.scene);
 }
 
 int RunCheckScene(const DeriveFlags& flags, std::ostream& out, std::ostream& err) {
   int exit = kExitOk;
-  const auto scene = LoadScene(flags.file, flags.defines, flags.maxErrors, err, &exit);
+  const auto scene =
+      LoadScene(flags.file, flags.defines, flags.maxErrors, err, &exit, flags.strict);
   return scene ? kExitOk : exit;
 }
 

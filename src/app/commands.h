@@ -24,6 +24,7 @@ struct DeriveFlags {
   uint64_t maxModules = 0;    // 0: the library default
   uint64_t maxTriangles = 0;  // mesh and render only; 0: the library default
   int maxErrors = 20;         // errors (and warnings) printed; 0: all
+  bool strict = false;        // --strict: any warning is an error (exit 2)
 };
 
 struct DeriveCommand {
@@ -63,23 +64,24 @@ int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit);
 
 // Builds the plant up to `spec.until`, printing its diagnostics (at most
-// maxErrors of them, 0: all); nullopt
-// with *exit set on an error.
+// maxErrors of them, 0: all); nullopt with *exit set on an error (or, with
+// `strict`, on a warning).
 std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErrors,
-                                       std::ostream& err, int* exit);
+                                       std::ostream& err, int* exit, bool strict = false);
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
-// Scene files (.xml): read strictly, every grammar they name parsed.
+// Scene files (.xml): read strictly, every grammar they name parsed; with
+// `strict`, a warning (of the scene or a grammar) is an error too.
 bool IsSceneFile(const std::string& path);
 std::optional<scene::Scene> LoadScene(const std::string& path,
                                       const std::vector<std::string>& defines, int maxErrors,
-                                      std::ostream& err, int* exit);
+                                      std::ostream& err, int* exit, bool strict = false);
 int RunCheckScene(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
 // Prints diagnostics; returns the exit status they call for (0 when there
-// are only warnings).
-int Report(const DiagnosticList& list, std::ostream& err, int maxErrors = 0);
+// are only warnings, 2 when there are warnings and `strict`, saying so).
+int Report(const DiagnosticList& list, std::ostream& err, int maxErrors = 0, bool strict = false);
 int Report(const Diagnostic& d, std::ostream& err);
 
 }  // namespace sylva::app

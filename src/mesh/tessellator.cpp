@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <type_traits>
 
 #include "core/memory.h"
@@ -315,11 +316,19 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   for (const SurfaceInstance& si : g.surfaces) {
     const TriangleMesh& s = options.surfaces->at(si.name);
     const uint32_t base = uint32_t(out.positions.size());
+    // ~name(s) scales all axes alike (the common case, computed as it
+    // always was); ~name(sx,sy,sz) each its own, normals by the inverse.
+    const Vec3 sc = si.scale;
+    const bool uniform = sc.x() == sc.y() && sc.y() == sc.z();
+    std::optional<Vec3> inverseScale;
+    if (!uniform && sc.x() != 0 && sc.y() != 0 && sc.z() != 0) inverseScale = sc.cwiseInverse();
     for (size_t i = 0; i < s.positions.size(); ++i) {
       const Vec3 p = s.positions[i].cast<double>(), n = s.normals[i].cast<double>();
-      const Vec3 wp = si.position + si.scale * (p.x() * si.frame.left + p.y() * si.frame.heading +
-                                                p.z() * si.frame.up);
-      const Vec3 wn = n.x() * si.frame.left + n.y() * si.frame.heading + n.z() * si.frame.up;
+      const Vec3 sp = uniform ? p : Vec3(p.cwiseProduct(sc));
+      const Vec3 local = sp.x() * si.frame.left + sp.y() * si.frame.heading + sp.z() * si.frame.up;
+      const Vec3 wp = si.position + (uniform ? sc.x() * local : local);
+      const Vec3 sn = inverseScale ? Vec3(n.cwiseProduct(*inverseScale)) : n;
+      const Vec3 wn = sn.x() * si.frame.left + sn.y() * si.frame.heading + sn.z() * si.frame.up;
       out.positions.push_back(F(wp));
       out.normals.push_back(F(wn.normalized()));
       out.uvs.push_back(s.uvs[i]);
