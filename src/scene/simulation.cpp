@@ -55,8 +55,8 @@ class WindDrag : public particles::LocalForce {
  public:
   WindDrag(double linear, double quadratic, const Wind* wind)
       : k1_(linear), k2_(quadratic), wind_(wind) {}
-  void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f,
-                       size_t begin, size_t end) const override {
+  void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
+                       size_t end) const override {
     for (size_t i = begin; i < end; ++i) {
       const Vec3 u = wind_ ? Vec3(v[i] - wind_->At(x[i], s.time)) : v[i];
       f[i - begin] -= (k1_ + k2_ * u.norm()) * u;
@@ -145,8 +145,9 @@ Birth Draw(Source& src) {
       const PlantPoints& p = *src.points;
       if (e.part == PlantPart::kSegments) {
         const double pick = u(0) * src.cumulative.back();
-        const size_t i = size_t(std::lower_bound(src.cumulative.begin(), src.cumulative.end(), pick) -
-                                src.cumulative.begin());
+        const size_t i =
+            size_t(std::lower_bound(src.cumulative.begin(), src.cumulative.end(), pick) -
+                   src.cumulative.begin());
         x = p.segmentPoints[std::min(i, p.segmentPoints.size() - 1)];
       } else {
         const std::vector<Vec3>& from = e.part == PlantPart::kTips ? p.tips : p.leaves;
@@ -177,7 +178,7 @@ struct ParticleSystem {
     const OnDeathDef* def;
   };
   std::vector<Death> onDeath;
-  uint64_t dropped = 0;  // births refused at `max`
+  uint64_t dropped = 0;                                // births refused at `max`
   std::shared_ptr<const mesh::TriangleMesh> drawMesh;  // as="mesh"
   std::vector<Vec3> spinAxis;                          // by particle id, lazily
 };
@@ -197,8 +198,8 @@ struct Flock {
 // A dart: the boids' default mesh, 1 unit long along +Z.
 std::shared_ptr<mesh::TriangleMesh> DartMesh() {
   auto m = std::make_shared<mesh::TriangleMesh>();
-  const mesh::Vec3f p[] = {{0, 0, 0.5f}, {-0.45f, 0, -0.5f}, {0, 0.08f, -0.3f},
-                           {0.45f, 0, -0.5f}, {0, -0.12f, -0.4f}};
+  const mesh::Vec3f p[] = {
+      {0, 0, 0.5f}, {-0.45f, 0, -0.5f}, {0, 0.08f, -0.3f}, {0.45f, 0, -0.5f}, {0, -0.12f, -0.4f}};
   const uint32_t tris[][3] = {{0, 1, 2}, {0, 2, 3}, {0, 4, 1}, {0, 3, 4}};
   for (const auto& t : tris) {
     const mesh::Vec3f n = (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]).normalized();
@@ -255,7 +256,8 @@ std::shared_ptr<const particles::TriangleBvh> Simulation::Impl::BvhOf(const std:
       }
     }
   }
-  auto bvh = std::make_shared<const particles::TriangleBvh>(std::move(vertices), std::move(triangles));
+  auto bvh =
+      std::make_shared<const particles::TriangleBvh>(std::move(vertices), std::move(triangles));
   bvhs[id] = bvh;
   return bvh;
 }
@@ -274,7 +276,8 @@ Status Simulation::Impl::AddColliders(particles::System& system,
         bool isCloth = false;
         for (const ClothDef& cl : scene->cloths) isCloth = isCloth || cl.id == id;
         if (isCloth) {
-          diags.Add(Warn(c.withLoc, "collisions with a cloth ('" + id + "') are not simulated yet"));
+          diags.Add(
+              Warn(c.withLoc, "collisions with a cloth ('" + id + "') are not simulated yet"));
           continue;
         }
         collider = particles::Collider::Mesh(BvhOf(id));
@@ -387,8 +390,12 @@ Status Simulation::Impl::Step() {
 Simulation::Simulation() : impl_(std::make_unique<Impl>()) {}
 Simulation::~Simulation() = default;
 
-double Simulation::time() const { return impl_->time; }
-double Simulation::stepLength() const { return impl_->h; }
+double Simulation::time() const {
+  return impl_->time;
+}
+double Simulation::stepLength() const {
+  return impl_->h;
+}
 
 Status Simulation::AdvanceTo(double t) {
   while (impl_->time + impl_->h / 2 < t)
@@ -448,8 +455,8 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
         std::make_shared<mesh::TriangleMesh>(std::move(*obj)));
   };
 
-  auto addForces = [&](particles::System& system, const std::vector<ForceDef>& forces,
-                       bool windOn, const SourceLoc& loc) -> Status {
+  auto addForces = [&](particles::System& system, const std::vector<ForceDef>& forces, bool windOn,
+                       const SourceLoc& loc) -> Status {
     bool drag = false;
     for (const ForceDef& f : forces) {
       switch (f.kind) {
@@ -470,8 +477,9 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
               for (const Vec3& p : it->second.segmentPoints) c += p;
               c /= double(it->second.segmentPoints.size());
             } else {
-              diags.Add(Warn(f.loc, "'of=\"" + f.of + "\"': only a plant or forest gives an "
-                                    "attractor its position yet; the origin is used"));
+              diags.Add(Warn(f.loc, "'of=\"" + f.of +
+                                        "\"': only a plant or forest gives an "
+                                        "attractor its position yet; the origin is used"));
             }
           }
           const double strength = f.strength, soft = std::max(f.radius, 1e-3);
@@ -511,8 +519,9 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
       }
     }
     if (windOn && wind && !drag)
-      diags.Add(Warn(loc, "the wind does not act here: it acts through a <drag> force, and this "
-                          "element has none"));
+      diags.Add(Warn(loc,
+                     "the wind does not act here: it acts through a <drag> force, and this "
+                     "element has none"));
     return {};
   };
 
@@ -523,12 +532,24 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
     ps->def = &p;
     ps->system = std::make_unique<particles::System>(threads);
     switch (p.integrator) {
-      case Integrator::kSymplectic: ps->integrator = particles::Integrator::kSymplecticEuler; break;
-      case Integrator::kEuler: ps->integrator = particles::Integrator::kExplicitEuler; break;
-      case Integrator::kRk2: ps->integrator = particles::Integrator::kMidpoint; break;
-      case Integrator::kRk4: ps->integrator = particles::Integrator::kRK4; break;
-      case Integrator::kImplicit: ps->integrator = particles::Integrator::kImplicitEuler; break;
-      case Integrator::kRk45: ps->adaptive = true; break;
+      case Integrator::kSymplectic:
+        ps->integrator = particles::Integrator::kSymplecticEuler;
+        break;
+      case Integrator::kEuler:
+        ps->integrator = particles::Integrator::kExplicitEuler;
+        break;
+      case Integrator::kRk2:
+        ps->integrator = particles::Integrator::kMidpoint;
+        break;
+      case Integrator::kRk4:
+        ps->integrator = particles::Integrator::kRK4;
+        break;
+      case Integrator::kImplicit:
+        ps->integrator = particles::Integrator::kImplicitEuler;
+        break;
+      case Integrator::kRk45:
+        ps->adaptive = true;
+        break;
     }
     if (Status s = addForces(*ps->system, p.forces, p.wind, p.loc); !s.ok()) return s.error();
     if (Status s = m.AddColliders(*ps->system, p.collides, diags); !s.ok()) return s.error();
@@ -552,18 +573,19 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
       if (e.shape == EmitterShape::kPlant) {
         const auto it = built.points.find(e.of);
         const PlantPoints* pts = it == built.points.end() ? nullptr : &it->second;
-        const size_t n = !pts ? 0
+        const size_t n = !pts                           ? 0
                          : e.part == PlantPart::kTips   ? pts->tips.size()
                          : e.part == PlantPart::kLeaves ? pts->leaves.size()
                                                         : pts->segmentPoints.size();
         if (n == 0)
-          return Fail(e.loc,
-                      "the plant '" + e.of + "' has no " +
-                          (e.part == PlantPart::kTips     ? std::string("branch tips")
-                           : e.part == PlantPart::kLeaves ? std::string("leaves (polygons or surfaces)")
-                                                          : std::string("segments")) +
-                          " to emit from",
-                      ErrorKind::kInput);
+          return Fail(
+              e.loc,
+              "the plant '" + e.of + "' has no " +
+                  (e.part == PlantPart::kTips     ? std::string("branch tips")
+                   : e.part == PlantPart::kLeaves ? std::string("leaves (polygons or surfaces)")
+                                                  : std::string("segments")) +
+                  " to emit from",
+              ErrorKind::kInput);
         src.points = pts;
         double sum = 0;
         for (double len : pts->segmentLengths) src.cumulative.push_back(sum += len);
@@ -626,8 +648,9 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
       if (f.kind == ForceKind::kGravity)
         sheet.gravity += f.g;
       else
-        diags.Add(Warn(f.loc, "cloth feels gravity and the wind; this force is not simulated on "
-                              "cloth yet"));
+        diags.Add(Warn(f.loc,
+                       "cloth feels gravity and the wind; this force is not simulated on "
+                       "cloth yet"));
     }
     for (const CollideDef& col : c.collides)
       diags.Add(Warn(col.loc, "cloth collisions are not simulated yet (the cloth passes through)"));
@@ -698,8 +721,7 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
           }
         }));
     if (Status s = addForces(*flock.system, f.forces, false, f.loc); !s.ok()) return s.error();
-    if (f.wind && wind)
-      flock.system->AddForce(std::make_shared<WindDrag>(0.2, 0, wind));
+    if (f.wind && wind) flock.system->AddForce(std::make_shared<WindDrag>(0.2, 0, wind));
     const uint64_t seed = ElementSeed(scene.seed, f.id, "flock", size_t(f.loc.line));
     for (int i = 0; i < f.count; ++i) {
       auto u = [&](uint64_t k) { return ToUnit(CounterHash(seed, uint64_t(i), k)); };
@@ -766,8 +788,8 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
         a.translate(st.position[i]);
         a.rotate(Eigen::AngleAxisd(angle, axis));
         a.scale(d.size);
-        md.instances.push_back({a.matrix().cast<float>(),
-                                ColorAt(d, st.age[i], st.lifetime[i]).cast<float>()});
+        md.instances.push_back(
+            {a.matrix().cast<float>(), ColorAt(d, st.age[i], st.lifetime[i]).cast<float>()});
       }
       list.meshes.push_back(std::move(md));
       continue;
@@ -851,9 +873,9 @@ void Simulation::WriteCsv(std::ostream& out) const {
   char line[320];
   out << "system,id,x,y,z,vx,vy,vz,age\n";
   auto row = [&](const std::string& system, uint64_t id, const Vec3& x, const Vec3& v, double age) {
-    std::snprintf(line, sizeof line, "%s,%llu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n",
-                  system.c_str(), static_cast<unsigned long long>(id), x.x(), x.y(), x.z(), v.x(),
-                  v.y(), v.z(), age);
+    std::snprintf(line, sizeof line, "%s,%llu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", system.c_str(),
+                  static_cast<unsigned long long>(id), x.x(), x.y(), x.z(), v.x(), v.y(), v.z(),
+                  age);
     out << line;
   };
   for (size_t k = 0; k < impl_->systems.size(); ++k) {
