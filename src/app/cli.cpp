@@ -168,6 +168,27 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   AddMaxErrorsFlag(c, check);
   AddStrictFlag(c, check.strict);
 
+  SimulateCommand simulate;
+  CLI::App* si = app.add_subcommand(
+      "simulate", "run a scene's simulation: frames as images (-o), the final state as CSV");
+  si->add_option("file", simulate.file, "scene file (.xml)")->required();
+  si->add_option("-o,--output", simulate.output,
+                 "frame images, a pattern with one %d: frames/%04d.png (none without -o)");
+  si->add_option("--duration", simulate.duration,
+                 "simulated seconds (default: the scene's <simulation duration>)")
+      ->check(CLI::Range(0.0, 1e6));
+  si->add_option("--fps", simulate.fps, "frames written a second (default: the scene's fps)")
+      ->check(CLI::Range(1e-3, 1000.0));
+  si->add_option("--dump", simulate.dump,
+                 "write every particle, cloth vertex and boid at the end as CSV");
+  si->add_option("--size", simulate.size, "frame size WxH (default 960x540)");
+  si->add_option("-D,--define", simulate.defines, "override a scene's <default>: NAME=VALUE");
+  si->add_option("--threads", simulate.threads, "worker threads (default: all cores)")
+      ->check(CLI::Range(0, 256));
+  si->add_option("--max-errors", simulate.maxErrors, "print at most this many errors")
+      ->check(CLI::Range(0, 1000000));
+  AddStrictFlag(si, simulate.strict);
+
   std::vector<std::string> rev(args.rbegin(), args.rend());
   try {
     app.parse(rev);
@@ -191,13 +212,16 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (d->parsed()) code = RunDerive(derive, out, err);
     if (c->parsed()) code = RunCheck(check, out, err);
     if (me->parsed()) code = RunMesh(mesh, out, err);
-    if (re->parsed() || vi->parsed()) {
+    if (si->parsed() && simulate.output.empty()) code = RunSimulate(simulate, out, err, {});
+    if (re->parsed() || vi->parsed() || (si->parsed() && !simulate.output.empty())) {
       if (!view.screenshot.empty() && view.frames == 0) view.frames = 3;
       const GraphicsCommands none;
       const GraphicsCommands& g = graphics ? *graphics : none;
       if (g.execGraphicsBinary) return ExecGraphics(args, out, err);
       if (re->parsed()) code = g.render ? g.render(render, out, err) : NotBuilt("render", err);
       if (vi->parsed()) code = g.view ? g.view(view, out, err) : NotBuilt("view", err);
+      if (si->parsed())
+        code = g.simulate ? g.simulate(simulate, out, err) : NotBuilt("simulate -o", err);
     }
   } catch (const std::bad_alloc&) {
     err << "sylva: error: out of memory; lower the derivation length (-n), the detail or the "

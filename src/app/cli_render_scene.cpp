@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <optional>
 #include <ostream>
 
 #include "app/cli.h"
@@ -109,6 +111,51 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
   err << line;
   (void)out;
   return kExitOk;
+}
+
+}  // namespace sylva::app
+
+namespace sylva::app {
+
+int RunSimulateWithFrames(const SimulateCommand& cmd, std::ostream& out, std::ostream& err) {
+  if (cmd.output.empty()) return RunSimulate(cmd, out, err, {});
+  if (!render::IsImagePath(cmd.output)) {
+    err << "sylva: error: " << cmd.output << ": unknown image format; use .png, .jpg or .jpeg\n";
+    return kExitBadInput;
+  }
+  int width = 0, height = 0;
+  if (!ParseSize(cmd.size, &width, &height)) {
+    err << "sylva: error: --size '" << cmd.size << "': expected WxH from 1x1 to 8192x8192\n";
+    return kExitBadInput;
+  }
+  // The context and renderer are made at the first frame, after the scene
+  // has loaded (a bad scene fails without touching OpenGL).
+  std::unique_ptr<render::HeadlessContext> context;
+  std::unique_ptr<render::Renderer> renderer;
+  std::optional<render::Camera> camera;
+  const FrameWriter write = [&](const SimulationFrame& f, const std::string& path) -> Status {
+    if (!renderer) {
+      auto c = render::HeadlessContext::Create();
+      if (!c) return c.error();
+      context = std::move(*c);
+      auto r = render::Renderer::Create(render::FindShaderDir());
+      if (!r) return r.error();
+      renderer = std::move(*r);
+      if (Status s = renderer->Resize(width, height); !s.ok()) return s;
+      camera = SceneCamera(f.scene, f.built, double(width) / height);
+    }
+    draw::DrawList list = scene::MakeDrawList(f.scene, f.built);
+    f.simulation.AddToDrawList(list);
+    if (Status s = renderer->Draw(list, *camera); !s.ok()) return s;
+    // Each frame's folder is made on demand (frames/%04d.png into frames/).
+    const size_t slash = path.rfind('/');
+    if (slash != std::string::npos && slash > 0) {
+      std::error_code ec;
+      std::filesystem::create_directories(path.substr(0, slash), ec);
+    }
+    return render::WriteImage(renderer->ReadPixels(), path);
+  };
+  return RunSimulate(cmd, out, err, write);
 }
 
 }  // namespace sylva::app

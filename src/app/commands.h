@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -10,7 +11,9 @@
 
 #include "core/diagnostic.h"
 #include "plant/plant.h"
+#include "scene/build.h"
 #include "scene/scene.h"
+#include "scene/simulation.h"
 
 namespace sylva::app {
 
@@ -70,6 +73,38 @@ std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErro
                                        std::ostream& err, int* exit, bool strict = false);
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
+
+// `sylva simulate scene.xml`: run the clock, write frames and the state.
+struct SimulateCommand {
+  std::string file;
+  std::vector<std::string> defines;  // -D NAME=VALUE: scene parameters
+  int threads = 0;
+  int maxErrors = 20;
+  bool strict = false;
+  std::optional<double> duration;  // default: the scene's <simulation duration>
+  std::optional<double> fps;       // frames a second written; default: the scene's fps
+  std::string output;              // frame pattern, e.g. frames/%04d.png; empty: no frames
+  std::string dump;                // CSV of every particle at the end
+  std::string size = "960x540";
+};
+
+// One frame of a running simulation, for the graphics side to draw.
+struct SimulationFrame {
+  const scene::Scene& scene;
+  const scene::BuiltScene& built;
+  const scene::Simulation& simulation;
+  int index;
+};
+// Writes the picture of a frame to `path` (sylva-graphics provides it).
+using FrameWriter = std::function<Status(const SimulationFrame& frame, const std::string& path)>;
+// Without a writer, no frames are drawn (no OpenGL is needed).
+int RunSimulate(const SimulateCommand& cmd, std::ostream& out, std::ostream& err,
+                const FrameWriter& writeFrame);
+// The runner with frames (cli_render_scene.cpp).
+int RunSimulateWithFrames(const SimulateCommand& cmd, std::ostream& out, std::ostream& err);
+// The frame path of a pattern with one %d conversion (a 0 flag and a width
+// allowed, %% for a percent sign); empty when the pattern is not one.
+std::string FramePath(const std::string& pattern, int index);
 
 // Scene files (.xml): read strictly, every grammar they name parsed; with
 // `strict`, a warning (of the scene or a grammar) is an error too.
