@@ -235,8 +235,13 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
   // Lights: the first sun casts the shadow.
   int shadowLight = -1;
   Eigen::Matrix4f lightViewProj = Eigen::Matrix4f::Identity();
+  // The shadow map covers what casts shadows (a wide terrain that does not
+  // cast would only spread its texels thin).
   Vec3 lo, hi;
-  const bool any = list.Bounds(lo, hi);
+  draw::DrawList casters;
+  for (const draw::MeshDraw& d : list.meshes)
+    if (d.castsShadow) casters.meshes.push_back(d);
+  const bool any = casters.Bounds(lo, hi);
   for (size_t i = 0; i < list.lights.size() && shadowLight < 0; ++i)
     if (list.lights[i].type == draw::Light::Type::kSun) shadowLight = int(i);
   if (shadowLight >= 0 && any) {

@@ -189,6 +189,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     m.mesh = TerrainMeshOf(*arrays);
     m.palette = {t.color.cast<float>()};
     m.instances.push_back({});
+    m.castsShadow = false;
     m.loc = t.loc;
     GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
     built.trianglesDrawn += m.mesh->triangleCount();
@@ -303,6 +304,7 @@ draw::DrawList MakeDrawList(const Scene& scene, const BuiltScene& built) {
     d.mesh = m.mesh;
     d.palette = m.palette;
     d.instances = m.instances;
+    d.castsShadow = m.castsShadow;
     list.meshes.push_back(std::move(d));
   }
   return list;

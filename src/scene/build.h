@@ -35,7 +35,8 @@ struct BuiltMesh {
   std::shared_ptr<const mesh::TriangleMesh> mesh;
   mesh::Palette palette;
   std::vector<draw::Instance> instances;
-  SourceLoc loc;  // the element it comes from
+  SourceLoc loc;            // the element it comes from
+  bool castsShadow = true;  // terrains do not (the sun's map then fits the plants)
 };
 
 // Points of a plant (or of every tree of a forest) in world space, where

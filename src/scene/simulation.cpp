@@ -779,15 +779,34 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
       draw::MeshDraw md;
       md.mesh = ps->drawMesh;
       md.palette = {mesh::Vec3f(1, 1, 1)};
+      // The mesh turns about its own centre.
+      mesh::Vec3f lo =
+          ps->drawMesh->positions.empty() ? mesh::Vec3f::Zero() : ps->drawMesh->positions[0];
+      mesh::Vec3f hi = lo;
+      for (const mesh::Vec3f& q : ps->drawMesh->positions) {
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+      }
+      const Vec3 pivot = ((lo + hi) / 2).cast<double>();
       for (size_t i = 0; i < st.size(); ++i) {
-        // Tumbling: a turn about an axis of the particle's own, growing with age.
         const uint64_t h = CounterHash(uint64_t(p.loc.line), st.id[i]);
-        const Vec3 axis = InCone(Vec3::UnitY(), 180, ToUnit(h), ToUnit(Mix64(h)));
-        const double angle = d.spinDegrees * kDegToRad * st.age[i] + 2 * kPi * ToUnit(Mix64(h ^ 7));
         Eigen::Affine3d a = Eigen::Affine3d::Identity();
-        a.translate(st.position[i]);
-        a.rotate(Eigen::AngleAxisd(angle, axis));
+        if (st.invMass[i] == 0) {
+          // At rest (stuck where it landed): lying flat, turned at random.
+          a.translate(st.position[i] + Vec3(0, 0.005, 0));
+          a.rotate(Eigen::AngleAxisd(2 * kPi * ToUnit(Mix64(h ^ 7)), Vec3::UnitY()));
+          a.rotate(Eigen::AngleAxisd(-kPi / 2, Vec3::UnitX()));
+        } else {
+          // Tumbling: a turn about an axis of the particle's own, growing
+          // with age.
+          const Vec3 axis = InCone(Vec3::UnitY(), 180, ToUnit(h), ToUnit(Mix64(h)));
+          const double angle =
+              d.spinDegrees * kDegToRad * st.age[i] + 2 * kPi * ToUnit(Mix64(h ^ 7));
+          a.translate(st.position[i]);
+          a.rotate(Eigen::AngleAxisd(angle, axis));
+        }
         a.scale(d.size);
+        a.translate(-pivot);
         md.instances.push_back(
             {a.matrix().cast<float>(), ColorAt(d, st.age[i], st.lifetime[i]).cast<float>()});
       }
