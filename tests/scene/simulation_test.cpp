@@ -1,0 +1,240 @@
+// The scene's simulation against what a user relies on: snow that lands on
+// a branch stays on it, leaves rest on the ground, emitters place particles
+// inside their shapes and at their rates, fireworks burst where shells die,
+// and a run is the same for any thread count.
+#include "scene/simulation.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/rng.h"
+#include "scene/reader.h"
+#include "scratch_dir.h"
+
+namespace sylva::scene {
+namespace {
+
+std::string Grammar(const char* name) {
+  return std::string(SYLVA_SOURCE_DIR) + "/grammars/" + name;
+}
+
+struct Run {
+  Scene scene;
+  BuiltScene built;
+  std::unique_ptr<Simulation> sim;
+};
+
+// Reads, builds and creates the simulation of `text`, or fails the test.
+std::unique_ptr<Run> Start(const std::string& text, int threads = 1) {
+  const auto dir = sylva::testing::ScratchDir("sylva_scene_sim_");
+  const std::string path = (dir / "s.xml").string();
+  std::ofstream(path) << text;
+  auto run = std::make_unique<Run>();
+  ReadResult r = ReadScene(path);
+  EXPECT_TRUE(r.scene) << r.diagnostics.FormatAll();
+  if (!r.scene) return nullptr;
+  run->scene = std::move(*r.scene);
+  BuildResult b = Build(run->scene, {});
+  EXPECT_TRUE(b.scene) << b.diagnostics.FormatAll();
+  if (!b.scene) return nullptr;
+  run->built = std::move(*b.scene);
+  DiagnosticList warnings;
+  SimulationOptions o;
+  o.threads = threads;
+  auto sim = Simulation::Create(run->scene, run->built, o, warnings);
+  EXPECT_TRUE(sim.ok()) << (sim.ok() ? "" : sim.error().message);
+  if (!sim.ok()) return nullptr;
+  run->sim = std::move(*sim);
+  return run;
+}
+
+struct Row {
+  std::string system;
+  Vec3 x, v;
+  double age;
+};
+
+std::vector<Row> Rows(const Simulation& sim) {
+  std::ostringstream csv;
+  sim.WriteCsv(csv);
+  std::istringstream in(csv.str());
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "system,id,x,y,z,vx,vy,vz,age");
+  std::vector<Row> rows;
+  while (std::getline(in, line)) {
+    Row r;
+    std::string field;
+    std::istringstream f(line);
+    std::getline(f, r.system, ',');
+    std::getline(f, field, ',');
+    double v[7];
+    for (double& x : v) {
+      std::getline(f, field, ',');
+      x = std::stod(field);
+    }
+    r.x = Vec3(v[0], v[1], v[2]);
+    r.v = Vec3(v[3], v[4], v[5]);
+    r.age = v[6];
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+TEST(SceneSimulation, SnowThatLandsOnABranchStaysThere) {
+  // A tree 6 m tall; snow falls on it from a box above and sticks.
+  auto run = Start(R"(<scene version="1">
+    <plant id="tree" grammar=")" + Grammar("abop/fig2_08a_ternary.lsys") +
+                   R"(" steps="5" height="6"/>
+    <particles id="snow" max="20000">
+      <emitter shape="box" at="0 8 0" size="8 0.5 8" rate="20000" direction="0 -1 0"
+               speed="2" lifetime="100"/>
+      <gravity/>
+      <collide with="tree ground" stick="true"/>
+    </particles>
+    <simulation fps="30" substeps="2"/>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(3).ok());
+  const std::vector<Row> rows = Rows(*run->sim);
+  size_t onTree = 0, onGround = 0, below = 0;
+  for (const Row& r : rows) {
+    if (r.x.y() < -1e-9) ++below;
+    if (r.v.norm() == 0 && r.x.y() > 0.05) ++onTree;
+    if (r.v.norm() == 0 && std::abs(r.x.y()) <= 1e-9) ++onGround;
+  }
+  EXPECT_EQ(below, 0u) << "flakes below the ground";
+  EXPECT_GT(onTree, 100u) << "flakes resting above the ground (on branches) of " << rows.size();
+  EXPECT_GT(onGround, 1000u) << "flakes resting on the ground of " << rows.size();
+  // What rests stays: three more seconds move none of the resting flakes.
+  std::vector<Vec3> rest;
+  for (const Row& r : rows)
+    if (r.v.norm() == 0) rest.push_back(r.x);
+  ASSERT_TRUE(run->sim->AdvanceTo(6).ok());
+  size_t kept = 0;
+  for (const Row& r : Rows(*run->sim))
+    for (const Vec3& p : rest)
+      if ((r.x - p).norm() == 0) {
+        ++kept;
+        break;
+      }
+  EXPECT_EQ(kept, rest.size()) << "resting flakes that moved: " << rest.size() - kept;
+}
+
+TEST(SceneSimulation, EmittersPlaceParticlesInsideTheirShapesAtTheirRates) {
+  auto run = Start(R"(<scene version="1">
+    <particles id="box" max="100000"><emitter shape="box" at="1 2 3" size="2 4 6" rate="1000" lifetime="100"/></particles>
+    <particles id="sphere" max="100000"><emitter shape="sphere" at="0 5 0" size="2" rate="1000" lifetime="100"/></particles>
+    <particles id="disc" max="100000"><emitter shape="disc" at="0 1 0" size="4" rate="1000" lifetime="100"/></particles>
+    <simulation fps="10" substeps="1"/>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(2).ok());
+  std::map<std::string, size_t> count;
+  for (const Row& r : Rows(*run->sim)) {
+    ++count[r.system];
+    // No forces: every particle sits where it was born.
+    if (r.system == "box") {
+      EXPECT_TRUE((r.x - Vec3(1, 2, 3)).cwiseAbs().cwiseQuotient(Vec3(1, 2, 3)).maxCoeff() <= 1)
+          << "box particle at " << r.x.transpose();
+    }
+    if (r.system == "sphere") EXPECT_LE((r.x - Vec3(0, 5, 0)).norm(), 1.0) << r.x.transpose();
+    if (r.system == "disc") {
+      EXPECT_EQ(r.x.y(), 1.0);
+      EXPECT_LE(Vec2(r.x.x(), r.x.z()).norm(), 2.0) << r.x.transpose();
+    }
+  }
+  // Rate 1000 a second for 2 s.
+  for (const char* s : {"box", "sphere", "disc"}) EXPECT_EQ(count[s], 2000u) << s;
+}
+
+TEST(SceneSimulation, FireworkShellsBurstIntoSparksWhereTheyDie) {
+  auto run = Start(R"(<scene version="1">
+    <particles id="shells" max="10">
+      <emitter burst="2" speed="20" lifetime="1" spread="0"/>
+      <gravity/>
+      <on-death emit="sparks" count="50"/>
+    </particles>
+    <particles id="sparks" max="1000">
+      <emitter rate="0" speed="5" spread="180" lifetime="10"/>
+    </particles>
+    <simulation fps="100" substeps="1"/>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(0.5).ok());
+  size_t sparks = 0;
+  for (const Row& r : Rows(*run->sim)) sparks += r.system == "sparks";
+  EXPECT_EQ(sparks, 0u) << "no burst before a shell dies";
+  ASSERT_TRUE(run->sim->AdvanceTo(1.1).ok());
+  std::vector<Row> rows = Rows(*run->sim);
+  size_t shells = 0;
+  sparks = 0;
+  Vec3 centre = Vec3::Zero();
+  for (const Row& r : rows) {
+    shells += r.system == "shells";
+    if (r.system == "sparks") {
+      ++sparks;
+      centre += r.x;
+    }
+  }
+  EXPECT_EQ(shells, 0u);
+  EXPECT_EQ(sparks, 100u) << "50 sparks for each of 2 shells";
+  // Shells go up at 20 m/s under gravity for 1 s and die at 15.1 m moving
+  // up at 10.2 m/s; the sparks (no forces) carry that velocity on for
+  // 0.1 s, spreading evenly about it: their centre is near 16.1 m.
+  centre /= double(sparks);
+  EXPECT_NEAR(centre.y(), 20 - 9.81 / 2 + (20 - 9.81) * 0.1, 0.3)
+      << "mean spark height " << centre.y();
+}
+
+TEST(SceneSimulation, SameStateForAnyThreadCount) {
+  const std::string text = R"(<scene version="1" seed="5">
+    <terrain id="hill" size="20 20" resolution="33" height="2"/>
+    <forest id="trees" grammar=")" + Grammar("abop/fig2_08a_ternary.lsys") +
+                           R"(" count="4" on="hill" area="-6 -6 6 6" steps="4" height="4"/>
+    <wind velocity="1 0 0" gust="1" scale="4" frequency="0.5"/>
+    <particles id="snow" max="5000">
+      <emitter shape="box" at="0 7 0" size="12 0.5 12" rate="3000" lifetime="50"/>
+      <gravity/><drag k="0.5"/>
+      <collide with="trees hill" stick="true"/>
+    </particles>
+    <simulation fps="30" substeps="1"/>
+  </scene>)";
+  std::string dumps[2];
+  for (int k = 0; k < 2; ++k) {
+    auto run = Start(text, k == 0 ? 1 : 2);
+    ASSERT_TRUE(run);
+    ASSERT_TRUE(run->sim->AdvanceTo(2).ok());
+    std::ostringstream csv;
+    run->sim->WriteCsv(csv);
+    dumps[k] = csv.str();
+  }
+  EXPECT_GT(dumps[0].size(), 100000u);
+  EXPECT_TRUE(dumps[0] == dumps[1]) << "1 and 2 threads differ";
+}
+
+TEST(SceneSimulation, ClothHangsFromItsPinsAndFlagsInTheWind) {
+  auto run = Start(R"(<scene version="1">
+    <cloth id="flag" size="2 1" resolution="20 10" position="0 3 0" pin="left">
+      <gravity/>
+    </cloth>
+    <wind velocity="8 0 0"/>
+    <simulation fps="30" substeps="2"/>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(4).ok());
+  const std::vector<Row> rows = Rows(*run->sim);
+  ASSERT_EQ(rows.size(), 200u);
+  // The pinned column stays; the free edge is blown downwind (+x) and
+  // does not fall below the pins by more than the cloth's width.
+  for (int j = 0; j < 10; ++j) EXPECT_NEAR(rows[size_t(j * 20)].x.x(), 0, 1e-9);
+  double meanX = 0;
+  for (int j = 0; j < 10; ++j) meanX += rows[size_t(j * 20 + 19)].x.x() / 10;
+  EXPECT_GT(meanX, 1.0) << "free edge's mean x; the wind blows along +x";
+}
+
+}  // namespace
+}  // namespace sylva::scene
