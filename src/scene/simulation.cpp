@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <map>
 #include <ostream>
+#include <unordered_map>
 
 #include "core/rng.h"
 #include "mesh/obj_reader.h"
@@ -81,6 +82,40 @@ class AccelerationField : public particles::LocalForce {
 
  private:
   Fn fn_;
+};
+
+// Falling leaves: a thin plate whose orientation is integrated with the
+// particle. The air pushes on the plate along its normal n only (a plate
+// slides easily edgewise), so a tilted leaf glides sideways; the flow turns
+// the plate broadside to it (torque a (n.u)(n x u) |u|^2 about the centre
+// of pressure, damped), so the tilt swings back and forth: the leaf
+// flutters and zigzags as it falls instead of dropping straight.
+struct LeafState {
+  Vec3 n = Vec3::UnitZ();  // plate normal (the leaf mesh's +Z)
+  Vec3 w = Vec3::Zero();   // angular velocity, rad/s
+};
+using LeafStates = std::unordered_map<uint32_t, LeafState>;
+
+// Extra drag along the plate's normal: f = -k (u.n) n, u = v - wind.
+class PlateDrag : public particles::LocalForce {
+ public:
+  PlateDrag(double k, const Wind* wind, const LeafStates* leaves)
+      : k_(k), wind_(wind), leaves_(leaves) {}
+  void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
+                       size_t end) const override {
+    for (size_t i = begin; i < end; ++i) {
+      const auto it = leaves_->find(s.id[i]);
+      if (it == leaves_->end() || s.invMass[i] == 0) continue;
+      const Vec3 u = wind_ ? Vec3(v[i] - wind_->At(x[i], s.time)) : v[i];
+      const Vec3& n = it->second.n;
+      f[i - begin] -= k_ * u.dot(n) * n;
+    }
+  }
+
+ private:
+  double k_;
+  const Wind* wind_;
+  const LeafStates* leaves_;
 };
 
 // --- emission ----------------------------------------------------------------
@@ -180,8 +215,48 @@ struct ParticleSystem {
   std::vector<Death> onDeath;
   uint64_t dropped = 0;                                // births refused at `max`
   std::shared_ptr<const mesh::TriangleMesh> drawMesh;  // as="mesh"
-  std::vector<Vec3> spinAxis;                          // by particle id, lazily
+  // Leaves (draw as="mesh" with spin): orientation by particle id.
+  bool flutter = false;
+  std::unique_ptr<LeafStates> leaves;
+  double plateK = 0;  // drag along the normal, N s/m
+  uint64_t leafSeed = 0;
+  // Turns each leaf by the flow's torque and its spin; new ones get a
+  // random orientation and spin, dead ones are forgotten.
+  void TurnLeaves(double h, const Wind* wind, double time);
 };
+
+void ParticleSystem::TurnLeaves(double h, const Wind* wind, double time) {
+  const ParticleState& st = system->state;
+  const double spin = def->draw.spinDegrees * kDegToRad;
+  LeafStates next;
+  next.reserve(st.size());
+  for (size_t i = 0; i < st.size(); ++i) {
+    auto it = leaves->find(st.id[i]);
+    LeafState leaf;
+    if (it == leaves->end()) {
+      const uint64_t k = CounterHash(leafSeed, st.id[i]);
+      leaf.n = InCone(Vec3::UnitY(), 180, ToUnit(k), ToUnit(Mix64(k)));
+      leaf.w = spin * InCone(Vec3::UnitY(), 180, ToUnit(Mix64(k ^ 1)), ToUnit(Mix64(k ^ 2)));
+    } else {
+      leaf = it->second;
+    }
+    if (st.invMass[i] > 0) {
+      const Vec3 u = wind ? Vec3(st.velocity[i] - wind->At(st.position[i], time)) : st.velocity[i];
+      const double speed = u.norm();
+      Vec3 torque = Vec3::Zero();
+      if (speed > 1e-9) {
+        const Vec3 d = u / speed;
+        torque = 20.0 * leaf.n.dot(d) * leaf.n.cross(d) * speed * speed;
+      }
+      leaf.w += h * (torque - 1.5 * leaf.w);
+      const double angle = leaf.w.norm() * h;
+      if (angle > 0) leaf.n = Eigen::AngleAxisd(angle, leaf.w.normalized()) * leaf.n;
+      leaf.n.normalize();
+    }
+    next.emplace(st.id[i], leaf);
+  }
+  *leaves = std::move(next);
+}
 
 struct ClothSheet {
   const ClothDef* def = nullptr;
@@ -327,6 +402,7 @@ Status Simulation::Impl::Step() {
     for (int k = 0; k < sub; ++k) {
       const double hs = h / sub;
       if (Status s = Emit(*ps, hs); !s.ok()) return s;
+      if (ps->flutter) ps->TurnLeaves(hs, hasWind ? &wind : nullptr, time);
       Status s = ps->adaptive ? ps->system->StepAdaptive(hs, particles::AdaptiveOptions{})
                               : ps->system->Step(hs, ps->integrator);
       if (!s.ok()) {
@@ -596,6 +672,17 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
       auto mesh = loadMesh(p.draw);
       if (!mesh) return mesh.error();
       ps->drawMesh = *mesh;
+      if (p.draw.spinDegrees != 0) {
+        // Leaves: the plate's drag is four times the system's linear drag.
+        for (const ForceDef& f : p.forces)
+          if (f.kind == ForceKind::kDrag && !f.quadratic) ps->plateK += 4 * f.k;
+        ps->flutter = true;
+        ps->leaves = std::make_unique<LeafStates>();
+        ps->leafSeed = CounterHash(ElementSeed(scene.seed, p.id, "leaves", size_t(p.loc.line)), 1);
+        if (ps->plateK > 0)
+          ps->system->AddForce(std::make_shared<PlateDrag>(
+              ps->plateK, p.wind && m.hasWind ? &m.wind : nullptr, ps->leaves.get()));
+      }
     }
     if (!p.id.empty()) byId[p.id] = ps.get();
     m.systems.push_back(std::move(ps));
@@ -796,6 +883,11 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
           a.translate(st.position[i] + Vec3(0, 0.005, 0));
           a.rotate(Eigen::AngleAxisd(2 * kPi * ToUnit(Mix64(h ^ 7)), Vec3::UnitY()));
           a.rotate(Eigen::AngleAxisd(-kPi / 2, Vec3::UnitX()));
+        } else if (ps->leaves && ps->leaves->count(st.id[i])) {
+          // A leaf: its plate normal (the mesh's +Z) as integrated.
+          a.translate(st.position[i]);
+          a.rotate(Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), ps->leaves->at(st.id[i]).n));
+          a.rotate(Eigen::AngleAxisd(2 * kPi * ToUnit(Mix64(h ^ 7)), Vec3::UnitZ()));
         } else {
           // Tumbling: a turn about an axis of the particle's own, growing
           // with age.

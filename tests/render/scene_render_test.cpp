@@ -46,13 +46,12 @@ TEST(SceneRender, TheFlagIsRedInTheMiddleOfTheSkyAndWavesWithTime) {
   const fs::path dir = sylva::testing::ScratchDir("sylva_scene_render_");
   std::string err;
   const std::string a = (dir / "a.png").string(), b = (dir / "b.png").string();
-  ASSERT_EQ(Sylva({"render", Example("flag.xml"), "--time", "2", "--size", "320x180", "-o", a},
-                  &err),
-            0)
+  ASSERT_EQ(
+      Sylva({"render", Example("flag.xml"), "--time", "2", "--size", "320x180", "-o", a}, &err), 0)
       << err;
-  ASSERT_EQ(Sylva({"render", Example("flag.xml"), "--time", "2.5", "--size", "320x180", "-o", b},
-                  &err),
-            0)
+  ASSERT_EQ(
+      Sylva({"render", Example("flag.xml"), "--time", "2.5", "--size", "320x180", "-o", b}, &err),
+      0)
       << err;
   const Pixels pa = Load(a), pb = Load(b);
   ASSERT_EQ(pa.w, 320);
@@ -112,7 +111,8 @@ TEST(SceneSimulate, WritesEveryFrameAndTheFinalStateAsCsv) {
     sparks += line.rfind("sparks,", 0) == 0;
   }
   EXPECT_GT(shells, 0u);
-  EXPECT_GT(sparks, 0u) << "by 3 s the first shells (born at 0.67 s, living 1.6 to 1.9 s) have burst";
+  EXPECT_GT(sparks, 0u)
+      << "by 3 s the first shells (born at 0.67 s, living 1.6 to 1.9 s) have burst";
 }
 
 }  // namespace

@@ -87,7 +87,8 @@ std::vector<Row> Rows(const Simulation& sim) {
 TEST(SceneSimulation, SnowThatLandsOnABranchStaysThere) {
   // A tree 6 m tall; snow falls on it from a box above and sticks.
   auto run = Start(R"(<scene version="1">
-    <plant id="tree" grammar=")" + Grammar("abop/fig2_08a_ternary.lsys") +
+    <plant id="tree" grammar=")" +
+                   Grammar("abop/fig2_08a_ternary.lsys") +
                    R"(" steps="5" height="6"/>
     <particles id="snow" max="20000">
       <emitter shape="box" at="0 8 0" size="8 0.5 8" rate="20000" direction="0 -1 0"
@@ -193,7 +194,8 @@ TEST(SceneSimulation, FireworkShellsBurstIntoSparksWhereTheyDie) {
 TEST(SceneSimulation, SameStateForAnyThreadCount) {
   const std::string text = R"(<scene version="1" seed="5">
     <terrain id="hill" size="20 20" resolution="33" height="2"/>
-    <forest id="trees" grammar=")" + Grammar("abop/fig2_08a_ternary.lsys") +
+    <forest id="trees" grammar=")" +
+                           Grammar("abop/fig2_08a_ternary.lsys") +
                            R"(" count="4" on="hill" area="-6 -6 6 6" steps="4" height="4"/>
     <wind velocity="1 0 0" gust="1" scale="4" frequency="0.5"/>
     <particles id="snow" max="5000">
@@ -234,6 +236,43 @@ TEST(SceneSimulation, ClothHangsFromItsPinsAndFlagsInTheWind) {
   double meanX = 0;
   for (int j = 0; j < 10; ++j) meanX += rows[size_t(j * 20 + 19)].x.x() / 10;
   EXPECT_GT(meanX, 1.0) << "free edge's mean x; the wind blows along +x";
+}
+
+}  // namespace
+}  // namespace sylva::scene
+
+namespace sylva::scene {
+namespace {
+
+// Mean horizontal distance from the drop point of particles at rest on the
+// ground, after dropping from 10 m in still air.
+double MeanDrift(const std::string& draw) {
+  auto run = Start(R"(<scene version="1" seed="3">
+    <particles id="p" max="400">
+      <emitter burst="200" at="0 10 0" lifetime="100" mass="0.002"/>
+      <gravity/><drag k="0.004"/>
+      <collide with="ground" stick="true"/>
+      )" + draw + R"(
+    </particles>
+    <simulation fps="60" substeps="2"/>
+  </scene>)");
+  if (!run) return -1;
+  EXPECT_TRUE(run->sim->AdvanceTo(30).ok());
+  double sum = 0;
+  size_t n = 0;
+  for (const Row& r : Rows(*run->sim)) {
+    EXPECT_EQ(r.v.norm(), 0) << "still falling after 30 s at " << r.x.transpose();
+    sum += Vec2(r.x.x(), r.x.z()).norm();
+    ++n;
+  }
+  return n ? sum / double(n) : -1;
+}
+
+TEST(SceneSimulation, LeavesFlutterAndGlideWhileSpritesFallStraight) {
+  const double sprites = MeanDrift(R"(<draw as="sprites"/>)");
+  const double leaves = MeanDrift(R"(<draw as="mesh" mesh="~leaf" size="0.2" spin="90"/>)");
+  EXPECT_LT(sprites, 1e-9) << "sprites in still air fall straight down";
+  EXPECT_GT(leaves, 0.5) << "mean sideways glide of leaves falling 10 m, metres";
 }
 
 }  // namespace
