@@ -24,8 +24,8 @@ static SceneLoad LoadUnsafe(const std::string& path, const std::vector<std::stri
   // Everything the scene reads, so an edit to any of it reloads.
   load.watched = s->files;
   auto watch = [&](const std::string& file) {
-    if (!file.empty() && std::find(load.watched.begin(), load.watched.end(), file) ==
-                             load.watched.end())
+    if (!file.empty() &&
+        std::find(load.watched.begin(), load.watched.end(), file) == load.watched.end())
       load.watched.push_back(file);
   };
   for (const scene::PlantDef& p : s->plants) watch(p.grammar);
@@ -71,7 +71,9 @@ SceneLoad LoadSceneForView(const std::string& path, const std::vector<std::strin
 
 Expected<std::unique_ptr<ScenePlayer>> ScenePlayer::Create(std::unique_ptr<LoadedScene> loaded) {
   std::unique_ptr<ScenePlayer> p(new ScenePlayer(std::move(loaded)));
-  if (Status s = p->Rebuild(); !s.ok()) return s.error();
+  Created sim = p->MakeSimulation();
+  if (!sim) return sim.error();
+  p->sim_ = std::move(*sim);
   return p;
 }
 
@@ -79,26 +81,44 @@ double ScenePlayer::time() const {
   return sim_ ? sim_->time() : 0.0;
 }
 
-Status ScenePlayer::Reset() {
-  seekTarget_ = -1;
-  return Rebuild();
-}
-
-Status ScenePlayer::Rebuild() {
+ScenePlayer::Created ScenePlayer::MakeSimulation() const {
   DiagnosticList warnings;  // reported when the scene was loaded
   scene::SimulationOptions options;
   options.threads = loaded_->threads;
-  sim_.reset();
-  auto sim = scene::Simulation::Create(loaded_->scene, loaded_->built, options, warnings);
+  return scene::Simulation::Create(loaded_->scene, loaded_->built, options, warnings);
+}
+
+void ScenePlayer::StartRebuild() {
+  if (pending_.valid()) return;  // one is on its way
+  pending_ = std::async(std::launch::async, [this] {
+    try {
+      return MakeSimulation();
+    } catch (const std::bad_alloc&) {
+      return Created(MakeError({}, "out of memory creating the simulation"));
+    }
+  });
+}
+
+Status ScenePlayer::FinishRebuild(bool wait) {
+  if (!pending_.valid()) return {};
+  if (!wait && pending_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return {};
+  Created sim = pending_.get();
   if (!sim) {
     error_ = sim.error().Format();
     playing_ = false;
+    seekTarget_ = -1;
     return sim.error();
   }
   sim_ = std::move(*sim);
   clock_ = 0;
   error_.clear();
   return {};
+}
+
+void ScenePlayer::Reset() {
+  seekTarget_ = -1;
+  error_.clear();
+  StartRebuild();
 }
 
 Status ScenePlayer::Advance(double t) {
@@ -124,6 +144,7 @@ void ScenePlayer::Play() {
 Status ScenePlayer::Step() {
   playing_ = false;
   seekTarget_ = -1;
+  if (rebuilding()) return {};  // the next frame starts from t = 0
   return Advance(time() + frameLength());
 }
 
@@ -132,15 +153,15 @@ void ScenePlayer::Seek(double t) {
 }
 
 Status ScenePlayer::Update(double wallSeconds, double budgetSeconds) {
-  if (!error_.empty()) return {};
+  if (Status s = FinishRebuild(budgetSeconds <= 0); !s.ok()) return s;
+  if (rebuilding() || !error_.empty()) return {};
   const double half = frameLength() / 2;
   if (seekTarget_ >= 0) {
     // Backward: start again from t = 0, then simulate forward frame by frame.
     if (seekTarget_ < time() - half) {
-      if (Status s = Rebuild(); !s.ok()) {
-        seekTarget_ = -1;
-        return s;
-      }
+      StartRebuild();
+      if (Status s = FinishRebuild(budgetSeconds <= 0); !s.ok()) return s;
+      if (rebuilding()) return {};
     }
     const auto start = Clock::now();
     while (time() < seekTarget_ - half) {

@@ -14,8 +14,12 @@
 // playback down (slower() says so) instead of blocking the window. A seek
 // (the time slider, --time) simulates forward within a wall-clock budget per
 // drawn frame; seeking backward rebuilds the Simulation at t = 0 first.
+// Rebuilding (reset, seeking back) runs on its own thread: creating a
+// Simulation can take a while (snowy_forest.xml's colliders, ~0.4 s here),
+// so the window goes on drawing the old state until the new one is ready.
 #pragma once
 
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -64,6 +68,8 @@ class ScenePlayer {
   double duration() const { return loaded_->scene.simulation.duration; }
   bool playing() const { return playing_; }
   bool seeking() const { return seekTarget_ >= 0; }
+  // A new Simulation at t = 0 is being created (reset, seeking back).
+  bool rebuilding() const { return pending_.valid(); }
   double seekTarget() const { return seekTarget_; }
   // Playback fell behind real time within the last second of playing.
   bool slower() const { return playing_ && sinceDrop_ < 1.0; }
@@ -77,14 +83,15 @@ class ScenePlayer {
   void Pause() { playing_ = false; }
   // Pauses and advances one frame.
   Status Step();
-  // Back to t = 0: a new Simulation (cancels a seek). Keeps playing if it
-  // was.
-  Status Reset();
+  // Back to t = 0: a new Simulation (cancels a seek), created in the
+  // background and swapped in by a later Update. Keeps playing if it was.
+  void Reset();
   // Moves toward time t (clamped to [0, duration]) in the next Updates.
   void Seek(double t);
   // One drawn frame: `wallSeconds` of real time passed since the last one.
   // Seeking: simulate toward the target for at most `budgetSeconds` (0: all
-  // the way). Playing: at most one simulation frame. Stops at the end of
+  // the way, waiting for a rebuild too). Playing: at most one simulation
+  // frame. Stops at the end of
   // the scene's duration. A failed step pauses and sets error().
   Status Update(double wallSeconds, double budgetSeconds);
 
@@ -94,16 +101,21 @@ class ScenePlayer {
 
  private:
   explicit ScenePlayer(std::unique_ptr<LoadedScene> loaded) : loaded_(std::move(loaded)) {}
-  Status Rebuild();          // a new Simulation at t = 0
-  Status Advance(double t);  // one AdvanceTo with its timing and error
+  using Created = Expected<std::unique_ptr<scene::Simulation>>;
+  Created MakeSimulation() const;
+  void StartRebuild();              // MakeSimulation on another thread
+  Status FinishRebuild(bool wait);  // swaps the new Simulation in when ready
+  Status Advance(double t);         // one AdvanceTo with its timing and error
   std::unique_ptr<LoadedScene> loaded_;
   std::unique_ptr<scene::Simulation> sim_;
   bool playing_ = false;
-  double clock_ = 0;         // playback's real-time clock (scene seconds)
-  double seekTarget_ = -1;   // < 0: not seeking
-  double sinceDrop_ = 1e9;   // seconds played since playback last fell behind
+  double clock_ = 0;        // playback's real-time clock (scene seconds)
+  double seekTarget_ = -1;  // < 0: not seeking
+  double sinceDrop_ = 1e9;  // seconds played since playback last fell behind
   double lastStep_ = 0;
   std::string error_;
+  // Declared last: destroyed (waited for) before what it reads.
+  std::future<Created> pending_;
 };
 
 // Triangles drawn by a list (every mesh times its instances).

@@ -42,11 +42,30 @@ struct SceneJob {
 
 struct SceneResult {
   uint64_t id = 0;
-  SceneLoad load;
+  SceneLoad load;                       // load.scene moved into the player
+  std::unique_ptr<ScenePlayer> player;  // at t = 0; null on an error
 };
 
+// Loads, builds and creates the simulation (which may take a while: the
+// colliders of a forest) off the UI thread.
 SceneResult RunSceneJob(const SceneJob& job) {
-  return {job.id, LoadSceneForView(job.path, job.defines, job.strict, job.threads)};
+  SceneResult r;
+  r.id = job.id;
+  r.load = LoadSceneForView(job.path, job.defines, job.strict, job.threads);
+  if (!r.load.scene) return r;
+  try {
+    auto created = ScenePlayer::Create(std::move(r.load.scene));
+    if (created) {
+      r.player = std::move(*created);
+    } else {
+      r.load.diagnostics += created.error().Format();
+      r.load.exit = created.error().kind == ErrorKind::kInput ? kExitBadInput : kExitRuntime;
+    }
+  } catch (const std::bad_alloc&) {
+    r.load.diagnostics += job.path + ": error: out of memory creating the simulation\n";
+    r.load.exit = kExitRuntime;
+  }
+  return r;
 }
 
 // The files of the scene and their modification times.
@@ -115,13 +134,15 @@ void DrawScenePanel(const std::string& path, ScenePlayer* player, const SceneSho
     ImGui::SameLine();
     if (ImGui::Button("step")) (void)player->Step();  // an error shows in the panel
     ImGui::SameLine();
-    if (ImGui::Button("reset")) (void)player->Reset();
+    if (ImGui::Button("reset")) player->Reset();
     float t = float(player->seeking() ? player->seekTarget() : player->time());
     const float end = float(std::max(player->duration(), player->time()));
     if (ImGui::SliderFloat("time", &t, 0.0f, end, "%.2f s")) player->Seek(t);
     ImGui::Text("t = %.3f s of %.3f s (%.0f fps)", player->time(), player->duration(),
                 1.0 / player->frameLength());
-    if (player->seeking()) {
+    if (player->rebuilding()) {
+      ImGui::TextColored(ImVec4(0.1f, 0.3f, 0.8f, 1), "starting again from t = 0...");
+    } else if (player->seeking()) {
       ImGui::TextColored(ImVec4(0.1f, 0.3f, 0.8f, 1), "simulating to %.2f s...",
                          player->seekTarget());
     }
@@ -181,11 +202,12 @@ int RunViewScene(const ViewCommand& cmd, int width, int height, std::ostream& ou
   int frame = 0;
   int shots = 0;
   MouseCamera mouse;
-  bool spaceWas = false, rightWas = false;
+  bool spaceWas = false, rightWas = false, pWas = false;
 
   while (!glfwWindowShouldClose(window.handle)) {
     const auto frameStart = Clock::now();
-    const double wall = std::min(std::chrono::duration<double>(frameStart - lastFrame).count(), 0.25);
+    const double wall =
+        std::min(std::chrono::duration<double>(frameStart - lastFrame).count(), 0.25);
     lastFrame = frameStart;
     glfwPollEvents();
     // Reload on change (polled four times a second).
@@ -197,16 +219,7 @@ int RunViewScene(const ViewCommand& cmd, int width, int height, std::ostream& ou
       SceneLoad& load = r->load;
       watch.Set(load.watched);
       shown.diagnostics = load.diagnostics;
-      std::unique_ptr<ScenePlayer> next;
-      if (load.scene) {
-        auto created = ScenePlayer::Create(std::move(load.scene));
-        if (created) {
-          next = std::move(*created);
-        } else {
-          shown.diagnostics += created.error().Format();
-          load.exit = Report(created.error(), err);
-        }
-      }
+      std::unique_ptr<ScenePlayer> next = std::move(r->player);
       if (next) {
         if (!player) {
           camera = SceneCamera(next->loaded().scene, next->loaded().built, double(width) / height);
@@ -288,9 +301,12 @@ int RunViewScene(const ViewCommand& cmd, int width, int height, std::ostream& ou
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
     ++frame;
-    if (player && !player->seeking()) ++readyFrames;
-    const bool key =
+    if (player && !player->seeking() && !player->rebuilding()) ++readyFrames;
+    // P saves a screenshot once per press.
+    const bool pDown =
         glfwGetKey(window.handle, GLFW_KEY_P) == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard;
+    const bool key = pDown && !pWas;
+    pWas = pDown;
     const bool done = screenshotMode && readyFrames >= cmd.frames;
     if (key || done) {
       std::string file =
@@ -299,8 +315,7 @@ int RunViewScene(const ViewCommand& cmd, int width, int height, std::ostream& ou
         if (Status s = render::WriteImage(render::ReadWindowPixels(fbw, fbh), file); !s.ok()) {
           exitCode = Report(s.error(), err);
         } else {
-          out << "screenshot: " << file << " at t = " << (player ? player->time() : 0.0)
-              << " s\n";
+          out << "screenshot: " << file << " at t = " << (player ? player->time() : 0.0) << " s\n";
         }
       }
     }

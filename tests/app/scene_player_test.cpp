@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
+#include <thread>
 
 #include "scratch_dir.h"
 
@@ -98,9 +100,34 @@ TEST(ScenePlayer, ResetGoesBackToZero) {
   ASSERT_TRUE(p);
   p->Seek(2.0);
   ASSERT_TRUE(p->Update(0, 0).ok());
-  ASSERT_TRUE(p->Reset().ok());
+  const size_t before = p->particles();
+  ASSERT_GT(before, 0u);
+  p->Reset();
+  // The new Simulation is made in the background; the old state is drawn
+  // until an Update swaps it in.
+  EXPECT_TRUE(p->rebuilding());
+  EXPECT_EQ(p->particles(), before);
+  EXPECT_NEAR(p->time(), 2.0, 1e-9);
+  ASSERT_TRUE(p->Update(0, 0).ok());  // no budget: waits for it
+  EXPECT_FALSE(p->rebuilding());
   EXPECT_EQ(p->time(), 0.0);
   EXPECT_EQ(p->particles(), 0u);
+}
+
+TEST(ScenePlayer, SeekingBackWithABudgetNeverWaitsForTheRebuild) {
+  auto p = Player();
+  ASSERT_TRUE(p);
+  p->Seek(2.0);
+  ASSERT_TRUE(p->Update(0, 0).ok());
+  p->Seek(1.0);
+  // Drawn frames with a budget go on while the rebuild runs, then the seek
+  // continues from t = 0 and arrives.
+  for (int i = 0; i < 10000 && p->seeking(); ++i) {
+    ASSERT_TRUE(p->Update(0, 0.03).ok());
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_FALSE(p->seeking());
+  EXPECT_NEAR(p->time(), 1.0, 1e-9);
 }
 
 TEST(ScenePlayer, PlayingStopsAtTheEndAndRestartsFromZero) {
@@ -130,8 +157,7 @@ TEST(LoadSceneForView, WatchesTheSceneAndItsGrammars) {
   ASSERT_TRUE(load.scene) << load.diagnostics;
   ASSERT_EQ(load.watched.size(), 2u);
   EXPECT_NE(load.watched[0].find("fireworks.xml"), std::string::npos) << load.watched[0];
-  EXPECT_NE(load.watched[1].find("fig2_07a_sympodial.lsys"), std::string::npos)
-      << load.watched[1];
+  EXPECT_NE(load.watched[1].find("fig2_07a_sympodial.lsys"), std::string::npos) << load.watched[1];
 }
 
 TEST(LoadSceneForView, AnErrorIsABadInputWithItsLocation) {
