@@ -149,7 +149,7 @@ Status ScenePlayer::Step() {
 }
 
 void ScenePlayer::Seek(double t) {
-  seekTarget_ = std::clamp(t, 0.0, duration());
+  seekTarget_ = std::max(t, 0.0);
 }
 
 Status ScenePlayer::Update(double wallSeconds, double budgetSeconds) {

@@ -86,7 +86,8 @@ class ScenePlayer {
   // Back to t = 0: a new Simulation (cancels a seek), created in the
   // background and swapped in by a later Update. Keeps playing if it was.
   void Reset();
-  // Moves toward time t (clamped to [0, duration]) in the next Updates.
+  // Moves toward time t (at least 0; the slider stops at the duration,
+  // --time may go past it) in the next Updates.
   void Seek(double t);
   // One drawn frame: `wallSeconds` of real time passed since the last one.
   // Seeking: simulate toward the target for at most `budgetSeconds` (0: all

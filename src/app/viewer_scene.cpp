@@ -71,13 +71,16 @@ SceneResult RunSceneJob(const SceneJob& job) {
 // The files of the scene and their modification times.
 class FileWatch {
  public:
-  // Watches `paths`; a path already watched keeps the time recorded before
-  // its reload began, so an edit made while loading is still seen.
-  void Set(const std::vector<std::string>& paths) {
+  // Watches `paths` (and, with keepOthers, the files watched already); a
+  // path already watched keeps the time recorded before its reload began,
+  // so an edit made while loading is still seen.
+  void Set(const std::vector<std::string>& paths, bool keepOthers = false) {
     std::vector<Entry> next;
+    if (keepOthers) next = entries_;
     for (const std::string& p : paths) {
-      auto it = std::find_if(entries_.begin(), entries_.end(),
-                             [&](const Entry& e) { return e.path == p; });
+      auto known = [&](const Entry& e) { return e.path == p; };
+      if (std::find_if(next.begin(), next.end(), known) != next.end()) continue;
+      auto it = std::find_if(entries_.begin(), entries_.end(), known);
       next.push_back(it != entries_.end() ? *it : Entry{p, TimeOf(p)});
     }
     entries_ = std::move(next);
@@ -217,7 +220,10 @@ int RunViewScene(const ViewCommand& cmd, int width, int height, std::ostream& ou
     }
     if (auto r = worker.Take()) {
       SceneLoad& load = r->load;
-      watch.Set(load.watched);
+      // A failed load may not know every file (an include or a grammar with
+      // an error): go on watching the last good scene's files too, so that
+      // fixing one reloads.
+      watch.Set(load.watched, /*keepOthers=*/!r->player);
       shown.diagnostics = load.diagnostics;
       std::unique_ptr<ScenePlayer> next = std::move(r->player);
       if (next) {

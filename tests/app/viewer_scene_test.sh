@@ -104,4 +104,9 @@ printf 'axiom: A(1)\nA(l) --> F(l*nope)\n' > "$work/tree.lsys"
 for _ in $(seq 100); do [[ $(errors) -ge 2 ]] && break; sleep 0.1; done
 grep -q "tree.lsys:2:14: error: unknown name 'nope'" "$work/view.err" || { cat "$work/view.err"; exit 1; }
 kill -0 "$viewer"
+# Fixing the grammar loads the scene again (the failed load still watches it).
+n=$(loads)
+cp "$src/grammars/abop/fig2_07a_sympodial.lsys" "$work/tree.lsys"
+for _ in $(seq 100); do [[ $(loads) -gt $n ]] && break; sleep 0.1; done
+[[ $(loads) -gt $n ]] || { echo "the fixed grammar did not load again"; cat "$work/view.err"; exit 1; }
 echo "viewer reloaded the scene and its grammar, reported errors and kept running"
