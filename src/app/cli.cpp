@@ -151,13 +151,21 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   ViewCommand view;
   CLI::App* vi =
       app.add_subcommand("view", "open the interactive viewer (reloads the file when it changes)");
-  vi->add_option("file", view.file, "grammar file (.lsys); default: a bundled ABOP tree");
+  vi->add_option("file", view.file,
+                 "grammar file (.lsys) or scene file (.xml, played); default: a bundled ABOP "
+                 "tree");
   vi->add_option("--screenshot", view.screenshot,
                  "save this picture (.png, .jpg) after --frames frames and quit");
   vi->add_option("--frames", view.frames, "frames to draw before the screenshot")
       ->check(CLI::Range(1, 1000000));
   vi->add_option("--size", view.size, "window size WxH (default 1280x720)");
   AddStrictFlag(vi, view.strict);
+  vi->add_option("--time", view.time, "scenes: start paused at this time in seconds")
+      ->check(CLI::Range(0.0, 1e6));
+  vi->add_option("-D,--define", view.defines,
+                 "scenes: override a <default>: NAME=VALUE (repeatable)");
+  vi->add_option("--threads", view.threads, "scenes: worker threads (default: all cores)")
+      ->check(CLI::Range(0, 256));
 
   DeriveFlags check;
   CLI::App* c = app.add_subcommand(

@@ -22,6 +22,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/viewer_window.h"
 #include "plant/plant.h"
 #include "plant/surface_library.h"
 #include "render/renderer.h"
@@ -111,139 +112,10 @@ Result RunJobSafely(const Job& job) {
   }
 }
 
-class Worker {
- public:
-  Worker() : thread_([this] { Loop(); }) {}
-  ~Worker() {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
-    }
-    wake_.notify_all();
-    thread_.join();
-  }
-  void Post(Job job) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      pending_ = std::move(job);
-    }
-    wake_.notify_all();
-  }
-  std::optional<Result> Take() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    std::optional<Result> r = std::move(done_);
-    done_.reset();
-    return r;
-  }
-  bool Busy() const { return busy_.load(); }
-
- private:
-  void Loop() {
-    for (;;) {
-      Job job;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        wake_.wait(lock, [&] { return stop_ || pending_.has_value(); });
-        if (stop_) return;
-        job = std::move(*pending_);
-        pending_.reset();
-        busy_ = true;
-      }
-      Result r = RunJobSafely(job);
-      std::lock_guard<std::mutex> lock(mutex_);
-      busy_ = false;
-      if (!pending_) done_ = std::move(r);  // overtaken results are dropped
-    }
-  }
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  std::optional<Job> pending_;
-  std::optional<Result> done_;
-  std::atomic<bool> busy_{false};
-  bool stop_ = false;
-  std::thread thread_;
-};
-
 std::string DefaultGrammar() {
   return (fs::path(plant::BundledDataDir()) / "grammars" / "abop" / "fig2_06a_monopodial.lsys")
       .string();
 }
-
-// The window, its GL context and Dear ImGui, or an error message.
-struct Window {
-  GLFWwindow* handle = nullptr;
-  ~Window() {
-    if (!handle) return;
-    ImGui_ImplOpenGL3_Shutdown();
-    ImGui_ImplGlfw_Shutdown();
-    ImGui::DestroyContext();
-    glfwDestroyWindow(handle);
-    glfwTerminate();
-  }
-};
-
-// Opens a window with an OpenGL 4.5 core context and Dear ImGui on it;
-// returns the exit status on failure (message printed).
-int OpenWindow(int width, int height, const std::string& title, bool vsync, Window& w,
-               std::ostream& err) {
-  if (!glfwInit()) {
-    err << "sylva: error: cannot open a window (no display? run under Xvfb, or use sylva render)\n";
-    return kExitRuntime;
-  }
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
-  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
-  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-  GLFWwindow* window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
-  if (!window) {
-    glfwTerminate();
-    err << "sylva: error: cannot create an OpenGL 4.5 window\n";
-    return kExitRuntime;
-  }
-  glfwMakeContextCurrent(window);
-  glfwSwapInterval(vsync ? 1 : 0);
-  glewExperimental = GL_TRUE;
-  if (glewInit() != GLEW_OK) {
-    glfwDestroyWindow(window);
-    glfwTerminate();
-    err << "sylva: error: cannot load OpenGL functions\n";
-    return kExitRuntime;
-  }
-  glGetError();
-  IMGUI_CHECKVERSION();
-  ImGui::CreateContext();
-  ImGui::GetIO().IniFilename = nullptr;
-  ImGui::StyleColorsLight();
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
-  ImGui_ImplOpenGL3_Init("#version 450 core");
-  w.handle = window;
-  return kExitOk;
-}
-
-// Left drag orbits, right drag pans, the wheel zooms (when ImGui does not
-// want the mouse).
-struct MouseCamera {
-  double lastX = 0, lastY = 0;
-  void Update(GLFWwindow* window, render::Camera& camera) {
-    const ImGuiIO& io = ImGui::GetIO();
-    double mx, my;
-    glfwGetCursorPos(window, &mx, &my);
-    if (!io.WantCaptureMouse) {
-      if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
-        camera.azimuth -= (mx - lastX) * 0.4;
-        camera.elevation = std::clamp(camera.elevation + (my - lastY) * 0.4, -85.0, 85.0);
-      }
-      if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) {
-        const Mat4 v = camera.View();
-        const Vec3 right(v(0, 0), v(0, 1), v(0, 2)), up(v(1, 0), v(1, 1), v(1, 2));
-        const double k = camera.distance * 0.0015;
-        camera.target += (-right * (mx - lastX) + up * (my - lastY)) * k;
-      }
-      if (io.MouseWheel != 0) camera.distance *= std::pow(0.9, io.MouseWheel);
-    }
-    lastX = mx;
-    lastY = my;
-  }
-};
 
 // What the panel shows of the newest results.
 struct Shown {
@@ -329,6 +201,12 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     err << path << ": error: cannot read file\n";
     return kExitBadInput;
   }
+  if (IsSceneFile(path)) return RunViewScene(cmd, width, height, out, err);
+  if (cmd.time || !cmd.defines.empty() || cmd.threads) {
+    err << "sylva: error: --time, -D and --threads are for scenes (.xml); a grammar's #defines "
+           "have sliders in the viewer\n";
+    return kExitBadInput;
+  }
   Window window;
   if (int code = OpenWindow(width, height, "Sylva - " + path, cmd.frames == 0, window, err))
     return code;
@@ -338,7 +216,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   (*renderer)->SetGround(true);
 
   int exitCode = kExitOk;
-  Worker worker;
+  Worker<Job, Result> worker(RunJobSafely);
   Job job;
   job.path = path;
   job.strict = cmd.strict;

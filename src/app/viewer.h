@@ -1,14 +1,20 @@
 // `sylva view`: the interactive viewer (GLFW window + Dear ImGui).
 //
-// It reloads the grammar when the file changes; a bad edit lists its
+// A scene file (.xml) is played (viewer_scene.cpp): its camera is the
+// initial view, a panel has play, pause, step, reset, a time slider, the
+// counts and the frame time, and the scene reloads when it, an included file
+// or a grammar it names changes. Otherwise the file is a grammar: the
+// viewer reloads it when the file changes; a bad edit lists its
 // diagnostics in a panel and keeps the last good plant on screen. Sliders
 // set every #define, the seed, the derivation step and the detail; changes
-// are derived on a worker thread, so the window never freezes. Mouse: left
-// drag orbits, right drag pans, wheel zooms; P saves a screenshot.
+// are derived on a worker thread, so the window never freezes. In both,
+// left drag orbits, right drag pans, wheel zooms; P saves a screenshot.
 #pragma once
 
 #include <iosfwd>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace sylva::app {
 
@@ -18,8 +24,15 @@ struct ViewCommand {
   int frames = 0;
   std::string size = "1280x720";
   bool strict = false;  // --strict: a plant with warnings is not shown (they are errors)
+  // Scenes (.xml) only:
+  std::optional<double> time;        // --time: start paused at this time (seconds)
+  std::vector<std::string> defines;  // -D NAME=VALUE: the scene's <default>s
+  int threads = 0;                   // --threads: build and simulation (0: all cores)
 };
 
 int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err);
+// The scene mode, once RunView has checked the flags and the file.
+int RunViewScene(const ViewCommand& cmd, int width, int height, std::ostream& out,
+                 std::ostream& err);
 
 }  // namespace sylva::app

@@ -1,0 +1,83 @@
+// The viewer's window, mouse camera: see viewer_window.h.
+#include "app/viewer_window.h"
+
+#include <GL/glew.h>
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <ostream>
+
+#include "app/cli.h"
+
+namespace sylva::app {
+
+Window::~Window() {
+  if (!handle) return;
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  glfwDestroyWindow(handle);
+  glfwTerminate();
+}
+
+int OpenWindow(int width, int height, const std::string& title, bool vsync, Window& w,
+               std::ostream& err) {
+  if (!glfwInit()) {
+    err << "sylva: error: cannot open a window (no display? run under Xvfb, or use sylva render)\n";
+    return kExitRuntime;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  GLFWwindow* window = glfwCreateWindow(width, height, title.c_str(), nullptr, nullptr);
+  if (!window) {
+    glfwTerminate();
+    err << "sylva: error: cannot create an OpenGL 4.5 window\n";
+    return kExitRuntime;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(vsync ? 1 : 0);
+  glewExperimental = GL_TRUE;
+  if (glewInit() != GLEW_OK) {
+    glfwDestroyWindow(window);
+    glfwTerminate();
+    err << "sylva: error: cannot load OpenGL functions\n";
+    return kExitRuntime;
+  }
+  glGetError();
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  ImGui::StyleColorsLight();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 450 core");
+  w.handle = window;
+  return kExitOk;
+}
+
+void MouseCamera::Update(GLFWwindow* window, render::Camera& camera) {
+  const ImGuiIO& io = ImGui::GetIO();
+  double mx, my;
+  glfwGetCursorPos(window, &mx, &my);
+  if (!io.WantCaptureMouse) {
+    if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
+      camera.azimuth -= (mx - lastX) * 0.4;
+      camera.elevation = std::clamp(camera.elevation + (my - lastY) * 0.4, -85.0, 85.0);
+    }
+    if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) {
+      const Mat4 v = camera.View();
+      const Vec3 right(v(0, 0), v(0, 1), v(0, 2)), up(v(1, 0), v(1, 1), v(1, 2));
+      const double k = camera.distance * 0.0015;
+      camera.target += (-right * (mx - lastX) + up * (my - lastY)) * k;
+    }
+    if (io.MouseWheel != 0) camera.distance *= std::pow(0.9, io.MouseWheel);
+  }
+  lastX = mx;
+  lastY = my;
+}
+
+}  // namespace sylva::app

@@ -1,0 +1,112 @@
+#!/usr/bin/env bash
+# The viewer playing a scene, in a real window under Xvfb:
+#  1. `sylva view fireworks.xml --time 3 --screenshot` shows the fireworks
+#     (bright pixels away from the panel that differ from the sky), and the
+#     picture at --time 0 has none: --time is honoured;
+#  2. a scene with an error exits 2 in screenshot mode, naming file:line:col,
+#     and writes no picture; --time on a grammar is an error;
+#  3. a running viewer reloads when the scene or a grammar it names changes:
+#     an error is reported (and the viewer keeps running), a fix loads again.
+# Usage: viewer_scene_test.sh SYLVA_BINARY SOURCE_DIR WORK_DIR
+set -euo pipefail
+sylva="$1"; src="$2"; work="$3"
+rm -rf "$work"; mkdir -p "$work"
+display=":$((200 + ($$ + 250) % 500))"
+Xvfb "$display" -screen 0 1280x800x24 -nolisten tcp >"$work/xvfb.log" 2>&1 &
+xvfb=$!
+viewer=""
+cleanup() { [[ -n "$viewer" ]] && kill "$viewer" 2>/dev/null; kill "$xvfb" 2>/dev/null; true; }
+trap cleanup EXIT
+export DISPLAY="$display"
+for _ in $(seq 50); do [[ -e "/tmp/.X11-unix/X${display#:}" ]] && break; sleep 0.1; done
+
+# Bright pixels outside the panel (top left, 380x260) that differ from the
+# sky of their row (the rightmost pixel) by more than 60 in some channel.
+bright() {
+  python3 - "$1" <<'PY'
+import struct, sys, zlib
+data = open(sys.argv[1], 'rb').read()
+assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+w, h = struct.unpack('>II', data[16:24])
+idat = b''; i = 8
+while i < len(data):
+    n, kind = struct.unpack('>I4s', data[i:i + 8]); body = data[i + 8:i + 8 + n]
+    if kind == b'IDAT': idat += body
+    i += 12 + n
+raw = zlib.decompress(idat); stride = 4 * w + 1
+assert w == 960 and h == 540, (w, h)
+prev = bytearray(4 * w); count = 0
+for y in range(h):
+    f = raw[y * stride]; row = bytearray(raw[y * stride + 1:(y + 1) * stride])
+    for x in range(4 * w):
+        a = row[x - 4] if x >= 4 else 0; b = prev[x]; c = prev[x - 4] if x >= 4 else 0
+        if f == 1: row[x] = (row[x] + a) & 255
+        elif f == 2: row[x] = (row[x] + b) & 255
+        elif f == 3: row[x] = (row[x] + (a + b) // 2) & 255
+        elif f == 4:
+            p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+            row[x] = (row[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+    sky = row[4 * (w - 1):4 * (w - 1) + 3]
+    for x in range(w):
+        if x < 380 and y < 260: continue
+        if max(abs(row[4 * x + k] - sky[k]) for k in range(3)) > 60: count += 1
+    prev = row
+print(count)
+PY
+}
+
+"$sylva" view "$src/examples/scenes/fireworks.xml" --time 3 --screenshot "$work/t3.png" \
+  --frames 3 --size 960x540 | tee "$work/t3.out"
+grep -q "at t = 3 s" "$work/t3.out"
+"$sylva" view "$src/examples/scenes/fireworks.xml" --screenshot "$work/t0.png" --frames 3 \
+  --size 960x540
+n3=$(bright "$work/t3.png"); n0=$(bright "$work/t0.png")
+echo "pixels off the sky: $n3 at t = 3 s, $n0 at t = 0"
+[[ "$n3" -gt 150 ]] || { echo "the fireworks are not in the picture at t = 3"; exit 1; }
+[[ "$n3" -gt $((n0 + 150)) ]] || { echo "--time 3 shows no more than t = 0"; exit 1; }
+
+# Errors: a bad scene exits 2 with its location and writes nothing.
+printf '<scene version="1">\n  <sky topp="#000000"/>\n</scene>\n' > "$work/bad.xml"
+set +e
+"$sylva" view "$work/bad.xml" --screenshot "$work/bad.png" --frames 3 --size 640x360 \
+  2>"$work/bad.err"
+code=$?
+set -e
+cat "$work/bad.err"
+[[ $code -eq 2 ]] || { echo "a bad scene exited $code, not 2"; exit 1; }
+grep -q "bad.xml:2:8: error: unknown attribute 'topp'" "$work/bad.err"
+[[ ! -e "$work/bad.png" ]]
+set +e
+"$sylva" view "$src/grammars/abop/fig2_06a_monopodial.lsys" --time 2 2>"$work/grammar.err"
+code=$?
+set -e
+[[ $code -eq 2 ]] && grep -q "are for scenes" "$work/grammar.err"
+
+# Live reload of the scene and of a grammar it names.
+cp "$src/grammars/abop/fig2_07a_sympodial.lsys" "$work/tree.lsys"
+sed 's|grammar="[^"]*"|grammar="tree.lsys"|' "$src/examples/scenes/fireworks.xml" > "$work/scene.xml"
+cp "$work/scene.xml" "$work/good.xml"
+"$sylva" view "$work/scene.xml" --size 640x360 >"$work/view.out" 2>"$work/view.err" &
+viewer=$!
+loads() { grep -c "placed 6 of 7 trees" "$work/view.err" || true; }
+errors() { grep -c "the scene has errors" "$work/view.err" || true; }
+for _ in $(seq 100); do [[ $(loads) -ge 1 ]] && break; sleep 0.1; done
+[[ $(loads) -eq 1 ]] || { cat "$work/view.err"; exit 1; }
+sleep 0.5
+sed 's|<sky top=|<sky tpo=|' "$work/good.xml" > "$work/next.xml"; mv "$work/next.xml" "$work/scene.xml"
+for _ in $(seq 100); do [[ $(errors) -ge 1 ]] && break; sleep 0.1; done
+grep -q "scene.xml:5:8: error: unknown attribute 'tpo'" "$work/view.err" || { cat "$work/view.err"; exit 1; }
+kill -0 "$viewer"
+cp "$work/good.xml" "$work/next.xml"; mv "$work/next.xml" "$work/scene.xml"
+for _ in $(seq 100); do [[ $(loads) -ge 2 ]] && break; sleep 0.1; done
+[[ $(loads) -ge 2 ]] || { echo "the fixed scene did not load again"; cat "$work/view.err"; exit 1; }
+printf 'axiom: A(1)\nA(l) --> F(l*nope)\n' > "$work/tree.lsys"
+for _ in $(seq 100); do [[ $(errors) -ge 2 ]] && break; sleep 0.1; done
+grep -q "tree.lsys:2:14: error: unknown name 'nope'" "$work/view.err" || { cat "$work/view.err"; exit 1; }
+kill -0 "$viewer"
+# Fixing the grammar loads the scene again (the failed load still watches it).
+n=$(loads)
+cp "$src/grammars/abop/fig2_07a_sympodial.lsys" "$work/tree.lsys"
+for _ in $(seq 100); do [[ $(loads) -gt $n ]] && break; sleep 0.1; done
+[[ $(loads) -gt $n ]] || { echo "the fixed grammar did not load again"; cat "$work/view.err"; exit 1; }
+echo "viewer reloaded the scene and its grammar, reported errors and kept running"
