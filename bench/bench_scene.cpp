@@ -48,8 +48,8 @@ std::string TenThousandElements(int total, int* written) {
   while (n + 6 <= total) {
     switch (k % 3) {
       case 0:
-        s << "  <plant id=\"p" << k << "\" grammar=\"" << g << "\" steps=\"3\" position=\"" << k % 97
-          << " 0 " << k / 97 << "\" rotate=\"" << k % 360 << "\" scale=\"1.1\">\n"
+        s << "  <plant id=\"p" << k << "\" grammar=\"" << g << "\" steps=\"3\" position=\""
+          << k % 97 << " 0 " << k / 97 << "\" rotate=\"" << k % 360 << "\" scale=\"1.1\">\n"
           << "    <define name=\"a\" value=\"22.5\"/>\n    <define name=\"l\" value=\"0.5\"/>\n"
           << "  </plant>\n";
         n += 3;
@@ -66,7 +66,8 @@ std::string TenThousandElements(int total, int* written) {
         n += 6;
         break;
       default:
-        s << "  <terrain id=\"t" << k << "\" size=\"20 20\" resolution=\"33\" height=\"2\" "
+        s << "  <terrain id=\"t" << k
+          << "\" size=\"20 20\" resolution=\"33\" height=\"2\" "
              "noise=\"fbm\" octaves=\"4\" color=\"#335522\"/>\n";
         n += 1;
         break;
@@ -174,7 +175,8 @@ void BM_SnowStep(benchmark::State& state) {
 // Timed from 1.5 s (all born, all still falling: drag holds them near
 // mg/k = 3.3 m/s, so the first reach the tree tops at about 1.6 s), 3.5 s
 // (part resting on branches and the ground, part falling) and 6 s (all
-// resting: births stop at 1 s when `max` is reached); 20,000 on 1 thread for profiling (valgrind --tool=callgrind
+// resting: births stop at 1 s when `max` is reached); 20,000 on 1 thread for profiling (valgrind
+// --tool=callgrind
 // ... --benchmark_filter=BM_SnowStep/20000). CPU time is the process's, all
 // threads together: on a loaded machine wall time / 2 threads is not the
 // step's cost, CPU / threads is what an idle machine would show.
