@@ -155,4 +155,12 @@ print('<scene version=\"1\">')
 print('<particles>' * 100000 + '</particles>' * 100000)
 print('</scene>')" > deep.xml
 expect deep_nesting deep.xml "deep.xml:2:34: error:" "elements nest deeper than any scene element can"
+# 60 MB (under the 64 MiB limit): a comment of spaces loads in bounded
+# memory (run() fails above 300 MB resident).
+python3 -c "
+import sys
+sys.stdout.write('<scene version=\"1\">\n<!--' + ' ' * 60000000 + '-->\n<sky/>\n</scene>\n')" > sixty.xml
+run check sixty.xml
+[[ $code == 0 ]] || fail "a 60 MB scene: exit $code: $err"
+echo "ok: a 60 MB scene loads with $kb KiB resident"
 echo "ok: all bad scenes are exit 2 at their line and column"
