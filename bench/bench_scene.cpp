@@ -105,13 +105,14 @@ BENCHMARK(BM_ReadScene10k)->Arg(10000)->Unit(benchmark::kMillisecond)->UseRealTi
 // box above them at 100,000 a second with max 100,000, so after one second
 // every particle exists. Steps of 1/24 s with one substep, as
 // examples/scenes/snowy_forest.xml.
-std::string SnowScene(int flakes) {
+std::string SnowScene(int flakes, bool gusts) {
   std::ostringstream s;
   s << "<scene version=\"1\" seed=\"7\">\n"
     << "  <forest id=\"firs\" grammar=\"" << Grammar("fig2_08a_ternary.lsys")
     << "\" count=\"50\" height=\"9\" area=\"-20 -20 20 20\" min-distance=\"4\" variants=\"8\" "
        "scale=\"0.9 1.3\" steps=\"6\"/>\n"
-    << "  <wind velocity=\"1.2 0 0.4\" gust=\"0.6\" scale=\"12\" frequency=\"0.15\"/>\n"
+    << "  <wind velocity=\"1.2 0 0.4\" gust=\"" << (gusts ? "0.6" : "0")
+    << "\" scale=\"12\" frequency=\"0.15\"/>\n"
     << "  <particles id=\"snow\" max=\"" << flakes << "\">\n"
     << "    <emitter shape=\"box\" at=\"0 14 0\" size=\"40 1 40\" rate=\"" << flakes
     << "\" direction=\"0 -1 0\" speed=\"0.4\" spread=\"20\" lifetime=\"30\" mass=\"0.0001\" "
@@ -130,10 +131,11 @@ struct SnowWorld {
   std::unique_ptr<scene::Simulation> sim;
 };
 
-// Arguments: flakes, threads, seconds simulated before timing.
+// Arguments: flakes, threads, tenths of a second simulated before timing,
+// gusts (1: the wind of snowy_forest.xml; 0: its mean only, no noise).
 void BM_SnowStep(benchmark::State& state) {
   const std::string path = TempFolder() + "/snow.xml";
-  std::ofstream(path) << SnowScene(int(state.range(0)));
+  std::ofstream(path) << SnowScene(int(state.range(0)), state.range(3) != 0);
   auto w = std::make_unique<SnowWorld>();
   scene::ReadResult r = scene::ReadScene(path);
   if (!r.scene) {
@@ -175,16 +177,18 @@ void BM_SnowStep(benchmark::State& state) {
 // Timed from 1.5 s (all born, all still falling: drag holds them near
 // mg/k = 3.3 m/s, so the first reach the tree tops at about 1.6 s), 3.5 s
 // (part resting on branches and the ground, part falling) and 6 s (all
-// resting: births stop at 1 s when `max` is reached); 20,000 on 1 thread for profiling (valgrind
-// --tool=callgrind
-// ... --benchmark_filter=BM_SnowStep/20000). CPU time is the process's, all
-// threads together: on a loaded machine wall time / 2 threads is not the
-// step's cost, CPU / threads is what an idle machine would show.
+// resting: births stop at 1 s when `max` is reached). 1.5 s once more
+// without gusts: the cost of sampling the noise wind. 20,000 on 1 thread
+// for profiling: valgrind --tool=callgrind bench_scene
+// --benchmark_filter=BM_SnowStep/20000. CPU time is the process's (all
+// threads): on a loaded machine wall time is not the step's cost, and
+// CPU / threads is what an idle machine would show.
 BENCHMARK(BM_SnowStep)
-    ->Args({20000, 1, 15})
-    ->Args({100000, 2, 15})
-    ->Args({100000, 2, 35})
-    ->Args({100000, 2, 60})
+    ->Args({20000, 1, 15, 1})
+    ->Args({100000, 2, 15, 1})
+    ->Args({100000, 2, 15, 0})
+    ->Args({100000, 2, 35, 1})
+    ->Args({100000, 2, 60, 1})
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
     ->UseRealTime()
