@@ -19,9 +19,11 @@ w() { printf '%s' "$2" > "$1"; }
 run() {
   local limit=""
   [[ $1 == check ]] && limit="ulimit -v 2097152;"
+  local timer=""  # GNU time for the peak resident size, where installed
+  [[ -x /usr/bin/time ]] && timer="/usr/bin/time -f 'maxrss %M' -o time.txt"
+  echo "maxrss 0" > time.txt
   set +e
-  bash -c "$limit exec /usr/bin/time -f 'maxrss %M' -o time.txt timeout 20 \"\$@\"" _ \
-    "$sylva" "$@" > /dev/null 2> err.txt
+  bash -c "$limit exec $timer timeout 20 \"\$@\"" _ "$sylva" "$@" > /dev/null 2> err.txt
   code=$?
   set -e
   err=$(cat err.txt)
