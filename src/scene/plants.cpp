@@ -19,7 +19,21 @@ void Check(const plant::PlantSpec& spec, const SourceLoc& where, const std::stri
   s.until = plant::Stage::kGrammar;
   const plant::PlantResult r = plant::BuildPlant(s);
   if (r.diagnostics.items.empty()) return;
-  for (const Diagnostic& d : r.diagnostics.items) out.Add(d);
+  bool placed = false;  // some diagnostic has a line in the grammar
+  for (Diagnostic d : r.diagnostics.items) {
+    // A grammar that cannot be read has no line of its own: the error is
+    // at the scene's attribute that names it.
+    if (d.loc.line == 0) {
+      d.message = "grammar '" + d.loc.file + "': " + d.message;
+      d.loc = where;
+      d.sourceLine.clear();
+      d.length = 1;
+    } else {
+      placed = true;
+    }
+    out.Add(std::move(d));
+  }
+  if (!placed) return;
   Diagnostic note = MakeError(where, "in the grammar of this <" + element + ">");
   note.severity = Severity::kNote;
   out.Add(std::move(note));

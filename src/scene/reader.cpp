@@ -17,6 +17,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <set>
@@ -184,12 +185,19 @@ class Reader {
   size_t bytesRead_ = 0;
   Scene scene_;
   std::map<std::string, SourceLoc> singletons_;
+  // A declared size, at the attribute that declares it (the element when
+  // the attribute is absent and its default is counted).
   struct Size {
     uint64_t bytes;
-    SourceLoc loc;
+    Diagnostic at;
     std::string what;
   };
   std::vector<Size> sizes_;
+  void AddSize(const Elem& e, const char* attr, uint64_t bytes, std::string what) {
+    const pugi::xml_attribute a = e.node.attribute(attr);
+    const int length = a ? std::max(1, int(std::strlen(a.value()))) : 1;
+    sizes_.push_back({bytes, e.file->AtValue(e.node, attr, 0, {}, length), std::move(what)});
+  }
 };
 
 // ---------------------------------------------------------------------------
@@ -468,7 +476,9 @@ bool Reader::Load(const std::string& path, int depth, std::vector<std::string>& 
     return fail("include cycle: " + names + key);
   }
   Expected<std::string> text = options_.readFile ? options_.readFile(path) : ReadFile(path);
-  if (!text) return fail(text.error().message);
+  if (!text)
+    return fail(from ? "cannot include '" + path + "': " + text.error().message
+                     : text.error().message);
   bytesRead_ += text->size();
   if (bytesRead_ > kMaxSceneBytes)
     return fail("a scene may read at most " + std::to_string(kMaxSceneBytes >> 20) +
@@ -836,7 +846,8 @@ TerrainDef Reader::ReadTerrain(const Elem& e) {
     a.Error("resolution",
             "diamond-square needs a resolution of 2^k + 1 (129, 257, 513 ...), found " +
                 std::to_string(t.resolution));
-  sizes_.push_back({uint64_t(t.resolution) * uint64_t(t.resolution) * 64, t.loc, "<terrain>"});
+  AddSize(e, "resolution", uint64_t(t.resolution) * uint64_t(t.resolution) * 64,
+          "<terrain resolution>");
   NoChildren(e);
   return t;
 }
@@ -926,7 +937,7 @@ ForestDef Reader::ReadForest(const Elem& e) {
   f.defines = ReadDefines(e);
   // An instance is a transform and a variant index; the variants' meshes
   // are counted when they are built.
-  sizes_.push_back({uint64_t(f.count) * 128, f.loc, "<forest>"});
+  AddSize(e, "count", uint64_t(f.count) * 128, "<forest count>");
   return f;
 }
 
@@ -1188,7 +1199,7 @@ ParticlesDef Reader::ReadParticles(const Elem& e) {
   }
   // A System particle: position, velocity, force, previous position (double,
   // 96 bytes), mass, birth, lifetime, radius, id (about 40 more).
-  sizes_.push_back({p.max * 160, p.loc, "<particles max>"});
+  AddSize(e, "max", p.max * 160, "<particles max>");
   return p;
 }
 
@@ -1248,7 +1259,7 @@ ClothDef Reader::ReadCloth(const Elem& e) {
                c.forces.push_back(ReadForce(ch));
            });
   // Vertex state and about six constraints a vertex.
-  sizes_.push_back({uint64_t(c.columns) * uint64_t(c.rows) * 400, c.loc, "<cloth resolution>"});
+  AddSize(e, "resolution", uint64_t(c.columns) * uint64_t(c.rows) * 400, "<cloth resolution>");
   return c;
 }
 
@@ -1285,7 +1296,7 @@ FlockDef Reader::ReadFlock(const Elem& e) {
                f.forces.push_back(ReadForce(c));
              }
            });
-  sizes_.push_back({uint64_t(f.count) * 200, f.loc, "<flock count>"});
+  AddSize(e, "count", uint64_t(f.count) * 200, "<flock count>");
   return f;
 }
 
@@ -1383,9 +1394,8 @@ void Reader::CheckMemory() {
                 "(the largest is this %s: %.1f GiB)",
                 double(total) / double(1 << 30), double(budget) / double(1 << 30),
                 biggest->what.c_str(), double(biggest->bytes) / double(1 << 30));
-  Diagnostic d = MakeError(biggest->loc, buf);
-  for (const auto& f : files_)
-    if (f->path() == biggest->loc.file) SetExcerpt(d, f->Line(biggest->loc.line));
+  Diagnostic d = biggest->at;
+  d.message = buf;
   Add(std::move(d));
 }
 

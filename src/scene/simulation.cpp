@@ -52,6 +52,8 @@ struct Wind {
 };
 
 // Drag relative to the wind: f = -(k1 + k2 |u|) u with u = v - wind(x, t).
+// Immovable particles (stuck where they landed) feel no force, so the wind,
+// the dearest part of a step, is not sampled for them.
 class WindDrag : public particles::LocalForce {
  public:
   WindDrag(double linear, double quadratic, const Wind* wind)
@@ -59,6 +61,7 @@ class WindDrag : public particles::LocalForce {
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override {
     for (size_t i = begin; i < end; ++i) {
+      if (s.invMass[i] == 0) continue;
       const Vec3 u = wind_ ? Vec3(v[i] - wind_->At(x[i], s.time)) : v[i];
       f[i - begin] -= (k1_ + k2_ * u.norm()) * u;
     }

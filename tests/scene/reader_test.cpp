@@ -208,6 +208,14 @@ TEST(SceneReader, IncludesSpliceRelativeToTheIncludingFile) {
   EXPECT_EQ(r.scene->files.size(), 2u);
 }
 
+TEST(SceneReader, AnUnreadableIncludeIsNamedAtItsFileAttribute) {
+  const ReadResult r = Read("<scene version=\"1\">\n  <include file=\"nowhere.xml\"/>\n</scene>\n");
+  EXPECT_FALSE(r.scene);
+  const std::string e = FirstError(r);
+  EXPECT_NE(e.find("s.xml:2:12: cannot include 'nowhere.xml': cannot read file"), std::string::npos)
+      << e;
+}
+
 TEST(SceneReader, IncludeCycleNamesTheChain) {
   Files f;
   f.files["a.xml"] = "<scene version=\"1\">\n<include file=\"b.xml\"/>\n</scene>\n";
@@ -248,10 +256,32 @@ TEST(SceneReader, DeclaredSizesBeyondMemoryAreRefusedBeforeBuilding) {
   const ReadResult r = ReadScene("s.xml", o);
   EXPECT_FALSE(r.scene);
   const std::string e = FirstError(r);
-  EXPECT_NE(e.find("s.xml:2:1: the declared sizes need about"), std::string::npos) << e;
+  // At the value of `max`, the attribute that declares the size.
+  EXPECT_NE(e.find("s.xml:2:17: the declared sizes need about"), std::string::npos) << e;
   EXPECT_NE(e.find("<particles max>"), std::string::npos) << e;
   o.memoryBudget = uint64_t(1) << 40;
   EXPECT_TRUE(ReadScene("s.xml", o).scene) << "the same scene fits in 1 TiB";
+}
+
+TEST(SceneReader, MemoryErrorPointsAtTheSizeAttributeOrItsElement) {
+  Files f;
+  f.files["s.xml"] =
+      "<scene version=\"1\">\n<terrain id=\"t\" resolution=\"8193\"/>\n"
+      "<particles max=\"10\"><emitter/></particles>\n</scene>\n";
+  ReadOptions o = f.Options();
+  o.memoryBudget = uint64_t(1) << 30;
+  ReadResult r = ReadScene("s.xml", o);
+  std::string e = FirstError(r);
+  EXPECT_NE(e.find("s.xml:2:29: the declared sizes"), std::string::npos) << e;
+  EXPECT_NE(e.find("<terrain resolution>"), std::string::npos) << e;
+  ASSERT_FALSE(r.diagnostics.items.empty());
+  EXPECT_EQ(r.diagnostics.items[0].length, 4) << "the caret spans the value 8193";
+  // A default size (resolution 257) is at the element.
+  o.memoryBudget = 1000;
+  f.files["s.xml"] = "<scene version=\"1\">\n<terrain/>\n</scene>\n";
+  r = ReadScene("s.xml", o);
+  e = FirstError(r);
+  EXPECT_NE(e.find("s.xml:2:1: the declared sizes"), std::string::npos) << e;
 }
 
 TEST(SceneReader, HostileNestingIsAnErrorNotACrash) {
@@ -285,6 +315,18 @@ TEST(SceneReader, BundledExampleScenesLoadWithTheirGrammars) {
     EXPECT_FALSE(g.HasErrors()) << entry.path() << "\n" << g.FormatAll();
   }
   EXPECT_EQ(count, 5) << "SCENE.md names five example scenes";
+}
+
+TEST(SceneGrammars, AnUnreadableGrammarIsAnErrorAtTheSceneAttribute) {
+  const ReadResult r = Read(
+      "<scene version=\"1\">\n  <forest grammar=\"no_such_grammar.lsys\" count=\"3\"/>\n"
+      "</scene>\n");
+  ASSERT_TRUE(r.scene) << r.diagnostics.FormatAll();
+  const DiagnosticList g = CheckGrammars(*r.scene);
+  ASSERT_EQ(g.items.size(), 1u) << "one error, no note: " << g.FormatAll();
+  const Diagnostic& d = g.items[0];
+  EXPECT_EQ(Where(d), "s.xml:2:20") << g.FormatAll();
+  EXPECT_NE(d.message.find("grammar 'no_such_grammar.lsys': "), std::string::npos) << d.message;
 }
 
 }  // namespace
