@@ -16,6 +16,7 @@ inline constexpr int kExitBadInput = 2;
 
 struct RenderCommand;
 struct ViewCommand;
+struct MeshCommand;
 
 // The commands that draw (render, view) need OpenGL, EGL, X11 and GLFW.
 // The `sylva` executable links none of them, so `sylva derive` starts as
@@ -26,7 +27,9 @@ struct ViewCommand;
 struct GraphicsCommands {
   int (*render)(const RenderCommand&, std::ostream& out, std::ostream& err) = nullptr;
   int (*view)(const ViewCommand&, std::ostream& out, std::ostream& err) = nullptr;
-  // Only the `sylva` executable sets this: render and view exec
+  // `sylva mesh --lod-eps`: the view is framed by the renderer's camera.
+  int (*meshForView)(const MeshCommand&, std::ostream& out, std::ostream& err) = nullptr;
+  // Only the `sylva` executable sets this: render, view and mesh --lod-eps exec
   // `sylva-graphics` with the same arguments (never in a test process).
   bool execGraphicsBinary = false;
 };

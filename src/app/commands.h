@@ -36,19 +36,32 @@ struct MeshCommand {
   DeriveFlags derive;
   std::string output;  // .obj .ply .glb .gltf
   int sides = 8;
+  // Screen-space detail for the view `size` and `camera` describe (as
+  // `sylva render` frames it); unset: uniform `sides`.
+  std::optional<double> lodEps;
+  std::string size = "960x540";
+  std::string camera;
 };
 
 struct RenderCommand {
   DeriveFlags derive;
   std::string output;  // .png
   std::string size = "960x540";
-  std::string camera;  // "azimuth,elevation,distance"; empty or distance 0: framed
-  int sides = 12;
+  std::string camera;        // "azimuth,elevation,distance"; empty or distance 0: framed
+  double lodEps = 0.5;       // screen-space detail tolerance, output pixels
+  std::optional<int> sides;  // set: uniform sides, no screen-space detail
+  int supersample = 1;       // render K x K larger, box-filter down
+  bool stats = false;        // `triangles: N` and stage times on stdout
+  bool cull = true;          // (tests) frustum culling with screen-space detail
 };
 
 int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err);
 int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err);
 int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
+// `sylva mesh --lod-eps` (sylva-graphics: the view is framed by render::Camera).
+int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
+// Writes plant.mesh to cmd.output and its summary to `err` (both mesh runners).
+int WriteMeshOf(const MeshCommand& cmd, const plant::Plant& plant, std::ostream& err);
 
 // The plant spec the flags describe (steps, seed, -D, threads, limits);
 // nullopt with *exit set when a flag is malformed (printed to `err`).

@@ -24,13 +24,19 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
 #include "core/status.h"
 #include "mesh/plant_geometry.h"
+#include "mesh/screen_detail.h"
 #include "mesh/triangle_mesh.h"
 #include "mesh/triangulate.h"
+
+namespace sylva {
+class ThreadPool;
+}
 
 namespace sylva::mesh {
 
@@ -53,8 +59,22 @@ constexpr size_t TubeTriangles(size_t segments, int sides) {
 inline constexpr uint64_t kDefaultMaxTriangles = uint64_t(1) << 26;
 
 struct TessellateOptions {
-  Detail detail;  // used when detailFn is empty
+  Detail detail;  // used when detailFn is empty and there is no view
   DetailFn detailFn;
+  // Screen-space detail (mesh/screen_detail.h, docs/lod.md): when set, it
+  // replaces detail and detailFn. Each chain gets the sides its largest
+  // projected radius needs for a silhouette error of view.eps pixels,
+  // joints the straight tube passes within eps/2 pixels of are merged, and
+  // tubes under a pixel wide get no caps. Spheres get the sides of their
+  // projected radius at their centre.
+  std::optional<ScreenView> view;
+  // With a view: drop primitives whose box lies outside the view frustum
+  // (a box straddling it is kept).
+  bool cull = true;
+  // Threads for planning and writing chains; null: the calling thread.
+  // The mesh is the same for any pool (offsets are fixed before writing).
+  // A detailFn is always called from the calling thread.
+  ThreadPool* pool = nullptr;
   // The mesh this call appends may not exceed this many triangles; the
   // count is made before any memory is allocated.
   uint64_t maxTriangles = kDefaultMaxTriangles;
@@ -73,5 +93,12 @@ struct TessellateStats {
 // error with the count).
 Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
                   TessellateStats* stats = nullptr);
+
+// A box holding every triangle Tessellate can make of `g` at any detail:
+// segment ends grown by their radius, spheres, polygons, and the surfaces
+// placed (those `surfaces` has; others are skipped). For framing a camera
+// before tessellating. Empty (lo > hi) when `g` draws nothing.
+Box TessellatedBounds(const PlantGeometry& g,
+                      const std::unordered_map<std::string, TriangleMesh>* surfaces);
 
 }  // namespace sylva::mesh
