@@ -63,11 +63,12 @@ int ParseView(const std::string& size, const std::string& camera, ViewFlags& v, 
 // the one --camera gives. The box comes from the geometry, before
 // tessellation, so every detail (uniform or screen-space) sees one view.
 Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSpec& spec,
-                                     const ViewFlags& v, bool lines) {
+                                     const ViewFlags& v, bool lines, mesh::Box* meshBox = nullptr) {
   Vec3 lo = p.geometry.boundsMin, hi = p.geometry.boundsMax;
   if (!lines) {
     auto box = plant::MeshBounds(p, spec);
     if (!box) return box.error();
+    if (meshBox) *meshBox = *box;
     if ((box->lo.array() <= box->hi.array()).all()) {
       lo = box->lo;
       hi = box->hi;
@@ -141,9 +142,9 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   ViewFlags v;
   if (int e = ParseView(cmd.size, cmd.camera, v, err); e != kExitOk) return e;
   const int K = cmd.supersample;
-  if (K < 1 || K > 8 || v.width * K > 16384 || v.height * K > 16384) {
+  if (K < 1 || K > 8 || v.width * K > 8192 || v.height * K > 8192) {
     err << "sylva: error: --supersample " << K << " with --size " << cmd.size
-        << ": the rendered image may be at most 16384x16384 (K from 1 to 8)\n";
+        << ": the rendered image may be at most 8192x8192 (K from 1 to 8)\n";
     return kExitBadInput;
   }
   if (!(cmd.lodEps > 0) || !std::isfinite(cmd.lodEps)) {
@@ -164,7 +165,8 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   const bool lines = plant::IsLineFigure(*geometry);
   const mesh::TriangleMesh& m = plant->mesh;
   render::LineBatch batch;
-  auto camera = FrameCamera(*plant, *spec, v, lines);
+  mesh::Box bounds;
+  auto camera = FrameCamera(*plant, *spec, v, lines, &bounds);
   if (!camera) return Report(camera.error(), err);
   const int W = v.width * K, H = v.height * K;
   if (lines) {
@@ -182,8 +184,12 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   } else {
     // Screen-space detail unless --sides asks for uniform tubes; eps is in
     // output pixels, so K times as many in the K-times larger image.
-    if (!cmd.sides) spec->view = ViewOf(*camera, W, H, cmd.lodEps * K);
-    spec->cull = cmd.cull;
+    if (!cmd.sides) {
+      spec->view = ViewOf(*camera, W, H, cmd.lodEps * K);
+      // Shadows of what lies outside the view may fall inside it.
+      spec->view->shadowFrom = render::KeyLightDirection();
+      spec->view->shadowPlaneY = bounds.lo.y();
+    }
     DiagnosticList warnings;
     Status s = plant::Tessellate(*plant, *spec, warnings);
     exit = Report(warnings, err, cmd.derive.maxErrors);
@@ -203,7 +209,8 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     (*renderer)->SetLines(batch);
   } else {
     (*renderer)->SetGround(true);
-    (*renderer)->SetMesh(m, palette);
+    // Ground and shadow map fitted to the whole plant, whatever was culled.
+    (*renderer)->SetMesh(m, palette, &bounds);
   }
   const double uploadMs = MsSince(t0);
   t0 = Clock::now();

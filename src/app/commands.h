@@ -52,7 +52,6 @@ struct RenderCommand {
   std::optional<int> sides;  // set: uniform sides, no screen-space detail
   int supersample = 1;       // render K x K larger, box-filter down
   bool stats = false;        // `triangles: N` and stage times on stdout
-  bool cull = true;          // (tests) frustum culling with screen-space detail
 };
 
 int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err);

@@ -36,6 +36,12 @@ struct ScreenView {
   Mat4 viewProjection = Mat4::Identity();  // world -> clip, OpenGL conventions
   int width = 960, height = 540;           // viewport, pixels
   double eps = 0.5;                        // silhouette tolerance, pixels (--lod-eps)
+  // Shadows: when nonzero, the unit direction toward a directional light
+  // whose shadows fall on the plane y = shadowPlaneY. Culling then keeps a
+  // primitive whose shadow may show even when the primitive does not (its
+  // box swept away from the light down to the plane).
+  Vec3 shadowFrom = Vec3::Zero();
+  double shadowPlaneY = 0;
 };
 
 // The fewest sides (3..256) whose chord error r (1 - cos(pi/n)) is at most

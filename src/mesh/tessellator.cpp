@@ -382,6 +382,17 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
                           double(p.z()) * si.frame.up));
       }
     }
+    const Vec3 L = view->shadowFrom;
+    if (L.y() > 1e-6) {
+      for (Box& b : boxes) {
+        if (!(b.lo.y() <= b.hi.y())) continue;
+        const double t = std::max(0.0, (b.hi.y() - view->shadowPlaneY) / L.y());
+        Box swept = b;
+        swept.Add(b.lo - t * L);
+        swept.Add(b.hi - t * L);
+        b = swept;
+      }
+    }
     visible = BoundingHierarchy(boxes).Visible(Frustum::FromViewProjection(view->viewProjection));
   }
   auto shown = [&](size_t item) { return visible.empty() || visible[item]; };
@@ -537,19 +548,28 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     for (uint32_t i : s.indices) out.indices.push_back(base + i);
     for (size_t t = 0; t < s.triangleCount(); ++t) out.material.push_back(si.color);
   }
-  if (stats) stats->chains += chains.size();
+  if (stats) {
+    stats->chains += chains.size();
+    for (uint8_t v : visible) stats->culled += v ? 0 : 1;
+  }
   return {};
 }
 
 Box TessellatedBounds(const PlantGeometry& g,
                       const std::unordered_map<std::string, TriangleMesh>* surfaces) {
   Box box;
+  // A tube is the hull of its end discs: a disc of radius r across the
+  // unit axis t reaches r sqrt(1 - t_k^2) along axis k.
   for (const Segment& s : g.segments) {
-    Box b;
-    b.Add(s.start);
-    b.Add(s.end);
-    b.Grow(std::max(s.radiusStart, s.radiusEnd));
-    box.Add(b);
+    const Vec3 d = s.end - s.start;
+    const double len = d.norm();
+    if (!(len > 1e-12)) continue;
+    const Vec3 t = d / len;
+    const Vec3 reach = (Vec3::Ones() - t.cwiseProduct(t)).cwiseMax(0.0).cwiseSqrt();
+    box.Add(s.start - reach * s.radiusStart);
+    box.Add(s.start + reach * s.radiusStart);
+    box.Add(s.end - reach * s.radiusEnd);
+    box.Add(s.end + reach * s.radiusEnd);
   }
   for (const Sphere& s : g.spheres) {
     Box b;

@@ -84,6 +84,7 @@ struct TessellateOptions {
 
 struct TessellateStats {
   size_t chains = 0, polygonsSkipped = 0;
+  size_t culled = 0;  // chains, spheres, polygons and surfaces outside the view
   std::vector<std::string> warnings;
 };
 
@@ -95,7 +96,9 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
                   TessellateStats* stats = nullptr);
 
 // A box holding every triangle Tessellate can make of `g` at any detail:
-// segment ends grown by their radius, spheres, polygons, and the surfaces
+// the end discs of every segment (the ring at a bent joint tilts to the
+// mean of its two segments, so it may reach a hair further), spheres,
+// polygons, and the surfaces
 // placed (those `surfaces` has; others are skipped). For framing a camera
 // before tessellating. Empty (lo > hi) when `g` draws nothing.
 Box TessellatedBounds(const PlantGeometry& g,

@@ -224,7 +224,8 @@ Status Renderer::Resize(int width, int height, int samples) {
   return {};
 }
 
-void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette) {
+void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette,
+                       const mesh::Box* bounds) {
   Gl& g = *gl_;
   // Per-vertex colour: the material of the first triangle using the vertex.
   std::vector<mesh::Vec3f> color(m.vertexCount(), mesh::Srgb(0.8f, 0.8f, 0.8f));
@@ -259,6 +260,10 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
       g.hi = g.hi.cwiseMax(p.cast<double>());
     }
   }
+  if (bounds && (bounds->lo.array() <= bounds->hi.array()).all()) {
+    g.lo = bounds->lo;
+    g.hi = bounds->hi;
+  }
   // Ground: a disc of 48 sectors under the mesh, 1.1 times its radius.
   {
     const Vec3 c((g.lo.x() + g.hi.x()) / 2, g.lo.y(), (g.lo.z() + g.hi.z()) / 2);
@@ -290,6 +295,10 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
 // The key light is fixed in world space; its orthographic view covers the
 // mesh's bounding sphere, so the map is made once per mesh.
 static const Vec3 kKeyDir = Vec3(-0.5, 0.8, 0.6).normalized();
+
+Vec3 KeyLightDirection() {
+  return kKeyDir;
+}
 
 void Renderer::RenderShadowMap() {
   Gl& g = *gl_;

@@ -18,6 +18,7 @@
 #include "core/status.h"
 #include "mesh/color.h"
 #include "mesh/export.h"
+#include "mesh/screen_detail.h"
 #include "mesh/triangle_mesh.h"
 #include "render/camera.h"
 
@@ -50,6 +51,10 @@ struct PointBatch {
 // executable or one or two levels up, else the source tree's `shaders/`.
 std::string FindShaderDir();
 
+// Unit direction toward the key light, which casts the shadows (fixed in
+// world space).
+Vec3 KeyLightDirection();
+
 class Renderer {
  public:
   // Compiles the shaders in `shaderDir`; needs a current context.
@@ -65,7 +70,12 @@ class Renderer {
 
   // Replaces the mesh (uploaded once; drawing it again uploads nothing) and
   // renders its shadow map from the key light once.
-  void SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette);
+  // `bounds`, when given, replaces the mesh's own box as the box the ground
+  // disc and the shadow map are fitted to: a mesh tessellated for one view
+  // (culled, screen-space detail) then gets the ground and shadows of the
+  // whole plant.
+  void SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette,
+               const mesh::Box* bounds = nullptr);
   // A ground disc under the mesh that receives its shadow (off by default).
   void SetGround(bool on) { ground_ = on; }
   void SetShadows(bool on) { shadows_ = on; }
