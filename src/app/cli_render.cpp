@@ -189,6 +189,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
       // Shadows of what lies outside the view may fall inside it.
       spec->view->shadowFrom = render::KeyLightDirection();
       spec->view->shadowPlaneY = bounds.lo.y();
+      spec->view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(bounds);
     }
     DiagnosticList warnings;
     Status s = plant::Tessellate(*plant, *spec, warnings);

@@ -40,8 +40,12 @@ struct ScreenView {
   // whose shadows fall on the plane y = shadowPlaneY. Culling then keeps a
   // primitive whose shadow may show even when the primitive does not (its
   // box swept away from the light down to the plane).
+  // A primitive outside the view kept for its shadow gets the detail of
+  // the shadow map instead (texels per world unit; no ribbons, which face
+  // the camera rather than the light).
   Vec3 shadowFrom = Vec3::Zero();
   double shadowPlaneY = 0;
+  double shadowTexelsPerUnit = 0;
 };
 
 // The fewest sides (3..256) whose chord error r (1 - cos(pi/n)) is at most

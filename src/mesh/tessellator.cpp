@@ -131,22 +131,24 @@ struct ChainPlan {
 constexpr double kRibbonPixels = 3;
 
 // Screen-space plan of a chain (docs/lod.md): the sides from the largest
-// projected radius; a joint is dropped when the tube straight from the last
+// projected radius (in shadow-map texels for a chain outside the view that
+// may shade it); a joint is dropped when the tube straight from the last
 // kept joint to a later one passes within eps/2 pixels of it (axis and
 // radius) and the colour does not change there; caps only on tubes at
 // least a pixel wide.
 void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
-               const ScreenView& view, ChainPlan& plan) {
+               const ScreenView& view, bool shadowOnly, ChainPlan& plan) {
   const size_t m = chain.size();
   std::vector<double> ppu(m + 1);
   double rPx = 0;
   for (size_t k = 0; k <= m; ++k) {
-    ppu[k] = PixelsPerUnit(view, f.P[k]);
+    ppu[k] = shadowOnly ? view.shadowTexelsPerUnit : PixelsPerUnit(view, f.P[k]);
     rPx = std::max(rPx, f.R[k] * ppu[k]);
   }
   plan.sides = SidesForPixelRadius(rPx, view.eps);
   plan.caps = !(rPx < 1);
-  plan.ribbon = rPx < kRibbonPixels * view.eps;
+  // A ribbon faces the camera, not the light: never for a shadow caster.
+  plan.ribbon = !shadowOnly && rPx < kRibbonPixels * view.eps;
   plan.joints.clear();
   if (m < 2) return;
   const double budget = view.eps / 2;
@@ -349,11 +351,12 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   }
   const auto chains = BuildChains(g);
   // Culling: one hierarchy over the boxes of every chain (tube radius
-  // included), sphere, polygon and surface, in that order.
-  std::vector<uint8_t> visible;
+  // included), sphere, polygon and surface, in that order, and one over
+  // the same boxes swept away from the light (their shadows).
+  std::vector<uint8_t> inView, inShadow;
   const size_t nc = chains.size(), ns = g.spheres.size(), np = g.polygons.size(),
                nf = g.surfaces.size();
-  if (view && options.cull) {
+  if (view) {
     std::vector<Box> boxes(nc + ns + np + nf);
     for (size_t c = 0; c < nc; ++c) {
       Box& b = boxes[c];
@@ -382,6 +385,8 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
                           double(p.z()) * si.frame.up));
       }
     }
+    const Frustum frustum = Frustum::FromViewProjection(view->viewProjection);
+    inView = BoundingHierarchy(boxes).Visible(frustum);
     const Vec3 L = view->shadowFrom;
     if (L.y() > 1e-6) {
       for (Box& b : boxes) {
@@ -392,10 +397,14 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
         swept.Add(b.hi - t * L);
         b = swept;
       }
+      inShadow = BoundingHierarchy(boxes).Visible(frustum);
     }
-    visible = BoundingHierarchy(boxes).Visible(Frustum::FromViewProjection(view->viewProjection));
   }
-  auto shown = [&](size_t item) { return visible.empty() || visible[item]; };
+  auto shown = [&](size_t item) {
+    return !view || !options.cull || inView[item] || (!inShadow.empty() && inShadow[item]);
+  };
+  // Outside the view, with shadows: detail for the shadow map, not the view.
+  auto shadowOnly = [&](size_t item) { return view && !inShadow.empty() && !inView[item]; };
   // Choose every chain's detail first, so the arrays are sized exactly once.
   std::vector<ChainPlan> plans(nc);
   auto plan = [&](size_t c, ChainFrames& frames) {
@@ -405,7 +414,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     if (!(rmax > 0) || !shown(c)) return;  // zero width, or culled: nothing to draw
     if (view) {
       BuildFrames(g, chain, frames);
-      PlanChain(g, chain, frames, *view, plans[c]);
+      PlanChain(g, chain, frames, *view, shadowOnly(c), plans[c]);
       return;
     }
     Vec3 lo = g.segments[chain[0]].start, hi = lo;
@@ -438,7 +447,9 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   for (size_t i = 0; i < ns; ++i) {
     const Sphere& s = g.spheres[i];
     if (!(s.radius > 0) || !shown(nc + i)) continue;
-    sphereSides[i] = detailFor(s.center, s.radius);
+    sphereSides[i] = shadowOnly(nc + i)
+                         ? SidesForPixelRadius(s.radius * view->shadowTexelsPerUnit, view->eps)
+                         : detailFor(s.center, s.radius);
     const uint64_t S = uint64_t(sphereSides[i]), R = std::max<uint64_t>(2, S / 2);
     total += S * (2 * R - 2);
   }
@@ -550,7 +561,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   }
   if (stats) {
     stats->chains += chains.size();
-    for (uint8_t v : visible) stats->culled += v ? 0 : 1;
+    for (size_t i = 0; i < inView.size(); ++i) stats->culled += shown(i) ? 0 : 1;
   }
   return {};
 }

@@ -55,6 +55,10 @@ std::string FindShaderDir();
 // world space).
 Vec3 KeyLightDirection();
 
+// Texels per world unit of the shadow map when the mesh's bounds (or the
+// bounds given to SetMesh) are `bounds`.
+double ShadowTexelsPerUnit(const mesh::Box& bounds);
+
 class Renderer {
  public:
   // Compiles the shaders in `shaderDir`; needs a current context.

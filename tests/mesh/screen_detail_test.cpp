@@ -103,8 +103,7 @@ TEST(ScreenDetail, MeasuredSilhouetteErrorOfRandomCylindersStaysUnderEps) {
     if (dir.norm() < 0.1) dir = Vec3::UnitZ();
     const Vec3 eye = dir.normalized() * (4 + 20 * u01(rng));
     view.viewProjection = LookAtPerspective(eye, Vec3(u(rng), u(rng), u(rng)) * 0.2,
-                                            20 + 60 * u01(rng),
-                                            double(view.width) / view.height);
+                                            20 + 60 * u01(rng), double(view.width) / view.height);
     TessellateOptions opt;
     opt.view = view;
     opt.cull = false;
@@ -177,8 +176,8 @@ TEST(ScreenDetail, HierarchyKeepsEveryBoxThatMeetsTheFrustum) {
   }
   boxes[17].lo.y() = std::nan("");  // unbounded boxes are kept
   const BoundingHierarchy h(boxes);
-  const Frustum f = Frustum::FromViewProjection(
-      LookAtPerspective(Vec3(0, 5, 40), Vec3(3, 0, 0), 30, 16.0 / 9));
+  const Frustum f =
+      Frustum::FromViewProjection(LookAtPerspective(Vec3(0, 5, 40), Vec3(3, 0, 0), 30, 16.0 / 9));
   const auto visible = h.Visible(f);
   size_t kept = 0, outside = 0;
   for (size_t i = 0; i < boxes.size(); ++i) {
