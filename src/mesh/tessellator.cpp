@@ -60,7 +60,12 @@ struct ChainFrames {
   std::vector<double> R, V;
 };
 
-void BuildFrames(const PlantGeometry& g, const std::vector<uint32_t>& chain, ChainFrames& f) {
+// How much of a chain's frames to compute: the axis (P, R) for planning,
+// with tangents and lengths (T, V) for a ribbon, everything for a tube.
+enum class FramePart { kAxis, kTangents, kAll };
+
+void BuildFrames(const PlantGeometry& g, const std::vector<uint32_t>& chain, ChainFrames& f,
+                 FramePart part = FramePart::kAll) {
   const size_t m = chain.size();
   auto& P = f.P;
   auto& T = f.T;
@@ -68,12 +73,17 @@ void BuildFrames(const PlantGeometry& g, const std::vector<uint32_t>& chain, Cha
   auto& R = f.R;
   auto& V = f.V;
   P.resize(m + 1);
-  T.resize(m + 1);
-  N.resize(m + 1);
   R.resize(m + 1);
-  V.resize(m + 1);
   P[0] = g.segments[chain[0]].start;
   for (size_t k = 0; k < m; ++k) P[k + 1] = g.segments[chain[k]].end;
+  R[0] = g.segments[chain[0]].radiusStart;
+  for (size_t k = 1; k < m; ++k) R[k] = g.segments[chain[k]].radiusStart;
+  R[m] = g.segments[chain[m - 1]].radiusEnd;
+  double rmax = *std::max_element(R.begin(), R.end());
+  for (double& r : R) r = std::max(r, rmax * 1e-3);
+  if (part == FramePart::kAxis) return;
+  T.resize(m + 1);
+  V.resize(m + 1);
   auto dir = [&](size_t k) { return (P[k + 1] - P[k]).normalized(); };
   T[0] = dir(0);
   T[m] = dir(m - 1);
@@ -81,13 +91,10 @@ void BuildFrames(const PlantGeometry& g, const std::vector<uint32_t>& chain, Cha
     Vec3 t = dir(k - 1) + dir(k);
     T[k] = t.norm() > 1e-9 ? t.normalized() : dir(k);
   }
-  R[0] = g.segments[chain[0]].radiusStart;
-  for (size_t k = 1; k < m; ++k) R[k] = g.segments[chain[k]].radiusStart;
-  R[m] = g.segments[chain[m - 1]].radiusEnd;
-  double rmax = *std::max_element(R.begin(), R.end());
-  for (double& r : R) r = std::max(r, rmax * 1e-3);
   V[0] = 0;
   for (size_t k = 0; k < m; ++k) V[k + 1] = V[k] + (P[k + 1] - P[k]).norm();
+  if (part == FramePart::kTangents) return;
+  N.resize(m + 1);
 
   // First normal: the turtle's L, made perpendicular to the tangent.
   Vec3 n0 = g.segments[chain[0]].left;
@@ -195,7 +202,7 @@ void EmitRibbon(const PlantGeometry& g, const std::vector<uint32_t>& chain, cons
     const size_t k = joint(r);
     const Vec3 toEye = TowardEye(view, f.P[k]);
     Vec3 side = f.T[k].cross(toEye);
-    side = side.norm() > 1e-9 ? Vec3(side.normalized()) : f.N[k];
+    side = side.norm() > 1e-9 ? Vec3(side.normalized()) : AnyPerpendicular(f.T[k]);
     Vec3 normal = toEye - f.T[k] * f.T[k].dot(toEye);
     normal = normal.norm() > 1e-9 ? Vec3(normal.normalized()) : f.T[k].cross(side);
     const float v = float(f.V[k]);
@@ -358,17 +365,20 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
                nf = g.surfaces.size();
   if (view) {
     std::vector<Box> boxes(nc + ns + np + nf);
-    for (size_t c = 0; c < nc; ++c) {
-      Box& b = boxes[c];
-      b.Add(g.segments[chains[c][0]].start);
-      double r = 0;
-      for (uint32_t k : chains[c]) {
-        const Segment& s = g.segments[k];
-        b.Add(s.end);
-        r = std::max({r, double(s.radiusStart), double(s.radiusEnd)});
-      }
-      b.Grow(r);
-    }
+    ForRanges(options.pool, nc, BalancedGrain(options.pool, nc, 1024),
+              [&](size_t begin, size_t end) {
+                for (size_t c = begin; c < end; ++c) {
+                  Box& b = boxes[c];
+                  b.Add(g.segments[chains[c][0]].start);
+                  double r = 0;
+                  for (uint32_t k : chains[c]) {
+                    const Segment& s = g.segments[k];
+                    b.Add(s.end);
+                    r = std::max({r, double(s.radiusStart), double(s.radiusEnd)});
+                  }
+                  b.Grow(r);
+                }
+              });
     for (size_t i = 0; i < ns; ++i) {
       boxes[nc + i].Add(g.spheres[i].center);
       boxes[nc + i].Grow(g.spheres[i].radius);
@@ -386,7 +396,20 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
       }
     }
     const Frustum frustum = Frustum::FromViewProjection(view->viewProjection);
-    inView = BoundingHierarchy(boxes).Visible(frustum);
+    // Everything inside (a framed plant): no hierarchy needed.
+    auto visibleIn = [&](const std::vector<Box>& b) {
+      Box all;
+      bool bounded = true;
+      for (const Box& x : b) {
+        all.Add(x);
+        bounded = bounded && x.lo.allFinite() && x.hi.allFinite();
+      }
+      if (bounded && frustum.Classify(all) == Frustum::Side::kInside) {
+        return std::vector<uint8_t>(b.size(), 1);
+      }
+      return BoundingHierarchy(b).Visible(frustum);
+    };
+    inView = visibleIn(boxes);
     const Vec3 L = view->shadowFrom;
     if (L.y() > 1e-6) {
       for (Box& b : boxes) {
@@ -397,7 +420,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
         swept.Add(b.hi - t * L);
         b = swept;
       }
-      inShadow = BoundingHierarchy(boxes).Visible(frustum);
+      inShadow = visibleIn(boxes);
     }
   }
   auto shown = [&](size_t item) {
@@ -413,7 +436,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     for (uint32_t k : chain) rmax = std::max<double>(rmax, g.segments[k].radiusStart);
     if (!(rmax > 0) || !shown(c)) return;  // zero width, or culled: nothing to draw
     if (view) {
-      BuildFrames(g, chain, frames);
+      BuildFrames(g, chain, frames, FramePart::kAxis);
       PlanChain(g, chain, frames, *view, shadowOnly(c), plans[c]);
       return;
     }
@@ -495,7 +518,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     ChainFrames frames;
     for (size_t c = begin; c < end; ++c) {
       if (!plans[c].sides) continue;
-      BuildFrames(g, chains[c], frames);
+      BuildFrames(g, chains[c], frames, plans[c].ribbon ? FramePart::kTangents : FramePart::kAll);
       if (plans[c].ribbon) {
         EmitRibbon(g, chains[c], frames, plans[c], *view, vbase + vOffset[c], tbase + tOffset[c],
                    out);
