@@ -412,15 +412,26 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     inView = visibleIn(boxes);
     const Vec3 L = view->shadowFrom;
     if (L.y() > 1e-6) {
-      for (Box& b : boxes) {
-        if (!(b.lo.y() <= b.hi.y())) continue;
-        const double t = std::max(0.0, (b.hi.y() - view->shadowPlaneY) / L.y());
-        Box swept = b;
-        swept.Add(b.lo - t * L);
-        swept.Add(b.hi - t * L);
-        b = swept;
+      // Only what is outside the view needs its shadow tested.
+      std::vector<uint32_t> outside;
+      std::vector<Box> swept;
+      for (size_t i = 0; i < boxes.size(); ++i) {
+        if (inView[i]) continue;
+        const Box& b = boxes[i];
+        Box s = b;
+        if (b.lo.y() <= b.hi.y()) {
+          const double t = std::max(0.0, (b.hi.y() - view->shadowPlaneY) / L.y());
+          s.Add(b.lo - t * L);
+          s.Add(b.hi - t * L);
+        }
+        outside.push_back(uint32_t(i));
+        swept.push_back(s);
       }
-      inShadow = visibleIn(boxes);
+      inShadow = inView;
+      if (!outside.empty()) {
+        const std::vector<uint8_t> shaded = visibleIn(swept);
+        for (size_t k = 0; k < outside.size(); ++k) inShadow[outside[k]] = shaded[k];
+      }
     }
   }
   auto shown = [&](size_t item) {
