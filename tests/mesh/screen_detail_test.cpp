@@ -272,3 +272,24 @@ TEST(ScreenDetail, BoundsHoldEveryVertexAtAnyDetail) {
 
 }  // namespace
 }  // namespace sylva::mesh
+
+namespace sylva::plant {
+namespace {
+
+TEST(PlantSpec, BadScreenViewIsReported) {
+  PlantSpec spec;
+  spec.path = "x.lsys";
+  spec.view = mesh::ScreenView{};
+  EXPECT_TRUE(Validate(spec).items.empty()) << Validate(spec).FormatAll();
+  spec.view->eps = 0;
+  spec.view->width = 0;
+  spec.view->viewProjection(2, 1) = std::nan("");
+  const DiagnosticList list = Validate(spec);
+  ASSERT_EQ(list.items.size(), 3u) << list.FormatAll();
+  EXPECT_NE(list.items[0].message.find("lod eps"), std::string::npos) << list.FormatAll();
+  EXPECT_NE(list.items[1].message.find("viewport 0x540"), std::string::npos) << list.FormatAll();
+  EXPECT_NE(list.items[2].message.find("non-finite"), std::string::npos) << list.FormatAll();
+}
+
+}  // namespace
+}  // namespace sylva::plant

@@ -199,5 +199,30 @@ TEST(ScreenDetailCli, RenderPrintsStatsAndLodIsTheDefault) {
   EXPECT_NE(err.find("--supersample"), std::string::npos) << err;
 }
 
+// `sylva mesh --lod-eps` writes the mesh of one view: fewer triangles than
+// the uniform default, and a valid file.
+TEST(ScreenDetailCli, MeshForOneView) {
+  const std::string g = std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys";
+  const std::string glb = ::testing::TempDir() + "sylva_lod_cli.glb";
+  auto trianglesOf = [](const std::string& err) {
+    const size_t at = err.find(" triangles,");
+    size_t begin = err.rfind(' ', at - 1);
+    return at == std::string::npos ? size_t(0) : std::stoul(err.substr(begin + 1, at - begin));
+  };
+  std::string out, err;
+  ASSERT_EQ(RunCli({"mesh", g, "-n", "12", "-o", glb}, &out, &err), 0) << err;
+  const size_t uniform = trianglesOf(err);
+  ASSERT_EQ(RunCli({"mesh", g, "-n", "12", "--lod-eps", "0.5", "--size", "320x180", "-o", glb},
+                   &out, &err),
+            0)
+      << err;
+  const size_t lod = trianglesOf(err);
+  EXPECT_GT(lod, 0u) << err;
+  EXPECT_LT(lod * 5, uniform) << lod << " for the view, " << uniform << " uniform (8 sides)";
+  EXPECT_EQ(RunCli({"mesh", g, "--lod-eps", "0.5", "--sides", "8", "-o", glb}, &out, &err), 2);
+  EXPECT_EQ(RunCli({"mesh", g, "--lod-eps", "0.5", "--size", "0x9", "-o", glb}, &out, &err), 2);
+  EXPECT_NE(err.find("--size '0x9'"), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace sylva::render
