@@ -3,12 +3,12 @@
 # libexec/sylva), the bundled data under share/sylva, and a CMake package:
 #   find_package(Sylva CONFIG REQUIRED)
 #   target_link_libraries(app PRIVATE Sylva::plant)
-# with Sylva::core, ::lsys, ::turtle, ::mesh, ::plant, ::particles and
-# ::render (when built), each bringing its dependencies.
+# with Sylva::core, ::lsys, ::turtle, ::mesh, ::plant, ::particles,
+# ::terrain and ::render (when built), each bringing its dependencies.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(_sylva_libs core lsys mesh turtle plant particles)
+set(_sylva_libs core lsys mesh turtle plant particles terrain draw scene)
 if(SYLVA_BUILD_RENDER)
   list(APPEND _sylva_libs render)
 endif()

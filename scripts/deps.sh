@@ -3,7 +3,7 @@
 # Usage: scripts/deps.sh [--fuzz]   (--fuzz adds clang and its libFuzzer runtime)
 set -euo pipefail
 packages=(cmake g++ make pkg-config clang-format libeigen3-dev libcli11-dev libgtest-dev libbenchmark-dev python3
-          libtinygltf-dev nlohmann-json3-dev libstb-dev assimp-utils
+          libtinygltf-dev nlohmann-json3-dev libstb-dev assimp-utils libpugixml-dev libxml2-utils
           libegl-dev libgl-dev libglew-dev libgl1-mesa-dri libegl-mesa0
           libglfw3-dev libimgui-dev xvfb)
 # node and npm run the Khronos glTF validator in the tests; any recent node will do.

@@ -20,15 +20,31 @@ int Report(const Diagnostic& d, std::ostream& err) {
   return d.kind == ErrorKind::kRuntime ? kExitRuntime : kExitBadInput;
 }
 
-int Report(const DiagnosticList& list, std::ostream& err, int maxErrors) {
+int Report(const DiagnosticList& list, std::ostream& err, int maxErrors, bool strict) {
   err << list.FormatAll(size_t(maxErrors));
   int code = list.droppedErrors > 0 ? kExitBadInput : kExitOk;
+  size_t warnings = 0;
   for (const auto& d : list.items) {
-    if (d.severity != Severity::kError) continue;
+    if (d.severity != Severity::kError) {
+      warnings += d.severity == Severity::kWarning;  // not notes
+      continue;
+    }
     int c = d.kind == ErrorKind::kRuntime ? kExitRuntime : kExitBadInput;
     if (c == kExitBadInput || code == kExitOk) code = c;
   }
+  if (strict && warnings > 0) {
+    err << "sylva: error: --strict: " << warnings
+        << (warnings == 1 ? " warning is treated as an error\n"
+                          : " warnings are treated as errors\n");
+    code = kExitBadInput;
+  }
   return code;
+}
+
+static void AddStrictFlag(CLI::App* cmd, bool& strict) {
+  cmd->add_flag("--strict", strict,
+                "treat every warning as an error (exit 2), e.g. a cpfg command Sylva does not "
+                "implement");
 }
 
 static void AddMaxErrorsFlag(CLI::App* cmd, DeriveFlags& f) {
@@ -58,6 +74,7 @@ static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
                   "(default 268435456)")
       ->check(CLI::Range(uint64_t(1), lsys::kMaxModulesCap));
   AddMaxErrorsFlag(cmd, f);
+  AddStrictFlag(cmd, f.strict);
 }
 
 static int NotBuilt(const char* command, std::ostream& err) {
@@ -131,6 +148,9 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   AddDeriveFlags(re, render.derive);
   re->add_option("-o,--output", render.output, "image file (.png, .jpg or .jpeg)")->required();
   re->add_option("--size", render.size, "image size WxH (default 960x540)");
+  re->add_option("--time", render.time,
+                 "scenes: simulate this many seconds before the picture (default 0)")
+      ->check(CLI::Range(0.0, 1e6));
   re->add_option("--camera", render.camera,
                  "azimuth,elevation,distance in degrees and units (distance 0: frame the plant)");
   AddMaxTrianglesFlag(re, render.derive);
@@ -156,12 +176,37 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   vi->add_option("--frames", view.frames, "frames to draw before the screenshot")
       ->check(CLI::Range(1, 1000000));
   vi->add_option("--size", view.size, "window size WxH (default 1280x720)");
+  AddStrictFlag(vi, view.strict);
 
   DeriveFlags check;
-  CLI::App* c = app.add_subcommand("check", "parse and check a grammar; print diagnostics");
-  c->add_option("file", check.file, "grammar file (.lsys)")->required();
-  c->add_option("-D,--define", check.defines, "override a #define: NAME=VALUE (repeatable)");
+  CLI::App* c = app.add_subcommand(
+      "check", "parse and check a grammar or a scene (.xml, with its grammars); print diagnostics");
+  c->add_option("file", check.file, "grammar file (.lsys) or scene file (.xml)")->required();
+  c->add_option("-D,--define", check.defines,
+                "override a grammar's #define or a scene's <default>: NAME=VALUE (repeatable)");
   AddMaxErrorsFlag(c, check);
+  AddStrictFlag(c, check.strict);
+
+  SimulateCommand simulate;
+  CLI::App* si = app.add_subcommand(
+      "simulate", "run a scene's simulation: frames as images (-o), the final state as CSV");
+  si->add_option("file", simulate.file, "scene file (.xml)")->required();
+  si->add_option("-o,--output", simulate.output,
+                 "frame images, a pattern with one %d: frames/%04d.png (none without -o)");
+  si->add_option("--duration", simulate.duration,
+                 "simulated seconds (default: the scene's <simulation duration>)")
+      ->check(CLI::Range(0.0, 1e6));
+  si->add_option("--fps", simulate.fps, "frames written a second (default: the scene's fps)")
+      ->check(CLI::Range(1e-3, 1000.0));
+  si->add_option("--dump", simulate.dump,
+                 "write every particle, cloth vertex and boid at the end as CSV");
+  si->add_option("--size", simulate.size, "frame size WxH (default 960x540)");
+  si->add_option("-D,--define", simulate.defines, "override a scene's <default>: NAME=VALUE");
+  si->add_option("--threads", simulate.threads, "worker threads (default: all cores)")
+      ->check(CLI::Range(0, 256));
+  si->add_option("--max-errors", simulate.maxErrors, "print at most this many errors")
+      ->check(CLI::Range(0, 1000000));
+  AddStrictFlag(si, simulate.strict);
 
   std::vector<std::string> rev(args.rbegin(), args.rend());
   try {
@@ -186,7 +231,9 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (d->parsed()) code = RunDerive(derive, out, err);
     if (c->parsed()) code = RunCheck(check, out, err);
     if (me->parsed() && !mesh.lodEps) code = RunMesh(mesh, out, err);
-    if (re->parsed() || vi->parsed() || (me->parsed() && mesh.lodEps)) {
+    if (si->parsed() && simulate.output.empty()) code = RunSimulate(simulate, out, err, {});
+    if (re->parsed() || vi->parsed() || (si->parsed() && !simulate.output.empty()) ||
+        (me->parsed() && mesh.lodEps)) {
       if (!view.screenshot.empty() && view.frames == 0) view.frames = 3;
       const GraphicsCommands none;
       const GraphicsCommands& g = graphics ? *graphics : none;
@@ -196,6 +243,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       if (me->parsed()) {
         code = g.meshForView ? g.meshForView(mesh, out, err) : NotBuilt("mesh --lod-eps", err);
       }
+      if (si->parsed())
+        code = g.simulate ? g.simulate(simulate, out, err) : NotBuilt("simulate -o", err);
     }
   } catch (const std::bad_alloc&) {
     err << "sylva: error: out of memory; lower the derivation length (-n), the detail or the "

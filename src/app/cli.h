@@ -17,6 +17,7 @@ inline constexpr int kExitBadInput = 2;
 struct RenderCommand;
 struct ViewCommand;
 struct MeshCommand;
+struct SimulateCommand;
 
 // The commands that draw (render, view) need OpenGL, EGL, X11 and GLFW.
 // The `sylva` executable links none of them, so `sylva derive` starts as
@@ -29,8 +30,9 @@ struct GraphicsCommands {
   int (*view)(const ViewCommand&, std::ostream& out, std::ostream& err) = nullptr;
   // `sylva mesh --lod-eps`: the view is framed by the renderer's camera.
   int (*meshForView)(const MeshCommand&, std::ostream& out, std::ostream& err) = nullptr;
-  // Only the `sylva` executable sets this: render, view and mesh --lod-eps exec
-  // `sylva-graphics` with the same arguments (never in a test process).
+  int (*simulate)(const SimulateCommand&, std::ostream& out, std::ostream& err) = nullptr;
+  // Only the `sylva` executable sets this: render, view, simulate with frames and mesh --lod-eps
+  // exec `sylva-graphics` with the same arguments (never in a test process).
   bool execGraphicsBinary = false;
 };
 

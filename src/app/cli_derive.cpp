@@ -55,19 +55,21 @@ std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err
 }
 
 std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErrors,
-                                       std::ostream& err, int* exit) {
+                                       std::ostream& err, int* exit, bool strict) {
   plant::PlantResult r = plant::BuildPlant(spec);
-  *exit = Report(r.diagnostics, err, maxErrors);
+  *exit = Report(r.diagnostics, err, maxErrors, strict);
   if (!r.plant && *exit == kExitOk) *exit = kExitBadInput;
+  if (*exit != kExitOk) return std::nullopt;
   return std::move(r.plant);
 }
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err) {
+  if (IsSceneFile(flags.file)) return RunCheckScene(flags, out, err);
   int exit = kExitOk;
   auto spec = SpecFrom(flags, err, &exit);
   if (!spec) return exit;
   spec->until = plant::Stage::kGrammar;
-  auto p = BuildPlant(*spec, flags.maxErrors, err, &exit);
+  auto p = BuildPlant(*spec, flags.maxErrors, err, &exit, flags.strict);
   return p ? kExitOk : exit;
 }
 
@@ -128,7 +130,7 @@ int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err) {
                    static_cast<unsigned long long>(modules));
     };
   }
-  auto p = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit);
+  auto p = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (shown) std::fprintf(stderr, "\r%60s\r", "");
   if (!p) return exit;
   const lsys::Grammar* g = &p->grammar;

@@ -20,7 +20,7 @@ int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   auto spec = SpecFrom(cmd.derive, err, &exit);
   if (!spec) return exit;
   spec->detail.sides = cmd.sides;
-  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit);
+  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   return WriteMeshOf(cmd, *plant, err);
 }

@@ -14,13 +14,13 @@
 
 namespace sylva::app {
 
-static bool ParseSize(const std::string& s, int* w, int* h) {
+bool ParseSize(const std::string& s, int* w, int* h) {
   int n = 0;
   if (std::sscanf(s.c_str(), "%dx%d%n", w, h, &n) != 2 || size_t(n) != s.size()) return false;
   return *w >= 1 && *h >= 1 && *w <= 8192 && *h <= 8192;
 }
 
-static bool ParseCamera(const std::string& s, double v[3]) {
+bool ParseCamera(const std::string& s, double v[3]) {
   int n = 0;
   if (std::sscanf(s.c_str(), "%lf,%lf,%lf%n", &v[0], &v[1], &v[2], &n) != 3 ||
       size_t(n) != s.size())
@@ -135,6 +135,7 @@ render::Image Downsample(const render::Image& big, int k) {
 
 int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   const auto tStart = Clock::now();
+  if (IsSceneFile(cmd.derive.file)) return RunRenderScene(cmd, out, err);
   if (!render::IsImagePath(cmd.output)) {
     err << "sylva: error: " << cmd.output << ": unknown image format; use .png, .jpg or .jpeg\n";
     return kExitBadInput;
@@ -147,7 +148,8 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
         << ": the rendered image may be at most 8192x8192 (K from 1 to 8)\n";
     return kExitBadInput;
   }
-  if (!(cmd.lodEps > 0) || !std::isfinite(cmd.lodEps)) {
+  const double lodEps = cmd.lodEps.value_or(0.5);
+  if (!(lodEps > 0) || !std::isfinite(lodEps)) {
     err << "sylva: error: --lod-eps must be a positive number of pixels\n";
     return kExitBadInput;
   }
@@ -156,7 +158,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (!spec) return exit;
   if (cmd.sides) spec->detail.sides = *cmd.sides;
   spec->until = plant::Stage::kGeometry;
-  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit);
+  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   const mesh::PlantGeometry* geometry = &plant->geometry;
   const mesh::Palette& palette = plant->palette;
@@ -185,7 +187,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     // Screen-space detail unless --sides asks for uniform tubes; eps is in
     // output pixels, so K times as many in the K-times larger image.
     if (!cmd.sides) {
-      spec->view = ViewOf(*camera, W, H, cmd.lodEps * K);
+      spec->view = ViewOf(*camera, W, H, lodEps * K);
       // Shadows of what lies outside the view may fall inside it.
       spec->view->shadowFrom = render::KeyLightDirection();
       spec->view->shadowPlaneY = bounds.lo.y();
@@ -193,8 +195,9 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     }
     DiagnosticList warnings;
     Status s = plant::Tessellate(*plant, *spec, warnings);
-    exit = Report(warnings, err, cmd.derive.maxErrors);
+    exit = Report(warnings, err, cmd.derive.maxErrors, cmd.derive.strict);
     if (!s.ok()) return Report(s.error(), err);
+    if (exit != kExitOk) return exit;
   }
 
   auto t0 = Clock::now();
@@ -268,7 +271,7 @@ int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err)
   auto spec = SpecFrom(cmd.derive, err, &exit);
   if (!spec) return exit;
   spec->until = plant::Stage::kGeometry;
-  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit);
+  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   // Framed as `sylva render` frames a mesh (never as a line figure).
   auto camera = FrameCamera(*plant, *spec, v, false);
@@ -276,10 +279,10 @@ int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err)
   spec->view = ViewOf(*camera, v.width, v.height, eps);
   DiagnosticList warnings;
   Status s = plant::Tessellate(*plant, *spec, warnings);
-  exit = Report(warnings, err, cmd.derive.maxErrors);
+  exit = Report(warnings, err, cmd.derive.maxErrors, cmd.derive.strict);
   if (!s.ok()) return Report(s.error(), err);
-  const int written = WriteMeshOf(cmd, *plant, err);
-  return written != kExitOk ? written : exit;
+  if (exit != kExitOk) return exit;
+  return WriteMeshOf(cmd, *plant, err);
 }
 
 }  // namespace sylva::app

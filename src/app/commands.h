@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -10,6 +11,9 @@
 
 #include "core/diagnostic.h"
 #include "plant/plant.h"
+#include "scene/build.h"
+#include "scene/scene.h"
+#include "scene/simulation.h"
 
 namespace sylva::app {
 
@@ -23,6 +27,7 @@ struct DeriveFlags {
   uint64_t maxModules = 0;    // 0: the library default
   uint64_t maxTriangles = 0;  // mesh and render only; 0: the library default
   int maxErrors = 20;         // errors (and warnings) printed; 0: all
+  bool strict = false;        // --strict: any warning is an error (exit 2)
 };
 
 struct DeriveCommand {
@@ -47,15 +52,22 @@ struct RenderCommand {
   DeriveFlags derive;
   std::string output;  // .png
   std::string size = "960x540";
-  std::string camera;        // "azimuth,elevation,distance"; empty or distance 0: framed
-  double lodEps = 0.5;       // screen-space detail tolerance, output pixels
-  std::optional<int> sides;  // set: uniform sides, no screen-space detail
-  int supersample = 1;       // render K x K larger, box-filter down
-  bool stats = false;        // `triangles: N` and stage times on stdout
+  std::string camera;            // "azimuth,elevation,distance"; empty or distance 0: framed
+  std::optional<double> lodEps;  // screen-space detail tolerance, output pixels (0.5)
+  std::optional<int> sides;      // set: uniform sides, no screen-space detail
+  int supersample = 1;           // render K x K larger, box-filter down
+  bool stats = false;            // `triangles: N` and stage times on stdout
+  double time = 0;               // scenes: simulated seconds before the picture
 };
 
 int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err);
 int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err);
+// `sylva render scene.xml` (cli_render_scene.cpp).
+int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& err);
+// "WxH", 1x1..8192x8192.
+bool ParseSize(const std::string& s, int* w, int* h);
+// "azimuth,elevation,distance": finite, elevation in (-90, 90), distance >= 0.
+bool ParseCamera(const std::string& s, double v[3]);
 int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 // `sylva mesh --lod-eps` (sylva-graphics: the view is framed by render::Camera).
 int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
@@ -67,16 +79,56 @@ int WriteMeshOf(const MeshCommand& cmd, const plant::Plant& plant, std::ostream&
 std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit);
 
 // Builds the plant up to `spec.until`, printing its diagnostics (at most
-// maxErrors of them, 0: all); nullopt
-// with *exit set on an error.
+// maxErrors of them, 0: all); nullopt with *exit set on an error (or, with
+// `strict`, on a warning).
 std::optional<plant::Plant> BuildPlant(const plant::PlantSpec& spec, int maxErrors,
-                                       std::ostream& err, int* exit);
+                                       std::ostream& err, int* exit, bool strict = false);
 
 int RunCheck(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
 
+// `sylva simulate scene.xml`: run the clock, write frames and the state.
+struct SimulateCommand {
+  std::string file;
+  std::vector<std::string> defines;  // -D NAME=VALUE: scene parameters
+  int threads = 0;
+  int maxErrors = 20;
+  bool strict = false;
+  std::optional<double> duration;  // default: the scene's <simulation duration>
+  std::optional<double> fps;       // frames a second written; default: the scene's fps
+  std::string output;              // frame pattern, e.g. frames/%04d.png; empty: no frames
+  std::string dump;                // CSV of every particle at the end
+  std::string size = "960x540";
+};
+
+// One frame of a running simulation, for the graphics side to draw.
+struct SimulationFrame {
+  const scene::Scene& scene;
+  const scene::BuiltScene& built;
+  const scene::Simulation& simulation;
+  int index;
+};
+// Writes the picture of a frame to `path` (sylva-graphics provides it).
+using FrameWriter = std::function<Status(const SimulationFrame& frame, const std::string& path)>;
+// Without a writer, no frames are drawn (no OpenGL is needed).
+int RunSimulate(const SimulateCommand& cmd, std::ostream& out, std::ostream& err,
+                const FrameWriter& writeFrame);
+// The runner with frames (cli_render_scene.cpp).
+int RunSimulateWithFrames(const SimulateCommand& cmd, std::ostream& out, std::ostream& err);
+// The frame path of a pattern with one %d conversion (a 0 flag and a width
+// allowed, %% for a percent sign); empty when the pattern is not one.
+std::string FramePath(const std::string& pattern, int index);
+
+// Scene files (.xml): read strictly, every grammar they name parsed; with
+// `strict`, a warning (of the scene or a grammar) is an error too.
+bool IsSceneFile(const std::string& path);
+std::optional<scene::Scene> LoadScene(const std::string& path,
+                                      const std::vector<std::string>& defines, int maxErrors,
+                                      std::ostream& err, int* exit, bool strict = false);
+int RunCheckScene(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
+
 // Prints diagnostics; returns the exit status they call for (0 when there
-// are only warnings).
-int Report(const DiagnosticList& list, std::ostream& err, int maxErrors = 0);
+// are only warnings, 2 when there are warnings and `strict`, saying so).
+int Report(const DiagnosticList& list, std::ostream& err, int maxErrors = 0, bool strict = false);
 int Report(const Diagnostic& d, std::ostream& err);
 
 }  // namespace sylva::app

@@ -10,6 +10,7 @@ const GraphicsCommands& LinkedGraphics() {
     GraphicsCommands c;
     c.render = &RunRender;
     c.meshForView = &RunMeshForView;
+    c.simulate = &RunSimulateWithFrames;
 #ifdef SYLVA_WITH_VIEWER
     c.view = &RunView;
 #endif

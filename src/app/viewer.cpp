@@ -39,6 +39,7 @@ struct Job {
   std::optional<uint64_t> seed;
   int steps = -1;
   int sides = 8;
+  bool strict = false;  // warnings are errors
 };
 
 struct Result {
@@ -66,6 +67,10 @@ Result RunJob(const Job& job) {
   plant::PlantResult built = plant::BuildPlant(spec);
   r.diagnostics = built.diagnostics.FormatAll();
   if (!built.plant) return r;
+  if (job.strict && !built.diagnostics.items.empty()) {
+    r.diagnostics += "sylva: error: --strict: warnings are treated as errors\n";
+    return r;
+  }
   plant::Plant& p = *built.plant;
   r.derivationLength = p.grammar.derivationLength;
   for (const auto& [k, v] : p.grammar.constants) r.constants.emplace_back(k, v);
@@ -336,6 +341,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   Worker worker;
   Job job;
   job.path = path;
+  job.strict = cmd.strict;
   uint64_t nextId = 1;
   auto post = [&] {
     job.id = nextId++;
@@ -381,6 +387,11 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
         err << "sylva view: the grammar has errors; keeping the last good plant\n"
             << shown.diagnostics;
         shown.lastFailed = true;
+        // A screenshot of a plant that cannot be built: nothing will come.
+        if (cmd.frames > 0 && !shown.plant) {
+          exitCode = kExitBadInput;
+          break;
+        }
       }
     }
     int fbw = 0, fbh = 0;

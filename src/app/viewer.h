@@ -17,6 +17,7 @@ struct ViewCommand {
   std::string screenshot;  // with frames > 0: save this PNG after `frames` frames and quit
   int frames = 0;
   std::string size = "1280x720";
+  bool strict = false;  // --strict: a plant with warnings is not shown (they are errors)
 };
 
 int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err);

@@ -343,10 +343,11 @@ Status Pass::Allocate(Word& out, bool outHasParams) {
 
 void Pass::Fail(Chunk& c, const Production& p, const EvalError& e, int column, size_t i) {
   if (c.error) return;
-  Diagnostic d = MakeError(SourceLoc{p.loc.file, p.loc.line, e.column ? e.column : column},
+  const SourceLoc loc = p.LocOf(e.column ? e.column : column);
+  Diagnostic d = MakeError(loc,
                            e.message + " (module " + std::to_string(i + 1) + " of the word, step " +
                                std::to_string(stepForMessages_) + ")",
-                           1, g_.SourceLine(p.loc));
+                           1, g_.SourceLine(loc));
   c.error = std::move(d);
 }
 

@@ -320,8 +320,12 @@ constexpr FunctionInfo kFunctions[] = {
     {"floor", OpCode::kFloor, 1},   {"ceil", OpCode::kCeil, 1},   {"min", OpCode::kMin, 2},
     {"max", OpCode::kMax, 2},       {"clamp", OpCode::kClamp, 3}, {"sign", OpCode::kSign, 1},
     {"trunc", OpCode::kTrunc, 1},   {"ran", OpCode::kRan, 1},     {"uniform", OpCode::kUniform, 2},
-    {"normal", OpCode::kNormal, 2},
+    {"normal", OpCode::kNormal, 2}, {"nran", OpCode::kNormal, 2},  // nran: cpfg's name
 };
+
+// cpfg's functions that Sylva does not have: named as such when called.
+constexpr std::string_view kCpfgFunctions[] = {"bran", "biran",  "tran", "srand",
+                                               "func", "inblob", "stop"};
 
 bool IsRandom(OpCode op) {
   return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal;
@@ -336,8 +340,9 @@ class Parser {
   Parser(std::string_view text, size_t pos, const ExprScope& scope, ExprParseError* err)
       : t_(text), p_(pos), scope_(scope), err_(err) {}
 
-  NodePtr Parse() { return Ternary(0); }
+  NodePtr Parse() { return Ternary(baseDepth_); }
   size_t pos() const { return p_; }
+  void SkipTrailingSpace() { SkipSpace(); }
 
  private:
   void SkipSpace() {
@@ -364,7 +369,7 @@ class Parser {
   NodePtr Make(OpCode op, int col, NodePtr a = nullptr, NodePtr b = nullptr) {
     auto n = std::make_unique<Node>();
     n->op = op;
-    n->column = col;
+    n->column = macroColumn_ ? macroColumn_ : col;
     if (a) n->kids.push_back(std::move(a));
     if (b) n->kids.push_back(std::move(b));
     return n;
@@ -560,7 +565,12 @@ class Parser {
       int len = int(name.size());
       SkipSpace();
       if (p_ < t_.size() && t_[p_] == '(') return Call(name, col, len, depth);
-      // Formal parameters shadow constants.
+      // Macro parameters, then formal parameters, shadow constants.
+      if (bound_) {
+        for (size_t i = 0; i < bound_->names.size(); ++i) {
+          if (bound_->names[i] == name) return Clone(*bound_->args[i]);
+        }
+      }
       if (scope_.formals) {
         for (size_t i = 0; i < scope_.formals->size(); ++i) {
           if ((*scope_.formals)[i] == name) {
@@ -600,11 +610,21 @@ class Parser {
   }
 
   NodePtr Call(const std::string& name, int col, int len, int depth) {
+    if (scope_.macros) {
+      auto it = scope_.macros->find(name);
+      if (it != scope_.macros->end()) return Macro(name, it->second, col, len, depth);
+    }
     const FunctionInfo* fn = nullptr;
     for (const auto& f : kFunctions) {
       if (name == f.name) fn = &f;
     }
-    if (!fn) return Error(col, "unknown function '" + name + "'", len);
+    if (!fn) {
+      for (std::string_view c : kCpfgFunctions) {
+        if (name == c)
+          return Error(col, "cpfg function '" + name + "' is not supported by Sylva", len);
+      }
+      return Error(col, "unknown function '" + name + "'", len);
+    }
     ++p_;  // '('
     auto n = Make(fn->op, col);
     SkipSpace();
@@ -627,10 +647,87 @@ class Parser {
     return n;
   }
 
+  // A deep copy, by a work list (argument trees may be long operator chains).
+  static NodePtr Clone(const Node& root) {
+    auto copyOne = [](const Node& n) {
+      auto c = std::make_unique<Node>();
+      c->op = n.op;
+      c->column = n.column;
+      c->value = n.value;
+      c->slot = n.slot;
+      c->ternary = n.ternary;
+      return c;
+    };
+    NodePtr out = copyOne(root);
+    std::vector<std::pair<const Node*, Node*>> pending{{&root, out.get()}};
+    while (!pending.empty()) {
+      auto [src, dst] = pending.back();
+      pending.pop_back();
+      for (const auto& k : src->kids) {
+        dst->kids.push_back(copyOne(*k));
+        pending.emplace_back(k.get(), dst->kids.back().get());
+      }
+    }
+    return out;
+  }
+
+  // NAME(args) of `#define NAME(params) body`: the body parsed with each
+  // parameter bound to a copy of its argument; its own nodes take the
+  // call's column.
+  NodePtr Macro(const std::string& name, const ExprMacro& m, int col, int len, int depth) {
+    if (scope_.usedConstants) scope_.usedConstants->insert(name);
+    if (depth + 1 > kMaxDepth)
+      return Error(col, "expression nested deeper than " + std::to_string(kMaxDepth), len);
+    ++p_;  // '('
+    Bound bound;
+    bound.names = m.params;
+    SkipSpace();
+    if (!Accept(")")) {
+      for (;;) {
+        NodePtr a = Ternary(depth + 1);
+        if (!a) return nullptr;
+        bound.args.push_back(std::move(a));
+        if (Accept(",")) continue;
+        if (Accept(")")) break;
+        return Error(Col(), "expected ',' or ')' in arguments of '" + name + "'");
+      }
+    }
+    if (bound.args.size() != m.params.size()) {
+      return Error(col,
+                   "'" + name + "' (#define) takes " + std::to_string(m.params.size()) +
+                       " argument" + (m.params.size() == 1 ? "" : "s") + ", given " +
+                       std::to_string(bound.args.size()),
+                   len);
+    }
+    ExprParseError inner;
+    Parser body(m.body, 0, scope_, &inner);
+    body.bound_ = &bound;
+    body.macroColumn_ = col;
+    body.baseDepth_ = depth + 1;
+    NodePtr n = body.Parse();
+    if (n) {
+      body.SkipTrailingSpace();
+      if (body.pos() < m.body.size()) {
+        n = nullptr;
+        inner.message = "unexpected text after the expression";
+      }
+    }
+    if (!n) return Error(col, "in '" + name + "' (#define): " + inner.message, len);
+    return n;
+  }
+
+  struct Bound {
+    std::vector<std::string> names;
+    std::vector<NodePtr> args;
+  };
+
   std::string_view t_;
   size_t p_;
   const ExprScope& scope_;
   ExprParseError* err_;
+  const Bound* bound_ = nullptr;  // inside a macro body: its parameters
+  int macroColumn_ = 0;           // inside a macro body: the call's column
+  int baseDepth_ = 0;
 };
 
 }  // namespace

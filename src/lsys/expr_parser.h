@@ -27,11 +27,22 @@ namespace sylva::lsys {
 // than 48"). Chains of binary operators (`1+1+...+1`) have no limit.
 inline constexpr int kMaxExprNesting = 48;
 
+// `#define NAME(a, b) body`: a function written in the grammar (cpfg files
+// use the C preprocessor's). A call `NAME(x, y)` is the body with each
+// parameter replaced by its argument expression, as the preprocessor would
+// (an argument with a random function is drawn once per use); errors inside
+// the body point at the call. Macros may call earlier macros.
+struct ExprMacro {
+  std::vector<std::string> params;
+  std::string body;  // checked when defined
+};
+
 // What names mean inside one expression.
 struct ExprScope {
   const std::unordered_map<std::string, double>* constants = nullptr;
-  std::unordered_set<std::string>* usedConstants = nullptr;  // may be null
+  std::unordered_set<std::string>* usedConstants = nullptr;  // may be null; macros too
   const std::vector<std::string>* formals = nullptr;         // slot = index
+  const std::unordered_map<std::string, ExprMacro>* macros = nullptr;
 };
 
 // Parses one expression starting at text[pos]; stops before the first

@@ -50,6 +50,16 @@ struct Production {
   SourceLoc loc;  // of the predecessor (Grammar::SourceLine has its text)
   // Columns of the parts, for run-time error messages.
   int conditionColumn = 0, weightColumn = 0;
+  // A production continued over several lines (a trailing `\`, cpfg's
+  // indented continuation) is read as one line; each piece says where its
+  // columns came from: columns from `at` + 1 on are on `line`, starting at
+  // `column` there. Empty: one line.
+  struct LinePiece {
+    int at = 0, line = 0, column = 1;
+  };
+  std::vector<LinePiece> pieces;
+  // The file position of a column of the production as read.
+  SourceLoc LocOf(int column) const;
 
   bool HasContext() const { return !left.empty() || !right.empty(); }
 };
@@ -74,7 +84,8 @@ struct Grammar {
   double step = 1;
   double width = 1;
   double widthFactor = 0.7;
-  double widthScale = 1;  // drawing: diameter = width x widthScale (cpfg's pixel widths)
+  double widthIncrement = 0;  // `width increment:` (cpfg): ! and # subtract/add it; 0: factor
+  double widthScale = 1;      // drawing: diameter = width x widthScale (cpfg's pixel widths)
   std::optional<Tropism> tropism;
   uint64_t seed = 1;
   // `palette: #rrggbb ...`: material colour of each colour index (sRGB as

@@ -18,6 +18,7 @@
 
 #include "core/atomic_file.h"
 #include "lsys/expr_parser.h"
+#include "lsys/unsupported.h"
 
 namespace sylva::lsys {
 namespace {
@@ -27,6 +28,21 @@ struct Line {
   int number = 0;
   std::string text;           // comments blanked, same columns
   std::string_view original;  // for excerpts: points into Grammar::sources
+  // Lines joined to this one (JoinContinuations): text from at + 1 on came
+  // from line `number` of the same file, starting at its column `column`.
+  struct Piece {
+    int at = 0, number = 0, column = 1;
+    std::string_view original;
+  };
+  std::vector<Piece> more;
+
+  // The piece that column `col` (1-based, of `text`) came from; null: the first line.
+  const Piece* PieceAt(int col) const {
+    // The last piece with at < col (pieces are in column order).
+    auto it = std::upper_bound(more.begin(), more.end(), col,
+                               [](int c, const Piece& q) { return c <= q.at; });
+    return it == more.begin() ? nullptr : &*(it - 1);
+  }
 };
 
 struct Define {
@@ -50,7 +66,7 @@ bool IsIdentChar(char c) {
 }
 
 // Single-character module names besides letters and digits.
-constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_";
+constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_;,#";
 
 // cpfg's @ commands, longest first where they share a prefix.
 constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS",
@@ -78,6 +94,38 @@ std::string Printable(char c) {
   return buf;
 }
 
+// Header statements and section keywords, longest first where they share a
+// prefix ("width factor" before "width").
+constexpr const char* kKeywords[] = {
+    "derivation length", "width factor",   "width increment", "width scale", "maximum depth",
+    "lsystem",           "axiom",          "angle",           "step",        "width",
+    "tropism",           "seed",           "ignore",          "consider",    "module",
+    "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette"};
+
+// The keyword that starts `t` at `pos` ("keyword:", or a bare section
+// keyword alone on its line), case-insensitive; *after is just past it.
+const char* MatchKeyword(const std::string& t, size_t pos, size_t* after) {
+  const std::string lower = Lower(t.substr(pos, 20));
+  for (const char* k : kKeywords) {
+    const size_t n = std::strlen(k);
+    if (lower.compare(0, n, k) != 0) continue;
+    size_t q = pos + n;
+    while (q < t.size() && IsSpace(t[q])) ++q;
+    const std::string_view kv = k;
+    const bool bare = kv == "endlsystem" || kv == "decomposition" || kv == "interpretation" ||
+                      kv == "homomorphism";
+    if (q < t.size() && t[q] == ':') {
+      *after = q + 1;
+      return k;
+    }
+    if (bare && q >= t.size()) {
+      *after = q;
+      return k;
+    }
+  }
+  return nullptr;
+}
+
 class GrammarParser {
  public:
   explicit GrammarParser(const ParseOptions& options) : opt_(options) {}
@@ -86,13 +134,23 @@ class GrammarParser {
 
  private:
   // --- diagnostics ---
-  SourceLoc Loc(const Line& l, int col) const { return SourceLoc{files_[l.file], l.number, col}; }
+  // The file position of column `col` of a (possibly joined) line, and the
+  // text of the file line it is on.
+  SourceLoc Loc(const Line& l, int col) const {
+    if (const Line::Piece* p = l.PieceAt(col))
+      return SourceLoc{files_[l.file], p->number, p->column + (col - 1 - p->at)};
+    return SourceLoc{files_[l.file], l.number, col};
+  }
+  static std::string_view OriginalAt(const Line& l, int col) {
+    const Line::Piece* p = l.PieceAt(col);
+    return p ? p->original : l.original;
+  }
   void Error(const Line& l, int col, std::string msg, int len = 1) {
     if (int(diags_.ErrorCount()) >= kMaxErrors) {
       ++diags_.droppedErrors;  // counted, so the report can say how many
       return;
     }
-    diags_.Add(MakeError(Loc(l, col), std::move(msg), len, l.original));
+    diags_.Add(MakeError(Loc(l, col), std::move(msg), len, OriginalAt(l, col)));
   }
   void Warn(SourceLoc loc, std::string_view line, std::string msg, int len = 1) {
     Diagnostic d = MakeError(std::move(loc), std::move(msg), len, line);
@@ -116,6 +174,7 @@ class GrammarParser {
   void ParseTropism(const Line& l, size_t after, size_t end);
   void ParseNumberStatement(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseDefine(const Line& l, size_t pos);
+  void ParseMacro(const Line& l, const std::string& name, int col, size_t pos);
   void ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen);
   bool LexName(const Line& l, size_t& pos, size_t end, std::string* name);
   bool ParseActualWord(const Line& l, size_t pos, size_t end, const ExprScope& scope,
@@ -130,7 +189,16 @@ class GrammarParser {
   bool ParseConstExpr(const Line& l, size_t pos, size_t end, double* out, Expr* expr = nullptr);
   bool CheckBrackets(const Line& l, const std::vector<SymbolId>& syms, const std::vector<int>& cols,
                      const char* what);
+  // opt_.isSurface, asked once per name; false without it.
+  bool IsSurface(const std::string& name) {
+    if (!opt_.isSurface) return false;
+    auto it = isSurface_.find(name);
+    if (it == isSurface_.end()) it = isSurface_.emplace(name, opt_.isSurface(name)).first;
+    return it->second;
+  }
   std::optional<SymbolId> Intern(const Line& l, int col, const std::string& name, int arity);
+  void JoinContinuations();
+  void WarnAfterEnd(const Line& l);
   void Finish();
   void WarnUnmatchable();
 
@@ -143,6 +211,7 @@ class GrammarParser {
   Section* section_ = &g_.main;
   bool haveAxiom_ = false;
   bool ended_ = false;
+  bool warnedAfterEnd_ = false;
   Successor axiom_;
   SourceLoc axiomLoc_;
   std::vector<int> axiomCols_;
@@ -153,9 +222,12 @@ class GrammarParser {
   std::vector<size_t> declaredLengths_;
   std::unordered_set<std::string_view> declaredSet_;
   std::unordered_map<std::string, Define> defines_;
+  std::unordered_map<std::string, ExprMacro> macros_;  // #define NAME(params) body
   std::unordered_set<std::string> usedConstants_;
   std::set<std::string> usedOverrides_;
   std::unordered_map<std::string, ArityUse> arityUse_;
+  std::unordered_set<std::string> unsupportedWarned_;  // name + reason
+  std::unordered_map<std::string, bool> isSurface_;
   std::set<std::string> ignoreNames_, considerNames_;
   bool haveIgnore_ = false, haveConsider_ = false;
   size_t bytesRead_ = 0;  // all files, for kMaxGrammarBytes
@@ -329,6 +401,9 @@ bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string*
     size_t q = pos + 1;
     if (q < end && IsIdentStart(t[q])) {
       while (q < end && IsIdentChar(t[q])) ++q;
+      if (q - pos > 2 && !IsSurface(t.substr(pos + 1, q - pos - 1)) &&
+          IsSurface(t.substr(pos + 1, 1)))
+        q = pos + 2;  // cpfg: a one-letter surface, then the next module
       *name = t.substr(pos, q - pos);
       pos = q;
       return true;
@@ -393,13 +468,18 @@ std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std:
     Error(l, col, "too many distinct modules (the limit is 65535)");
     return std::nullopt;
   }
+  // What Sylva does not act on is said once, at its first use.
+  if (auto why = UnsupportedModule(name, arity)) {
+    if (unsupportedWarned_.insert(name + '\x01' + *why).second)
+      Warn(Loc(l, col), OriginalAt(l, col), *why, int(name.size()));
+  }
   auto it = arityUse_.find(name);
   if (it == arityUse_.end()) {
     arityUse_.emplace(name, ArityUse{arity, Loc(l, col)});
   } else if (it->second.arity != arity && name != "[" && name != "]") {
     // One warning per name.
     if (it->second.arity >= 0) {
-      Warn(Loc(l, col), l.original,
+      Warn(Loc(l, col), OriginalAt(l, col),
            "module '" + name + "' is used with " + std::to_string(arity) + " parameter" +
                (arity == 1 ? "" : "s") + " here and with " + std::to_string(it->second.arity) +
                " at line " + std::to_string(it->second.loc.line) + "; they are different modules",
@@ -533,7 +613,7 @@ bool GrammarParser::ParseFormalWord(const Line& l, size_t& pos, size_t end,
 
 bool GrammarParser::ParseConstExpr(const Line& l, size_t pos, size_t end, double* out,
                                    Expr* exprOut) {
-  ExprScope scope{&g_.constants, &usedConstants_, nullptr};
+  ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   std::string_view view(l.text.data(), end);
   Expr e;
   ExprParseError err;
@@ -573,6 +653,10 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
   while (pos < t.size() && IsIdentChar(t[pos])) ++pos;
   std::string name = t.substr(s, pos - s);
   int col = int(s) + 1;
+  if (pos < t.size() && t[pos] == '(') {
+    ParseMacro(l, name, col, pos);
+    return;
+  }
   if (pos < t.size() && !IsSpace(t[pos])) {
     Error(l, int(pos) + 1, "expected a space after the name of #define '" + name + "'");
     return;
@@ -600,13 +684,84 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
   defines_[name] = Define{Loc(l, col), int(name.size())};
 }
 
+// `#define NAME(a, b) body` (the `(` right after the name, as in C): a
+// function of its parameters, the body checked now with them as its only
+// names besides constants and earlier macros.
+void GrammarParser::ParseMacro(const Line& l, const std::string& name, int col, size_t pos) {
+  const std::string& t = l.text;
+  ExprMacro m;
+  ++pos;  // '('
+  for (;;) {
+    while (pos < t.size() && IsSpace(t[pos])) ++pos;
+    if (m.params.empty() && pos < t.size() && t[pos] == ')') {
+      ++pos;
+      break;
+    }
+    if (pos >= t.size() || !IsIdentStart(t[pos])) {
+      Error(l, int(pos) + 1, "expected a parameter name in '#define " + name + "(...)'");
+      return;
+    }
+    const size_t s = pos;
+    while (pos < t.size() && IsIdentChar(t[pos])) ++pos;
+    std::string param = t.substr(s, pos - s);
+    if (std::find(m.params.begin(), m.params.end(), param) != m.params.end()) {
+      Error(l, int(s) + 1, "parameter '" + param + "' appears twice", int(param.size()));
+      return;
+    }
+    m.params.push_back(std::move(param));
+    while (pos < t.size() && IsSpace(t[pos])) ++pos;
+    if (pos < t.size() && t[pos] == ',') {
+      ++pos;
+      continue;
+    }
+    if (pos < t.size() && t[pos] == ')') {
+      ++pos;
+      break;
+    }
+    Error(l, int(pos) + 1, "expected ',' or ')' after a parameter of '#define " + name + "'");
+    return;
+  }
+  if (defines_.count(name)) {
+    Error(l, col,
+          "redefinition of '" + name + "' (first defined at line " +
+              std::to_string(defines_[name].loc.line) + ")",
+          int(name.size()));
+    return;
+  }
+  while (pos < t.size() && IsSpace(t[pos])) ++pos;
+  size_t end = t.size();
+  while (end > pos && IsSpace(t[end - 1])) --end;
+  if (pos >= end) {
+    Error(l, col, "#define '" + name + "' has no body", int(name.size()));
+    return;
+  }
+  // Check the body where it is written, its parameters standing as formals.
+  ExprScope scope{&g_.constants, &usedConstants_, &m.params, &macros_};
+  std::string_view view(t.data(), end);
+  Expr body;
+  ExprParseError err;
+  size_t q = pos;
+  if (!ParseExpr(view, &q, scope, &body, &err)) {
+    Error(l, err.column, err.message, err.length);
+    return;
+  }
+  while (q < end && IsSpace(t[q])) ++q;
+  if (q < end) {
+    Error(l, int(q) + 1, "unexpected text after the body of '#define " + name + "'");
+    return;
+  }
+  m.body = t.substr(pos, end - pos);
+  macros_.emplace(name, std::move(m));
+  defines_[name] = Define{Loc(l, col), int(name.size())};
+}
+
 // Header statements: "keyword:" at the start of a line, case-insensitive.
 void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end) {
   if (haveAxiom_) {
     Error(l, col, "second axiom (the first is at line " + std::to_string(axiomLoc_.line) + ")", 5);
     return;
   }
-  ExprScope scope{&g_.constants, &usedConstants_, nullptr};
+  ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   Successor s;
   if (!ParseActualWord(l, after, end, scope, &s)) return;
   if (s.symbols.empty()) {
@@ -721,6 +876,12 @@ void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, si
     g_.width = v;
   } else if (k == "width factor") {
     g_.widthFactor = v;
+  } else if (k == "width increment") {
+    if (!(v > 0)) {
+      Error(l, vcol, "width increment must be positive");
+      return;
+    }
+    g_.widthIncrement = v;
   } else if (k == "width scale") {
     if (!(v > 0)) {
       Error(l, vcol, "width scale must be positive");
@@ -737,48 +898,9 @@ void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, si
 }
 
 bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
-  static const char* kKeywords[] = {"derivation length",
-                                    "width factor",
-                                    "width scale",
-                                    "maximum depth",
-                                    "lsystem",
-                                    "axiom",
-                                    "angle",
-                                    "step",
-                                    "width",
-                                    "tropism",
-                                    "seed",
-                                    "ignore",
-                                    "consider",
-                                    "module",
-                                    "decomposition",
-                                    "interpretation",
-                                    "homomorphism",
-                                    "endlsystem",
-                                    "palette"};
   const std::string& t = l.text;
-  std::string lower = Lower(t.substr(pos, 20));
-  const char* kw = nullptr;
   size_t after = 0;
-  for (const char* k : kKeywords) {
-    size_t n = std::strlen(k);
-    if (lower.compare(0, n, k) != 0) continue;
-    size_t q = pos + n;
-    while (q < t.size() && IsSpace(t[q])) ++q;
-    bool colon = q < t.size() && t[q] == ':';
-    bool bare = std::string_view(k) == "endlsystem" || std::string_view(k) == "decomposition" ||
-                std::string_view(k) == "interpretation" || std::string_view(k) == "homomorphism";
-    if (colon) {
-      kw = k;
-      after = q + 1;
-      break;
-    }
-    if (bare && (q >= t.size())) {
-      kw = k;
-      after = q;
-      break;
-    }
-  }
+  const char* kw = MatchKeyword(t, pos, &after);
   if (!kw) return false;
   std::string k = kw;
   size_t end = t.size();
@@ -865,6 +987,74 @@ static size_t FindTopLevel(const std::string& t, size_t from, size_t to, std::st
       return i;
   }
   return std::string::npos;
+}
+
+// A line continued on the next: by a `\` at its end (the `\` reads as a
+// space), or, for a production, by indented lines that are neither
+// statements nor productions themselves (cpfg's way of writing a long
+// successor, or the `-->` of a production on the line after its
+// predecessor and condition). Lines of different files are never joined.
+// Joined lines keep where each piece came from (Line::more), so errors
+// point into the right line and column.
+void GrammarParser::JoinContinuations() {
+  auto firstText = [](const std::string& t) {
+    size_t p = 0;
+    while (p < t.size() && IsSpace(t[p])) ++p;
+    return p;
+  };
+  auto hasArrow = [](const std::string& t) {
+    return FindTopLevel(t, 0, t.size(), "->") != std::string::npos;
+  };
+  auto startsWithArrow = [&](const std::string& t) {
+    const size_t p = firstText(t);
+    return t.compare(p, 2, "->") == 0 || t.compare(p, 3, "-->") == 0;
+  };
+  // Not blank, not a statement, not a directive.
+  auto isProduction = [&](const Line& l) {
+    const size_t p = firstText(l.text);
+    size_t after = 0;
+    return p < l.text.size() && l.text[p] != '#' && !MatchKeyword(l.text, p, &after);
+  };
+  // `l` ends with `\` and `next` goes on with it (text that is not a
+  // statement, directive or production of its own; otherwise the `\` is
+  // the roll module that ends a word): blanks the `\` and says so.
+  auto takeBackslash = [&](Line& l, const Line* next) {
+    if (!next || next->file != l.file || !isProduction(*next) ||
+        (hasArrow(next->text) && !startsWithArrow(next->text)))
+      return false;
+    size_t e = l.text.size();
+    while (e > 0 && IsSpace(l.text[e - 1])) --e;
+    if (e == 0 || l.text[e - 1] != '\\') return false;
+    l.text[e - 1] = ' ';
+    return true;
+  };
+  std::vector<Line> out;
+  out.reserve(lines_.size());
+  bool continued = false;  // out.back() ended with a backslash
+  bool curArrow = false;   // out.back() has a `->` (kept, not rescanned: linear time)
+  for (size_t i = 0; i < lines_.size(); ++i) {
+    Line& l = lines_[i];
+    const Line* next = i + 1 < lines_.size() ? &lines_[i + 1] : nullptr;
+    const size_t p = firstText(l.text);
+    const bool blank = p >= l.text.size();
+    bool join = continued;
+    if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
+        isProduction(out.back())) {
+      join = curArrow ? !hasArrow(l.text) : startsWithArrow(l.text);
+    }
+    if (!join) {
+      out.push_back(std::move(l));
+      curArrow = hasArrow(out.back().text);
+      continued = takeBackslash(out.back(), next);
+      continue;
+    }
+    curArrow = curArrow || hasArrow(l.text);
+    Line& cur = out.back();
+    cur.more.push_back(Line::Piece{int(cur.text.size()), l.number, 1, l.original});
+    cur.text += l.text;
+    continued = takeBackslash(cur, next);
+  }
+  lines_ = std::move(out);
 }
 
 void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen) {
@@ -972,7 +1162,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     }
   }
   p.formalCount = uint16_t(formals.size());
-  ExprScope scope{&g_.constants, &usedConstants_, &formals};
+  ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
 
   // Condition.
   if (condAt != std::string::npos) {
@@ -999,8 +1189,8 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
       }
       p.conditionColumn = int(c) + 1;
       if (cond.IsConstant() && cond.constant() == 0) {
-        Warn(Loc(l, int(c) + 1), l.original, "condition is always false: production never applies",
-             int(e - c));
+        Warn(Loc(l, int(c) + 1), OriginalAt(l, int(c) + 1),
+             "condition is always false: production never applies", int(e - c));
       }
       if (!(cond.IsConstant() && cond.constant() != 0)) p.condition = std::move(cond);
     }
@@ -1050,6 +1240,11 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     p.weight = std::move(weight);
   }
   p.loc = Loc(l, pf.column);
+  if (!l.more.empty()) {
+    p.pieces.push_back(Production::LinePiece{0, l.number, 1});
+    for (const Line::Piece& q : l.more)
+      p.pieces.push_back(Production::LinePiece{q.at, q.number, q.column});
+  }
   if (section_->productions.size() >= kMaxProductionsPerSection) {
     Error(l, pf.column,
           "more than " + std::to_string(kMaxProductionsPerSection) + " productions in one section");
@@ -1099,6 +1294,29 @@ void GrammarParser::ParseLine(const Line& l) {
 
 // ---------------------------------------------------------------------------
 // After all lines
+
+// The first line with text after `endlsystem`: Sylva reads one L-system a
+// file, so what follows is said to be ignored, where it starts.
+void GrammarParser::WarnAfterEnd(const Line& l) {
+  const std::string& t = l.text;
+  size_t pos = 0;
+  while (pos < t.size() && IsSpace(t[pos])) ++pos;
+  if (pos >= t.size()) return;
+  warnedAfterEnd_ = true;
+  size_t e = pos;
+  while (e < t.size() && IsIdentChar(t[e])) ++e;
+  size_t c = e;
+  while (c < t.size() && IsSpace(t[c])) ++c;
+  if (Lower(t.substr(pos, e - pos)) == "lsystem" && c < t.size() && t[c] == ':') {
+    Warn(Loc(l, int(pos) + 1), l.original,
+         "a second 'lsystem:' block (a cpfg sub-L-system) is not supported: it and everything "
+         "after it are ignored",
+         int(e - pos));
+    return;
+  }
+  Warn(Loc(l, int(pos) + 1), l.original,
+       "text after 'endlsystem' is ignored (Sylva reads one L-system a file)", 1);
+}
 
 void GrammarParser::WarnUnmatchable() {
   // Symbols that can occur in a derived word: the axiom and every successor
@@ -1204,6 +1422,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   }
   std::vector<std::string> stack{std::filesystem::path(path).lexically_normal().string()};
   Preprocess(std::make_shared<const std::string>(text), path, 0, stack);
+  JoinContinuations();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
   // module: declarations apply to the whole file, wherever they stand.
@@ -1236,7 +1455,11 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   declaredLengths_.erase(std::unique(declaredLengths_.begin(), declaredLengths_.end()),
                          declaredLengths_.end());
   for (const Line& l : lines_) {
-    if (ended_) break;
+    if (ended_) {
+      WarnAfterEnd(l);
+      if (warnedAfterEnd_) break;
+      continue;
+    }
     ParseLine(l);
   }
   Finish();
@@ -1248,6 +1471,15 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
 }
 
 }  // namespace
+
+SourceLoc Production::LocOf(int column) const {
+  const LinePiece* piece = nullptr;
+  for (const LinePiece& q : pieces) {
+    if (column > q.at) piece = &q;
+  }
+  if (!piece) return SourceLoc{loc.file, loc.line, column};
+  return SourceLoc{loc.file, piece->line, piece->column + (column - 1 - piece->at)};
+}
 
 std::string_view Grammar::SourceLine(const SourceLoc& loc) const {
   for (const SourceFile& f : sources) {

@@ -36,6 +36,13 @@ struct ParseOptions {
   // Reads a file (for the main file when parsing from disk, and #include).
   // Default: the file system.
   std::function<std::optional<std::string>(const std::string& path)> readFile;
+  // Whether a predefined surface of this name (without `~`) exists. cpfg's
+  // surface names are one letter, so `~lF` is `~l` then `F`; Sylva's may be
+  // longer (`~leaf`). With this set, `~` and the identifier after it is
+  // read whole when that name is a surface, else as its first letter when
+  // that one is (`~lF` with l.obj and no lF.obj), else whole (and later
+  // reported as an unknown surface). Empty: always whole.
+  std::function<bool(const std::string& name)> isSurface;
   // What may be read: per file, and all files of the grammar together.
   size_t maxFileBytes = kMaxGrammarFileBytes;
   size_t maxTotalBytes = kMaxGrammarBytes;

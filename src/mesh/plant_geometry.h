@@ -44,7 +44,9 @@ struct SurfaceInstance {
   std::string name;  // without the `~`
   Vec3 position;
   Frame frame;
-  double scale = 1;
+  // Scale along the surface's own x, y, z (the turtle's L, H, U):
+  // `~name(s)` is (s, s, s), `~name(sx, sy, sz)` each its own.
+  Vec3 scale{1, 1, 1};
   uint16_t color = 0;
   uint32_t module = 0;
 };

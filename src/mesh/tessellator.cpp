@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <type_traits>
 
 #include "core/memory.h"
@@ -23,6 +24,13 @@ Vec3f F(const Vec3& v) {
 Vec3 AnyPerpendicular(const Vec3& t) {
   Vec3 a = std::abs(t.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
   return (a - t * t.dot(a)).normalized();
+}
+
+// Where a surface's vertex p lands (for bounds; the tessellation below
+// places it with the same arithmetic up to rounding).
+Vec3 SurfacePoint(const SurfaceInstance& si, const Vec3f& p) {
+  const Vec3 sp = p.cast<double>().cwiseProduct(si.scale);
+  return si.position + sp.x() * si.frame.left + sp.y() * si.frame.heading + sp.z() * si.frame.up;
 }
 
 int ClampSides(int s) {
@@ -389,11 +397,8 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
       const SurfaceInstance& si = g.surfaces[i];
       const TriangleMesh& sm = options.surfaces->at(si.name);
       Box& b = boxes[nc + ns + np + i];
-      for (const Vec3f& p : sm.positions) {
-        b.Add(si.position +
-              si.scale * (double(p.x()) * si.frame.left + double(p.y()) * si.frame.heading +
-                          double(p.z()) * si.frame.up));
-      }
+      for (const Vec3f& p : sm.positions) b.Add(SurfacePoint(si, p));
+      b.Grow(1e-6 * (1 + si.position.norm()));  // the tessellation's rounding
     }
     const Frustum frustum = Frustum::FromViewProjection(view->viewProjection);
     // Everything inside (a framed plant): no hierarchy needed.
@@ -581,11 +586,19 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     const SurfaceInstance& si = g.surfaces[f];
     const TriangleMesh& s = options.surfaces->at(si.name);
     const uint32_t base = uint32_t(out.positions.size());
+    // ~name(s) scales all axes alike (the common case, computed as it
+    // always was); ~name(sx,sy,sz) each its own, normals by the inverse.
+    const Vec3 sc = si.scale;
+    const bool uniform = sc.x() == sc.y() && sc.y() == sc.z();
+    std::optional<Vec3> inverseScale;
+    if (!uniform && sc.x() != 0 && sc.y() != 0 && sc.z() != 0) inverseScale = sc.cwiseInverse();
     for (size_t i = 0; i < s.positions.size(); ++i) {
       const Vec3 p = s.positions[i].cast<double>(), n = s.normals[i].cast<double>();
-      const Vec3 wp = si.position + si.scale * (p.x() * si.frame.left + p.y() * si.frame.heading +
-                                                p.z() * si.frame.up);
-      const Vec3 wn = n.x() * si.frame.left + n.y() * si.frame.heading + n.z() * si.frame.up;
+      const Vec3 sp = uniform ? p : Vec3(p.cwiseProduct(sc));
+      const Vec3 local = sp.x() * si.frame.left + sp.y() * si.frame.heading + sp.z() * si.frame.up;
+      const Vec3 wp = si.position + (uniform ? sc.x() * local : local);
+      const Vec3 sn = inverseScale ? Vec3(n.cwiseProduct(*inverseScale)) : n;
+      const Vec3 wn = sn.x() * si.frame.left + sn.y() * si.frame.heading + sn.z() * si.frame.up;
       out.positions.push_back(F(wp));
       out.normals.push_back(F(wn.normalized()));
       out.uvs.push_back(s.uvs[i]);
@@ -628,9 +641,7 @@ Box TessellatedBounds(const PlantGeometry& g,
     auto it = surfaces ? surfaces->find(si.name) : decltype(surfaces->end()){};
     if (!surfaces || it == surfaces->end()) continue;
     for (const Vec3f& p : it->second.positions) {
-      box.Add(si.position +
-              si.scale * (double(p.x()) * si.frame.left + double(p.y()) * si.frame.heading +
-                          double(p.z()) * si.frame.up));
+      box.Add(SurfacePoint(si, p));
     }
   }
   return box;

@@ -175,6 +175,9 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
   lsys::ParseOptions popt;
   popt.overrides = spec.defines;
   popt.readFile = spec.readFile;
+  // `~lF`: cpfg's one-letter surface `l` then `F` when l.obj exists and lF.obj does not.
+  const SurfaceLibrary surfaces(spec.path, spec.surfacePath, spec.readFile);
+  popt.isSurface = [&surfaces](const std::string& name) { return surfaces.Has(name); };
   lsys::ParseResult parsed = spec.text ? lsys::ParseGrammarText(*spec.text, spec.path, popt)
                                        : lsys::ParseGrammarFile(spec.path, popt);
   for (auto& d : parsed.diagnostics.items) diagnostics.Add(d);

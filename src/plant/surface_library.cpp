@@ -52,6 +52,28 @@ SurfaceLibrary::SurfaceLibrary(const std::string& grammarPath,
   searchPath_.push_back(Join(Join(BundledDataDir(), "grammars"), "surfaces"));
 }
 
+std::string SurfaceLibrary::Locate(const std::string& name,
+                                   std::optional<std::string>* text) const {
+  const std::string file = name + ".obj";
+  for (const std::string& dir : searchPath_) {
+    const std::string candidate = Join(dir, file);
+    if (readFile_) {
+      *text = readFile_(candidate);
+      if (*text) return candidate;
+      continue;
+    }
+    struct stat st;
+    if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode)) return candidate;
+  }
+  return {};
+}
+
+bool SurfaceLibrary::Has(const std::string& name) const {
+  if (meshes_.count(name)) return true;
+  std::optional<std::string> text;
+  return !Locate(name, &text).empty();
+}
+
 Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::Grammar& g) {
   std::set<std::string> names;
   for (const auto& si : geometry.surfaces) {
@@ -60,29 +82,18 @@ Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::
   for (const std::string& name : names) {
     const std::string file = name + ".obj";
     std::optional<std::string> text;
-    std::string found;
-    for (const std::string& dir : searchPath_) {
-      const std::string candidate = Join(dir, file);
-      if (readFile_) {
-        text = readFile_(candidate);
-        if (text) {
-          found = candidate;
-          break;
-        }
-        continue;
-      }
-      struct stat st;
-      if (::stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
-        found = candidate;
-        break;
-      }
-    }
+    const std::string found = Locate(name, &text);
     if (found.empty()) {
       Diagnostic d;
       d.loc.file = g.path;
       d.message = "unknown surface '" + name + "': no " + file + " in";
       for (size_t i = 0; i < searchPath_.size(); ++i) {
         d.message += (i ? ", " : " ") + searchPath_[i];
+      }
+      if (name.size() > 1) {
+        d.message += " (cpfg surface names are one letter: with " + name.substr(0, 1) +
+                     ".obj there, '~" + name + "' is read as '~" + name.substr(0, 1) +
+                     "' followed by '" + name.substr(1) + "')";
       }
       // Point at the surface's first use in the grammar.
       if (auto it = g.symbolLoc.find("~" + name); it != g.symbolLoc.end()) {

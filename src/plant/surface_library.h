@@ -40,11 +40,19 @@ class SurfaceLibrary {
   // `g` when it can.
   Status LoadFor(const mesh::PlantGeometry& geometry, const lsys::Grammar& g);
 
+  // Whether NAME.obj is in the search path (what the grammar parser asks
+  // to read cpfg's one-letter `~lF` as `~l` then `F`).
+  bool Has(const std::string& name) const;
+
   // Surfaces by name (without `~`): what mesh::TessellateOptions takes.
   const std::unordered_map<std::string, mesh::TriangleMesh>& meshes() const { return meshes_; }
   const std::vector<std::string>& searchPath() const { return searchPath_; }
 
  private:
+  // The path of NAME.obj in the search path (empty when none) and, with a
+  // FileReader, its text.
+  std::string Locate(const std::string& name, std::optional<std::string>* text) const;
+
   std::vector<std::string> searchPath_;
   FileReader readFile_;
   std::unordered_map<std::string, mesh::TriangleMesh> meshes_;

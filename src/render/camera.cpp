@@ -29,7 +29,8 @@ Mat4 Camera::View() const {
 }
 
 Mat4 Camera::Projection(double aspect) const {
-  const double zn = std::max(distance * 1e-3, 1e-6), zf = distance * 4 + 1;
+  const double zn = nearPlane > 0 ? nearPlane : std::max(distance * 1e-3, 1e-6);
+  const double zf = farPlane > zn ? farPlane : std::max(distance * 4 + 1, zn * 2);
   Mat4 p = Mat4::Zero();
   if (orthographic) {
     const double h = orthoHeight / 2, w = h * aspect;

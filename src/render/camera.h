@@ -19,6 +19,8 @@ struct Camera {
   double fovY = 35;  // degrees (perspective)
   bool orthographic = false;
   double orthoHeight = 10;  // world units shown vertically (orthographic)
+  // Clip planes; 0: from the distance (distance / 1000 and 4 distance + 1).
+  double nearPlane = 0, farPlane = 0;
 
   Vec3 Eye() const;
   Mat4 View() const;

@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "core/atomic_file.h"
+#include "render/gl_program.h"
 
 namespace sylva::render {
 
@@ -63,12 +64,18 @@ static Diagnostic ShaderError(const std::string& file, const std::string& messag
   return d;
 }
 
-static Expected<GLuint> CompileProgram(const std::string& dir, const std::string& name) {
+Expected<unsigned> CompileProgram(const std::string& dir, const std::string& name) {
+  return CompileProgram(dir, name + ".vert", name + ".frag");
+}
+
+Expected<unsigned> CompileProgram(const std::string& dir, const std::string& vert,
+                                  const std::string& frag) {
+  const std::string name = vert.substr(0, vert.rfind('.'));
   GLuint shaders[2];
-  const char* exts[2] = {".vert", ".frag"};
+  const std::string files[2] = {vert, frag};
   const GLenum kinds[2] = {GL_VERTEX_SHADER, GL_FRAGMENT_SHADER};
   for (int k = 0; k < 2; ++k) {
-    const std::string path = (fs::path(dir) / (name + exts[k])).string();
+    const std::string path = (fs::path(dir) / files[k]).string();
     auto text = ReadFile(path);
     if (!text) return ShaderError(path, "cannot read shader: " + text.error().message);
     shaders[k] = glCreateShader(kinds[k]);
@@ -105,6 +112,7 @@ static Expected<GLuint> CompileProgram(const std::string& dir, const std::string
 Expected<std::unique_ptr<Renderer>> Renderer::Create(const std::string& shaderDir) {
   std::unique_ptr<Renderer> r(new Renderer());
   r->gl_ = std::make_unique<Gl>();
+  r->shaderDir_ = shaderDir;
   Gl& g = *r->gl_;
   auto mesh = CompileProgram(shaderDir, "mesh");
   if (!mesh) return mesh.error();
@@ -158,6 +166,7 @@ Expected<std::unique_ptr<Renderer>> Renderer::Create(const std::string& shaderDi
 }
 
 Renderer::~Renderer() {
+  DestroyScenePass(scene_);
   if (!gl_) return;
   Gl& g = *gl_;
   glDeleteProgram(g.meshProgram);
@@ -434,6 +443,13 @@ void Renderer::Draw(const Camera& camera) {
   glBindFramebuffer(GL_READ_FRAMEBUFFER, g.msFbo);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.resolveFbo);
   glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+}
+
+unsigned Renderer::MultisampleFramebuffer() const {
+  return gl_->msFbo;
+}
+unsigned Renderer::ResolveFramebuffer() const {
+  return gl_->resolveFbo;
 }
 
 void Renderer::Finish() {

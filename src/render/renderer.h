@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "draw/draw_list.h"
 #include "mesh/color.h"
 #include "mesh/export.h"
 #include "mesh/screen_detail.h"
@@ -91,6 +92,11 @@ class Renderer {
   // Draws the current mesh, points and lines: no allocation and no upload;
   // one draw call for the mesh, one for the points, one for the lines.
   void Draw(const Camera& camera);
+  // Draws a DrawList (src/draw): meshes by instance, lights (up to 8, the
+  // first sun casting shadows), sky, sprites and lines. Meshes are uploaded
+  // once while the list keeps sharing them. An error (Check()) draws
+  // nothing.
+  [[nodiscard]] Status Draw(const draw::DrawList& list, const Camera& camera);
   void Finish();  // waits for the GPU (for timing)
   // Copies the last frame to the window's framebuffer (the viewer), scaled
   // to width x height.
@@ -108,6 +114,12 @@ class Renderer {
   mesh::Vec3f background_ = mesh::Srgb(0.94f, 0.95f, 0.96f);  // linear
   bool ground_ = false, shadows_ = true;
   void RenderShadowMap();
+  unsigned MultisampleFramebuffer() const;
+  unsigned ResolveFramebuffer() const;
+  struct ScenePass;  // scene_pass.cpp: the DrawList pipelines, made on first use
+  ScenePass* scene_ = nullptr;
+  static void DestroyScenePass(ScenePass* pass);
+  std::string shaderDir_;
 };
 
 // Reads the current window's back buffer (after everything, UI included,

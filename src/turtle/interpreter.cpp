@@ -28,12 +28,15 @@ enum class Op : uint8_t {
   kPush,
   kPop,
   kWidth,
+  kWidthUp,
   kColor,
+  kColorDown,
   kPolygonBegin,
   kVertex,
   kPolygonEnd,
   kSurface,
   kSphere,
+  kMoveTo,
 };
 
 Op OpFor(const std::string& name) {
@@ -70,7 +73,12 @@ Op OpFor(const std::string& name) {
       case '!':
         return Op::kWidth;
       case '\'':
+      case ';':
         return Op::kColor;
+      case ',':
+        return Op::kColorDown;
+      case '#':
+        return Op::kWidthUp;
       case '{':
         return Op::kPolygonBegin;
       case '.':
@@ -83,6 +91,7 @@ Op OpFor(const std::string& name) {
   }
   if (name[0] == '~') return Op::kSurface;
   if (name == "@O") return Op::kSphere;
+  if (name == "@M") return Op::kMoveTo;
   return Op::kNone;
 }
 
@@ -185,6 +194,7 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   d.step = g.step;
   d.width = g.width;
   d.widthFactor = g.widthFactor;
+  d.widthIncrement = g.widthIncrement;
   d.widthScale = g.widthScale;
   if (g.tropism) {
     d.tropism = Vec3(g.tropism->x, g.tropism->y, g.tropism->z);
@@ -243,7 +253,7 @@ static Status CheckRange(const PlantGeometry& g, const lsys::Word& word,
     if (!okPoint(sp.center) || !ok(sp.radius)) return fail(sp.module, "a sphere");
   }
   for (const SurfaceInstance& si : g.surfaces) {
-    if (!okPoint(si.position) || !ok(si.scale)) return fail(si.module, "a surface placement");
+    if (!okPoint(si.position) || !okPoint(si.scale)) return fail(si.module, "a surface placement");
   }
   return {};
 }
@@ -457,10 +467,28 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         stack.pop_back();
         break;
       case Op::kWidth:
-        t.width = np ? p[0] : t.width * def.widthFactor;
+        if (np) {
+          t.width = p[0];
+        } else if (def.widthIncrement > 0) {
+          t.width = std::max(t.width - def.widthIncrement, 0.0);
+        } else {
+          t.width *= def.widthFactor;
+        }
+        break;
+      case Op::kWidthUp:
+        if (np) {
+          t.width = p[0];
+        } else if (def.widthIncrement > 0) {
+          t.width += def.widthIncrement;
+        } else if (def.widthFactor != 0) {
+          t.width /= def.widthFactor;
+        }
         break;
       case Op::kColor:
-        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : t.color + 1);
+        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : std::min(t.color + 1, 65535));
+        break;
+      case Op::kColorDown:
+        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : std::max(t.color - 1, 0));
         break;
       case Op::kPolygonBegin: {
         Polygon poly;
@@ -480,7 +508,12 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         si.name = symbols.name(sym).substr(1);
         si.position = t.pos;
         si.frame = t.frame;
-        si.scale = np ? p[0] : 1.0;
+        // ~name(s): uniform; ~name(sx, sy, sz): along L, H, U (cpfg).
+        if (np >= 3) {
+          si.scale = Vec3(p[0], p[1], p[2]);
+        } else if (np) {
+          si.scale = Vec3(p[0], p[0], p[0]);
+        }
         si.color = t.color;
         si.module = uint32_t(i);
         g.surfaces.push_back(std::move(si));
@@ -495,6 +528,14 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         g.spheres.push_back(sp);
         break;
       }
+      case Op::kMoveTo:
+        // @M(x,y,z): cpfg's move-to, drawing nothing. Other arities are
+        // warned about by the parser and do nothing.
+        if (np >= 3) {
+          t.pos = Vec3(p[0], p[1], p[2]);
+          visit(t.pos);
+        }
+        break;
       case Op::kNone:
         break;
     }

@@ -12,11 +12,13 @@
 // G g move without recording a polygon vertex. Inside a polygon `{ ... }`, F
 // and f add their end point as a vertex and draw no segment; `.` adds the
 // current position. `[` `]` push and pop the turtle state (not the polygon).
-// !(w) sets the width (a diameter), ! multiplies it by the width factor;
-// '(c) sets the colour index, ' adds 1; ~name(s) places a surface scaled by
-// s (default 1); @O(d) a sphere of diameter d (default: the width).
-// Tropism (ABOP eq. 2.3): after every F and f, the frame turns about H x T
-// by e |H x T|.
+// !(w) and #(w) set the width (a diameter); ! alone multiplies it by the
+// width factor and # divides by it, or, with `width increment:`, they
+// subtract and add the increment (cpfg; never below 0); '(c) ;(c) ,(c) set
+// the colour index, ' and ; add 1, , subtracts 1 (never below 0); ~name(s) places a surface scaled
+// by s (default 1), ~name(sx,sy,sz) scaled along L, H, U; @O(d) a sphere of diameter d (default:
+// the width); @M(x,y,z) moves to (x,y,z) drawing nothing. Tropism (ABOP eq. 2.3): after every F and
+// f, the frame turns about H x T by e |H x T|.
 #pragma once
 
 #include <optional>
@@ -36,13 +38,15 @@ using mesh::Sphere;
 using mesh::SurfaceInstance;
 
 // What the turtle needs of a grammar; TurtleDefFrom fills it from the
-// grammar's header (angle:, step:, width:, width factor:, tropism:).
+// grammar's header (angle:, step:, width:, width factor:, width increment:,
+// tropism:).
 struct TurtleDef {
   double angle = 90;  // degrees, for rotations with no parameter
   double step = 1;    // for F f G g with no parameter
   double width = 1;   // initial width (diameter)
   double widthFactor = 0.7;
-  double widthScale = 1;  // drawn diameter = width x widthScale
+  double widthIncrement = 0;  // > 0: ! and # subtract and add it (cpfg); 0: the factor
+  double widthScale = 1;      // drawn diameter = width x widthScale
   Vec3 tropism{0, -1, 0};
   double susceptibility = 0;  // 0: no tropism
 };

@@ -167,5 +167,77 @@ TEST(CliMesh, UnknownSurfacePointsAtTheTilde) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+TEST(Cli, StrictMakesWarningsErrorsOnEveryCommand) {
+  std::string f = WriteFile("gc.l", "axiom: A\nA --> F@Gs F@Ge A\n");
+  auto plain = RunSylva({"check", f});
+  EXPECT_EQ(plain.code, 0) << plain.err;
+  EXPECT_NE(plain.err.find("gc.l:2:8: warning: '@Gs' (cpfg: start of a generalized cylinder) is "
+                           "not implemented in Sylva: it does nothing"),
+            std::string::npos)
+      << plain.err;
+  auto strict = RunSylva({"check", "--strict", f});
+  EXPECT_EQ(strict.code, 2) << strict.err;
+  EXPECT_NE(strict.err.find("sylva: error: --strict: 2 warnings are treated as errors"),
+            std::string::npos)
+      << strict.err;
+  auto derive = RunSylva({"derive", "--strict", f, "-n", "1"});
+  EXPECT_EQ(derive.code, 2) << derive.err;
+  EXPECT_EQ(derive.out, "");
+  std::string out = (Scratch() / "gc.obj").string();
+  auto mesh = RunSylva({"mesh", "--strict", f, "-n", "1", "-o", out});
+  EXPECT_EQ(mesh.code, 2) << mesh.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  auto meshPlain = RunSylva({"mesh", f, "-n", "1", "-o", out});
+  EXPECT_EQ(meshPlain.code, 0) << meshPlain.err;
+#ifdef SYLVA_TESTS_WITH_GRAPHICS
+  std::string png = (Scratch() / "gc.png").string();
+  auto render = RunSylva({"render", "--strict", f, "-n", "1", "-o", png, "--size", "64x64"});
+  EXPECT_EQ(render.code, 2) << render.err;
+  EXPECT_FALSE(std::filesystem::exists(png));
+#endif
+}
+
+TEST(Cli, StrictIsQuietOnACleanGrammar) {
+  auto r = RunSylva({"check", "--strict", Source("grammars/abop/fig1_24a_bracketed_plant.lsys")});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+}
+
+TEST(CliMesh, CpfgOneLetterSurfaceBesideTheGrammar) {
+  // ~lF with l.obj beside the grammar: cpfg's surface l, then F.
+  WriteFile("l.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  std::string f = WriteFile("onel.l", "axiom: ~lF\n");
+  std::string out = (Scratch() / "onel.obj").string();
+  auto r = RunSylva({"mesh", "--strict", f, "-o", out});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("1 segments"), std::string::npos) << r.err;
+}
+
+TEST(CliMesh, UnknownLongSurfaceNameMentionsCpfgOneLetterNames) {
+  std::string f = WriteFile("lq.l", "axiom: ~qF\n");
+  std::string out = (Scratch() / "lq.obj").string();
+  auto r = RunSylva({"mesh", f, "-o", out});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("with q.obj there, '~qF' is read as '~q' followed by 'F'"),
+            std::string::npos)
+      << r.err;
+}
+
+TEST(Cli, StrictAppliesToTheGrammarsOfAScene) {
+  std::string g = WriteFile("scene_gc.l", "axiom: F@Gs\n");
+  std::string f = WriteFile("strict_scene.xml",
+                            "<scene version=\"1\">\n  <plant id=\"p\" grammar=\"scene_gc.l\" "
+                            "position=\"0 0 0\"/>\n</scene>\n");
+  auto plain = RunSylva({"check", f});
+  EXPECT_EQ(plain.code, 0) << plain.err;
+  EXPECT_NE(plain.err.find("scene_gc.l:1:9: warning: '@Gs'"), std::string::npos) << plain.err;
+  auto strict = RunSylva({"check", "--strict", f});
+  EXPECT_EQ(strict.code, 2) << strict.err;
+  // One warning; the note that names the <plant> is not counted.
+  EXPECT_NE(strict.err.find("sylva: error: --strict: 1 warning is treated as an error"),
+            std::string::npos)
+      << strict.err;
+}
+
 }  // namespace
 }  // namespace sylva::app

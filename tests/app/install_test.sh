@@ -9,6 +9,7 @@ build="$1"; src="$2"; work="$3"; cxxflags="${4:-}"; ldflags="${5:-}"
 rm -rf "$work"; mkdir -p "$work"
 cmake --install "$build" --prefix "$work/prefix" >/dev/null
 test -f "$work/prefix/include/sylva/plant/plant.h"
+test -f "$work/prefix/include/sylva/terrain/height_field.h"
 test -f "$work/prefix/lib/cmake/Sylva/SylvaConfig.cmake"
 cmake -S "$src/examples/consumer" -B "$work/consumer" -DCMAKE_PREFIX_PATH="$work/prefix" \
   -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS="$cxxflags" -DCMAKE_EXE_LINKER_FLAGS="$ldflags" >/dev/null

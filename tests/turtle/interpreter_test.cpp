@@ -182,7 +182,7 @@ TEST(Turtle, SurfacesAndSpheres) {
   Drawn d = Draw("axiom: F~leaf(2)!(3)@O@O(1)\n");
   ASSERT_EQ(d.geometry.surfaces.size(), 1u);
   EXPECT_EQ(d.geometry.surfaces[0].name, "leaf");
-  EXPECT_EQ(d.geometry.surfaces[0].scale, 2);
+  EXPECT_VEC_NEAR(d.geometry.surfaces[0].scale, Vec3(2, 2, 2), 1e-12);
   EXPECT_VEC_NEAR(d.geometry.surfaces[0].position, Vec3(0, 1, 0), 1e-12);
   ASSERT_EQ(d.geometry.spheres.size(), 2u);
   EXPECT_EQ(d.geometry.spheres[0].radius, 1.5);
@@ -294,6 +294,69 @@ TEST(Turtle, OutOfRangeGeometryIsAnErrorNamingTheModule) {
   // Large but representable is fine.
   auto p = testing::PlantFromText("axiom: F(1e14)!(1e10)F\n", -1, plant::Stage::kGeometry);
   EXPECT_TRUE(p);
+}
+
+TEST(Turtle, SurfaceWithThreeScalesScalesEachAxis) {
+  Drawn d = Draw("axiom: ~leaf(1,2,3) ~leaf(4) ~leaf(5,6) ~leaf\n");
+  ASSERT_EQ(d.geometry.surfaces.size(), 4u);
+  EXPECT_VEC_NEAR(d.geometry.surfaces[0].scale, Vec3(1, 2, 3), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.surfaces[1].scale, Vec3(4, 4, 4), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.surfaces[2].scale, Vec3(5, 5, 5), 1e-12);  // warned: first only
+  EXPECT_VEC_NEAR(d.geometry.surfaces[3].scale, Vec3(1, 1, 1), 1e-12);
+}
+
+TEST(Turtle, SurfaceWithThreeScalesMeshesStretchedAlongHeading) {
+  // The bundled leaf is 1 long along its y (the heading): (1, 3, 1) makes
+  // it 3 long, and no wider.
+  auto flat = testing::PlantFromText("axiom: ~leaf(1)\n", -1, plant::Stage::kMesh);
+  auto tall = testing::PlantFromText("axiom: ~leaf(1,3,1)\n", -1, plant::Stage::kMesh);
+  ASSERT_TRUE(flat && tall);
+  auto extent = [](const mesh::TriangleMesh& m) {
+    mesh::Vec3f lo = m.positions[0], hi = m.positions[0];
+    for (const auto& p : m.positions) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    return (hi - lo).cast<double>().eval();
+  };
+  const Vec3 a = extent(flat->mesh), b = extent(tall->mesh);
+  EXPECT_NEAR(b.y(), 3 * a.y(), 1e-5) << Str(a) << " " << Str(b);
+  EXPECT_NEAR(b.x(), a.x(), 1e-6) << Str(a) << " " << Str(b);
+  EXPECT_NEAR(b.z(), a.z(), 1e-6) << Str(a) << " " << Str(b);
+}
+
+TEST(Turtle, MoveToSetsThePositionWithoutDrawing) {
+  Drawn d = Draw("axiom: F @M(3,4,5) F\n");
+  ASSERT_EQ(d.geometry.segments.size(), 2u);
+  EXPECT_VEC_NEAR(d.geometry.segments[1].start, Vec3(3, 4, 5), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.segments[1].end, Vec3(3, 5, 5), 1e-12);
+}
+
+TEST(Turtle, CpfgColourIndexUpDownAndSet) {
+  // ; up, , down (never below 0), ;(n) and ,(n) set; ' is ; as before.
+  Drawn d = Draw("axiom: ;F;(5)F,F,(2)F,,,F'F\n");
+  ASSERT_EQ(d.geometry.segments.size(), 6u);
+  const int want[] = {1, 5, 4, 2, 0, 1};
+  for (size_t i = 0; i < 6; ++i)
+    EXPECT_EQ(d.geometry.segments[i].color, want[i]) << "segment " << i;
+}
+
+TEST(Turtle, WidthDownAndUpByTheFactor) {
+  // Without `width increment:`, ! multiplies by the width factor and #
+  // divides by it; !(w) and #(w) set.
+  Drawn d = Draw("width: 2\nwidth factor: 0.5\naxiom: !F#F#F#(3)F!(4)F\n");
+  ASSERT_EQ(d.geometry.segments.size(), 5u);
+  const double want[] = {1, 2, 4, 3, 4};
+  for (size_t i = 0; i < 5; ++i)
+    EXPECT_NEAR(d.geometry.segments[i].radiusStart, want[i] / 2, 1e-6) << "segment " << i;
+}
+
+TEST(Turtle, WidthDownAndUpByTheIncrementAsCpfg) {
+  Drawn d = Draw("width: 1\nwidth increment: 0.25\naxiom: !F#F#F!(0.1)F!F#(2)F\n");
+  ASSERT_EQ(d.geometry.segments.size(), 6u);
+  const double want[] = {0.75, 1, 1.25, 0.1, 0, 2};  // never below 0
+  for (size_t i = 0; i < 6; ++i)
+    EXPECT_NEAR(d.geometry.segments[i].radiusStart, want[i] / 2, 1e-6) << "segment " << i;
 }
 
 }  // namespace

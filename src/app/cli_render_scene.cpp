@@ -1,0 +1,166 @@
+// sylva render scene.xml: read the scene, build its terrain, plants and
+// forests, describe the frame as a DrawList and render it headless.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+
+#include "app/cli.h"
+#include "app/commands.h"
+#include "render/camera.h"
+#include "render/headless_context.h"
+#include "render/renderer.h"
+#include "scene/build.h"
+#include "scene/simulation.h"
+
+namespace sylva::app {
+
+// The scene's camera, or one framing everything drawn.
+static render::Camera SceneCamera(const scene::Scene& s, const scene::BuiltScene& built,
+                                  double aspect) {
+  if (!s.camera) {
+    render::Camera c = render::Camera::Frame(built.lo, built.hi, aspect, 30, 15, false);
+    c.fovY = 40;
+    return c;
+  }
+  const scene::CameraDef& d = *s.camera;
+  render::Camera c;
+  c.fovY = d.fovDegrees;
+  c.target = d.target;
+  if (d.orbit) {
+    c.azimuth = d.orbit->x();
+    c.elevation = std::clamp(d.orbit->y(), -89.0, 89.0);
+    c.distance = d.orbit->z();
+  } else {
+    const Vec3 v = *d.position - d.target;
+    c.distance = v.norm();
+    c.elevation = std::asin(std::clamp(v.y() / c.distance, -1.0, 1.0)) * kRadToDeg;
+    c.azimuth = std::atan2(v.x(), v.z()) * kRadToDeg;
+  }
+  // Clip planes that hold the whole scene unless the file sets them.
+  const double reach = (c.Eye() - (built.lo + built.hi) / 2).norm() + (built.hi - built.lo).norm();
+  c.nearPlane = d.near.value_or(std::max(1e-3, c.distance * 1e-3));
+  c.farPlane = d.far.value_or(std::max(reach * 1.5, c.nearPlane * 2));
+  return c;
+}
+
+int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  if (!render::IsImagePath(cmd.output)) {
+    err << "sylva: error: " << cmd.output << ": unknown image format; use .png, .jpg or .jpeg\n";
+    return kExitBadInput;
+  }
+  int width = 0, height = 0;
+  if (!ParseSize(cmd.size, &width, &height)) {
+    err << "sylva: error: --size '" << cmd.size << "': expected WxH from 1x1 to 8192x8192\n";
+    return kExitBadInput;
+  }
+  if (!cmd.camera.empty()) {
+    err << "sylva: error: --camera is for grammars; a scene sets its view with <camera>\n";
+    return kExitBadInput;
+  }
+  if (cmd.lodEps || cmd.supersample != 1 || cmd.stats) {
+    err << "sylva: error: --lod-eps, --supersample and --stats are for grammars; a scene's "
+           "plants are drawn with uniform --sides\n";
+    return kExitBadInput;
+  }
+  if (cmd.derive.steps || cmd.derive.seed) {
+    err << "sylva: error: -n and --seed are for grammars; a scene sets them on <plant> and "
+           "<forest>\n";
+    return kExitBadInput;
+  }
+  int exit = kExitOk;
+  const auto scene =
+      LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err, &exit);
+  if (!scene) return exit;
+  scene::BuildOptions options;
+  options.threads = cmd.derive.threads;
+  options.sides = cmd.sides.value_or(12);  // scenes: uniform tubes (no screen-space detail yet)
+  scene::BuildResult built = scene::Build(*scene, options);
+  exit = Report(built.diagnostics, err, cmd.derive.maxErrors);
+  if (!built.scene) return exit == kExitOk ? kExitRuntime : exit;
+  const auto t1 = Clock::now();
+  DiagnosticList simWarnings;
+  scene::SimulationOptions simOptions;
+  simOptions.threads = cmd.derive.threads;
+  auto sim = scene::Simulation::Create(*scene, *built.scene, simOptions, simWarnings);
+  exit = Report(simWarnings, err, cmd.derive.maxErrors);
+  if (!sim) return Report(sim.error(), err);
+  if (Status s = (*sim)->AdvanceTo(cmd.time); !s.ok()) return Report(s.error(), err);
+  const auto t2 = Clock::now();
+
+  draw::DrawList list = scene::MakeDrawList(*scene, *built.scene);
+  (*sim)->AddToDrawList(list);
+  const render::Camera camera = SceneCamera(*scene, *built.scene, double(width) / height);
+  auto context = render::HeadlessContext::Create();
+  if (!context) return Report(context.error(), err);
+  auto renderer = render::Renderer::Create(render::FindShaderDir());
+  if (!renderer) return Report(renderer.error(), err);
+  if (Status s = (*renderer)->Resize(width, height); !s.ok()) return Report(s.error(), err);
+  if (Status s = (*renderer)->Draw(list, camera); !s.ok()) return Report(s.error(), err);
+  const render::Image image = (*renderer)->ReadPixels();
+  if (Status s = render::WriteImage(image, cmd.output); !s.ok()) return Report(s.error(), err);
+  const auto t3 = Clock::now();
+  char line[400];
+  std::snprintf(line, sizeof line,
+                "%s: %dx%d at t = %.3f s, %zu meshes, %zu static triangles, %zu simulated "
+                "points; build %.2f s, simulate %.2f s, render %.2f s (%s)\n",
+                cmd.output.c_str(), width, height, (*sim)->time(), list.meshes.size(),
+                built.scene->trianglesDrawn, (*sim)->Count(),
+                std::chrono::duration<double>(t1 - t0).count(),
+                std::chrono::duration<double>(t2 - t1).count(),
+                std::chrono::duration<double>(t3 - t2).count(), (*context)->Renderer().c_str());
+  err << line;
+  (void)out;
+  return kExitOk;
+}
+
+}  // namespace sylva::app
+
+namespace sylva::app {
+
+int RunSimulateWithFrames(const SimulateCommand& cmd, std::ostream& out, std::ostream& err) {
+  if (cmd.output.empty()) return RunSimulate(cmd, out, err, {});
+  if (!render::IsImagePath(cmd.output)) {
+    err << "sylva: error: " << cmd.output << ": unknown image format; use .png, .jpg or .jpeg\n";
+    return kExitBadInput;
+  }
+  int width = 0, height = 0;
+  if (!ParseSize(cmd.size, &width, &height)) {
+    err << "sylva: error: --size '" << cmd.size << "': expected WxH from 1x1 to 8192x8192\n";
+    return kExitBadInput;
+  }
+  // The context and renderer are made at the first frame, after the scene
+  // has loaded (a bad scene fails without touching OpenGL).
+  std::unique_ptr<render::HeadlessContext> context;
+  std::unique_ptr<render::Renderer> renderer;
+  std::optional<render::Camera> camera;
+  const FrameWriter write = [&](const SimulationFrame& f, const std::string& path) -> Status {
+    if (!renderer) {
+      auto c = render::HeadlessContext::Create();
+      if (!c) return c.error();
+      context = std::move(*c);
+      auto r = render::Renderer::Create(render::FindShaderDir());
+      if (!r) return r.error();
+      renderer = std::move(*r);
+      if (Status s = renderer->Resize(width, height); !s.ok()) return s;
+      camera = SceneCamera(f.scene, f.built, double(width) / height);
+    }
+    draw::DrawList list = scene::MakeDrawList(f.scene, f.built);
+    f.simulation.AddToDrawList(list);
+    if (Status s = renderer->Draw(list, *camera); !s.ok()) return s;
+    // Each frame's folder is made on demand (frames/%04d.png into frames/).
+    const size_t slash = path.rfind('/');
+    if (slash != std::string::npos && slash > 0) {
+      std::error_code ec;
+      std::filesystem::create_directories(path.substr(0, slash), ec);
+    }
+    return render::WriteImage(renderer->ReadPixels(), path);
+  };
+  return RunSimulate(cmd, out, err, write);
+}
+
+}  // namespace sylva::app

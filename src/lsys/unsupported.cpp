@@ -1,0 +1,75 @@
+#include "lsys/unsupported.h"
+
+namespace sylva::lsys {
+
+namespace {
+
+struct Command {
+  std::string_view name;
+  std::string_view what;  // cpfg's meaning, as its manual names it
+};
+
+// cpfg's @ commands that Sylva lexes but does not draw.
+constexpr Command kUndrawn[] = {
+    {"@Gs", "start of a generalized cylinder"},
+    {"@Ge", "end of a generalized cylinder"},
+    {"@Gc", "generalized cylinder control point"},
+    {"@Gr", "generalized cylinder radius"},
+    {"@Gt", "generalized cylinder tangent"},
+    {"@Tf", "tropism change"},
+    {"@Ts", "tropism strength"},
+    {"@PS", "bicubic patch"},
+    {"@PD", "bicubic patch"},
+    {"@Sx", "surface command"},
+    {"@o", "disc"},
+    {"@c", "circle"},
+    {"@v", "roll to vertical"},
+    {"@m", "move-to with drawing"},
+    {"@R", "set heading and up"},
+    {"@D", "scale factor"},
+    {"@i", "interpolation"},
+    {"@L", "label"},
+    {"@b", "bounding box"},
+};
+
+std::string Params(int n) {
+  return std::to_string(n) + (n == 1 ? " parameter" : " parameters");
+}
+
+}  // namespace
+
+std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
+  if (name.empty()) return std::nullopt;
+  if (name[0] == '@') {
+    if (name == "@O") {
+      if (arity <= 1) return std::nullopt;
+      return "'@O' (sphere) uses 1 parameter, the diameter; the other " +
+             std::to_string(arity - 1) + " are ignored";
+    }
+    if (name == "@M") {
+      if (arity == 3) return std::nullopt;
+      return "'@M' (move to) needs 3 parameters (x, y, z); with " + Params(arity) +
+             " it does nothing";
+    }
+    for (const Command& c : kUndrawn) {
+      if (name == c.name) {
+        return "'" + std::string(name) + "' (cpfg: " + std::string(c.what) +
+               ") is not implemented in Sylva: it does nothing";
+      }
+    }
+    return "'" + std::string(name) + "' is not a command Sylva knows: it does nothing";
+  }
+  if (name[0] == '?') {
+    return "query module '" + std::string(name) +
+           "' is not answered yet: its parameters keep the values written in the grammar";
+  }
+  if (name[0] == '~') {
+    if (arity <= 1 || arity == 3) return std::nullopt;
+    return "surface '" + std::string(name) + "' takes 1 scale or 3 (x, y, z); of its " +
+           Params(arity) +
+           (arity == 2 ? " only the first (a uniform scale) is used" : " the first 3 are used");
+  }
+  return std::nullopt;
+}
+
+}  // namespace sylva::lsys

@@ -1,0 +1,389 @@
+// The DrawList pipelines of the renderer: instanced meshes lit by the
+// list's lights (the first sun casting a shadow map fitted to the list's
+// bounds), a sky gradient, sprites with alpha or additive blending, and
+// lines. Meshes are uploaded once and kept while the list shares them (the
+// cache holds a reference); per-instance data is uploaded each frame.
+#include <GL/glew.h>
+
+#include <cmath>
+#include <unordered_map>
+
+#include "render/gl_program.h"
+#include "render/renderer.h"
+
+namespace sylva::render {
+
+namespace {
+
+struct GpuMesh {
+  std::shared_ptr<const mesh::TriangleMesh> mesh;  // keeps the key alive
+  mesh::Palette palette;
+  GLuint vao = 0, buffers[3] = {0, 0, 0}, index = 0, instances = 0;
+  GLsizei indexCount = 0;
+  bool used = false;
+};
+
+void DeleteMesh(GpuMesh& m) {
+  glDeleteBuffers(3, m.buffers);
+  glDeleteBuffers(1, &m.index);
+  glDeleteBuffers(1, &m.instances);
+  glDeleteVertexArrays(1, &m.vao);
+}
+
+// Per-vertex colour from the material of the first triangle using it.
+std::vector<mesh::Vec3f> VertexColors(const mesh::TriangleMesh& m, const mesh::Palette& palette) {
+  std::vector<mesh::Vec3f> color(m.vertexCount(), mesh::Srgb(0.8f, 0.8f, 0.8f));
+  if (palette.empty()) return color;
+  std::vector<uint8_t> seen(m.vertexCount(), 0);
+  for (size_t t = 0; t < m.triangleCount(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t i = m.indices[3 * t + size_t(e)];
+      if (!seen[i]) {
+        seen[i] = 1;
+        color[i] = palette[m.material[t] % palette.size()];
+      }
+    }
+  return color;
+}
+
+// Instance layout: a 4x4 matrix (columns at locations 3..6) and a tint (7).
+struct GpuInstance {
+  float model[16];
+  float tint[3];
+};
+static_assert(sizeof(GpuInstance) == 76, "instance layout");
+
+}  // namespace
+
+struct Renderer::ScenePass {
+  GLuint meshProgram = 0, shadowProgram = 0, skyProgram = 0, spriteProgram = 0, lineProgram = 0;
+  GLint viewProj = -1, eye = -1, lightCount = -1, lightType = -1, lightVector = -1, lightColor = -1,
+        shadowLight = -1, lightViewProj = -1, shadowMap = -1;
+  GLint shadowViewProj = -1;
+  GLint skyInverse = -1, skyTop = -1, skyHorizon = -1;
+  GLint spriteViewProj = -1, spriteScale = -1, lineViewProj = -1;
+  GLuint shadowFbo = 0, shadowDepth = 0, emptyVao = 0;
+  static constexpr int kShadowSize = 4096;
+  std::unordered_map<const mesh::TriangleMesh*, GpuMesh> meshes;
+  GLuint spriteVao = 0, spriteBuffers[4] = {0, 0, 0, 0};
+  GLuint lineVao = 0, lineBuffers[2] = {0, 0};
+
+  ~ScenePass() {
+    for (auto& [k, m] : meshes) DeleteMesh(m);
+    for (GLuint p : {meshProgram, shadowProgram, skyProgram, spriteProgram, lineProgram})
+      glDeleteProgram(p);
+    glDeleteFramebuffers(1, &shadowFbo);
+    glDeleteTextures(1, &shadowDepth);
+    glDeleteVertexArrays(1, &emptyVao);
+    glDeleteVertexArrays(1, &spriteVao);
+    glDeleteBuffers(4, spriteBuffers);
+    glDeleteVertexArrays(1, &lineVao);
+    glDeleteBuffers(2, lineBuffers);
+  }
+
+  Status Init(const std::string& dir) {
+    auto program = [&](const char* vert, const char* frag, GLuint& out) -> Status {
+      auto p = CompileProgram(dir, vert, frag);
+      if (!p) return p.error();
+      out = *p;
+      return {};
+    };
+    if (Status s = program("scene.vert", "scene.frag", meshProgram); !s.ok()) return s;
+    if (Status s = program("scene_shadow.vert", "shadow.frag", shadowProgram); !s.ok()) return s;
+    if (Status s = program("sky.vert", "sky.frag", skyProgram); !s.ok()) return s;
+    if (Status s = program("sprite.vert", "sprite.frag", spriteProgram); !s.ok()) return s;
+    if (Status s = program("line.vert", "line.frag", lineProgram); !s.ok()) return s;
+    viewProj = glGetUniformLocation(meshProgram, "uViewProj");
+    eye = glGetUniformLocation(meshProgram, "uEye");
+    lightCount = glGetUniformLocation(meshProgram, "uLightCount");
+    lightType = glGetUniformLocation(meshProgram, "uLightType");
+    lightVector = glGetUniformLocation(meshProgram, "uLightVector");
+    lightColor = glGetUniformLocation(meshProgram, "uLightColor");
+    shadowLight = glGetUniformLocation(meshProgram, "uShadowLight");
+    lightViewProj = glGetUniformLocation(meshProgram, "uLightViewProj");
+    shadowMap = glGetUniformLocation(meshProgram, "uShadow");
+    shadowViewProj = glGetUniformLocation(shadowProgram, "uLightViewProj");
+    skyInverse = glGetUniformLocation(skyProgram, "uInverseViewProj");
+    skyTop = glGetUniformLocation(skyProgram, "uTop");
+    skyHorizon = glGetUniformLocation(skyProgram, "uHorizon");
+    spriteViewProj = glGetUniformLocation(spriteProgram, "uViewProj");
+    spriteScale = glGetUniformLocation(spriteProgram, "uPixelsPerUnit");
+    lineViewProj = glGetUniformLocation(lineProgram, "uViewProj");
+    glGenTextures(1, &shadowDepth);
+    glBindTexture(GL_TEXTURE_2D, shadowDepth);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, kShadowSize, kShadowSize, 0,
+                 GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glGenFramebuffers(1, &shadowFbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadowFbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadowDepth, 0);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glGenVertexArrays(1, &emptyVao);
+    glGenVertexArrays(1, &spriteVao);
+    glGenBuffers(4, spriteBuffers);
+    glGenVertexArrays(1, &lineVao);
+    glGenBuffers(2, lineBuffers);
+    return {};
+  }
+
+  GpuMesh& Upload(const draw::MeshDraw& d) {
+    GpuMesh& g = meshes[d.mesh.get()];
+    g.used = true;
+    if (g.vao && g.palette == d.palette) return g;
+    if (g.vao) DeleteMesh(g);
+    g = GpuMesh{};
+    g.used = true;
+    g.mesh = d.mesh;
+    g.palette = d.palette;
+    const mesh::TriangleMesh& m = *d.mesh;
+    const std::vector<mesh::Vec3f> color = VertexColors(m, d.palette);
+    glGenVertexArrays(1, &g.vao);
+    glGenBuffers(3, g.buffers);
+    glGenBuffers(1, &g.index);
+    glGenBuffers(1, &g.instances);
+    glBindVertexArray(g.vao);
+    const void* data[3] = {m.positions.data(), m.normals.data(), color.data()};
+    for (int k = 0; k < 3; ++k) {
+      glBindBuffer(GL_ARRAY_BUFFER, g.buffers[k]);
+      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertexCount() * 12), data[k], GL_STATIC_DRAW);
+      glEnableVertexAttribArray(GLuint(k));
+      glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, g.instances);
+    for (int c = 0; c < 4; ++c) {
+      glEnableVertexAttribArray(GLuint(3 + c));
+      glVertexAttribPointer(GLuint(3 + c), 4, GL_FLOAT, GL_FALSE, sizeof(GpuInstance),
+                            reinterpret_cast<const void*>(size_t(16 * c)));
+      glVertexAttribDivisor(GLuint(3 + c), 1);
+    }
+    glEnableVertexAttribArray(7);
+    glVertexAttribPointer(7, 3, GL_FLOAT, GL_FALSE, sizeof(GpuInstance),
+                          reinterpret_cast<const void*>(size_t(64)));
+    glVertexAttribDivisor(7, 1);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
+                 GL_STATIC_DRAW);
+    g.indexCount = GLsizei(m.indices.size());
+    glBindVertexArray(0);
+    return g;
+  }
+
+  void UploadInstances(GpuMesh& g, const std::vector<draw::Instance>& instances) {
+    std::vector<GpuInstance> data(instances.size());
+    for (size_t i = 0; i < instances.size(); ++i) {
+      std::copy(instances[i].transform.data(), instances[i].transform.data() + 16, data[i].model);
+      for (int c = 0; c < 3; ++c) data[i].tint[c] = instances[i].tint[c];
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, g.instances);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(data.size() * sizeof(GpuInstance)), data.data(),
+                 GL_STREAM_DRAW);
+  }
+
+  // Fits the sun's orthographic view to the list's bounding sphere.
+  Eigen::Matrix4f SunViewProj(const Vec3& toLight, const Vec3& lo, const Vec3& hi) const {
+    Camera light;
+    light.orthographic = true;
+    light.target = (lo + hi) / 2;
+    const double r = std::max((hi - lo).norm() / 2, 1e-3) * 1.05;
+    light.distance = 3 * r;
+    light.elevation = std::asin(std::clamp(toLight.y(), -1.0, 1.0)) * kRadToDeg;
+    light.azimuth = std::atan2(toLight.x(), toLight.z()) * kRadToDeg;
+    light.orthoHeight = 2 * r;
+    return light.ViewProjection(1.0).cast<float>();
+  }
+};
+
+void Renderer::DestroyScenePass(ScenePass* pass) {
+  delete pass;
+}
+
+Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
+  if (Status s = list.Check(); !s.ok()) return s;
+  if (!scene_) {
+    auto* pass = new ScenePass();
+    if (Status s = pass->Init(shaderDir_); !s.ok()) {
+      delete pass;
+      return s;
+    }
+    scene_ = pass;
+  }
+  ScenePass& p = *scene_;
+  for (auto& [k, m] : p.meshes) m.used = false;
+  std::vector<GpuMesh*> gpu;
+  for (const draw::MeshDraw& d : list.meshes) {
+    GpuMesh& g = p.Upload(d);
+    p.UploadInstances(g, d.instances);
+    gpu.push_back(&g);
+  }
+  // Meshes the list no longer shares are freed.
+  for (auto it = p.meshes.begin(); it != p.meshes.end();) {
+    if (it->second.used) {
+      ++it;
+    } else {
+      DeleteMesh(it->second);
+      it = p.meshes.erase(it);
+    }
+  }
+
+  // Lights: the first sun casts the shadow.
+  int shadowLight = -1;
+  Eigen::Matrix4f lightViewProj = Eigen::Matrix4f::Identity();
+  // The shadow map covers what casts shadows (a wide terrain that does not
+  // cast would only spread its texels thin).
+  Vec3 lo, hi;
+  draw::DrawList casters;
+  for (const draw::MeshDraw& d : list.meshes)
+    if (d.castsShadow) casters.meshes.push_back(d);
+  const bool any = casters.Bounds(lo, hi);
+  for (size_t i = 0; i < list.lights.size() && shadowLight < 0; ++i)
+    if (list.lights[i].type == draw::Light::Type::kSun) shadowLight = int(i);
+  if (shadowLight >= 0 && any) {
+    const Vec3 toLight = -list.lights[size_t(shadowLight)].direction.cast<double>().normalized();
+    lightViewProj = p.SunViewProj(toLight, lo, hi);
+    glBindFramebuffer(GL_FRAMEBUFFER, p.shadowFbo);
+    glViewport(0, 0, ScenePass::kShadowSize, ScenePass::kShadowSize);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(2.0f, 4.0f);
+    glUseProgram(p.shadowProgram);
+    glUniformMatrix4fv(p.shadowViewProj, 1, GL_FALSE, lightViewProj.data());
+    for (size_t i = 0; i < list.meshes.size(); ++i) {
+      if (!list.meshes[i].castsShadow || list.meshes[i].instances.empty()) continue;
+      glBindVertexArray(gpu[i]->vao);
+      glDrawElementsInstanced(GL_TRIANGLES, gpu[i]->indexCount, GL_UNSIGNED_INT, nullptr,
+                              GLsizei(list.meshes[i].instances.size()));
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+  } else {
+    shadowLight = -1;
+  }
+
+  glBindFramebuffer(GL_FRAMEBUFFER, MultisampleFramebuffer());
+  glViewport(0, 0, width_, height_);
+  const mesh::Vec3f clear = mesh::ToSrgb(list.background);
+  glClearColor(clear.x(), clear.y(), clear.z(), 1);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_MULTISAMPLE);
+  const double aspect = double(width_) / height_;
+  const Mat4 vpd = camera.ViewProjection(aspect);
+  const Eigen::Matrix4f vp = vpd.cast<float>();
+
+  if (list.sky) {
+    glDisable(GL_DEPTH_TEST);
+    glUseProgram(p.skyProgram);
+    const Eigen::Matrix4f inv = vpd.inverse().cast<float>();
+    glUniformMatrix4fv(p.skyInverse, 1, GL_FALSE, inv.data());
+    glUniform3fv(p.skyTop, 1, list.sky->top.data());
+    glUniform3fv(p.skyHorizon, 1, list.sky->horizon.data());
+    glBindVertexArray(p.emptyVao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  }
+  glEnable(GL_DEPTH_TEST);
+
+  if (!list.meshes.empty()) {
+    // No lights: a default key, fill and ambient, as the single-mesh path.
+    std::vector<draw::Light> lights = list.lights;
+    if (lights.empty()) {
+      lights.push_back(draw::Light::Sun({0.5f, -0.8f, -0.6f}, {1.0f, 0.95f, 0.85f}, 0.9f));
+      lights.push_back(draw::Light::Sun({-0.7f, -0.2f, 0.4f}, {0.55f, 0.62f, 0.75f}, 0.35f));
+      lights.push_back(draw::Light::Ambient({0.35f, 0.36f, 0.38f}, 1.0f));
+    }
+    int types[draw::kMaxLights];
+    float vectors[3 * draw::kMaxLights], colors[3 * draw::kMaxLights];
+    for (size_t i = 0; i < lights.size(); ++i) {
+      const draw::Light& l = lights[i];
+      types[i] = l.type == draw::Light::Type::kSun       ? 0
+                 : l.type == draw::Light::Type::kAmbient ? 1
+                                                         : 2;
+      const mesh::Vec3f v =
+          l.type == draw::Light::Type::kPoint ? l.position : mesh::Vec3f(-l.direction.normalized());
+      const mesh::Vec3f c = l.color * l.intensity;
+      for (int k = 0; k < 3; ++k) {
+        vectors[3 * i + size_t(k)] = v[k];
+        colors[3 * i + size_t(k)] = c[k];
+      }
+    }
+    glUseProgram(p.meshProgram);
+    glUniformMatrix4fv(p.viewProj, 1, GL_FALSE, vp.data());
+    const Eigen::Vector3f eye = camera.Eye().cast<float>();
+    glUniform3fv(p.eye, 1, eye.data());
+    glUniform1i(p.lightCount, GLint(lights.size()));
+    glUniform1iv(p.lightType, GLsizei(lights.size()), types);
+    glUniform3fv(p.lightVector, GLsizei(lights.size()), vectors);
+    glUniform3fv(p.lightColor, GLsizei(lights.size()), colors);
+    glUniform1i(p.shadowLight, shadowLight);
+    glUniformMatrix4fv(p.lightViewProj, 1, GL_FALSE, lightViewProj.data());
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, p.shadowDepth);
+    glUniform1i(p.shadowMap, 0);
+    for (size_t i = 0; i < list.meshes.size(); ++i) {
+      if (list.meshes[i].instances.empty()) continue;
+      glBindVertexArray(gpu[i]->vao);
+      glDrawElementsInstanced(GL_TRIANGLES, gpu[i]->indexCount, GL_UNSIGNED_INT, nullptr,
+                              GLsizei(list.meshes[i].instances.size()));
+    }
+  }
+
+  for (const draw::Lines& l : list.lines) {
+    if (l.points.empty()) continue;
+    glUseProgram(p.lineProgram);
+    glUniformMatrix4fv(p.lineViewProj, 1, GL_FALSE, vp.data());
+    glBindVertexArray(p.lineVao);
+    const void* data[2] = {l.points.data(), l.colors.data()};
+    for (int k = 0; k < 2; ++k) {
+      glBindBuffer(GL_ARRAY_BUFFER, p.lineBuffers[k]);
+      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(l.points.size() * 12), data[k], GL_STREAM_DRAW);
+      glEnableVertexAttribArray(GLuint(k));
+      glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
+    }
+    glDrawArrays(GL_LINES, 0, GLsizei(l.points.size()));
+  }
+
+  // Sprites last: blended, depth-tested, not writing depth.
+  if (!list.sprites.empty()) {
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    glEnable(GL_BLEND);
+    glDepthMask(GL_FALSE);
+    glUseProgram(p.spriteProgram);
+    glUniformMatrix4fv(p.spriteViewProj, 1, GL_FALSE, vp.data());
+    glUniform1f(p.spriteScale, float(camera.Projection(aspect)(1, 1) * height_ * 0.5));
+    glBindVertexArray(p.spriteVao);
+    for (const draw::Sprites& s : list.sprites) {
+      if (s.positions.empty()) continue;
+      const size_t n = s.positions.size();
+      const std::vector<float> opaque(s.alphas.empty() ? n : 0, 1.0f);
+      const std::vector<float>& alphas = s.alphas.empty() ? opaque : s.alphas;
+      const void* data[4] = {s.positions.data(), s.sizes.data(), s.colors.data(), alphas.data()};
+      const int widths[4] = {3, 1, 3, 1};
+      for (int k = 0; k < 4; ++k) {
+        glBindBuffer(GL_ARRAY_BUFFER, p.spriteBuffers[k]);
+        glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(n * 4 * size_t(widths[k])), data[k],
+                     GL_STREAM_DRAW);
+        glEnableVertexAttribArray(GLuint(k));
+        glVertexAttribPointer(GLuint(k), widths[k], GL_FLOAT, GL_FALSE, 4 * widths[k], nullptr);
+      }
+      if (s.blend == draw::Blend::kAdditive)
+        glBlendFunc(GL_SRC_ALPHA, GL_ONE);
+      else
+        glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+      glDrawArrays(GL_POINTS, 0, GLsizei(n));
+    }
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+  }
+  glBindVertexArray(0);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, MultisampleFramebuffer());
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, ResolveFramebuffer());
+  glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  return {};
+}
+
+}  // namespace sylva::render

@@ -1,0 +1,313 @@
+#include "scene/build.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "core/rng.h"
+#include "scene/plants.h"
+
+namespace sylva::scene {
+namespace {
+
+Diagnostic AtElement(const SourceLoc& loc, std::string message,
+                     Severity severity = Severity::kError) {
+  Diagnostic d = MakeError(loc, std::move(message));
+  d.severity = severity;
+  return d;
+}
+
+// A plant's mesh, or its diagnostics with a note at the scene element.
+std::optional<plant::Plant> Grow(plant::PlantSpec spec, const BuildOptions& options,
+                                 const SourceLoc& where, const char* element,
+                                 DiagnosticList& diags) {
+  spec.threads = options.threads;
+  spec.detail.sides = options.sides;
+  spec.until = plant::Stage::kMesh;
+  plant::PlantResult r = plant::BuildPlant(spec);
+  for (Diagnostic& d : r.diagnostics.items) diags.Add(std::move(d));
+  if (!r.plant || !r.diagnostics.items.empty()) {
+    Diagnostic note = MakeError(where, std::string("in the grammar of this <") + element + ">");
+    note.severity = Severity::kNote;
+    diags.Add(std::move(note));
+  }
+  return std::move(r.plant);
+}
+
+// Box of a mesh through a transform.
+void GrowBounds(const mesh::TriangleMesh& m, const draw::Mat4f& t, Vec3& lo, Vec3& hi, bool& any) {
+  for (const mesh::Vec3f& p : m.positions) {
+    const Vec3 w = (t.cast<double>() * p.cast<double>().homogeneous()).head<3>();
+    lo = any ? lo.cwiseMin(w) : w;
+    hi = any ? hi.cwiseMax(w) : w;
+    any = true;
+  }
+}
+
+std::shared_ptr<mesh::TriangleMesh> TerrainMeshOf(const terrain::TerrainMesh& t) {
+  auto m = std::make_shared<mesh::TriangleMesh>();
+  const size_t n = t.positions.size() / 3;
+  m->positions.resize(n);
+  m->normals.resize(n);
+  m->uvs.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    m->positions[i] =
+        mesh::Vec3f(t.positions[3 * i], t.positions[3 * i + 1], t.positions[3 * i + 2]);
+    m->normals[i] = mesh::Vec3f(t.normals[3 * i], t.normals[3 * i + 1], t.normals[3 * i + 2]);
+    m->uvs[i] = mesh::Vec2f(t.positions[3 * i], t.positions[3 * i + 2]);
+  }
+  m->indices = t.indices;
+  m->material.assign(t.indices.size() / 3, 0);
+  return m;
+}
+
+// The factor that makes the mesh `height` metres tall (its y extent).
+double HeightScale(const mesh::TriangleMesh& m, double height, const SourceLoc& loc,
+                   DiagnosticList& diags) {
+  float lo = 0, hi = 0;
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    lo = i ? std::min(lo, m.positions[i].y()) : m.positions[i].y();
+    hi = i ? std::max(hi, m.positions[i].y()) : m.positions[i].y();
+  }
+  if (!(hi > lo)) {
+    diags.Add(AtElement(loc, "'height' cannot scale a plant with no vertical extent; drawn at 1:1",
+                        Severity::kWarning));
+    return 1;
+  }
+  return height / double(hi - lo);
+}
+
+// Tips, segment points and leaves of `g` through the transform `t`.
+void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t, PlantPoints& out) {
+  const Eigen::Matrix4d m = t.cast<double>();
+  auto world = [&](const Vec3& p) { return Vec3((m * p.homogeneous()).head<3>()); };
+  struct Hash {
+    size_t operator()(const Vec3& v) const {
+      return std::hash<double>()(v.x()) ^ (std::hash<double>()(v.y()) << 1) ^
+             (std::hash<double>()(v.z()) << 2);
+    }
+  };
+  std::unordered_map<Vec3, int, Hash> starts;
+  for (const mesh::Segment& s : g.segments) starts[s.start] = 1;
+  const double scale = m.block<3, 1>(0, 0).norm();
+  for (const mesh::Segment& s : g.segments) {
+    if (!starts.count(s.end)) out.tips.push_back(world(s.end));
+    out.segmentPoints.push_back(world((s.start + s.end) / 2));
+    out.segmentLengths.push_back((s.end - s.start).norm() * scale);
+  }
+  for (const mesh::Polygon& p : g.polygons) {
+    if (p.vertices.empty()) continue;
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& v : p.vertices) c += v;
+    out.leaves.push_back(world(c / double(p.vertices.size())));
+  }
+  for (const mesh::SurfaceInstance& s : g.surfaces) out.leaves.push_back(world(s.position));
+}
+
+}  // namespace
+
+terrain::TerrainDef TerrainDefOf(const TerrainDef& t, uint64_t seed) {
+  terrain::TerrainDef d;
+  d.sizeX = t.size.x();
+  d.sizeZ = t.size.y();
+  d.resolution = t.resolution;
+  d.height = t.noise == NoiseKind::kFlat ? 0 : t.height;
+  d.noise = t.noise == NoiseKind::kFbm             ? terrain::NoiseKind::kFbm
+            : t.noise == NoiseKind::kRidged        ? terrain::NoiseKind::kRidged
+            : t.noise == NoiseKind::kDiamondSquare ? terrain::NoiseKind::kDiamondSquare
+                                                   : terrain::NoiseKind::kFlat;
+  d.octaves = t.octaves;
+  d.lacunarity = t.lacunarity;
+  d.gain = t.gain;
+  d.seed = seed;
+  return d;
+}
+
+double BuiltScene::GroundHeight(double x, double z) const {
+  for (const terrain::HeightField& t : terrains)
+    if (t.Contains(x, z)) return t.Height(x, z);
+  return 0;
+}
+
+std::vector<Vec2> ScatterPoisson(const ForestDef& f, uint64_t seed) {
+  // Dart throwing with a background grid of cell r / sqrt(2) (one point a
+  // cell): candidate k is drawn from the counter-based stream (seed, k), so
+  // the result does not depend on anything but the def.
+  const Vec2 a0(f.area[0], f.area[1]), a1(f.area[2], f.area[3]);
+  const Vec2 extent = a1 - a0;
+  const double r = f.minDistance > 0
+                       ? f.minDistance
+                       : 0.7 * std::sqrt(extent.x() * extent.y() / std::max(1, f.count));
+  const double cell = r / std::sqrt(2.0);
+  const int nx = std::max(1, int(std::ceil(extent.x() / cell)));
+  const int nz = std::max(1, int(std::ceil(extent.y() / cell)));
+  std::vector<int> grid(size_t(nx) * size_t(nz), -1);
+  std::vector<Vec2> out;
+  const uint64_t attempts = uint64_t(f.count) * 30 + 100;
+  for (uint64_t k = 0; k < attempts && int(out.size()) < f.count; ++k) {
+    const Vec2 p(a0.x() + extent.x() * ToUnit(CounterHash(seed, 0x5ca7, k, 0)),
+                 a0.y() + extent.y() * ToUnit(CounterHash(seed, 0x5ca7, k, 1)));
+    const int ci = std::min(nx - 1, int((p.x() - a0.x()) / cell));
+    const int cj = std::min(nz - 1, int((p.y() - a0.y()) / cell));
+    bool ok = true;
+    for (int j = std::max(0, cj - 2); ok && j <= std::min(nz - 1, cj + 2); ++j)
+      for (int i = std::max(0, ci - 2); ok && i <= std::min(nx - 1, ci + 2); ++i) {
+        const int q = grid[size_t(j) * size_t(nx) + size_t(i)];
+        if (q >= 0 && (out[size_t(q)] - p).norm() < r) ok = false;
+      }
+    if (!ok) continue;
+    grid[size_t(cj) * size_t(nx) + size_t(ci)] = int(out.size());
+    out.push_back(p);
+  }
+  return out;
+}
+
+BuildResult Build(const Scene& scene, const BuildOptions& options) {
+  BuildResult result;
+  DiagnosticList& diags = result.diagnostics;
+  BuiltScene built;
+  bool any = false;
+
+  for (size_t i = 0; i < scene.terrains.size(); ++i) {
+    const TerrainDef& t = scene.terrains[i];
+    const uint64_t seed = t.seed.value_or(ElementSeed(scene.seed, t.id, "terrain", i));
+    Expected<terrain::HeightField> field = terrain::HeightField::Create(TerrainDefOf(t, seed));
+    if (!field) {
+      Diagnostic d = field.error();
+      d.loc = t.loc;
+      diags.Add(std::move(d));
+      continue;
+    }
+    Expected<terrain::TerrainMesh> arrays = field->MakeMesh();
+    if (!arrays) {
+      Diagnostic d = arrays.error();
+      d.loc = t.loc;
+      diags.Add(std::move(d));
+      continue;
+    }
+    BuiltMesh m;
+    m.mesh = TerrainMeshOf(*arrays);
+    m.palette = {t.color.cast<float>()};
+    m.instances.push_back({});
+    m.castsShadow = false;
+    m.loc = t.loc;
+    GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
+    built.trianglesDrawn += m.mesh->triangleCount();
+    if (!t.id.empty()) built.meshesOf[t.id].push_back(built.meshes.size());
+    built.meshes.push_back(std::move(m));
+    built.terrains.push_back(std::move(*field));
+  }
+  if (diags.HasErrors()) {
+    result.diagnostics = std::move(diags);
+    return result;
+  }
+
+  for (const PlantDef& p : scene.plants) {
+    std::optional<plant::Plant> grown = Grow(SpecFor(p), options, p.grammarLoc, "plant", diags);
+    if (!grown) continue;
+    BuiltMesh m;
+    m.mesh = std::make_shared<mesh::TriangleMesh>(std::move(grown->mesh));
+    m.palette = grown->palette;
+    Vec3 at = p.position;
+    if (!p.positionHasY) at.y() = built.GroundHeight(at.x(), at.z());
+    const double unit = p.height ? HeightScale(*m.mesh, *p.height, p.loc, diags) : 1;
+    m.instances.push_back({draw::Transform(at, p.rotateDegrees, p.scale * unit), {1, 1, 1}});
+    m.loc = p.loc;
+    GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
+    built.trianglesDrawn += m.mesh->triangleCount();
+    if (!p.id.empty()) {
+      AddPoints(grown->geometry, m.instances[0].transform, built.points[p.id]);
+      built.meshesOf[p.id].push_back(built.meshes.size());
+    }
+    built.meshes.push_back(std::move(m));
+  }
+
+  for (size_t fi = 0; fi < scene.forests.size(); ++fi) {
+    const ForestDef& f = scene.forests[fi];
+    const uint64_t forestSeed = f.seed.value_or(ElementSeed(scene.seed, f.id, "forest", fi));
+    const std::vector<Vec2> spots = ScatterPoisson(f, forestSeed);
+    if (int(spots.size()) < f.count)
+      diags.Add(AtElement(f.loc,
+                          "placed " + std::to_string(spots.size()) + " of " +
+                              std::to_string(f.count) +
+                              " trees: the area is too small for min-distance",
+                          Severity::kWarning));
+    const terrain::HeightField* on = nullptr;
+    for (size_t i = 0; i < scene.terrains.size(); ++i)
+      if (!f.on.empty() && scene.terrains[i].id == f.on) on = &built.terrains[i];
+    const int variants = std::min<int>(f.variants, std::max<int>(1, int(spots.size())));
+    const size_t first = built.meshes.size();
+    std::vector<double> unit;
+    std::vector<mesh::PlantGeometry> geometry;
+    for (int v = 0; v < variants; ++v) {
+      std::optional<plant::Plant> grown =
+          Grow(SpecFor(f, forestSeed, v), options, f.grammarLoc, "forest", diags);
+      if (!grown) break;
+      BuiltMesh m;
+      m.mesh = std::make_shared<mesh::TriangleMesh>(std::move(grown->mesh));
+      m.palette = grown->palette;
+      m.loc = f.loc;
+      unit.push_back(f.height ? HeightScale(*m.mesh, *f.height, f.loc, diags) : 1);
+      if (!f.id.empty()) {
+        geometry.push_back(std::move(grown->geometry));
+        built.meshesOf[f.id].push_back(built.meshes.size());
+      }
+      built.meshes.push_back(std::move(m));
+    }
+    if (int(built.meshes.size() - first) != variants) continue;
+    for (size_t k = 0; k < spots.size(); ++k) {
+      const uint64_t h = CounterHash(forestSeed, 0xf0e57, k);
+      const int v = int(h % uint64_t(variants));
+      const double yaw = 360 * ToUnit(CounterHash(forestSeed, 0xf0e57, k, 1));
+      const double s =
+          unit[size_t(v)] * (f.scale.x() + (f.scale.y() - f.scale.x()) *
+                                               ToUnit(CounterHash(forestSeed, 0xf0e57, k, 2)));
+      const double y = on ? on->Height(spots[k].x(), spots[k].y()) : 0;
+      BuiltMesh& m = built.meshes[first + size_t(v)];
+      m.instances.push_back(
+          {draw::Transform(Vec3(spots[k].x(), y, spots[k].y()), yaw, s), {1, 1, 1}});
+      GrowBounds(*m.mesh, m.instances.back().transform, built.lo, built.hi, any);
+      built.trianglesDrawn += m.mesh->triangleCount();
+      if (!f.id.empty())
+        AddPoints(geometry[size_t(v)], m.instances.back().transform, built.points[f.id]);
+    }
+  }
+
+  if (!diags.HasErrors()) result.scene = std::move(built);
+  return result;
+}
+
+draw::DrawList MakeDrawList(const Scene& scene, const BuiltScene& built) {
+  draw::DrawList list;
+  for (const LightDef& l : scene.lights) {
+    const draw::Vec3f c = l.color.cast<float>();
+    const float i = float(l.intensity);
+    switch (l.type) {
+      case LightType::kSun:
+        list.lights.push_back(draw::Light::Sun(l.direction.cast<float>(), c, i));
+        break;
+      case LightType::kAmbient:
+        list.lights.push_back(draw::Light::Ambient(c, i));
+        break;
+      case LightType::kPoint:
+        list.lights.push_back(draw::Light::Point(l.position.cast<float>(), c, i));
+        break;
+    }
+  }
+  if (scene.sky) {
+    list.sky = draw::Sky{scene.sky->top.cast<float>(), scene.sky->horizon.cast<float>()};
+    list.background = list.sky->horizon;
+  }
+  for (const BuiltMesh& m : built.meshes) {
+    if (m.instances.empty()) continue;
+    draw::MeshDraw d;
+    d.mesh = m.mesh;
+    d.palette = m.palette;
+    d.instances = m.instances;
+    d.castsShadow = m.castsShadow;
+    list.meshes.push_back(std::move(d));
+  }
+  return list;
+}
+
+}  // namespace sylva::scene

@@ -1,0 +1,83 @@
+// Building a scene's static world: terrain height fields and their meshes,
+// plants and forests (each forest as `variants` derivations shared by its
+// instances, scattered by deterministic Poisson-disc sampling), and the
+// DrawList of the result (lights, sky, meshes with transforms).
+//
+//   scene::ReadResult r = scene::ReadScene("forest.xml");
+//   scene::BuildResult b = scene::Build(*r.scene, {});
+//   draw::DrawList list = scene::MakeDrawList(*b.scene);
+//
+// Particles, cloth and flocks live in the Simulation (simulation.h), which
+// reads the built world (colliders, emitters on plants and terrain).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/diagnostic.h"
+#include "draw/draw_list.h"
+#include "mesh/export.h"
+#include "mesh/triangle_mesh.h"
+#include "scene/scene.h"
+#include "terrain/height_field.h"
+
+namespace sylva::scene {
+
+struct BuildOptions {
+  int threads = 0;  // derivation threads; 0: all cores
+  int sides = 8;    // tube sides of every plant (uniform detail)
+};
+
+// One mesh with the places it is drawn.
+struct BuiltMesh {
+  std::shared_ptr<const mesh::TriangleMesh> mesh;
+  mesh::Palette palette;
+  std::vector<draw::Instance> instances;
+  SourceLoc loc;            // the element it comes from
+  bool castsShadow = true;  // terrains do not (the sun's map then fits the plants)
+};
+
+// Points of a plant (or of every tree of a forest) in world space, where
+// emitters place particles: branch tips, points along the segments (their
+// midpoints, with the segments' lengths as weights), leaves (polygon and
+// surface centres).
+struct PlantPoints {
+  std::vector<Vec3> tips, segmentPoints, leaves;
+  std::vector<double> segmentLengths;
+};
+
+struct BuiltScene {
+  std::vector<terrain::HeightField> terrains;  // in the order of scene.terrains
+  std::vector<BuiltMesh> meshes;               // terrains, plants, forest variants
+  // By element id: the meshes of a terrain, plant or forest (indices into
+  // `meshes`) and the emission points of a plant or forest.
+  std::map<std::string, std::vector<size_t>> meshesOf;
+  std::map<std::string, PlantPoints> points;
+  size_t trianglesDrawn = 0;                  // over every instance
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();  // bounds of everything drawn
+  // The surface height under (x, z): the first terrain containing the
+  // point, else 0 (the ground plane).
+  double GroundHeight(double x, double z) const;
+};
+
+struct BuildResult {
+  std::optional<BuiltScene> scene;  // set when there is no error
+  DiagnosticList diagnostics;       // grammar errors carry a note at the scene element
+};
+
+BuildResult Build(const Scene& scene, const BuildOptions& options);
+
+// The scene's terrain def for the terrain library, with its seed.
+terrain::TerrainDef TerrainDefOf(const TerrainDef& t, uint64_t seed);
+
+// Forest placement: up to `count` points in `area` at least `minDistance`
+// apart (0: chosen from the area and count), deterministic for a seed.
+std::vector<Vec2> ScatterPoisson(const ForestDef& forest, uint64_t seed);
+
+// Lights (the renderer's defaults when the scene has none), sky and every
+// built mesh with its instances.
+draw::DrawList MakeDrawList(const Scene& scene, const BuiltScene& built);
+
+}  // namespace sylva::scene

@@ -1,0 +1,922 @@
+// The scene's simulation clock; see simulation.h. Sections:
+//   wind and the scene-level forces (wind drag, attractor, vortex, noise)
+//   emission (shapes, cones, births spread over a step, on-death bursts)
+//   colliders (ground, terrain, plants and forests as triangle hierarchies)
+//   cloth and flocks
+//   drawing and the CSV dump
+#include "scene/simulation.h"
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <ostream>
+
+#include "core/rng.h"
+#include "mesh/obj_reader.h"
+#include "particles/cloth.h"
+#include "particles/emitter.h"
+#include "particles/flocking.h"
+#include "particles/forces.h"
+#include "particles/system.h"
+#include "plant/surface_library.h"
+#include "scene/plants.h"
+
+namespace sylva::scene {
+namespace {
+
+using particles::ParticleState;
+
+Diagnostic Warn(const SourceLoc& loc, std::string message) {
+  Diagnostic d = MakeError(loc, std::move(message));
+  d.severity = Severity::kWarning;
+  return d;
+}
+
+Diagnostic Fail(const SourceLoc& loc, std::string message, ErrorKind kind = ErrorKind::kRuntime) {
+  Diagnostic d = MakeError(loc, std::move(message));
+  d.kind = kind;
+  return d;
+}
+
+// --- wind and forces -------------------------------------------------------
+
+// The scene's one wind: a mean velocity plus a divergence-free gust field.
+struct Wind {
+  Vec3 mean = Vec3::Zero();
+  std::shared_ptr<particles::NoiseWind> gusts;  // null: no gusts
+  Vec3 At(const Vec3& x, double t) const { return gusts ? gusts->Velocity(x, t) : mean; }
+};
+
+// Drag relative to the wind: f = -(k1 + k2 |u|) u with u = v - wind(x, t).
+class WindDrag : public particles::LocalForce {
+ public:
+  WindDrag(double linear, double quadratic, const Wind* wind)
+      : k1_(linear), k2_(quadratic), wind_(wind) {}
+  void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
+                       size_t end) const override {
+    for (size_t i = begin; i < end; ++i) {
+      const Vec3 u = wind_ ? Vec3(v[i] - wind_->At(x[i], s.time)) : v[i];
+      f[i - begin] -= (k1_ + k2_ * u.norm()) * u;
+    }
+  }
+
+ private:
+  double k1_, k2_;
+  const Wind* wind_;
+};
+
+// An acceleration field a(x, t), applied as m a.
+class AccelerationField : public particles::LocalForce {
+ public:
+  using Fn = std::function<Vec3(const Vec3& x, double t)>;
+  explicit AccelerationField(Fn fn) : fn_(std::move(fn)) {}
+  void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3*, Vec3* f, size_t begin,
+                       size_t end) const override {
+    for (size_t i = begin; i < end; ++i)
+      if (s.invMass[i] > 0) f[i - begin] += s.mass[i] * fn_(x[i], s.time);
+  }
+
+ private:
+  Fn fn_;
+};
+
+// --- emission ----------------------------------------------------------------
+
+// A unit vector in the cone of half-angle `spread` (degrees) about `axis`,
+// uniform over the spherical cap.
+Vec3 InCone(const Vec3& axis, double spreadDegrees, double u1, double u2) {
+  const Vec3 a = axis.normalized();
+  const double cosMax = std::cos(spreadDegrees * kDegToRad);
+  const double c = 1 - u1 * (1 - cosMax), s = std::sqrt(std::max(0.0, 1 - c * c));
+  const double phi = 2 * kPi * u2;
+  const Vec3 t = std::abs(a.x()) < 0.9 ? a.cross(Vec3::UnitX()).normalized()
+                                       : a.cross(Vec3::UnitY()).normalized();
+  const Vec3 b = a.cross(t);
+  return c * a + s * (std::cos(phi) * t + std::sin(phi) * b);
+}
+
+struct Source {
+  const EmitterDef* def = nullptr;
+  uint64_t seed = 0;    // the stream of this emitter
+  uint64_t births = 0;  // draws so far
+  double carry = 0;     // fractional births carried to the next step
+  const terrain::HeightField* terrain = nullptr;
+  const PlantPoints* points = nullptr;
+  std::vector<double> cumulative;  // segment lengths, summed (part="segments")
+};
+
+struct Birth {
+  Vec3 x, v;
+  double lifetime, mass;
+};
+
+Birth Draw(Source& src) {
+  const EmitterDef& e = *src.def;
+  const uint64_t n = src.births++;
+  auto u = [&](uint64_t k) { return ToUnit(CounterHash(src.seed, n, k)); };
+  Vec3 x = e.at;
+  switch (e.shape) {
+    case EmitterShape::kPoint:
+      break;
+    case EmitterShape::kSphere: {
+      const Vec3 d = InCone(Vec3::UnitY(), 180, u(0), u(1)) * std::cbrt(u(2));
+      x += 0.5 * e.size.cwiseProduct(d);
+      break;
+    }
+    case EmitterShape::kBox:
+      x += Vec3(u(0) - 0.5, u(1) - 0.5, u(2) - 0.5).cwiseProduct(e.size);
+      break;
+    case EmitterShape::kDisc: {
+      const double r = 0.5 * e.size.x() * std::sqrt(u(0)), phi = 2 * kPi * u(1);
+      x += Vec3(r * std::cos(phi), 0, r * std::sin(phi));
+      break;
+    }
+    case EmitterShape::kTerrain: {
+      const terrain::HeightField& t = *src.terrain;
+      const double hx = t.def().sizeX / 2, hz = t.def().sizeZ / 2;
+      const double px = -hx + 2 * hx * u(0), pz = -hz + 2 * hz * u(1);
+      x = Vec3(px, t.Height(px, pz), pz) + 0.01 * t.Normal(px, pz);
+      break;
+    }
+    case EmitterShape::kPlant: {
+      const PlantPoints& p = *src.points;
+      if (e.part == PlantPart::kSegments) {
+        const double pick = u(0) * src.cumulative.back();
+        const size_t i =
+            size_t(std::lower_bound(src.cumulative.begin(), src.cumulative.end(), pick) -
+                   src.cumulative.begin());
+        x = p.segmentPoints[std::min(i, p.segmentPoints.size() - 1)];
+      } else {
+        const std::vector<Vec3>& from = e.part == PlantPart::kTips ? p.tips : p.leaves;
+        x = from[std::min(from.size() - 1, size_t(u(0) * double(from.size())))];
+      }
+      break;
+    }
+  }
+  const Vec3 dir = InCone(e.direction, e.spreadDegrees, u(3), u(4));
+  const double life = e.lifetime.x() + (e.lifetime.y() - e.lifetime.x()) * u(5);
+  return Birth{x, e.speed * dir, life, e.mass};
+}
+
+// --- the systems -------------------------------------------------------------
+
+struct MeshSource {
+  std::shared_ptr<const mesh::TriangleMesh> mesh;
+};
+
+struct ParticleSystem {
+  const ParticlesDef* def = nullptr;
+  std::unique_ptr<particles::System> system;
+  particles::Integrator integrator = particles::Integrator::kSymplecticEuler;
+  bool adaptive = false;
+  std::vector<Source> sources;
+  struct Death {
+    ParticleSystem* target;
+    const OnDeathDef* def;
+  };
+  std::vector<Death> onDeath;
+  uint64_t dropped = 0;                                // births refused at `max`
+  std::shared_ptr<const mesh::TriangleMesh> drawMesh;  // as="mesh"
+  std::vector<Vec3> spinAxis;                          // by particle id, lazily
+};
+
+struct ClothSheet {
+  const ClothDef* def = nullptr;
+  std::unique_ptr<particles::Cloth> cloth;
+  Vec3 gravity = Vec3::Zero();
+};
+
+struct Flock {
+  const FlockDef* def = nullptr;
+  std::unique_ptr<particles::System> system;
+  std::shared_ptr<const mesh::TriangleMesh> drawMesh;
+};
+
+// A dart: the boids' default mesh, 1 unit long along +Z.
+std::shared_ptr<mesh::TriangleMesh> DartMesh() {
+  auto m = std::make_shared<mesh::TriangleMesh>();
+  const mesh::Vec3f p[] = {
+      {0, 0, 0.5f}, {-0.45f, 0, -0.5f}, {0, 0.08f, -0.3f}, {0.45f, 0, -0.5f}, {0, -0.12f, -0.4f}};
+  const uint32_t tris[][3] = {{0, 1, 2}, {0, 2, 3}, {0, 4, 1}, {0, 3, 4}};
+  for (const auto& t : tris) {
+    const mesh::Vec3f n = (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]).normalized();
+    for (uint32_t k : t) {
+      m->positions.push_back(p[k]);
+      m->normals.push_back(n);
+      m->uvs.push_back({0, 0});
+      m->indices.push_back(uint32_t(m->indices.size()));
+    }
+    m->material.push_back(0);
+  }
+  return m;
+}
+
+}  // namespace
+
+struct Simulation::Impl {
+  const Scene* scene = nullptr;
+  const BuiltScene* built = nullptr;
+  double h = 1.0 / 120;
+  double time = 0;
+  uint64_t steps = 0;
+  Wind wind;
+  bool hasWind = false;
+  std::vector<std::unique_ptr<ParticleSystem>> systems;
+  std::vector<ClothSheet> cloths;
+  std::vector<Flock> flocks;
+  std::map<std::string, std::shared_ptr<const particles::TriangleBvh>> bvhs;
+
+  Status AddColliders(particles::System& system, const std::vector<CollideDef>& collides,
+                      DiagnosticList& diags);
+  std::shared_ptr<const particles::TriangleBvh> BvhOf(const std::string& id);
+  Status Emit(ParticleSystem& ps, double h);
+  Status Step();
+};
+
+std::shared_ptr<const particles::TriangleBvh> Simulation::Impl::BvhOf(const std::string& id) {
+  const auto cached = bvhs.find(id);
+  if (cached != bvhs.end()) return cached->second;
+  std::vector<Vec3> vertices;
+  std::vector<std::array<uint32_t, 3>> triangles;
+  const auto it = built->meshesOf.find(id);
+  if (it != built->meshesOf.end()) {
+    for (size_t k : it->second) {
+      const BuiltMesh& m = built->meshes[k];
+      for (const draw::Instance& inst : m.instances) {
+        const Eigen::Matrix4d t = inst.transform.cast<double>();
+        const uint32_t base = uint32_t(vertices.size());
+        for (const mesh::Vec3f& p : m.mesh->positions)
+          vertices.push_back((t * p.cast<double>().homogeneous()).head<3>());
+        for (size_t i = 0; i + 2 < m.mesh->indices.size(); i += 3)
+          triangles.push_back({base + m.mesh->indices[i], base + m.mesh->indices[i + 1],
+                               base + m.mesh->indices[i + 2]});
+      }
+    }
+  }
+  auto bvh =
+      std::make_shared<const particles::TriangleBvh>(std::move(vertices), std::move(triangles));
+  bvhs[id] = bvh;
+  return bvh;
+}
+
+Status Simulation::Impl::AddColliders(particles::System& system,
+                                      const std::vector<CollideDef>& collides,
+                                      DiagnosticList& diags) {
+  for (const CollideDef& c : collides) {
+    const particles::Response response =
+        c.stick ? particles::Response::kStick : particles::Response::kBounce;
+    for (const std::string& id : c.with) {
+      particles::Collider collider;
+      if (id == "ground") {
+        collider = particles::Collider::Plane(Vec3::Zero(), Vec3::UnitY());
+      } else {
+        bool isCloth = false;
+        for (const ClothDef& cl : scene->cloths) isCloth = isCloth || cl.id == id;
+        if (isCloth) {
+          diags.Add(
+              Warn(c.withLoc, "collisions with a cloth ('" + id + "') are not simulated yet"));
+          continue;
+        }
+        collider = particles::Collider::Mesh(BvhOf(id));
+      }
+      collider.Restitution(c.restitution).Friction(std::min(c.friction, 1e3)).Respond(response);
+      if (Status s = system.AddCollider(collider); !s.ok()) {
+        Diagnostic d = s.error();
+        d.loc = c.loc;
+        return d;
+      }
+    }
+  }
+  return {};
+}
+
+Status Simulation::Impl::Emit(ParticleSystem& ps, double step) {
+  ParticleState& st = ps.system->state;
+  for (Source& src : ps.sources) {
+    const EmitterDef& e = *src.def;
+    uint64_t n = 0;
+    if (steps == 0) n += e.burst;
+    const double due = src.carry + e.rate * step;
+    const uint64_t fromRate = uint64_t(std::floor(due));
+    src.carry = due - double(fromRate);
+    n += fromRate;
+    for (uint64_t j = 0; j < n; ++j) {
+      if (st.size() >= ps.def->max) {
+        ps.dropped += n - j;
+        break;
+      }
+      const Birth b = Draw(src);
+      // Born at a point in the step, not at its start: spread births over
+      // the step so a stream shows no bands.
+      const double remaining =
+          j < fromRate ? step * (1 - (double(j) + 0.5) / double(std::max<uint64_t>(fromRate, 1)))
+                       : 0;
+      st.Add(b.x + b.v * remaining, b.v, b.mass, b.lifetime);
+      st.age.back() = remaining;
+    }
+  }
+  return {};
+}
+
+Status Simulation::Impl::Step() {
+  for (auto& ps : systems) {
+    const int sub = ps->def->substeps;
+    for (int k = 0; k < sub; ++k) {
+      const double hs = h / sub;
+      if (Status s = Emit(*ps, hs); !s.ok()) return s;
+      Status s = ps->adaptive ? ps->system->StepAdaptive(hs, particles::AdaptiveOptions{})
+                              : ps->system->Step(hs, ps->integrator);
+      if (!s.ok()) {
+        Diagnostic d = s.error();
+        d.loc = ps->def->loc;
+        d.message = "<particles> at t = " + std::to_string(time) + " s: " + d.message;
+        return d;
+      }
+    }
+    // Deaths: secondary bursts where they happen, then removal.
+    ParticleState& st = ps->system->state;
+    for (const ParticleSystem::Death& death : ps->onDeath) {
+      ParticleState& target = death.target->system->state;
+      for (size_t i = 0; i < st.size(); ++i) {
+        if (st.age[i] < st.lifetime[i]) continue;
+        for (int c = 0; c < death.def->count; ++c) {
+          if (target.size() >= death.target->def->max) {
+            ++death.target->dropped;
+            continue;
+          }
+          Birth b{st.position[i], Vec3::Zero(), 1, 1};
+          if (!death.target->sources.empty()) {
+            Source& src = death.target->sources[0];
+            const Birth drawn = Draw(src);
+            b.v = drawn.v;
+            b.lifetime = drawn.lifetime;
+            b.mass = drawn.mass;
+          }
+          target.Add(st.position[i], st.velocity[i] + b.v, b.mass, b.lifetime);
+        }
+      }
+    }
+    particles::RemoveDead(st);
+  }
+  for (ClothSheet& c : cloths) {
+    Vec3 w = Vec3::Zero();
+    if (hasWind && c.def->wind) {
+      Vec3 centre = Vec3::Zero();
+      for (const Vec3& p : c.cloth->positions()) centre += p;
+      w = wind.At(centre / double(c.cloth->positions().size()), time);
+    }
+    c.cloth->Step(h, c.gravity, w);
+    for (const Vec3& p : c.cloth->positions())
+      if (!p.allFinite())
+        return Fail(c.def->loc, "<cloth> at t = " + std::to_string(time) +
+                                    " s: a vertex position is not finite (the cloth exploded; "
+                                    "lower the step or raise the solver's substeps)");
+  }
+  for (Flock& f : flocks) {
+    if (Status s = f.system->Step(h, particles::Integrator::kSymplecticEuler); !s.ok()) {
+      Diagnostic d = s.error();
+      d.loc = f.def->loc;
+      return d;
+    }
+  }
+  time += h;
+  ++steps;
+  return {};
+}
+
+Simulation::Simulation() : impl_(std::make_unique<Impl>()) {}
+Simulation::~Simulation() = default;
+
+double Simulation::time() const {
+  return impl_->time;
+}
+double Simulation::stepLength() const {
+  return impl_->h;
+}
+
+Status Simulation::AdvanceTo(double t) {
+  while (impl_->time + impl_->h / 2 < t)
+    if (Status s = impl_->Step(); !s.ok()) return s;
+  return {};
+}
+
+Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
+                                                         const BuiltScene& built,
+                                                         const SimulationOptions& options,
+                                                         DiagnosticList& diags) {
+  std::unique_ptr<Simulation> sim(new Simulation());
+  Impl& m = *sim->impl_;
+  m.scene = &scene;
+  m.built = &built;
+  m.h = 1.0 / (scene.simulation.fps * scene.simulation.substeps);
+  const int threads = scene.simulation.threads ? scene.simulation.threads : options.threads;
+
+  if (scene.wind) {
+    m.hasWind = true;
+    m.wind.mean = scene.wind->velocity;
+    if (scene.wind->gust > 0) {
+      particles::NoiseWindDef w;
+      w.mean = scene.wind->velocity;
+      w.speed = scene.wind->gust;
+      w.scale = scene.wind->scale;
+      w.frequency = 2 * kPi * scene.wind->frequency;
+      w.seed = ElementSeed(scene.seed, "", "wind", 0);
+      auto gusts = particles::NoiseWind::Create(w);
+      if (!gusts) return Fail(scene.wind->loc, gusts.error().message, ErrorKind::kInput);
+      m.wind.gusts = *gusts;
+    }
+  }
+  const Wind* wind = m.hasWind ? &m.wind : nullptr;
+  plant::SurfaceLibrary surfaces(scene.path);
+
+  // Loads a draw mesh: `~name` from the surface library's folders, or .obj.
+  auto loadMesh = [&](const DrawDef& d) -> Expected<std::shared_ptr<const mesh::TriangleMesh>> {
+    std::string path = d.mesh;
+    if (!path.empty() && path[0] == '~') {
+      path.clear();
+      for (const std::string& dir : surfaces.searchPath()) {
+        const std::string candidate = dir + "/" + d.mesh.substr(1) + ".obj";
+        struct stat st {};
+        if (stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+          path = candidate;
+          break;
+        }
+      }
+      if (path.empty())
+        return Fail(d.loc, "no surface file " + d.mesh.substr(1) + ".obj for '" + d.mesh + "'",
+                    ErrorKind::kInput);
+    }
+    Expected<mesh::TriangleMesh> obj = mesh::ReadObj(path);
+    if (!obj) return Fail(d.loc, obj.error().message, ErrorKind::kInput);
+    return std::shared_ptr<const mesh::TriangleMesh>(
+        std::make_shared<mesh::TriangleMesh>(std::move(*obj)));
+  };
+
+  auto addForces = [&](particles::System& system, const std::vector<ForceDef>& forces, bool windOn,
+                       const SourceLoc& loc) -> Status {
+    bool drag = false;
+    for (const ForceDef& f : forces) {
+      switch (f.kind) {
+        case ForceKind::kGravity:
+          system.AddForce(std::make_shared<particles::Gravity>(f.g));
+          break;
+        case ForceKind::kDrag:
+          drag = true;
+          system.AddForce(std::make_shared<WindDrag>(f.quadratic ? 0 : f.k, f.quadratic ? f.k : 0,
+                                                     windOn ? wind : nullptr));
+          break;
+        case ForceKind::kAttractor: {
+          Vec3 c = f.position.value_or(Vec3::Zero());
+          if (!f.of.empty()) {
+            const auto it = built.points.find(f.of);
+            if (it != built.points.end() && !it->second.segmentPoints.empty()) {
+              c = Vec3::Zero();
+              for (const Vec3& p : it->second.segmentPoints) c += p;
+              c /= double(it->second.segmentPoints.size());
+            } else {
+              diags.Add(Warn(f.loc, "'of=\"" + f.of +
+                                        "\"': only a plant or forest gives an "
+                                        "attractor its position yet; the origin is used"));
+            }
+          }
+          const double strength = f.strength, soft = std::max(f.radius, 1e-3);
+          const bool inverseSquare = f.falloff == Falloff::kInverseSquare;
+          system.AddForce(std::make_shared<AccelerationField>([=](const Vec3& x, double) {
+            const Vec3 d = c - x;
+            const double r = std::max(d.norm(), soft);
+            return Vec3(d / r * strength / (inverseSquare ? r * r : r));
+          }));
+          break;
+        }
+        case ForceKind::kVortex: {
+          const Vec3 c = f.position.value_or(Vec3::Zero()), a = f.axis.normalized();
+          const double strength = f.strength;
+          system.AddForce(std::make_shared<AccelerationField>([=](const Vec3& x, double) {
+            const Vec3 r = x - c;
+            const Vec3 radial = r - a * a.dot(r);
+            const double n = radial.norm();
+            return n < 1e-9 ? Vec3(Vec3::Zero()) : Vec3(strength * a.cross(radial) / n);
+          }));
+          break;
+        }
+        case ForceKind::kNoise: {
+          particles::NoiseWindDef w;
+          w.speed = 1;
+          w.scale = f.scale;
+          w.frequency = 2 * kPi * f.frequency;
+          w.seed = ElementSeed(scene.seed, f.id, "noise-force", size_t(f.loc.line));
+          auto field = particles::NoiseWind::Create(w);
+          if (!field) return Fail(f.loc, field.error().message, ErrorKind::kInput);
+          std::shared_ptr<particles::NoiseWind> n = *field;
+          const double strength = f.strength;
+          system.AddForce(std::make_shared<AccelerationField>(
+              [=](const Vec3& x, double t) { return Vec3(strength * n->Velocity(x, t)); }));
+          break;
+        }
+      }
+    }
+    if (windOn && wind && !drag)
+      diags.Add(Warn(loc,
+                     "the wind does not act here: it acts through a <drag> force, and this "
+                     "element has none"));
+    return {};
+  };
+
+  // Particle systems.
+  std::map<std::string, ParticleSystem*> byId;
+  for (const ParticlesDef& p : scene.particles) {
+    auto ps = std::make_unique<ParticleSystem>();
+    ps->def = &p;
+    ps->system = std::make_unique<particles::System>(threads);
+    switch (p.integrator) {
+      case Integrator::kSymplectic:
+        ps->integrator = particles::Integrator::kSymplecticEuler;
+        break;
+      case Integrator::kEuler:
+        ps->integrator = particles::Integrator::kExplicitEuler;
+        break;
+      case Integrator::kRk2:
+        ps->integrator = particles::Integrator::kMidpoint;
+        break;
+      case Integrator::kRk4:
+        ps->integrator = particles::Integrator::kRK4;
+        break;
+      case Integrator::kImplicit:
+        ps->integrator = particles::Integrator::kImplicitEuler;
+        break;
+      case Integrator::kRk45:
+        ps->adaptive = true;
+        break;
+    }
+    if (Status s = addForces(*ps->system, p.forces, p.wind, p.loc); !s.ok()) return s.error();
+    if (Status s = m.AddColliders(*ps->system, p.collides, diags); !s.ok()) return s.error();
+    if (p.selfCollideRestitution) {
+      const double radius = p.emitters.empty() ? 0.05 : std::max(p.emitters[0].radius, 1e-6);
+      if (Status s = ps->system->EnableParticleCollisions(radius, *p.selfCollideRestitution);
+          !s.ok())
+        return Fail(p.loc, s.error().message, ErrorKind::kInput);
+    }
+    for (const SpringsDef& sp : p.springs)
+      diags.Add(Warn(sp.loc, "<springs> in a scene are not simulated yet"));
+    for (size_t k = 0; k < p.emitters.size(); ++k) {
+      const EmitterDef& e = p.emitters[k];
+      Source src;
+      src.def = &e;
+      src.seed = CounterHash(ElementSeed(scene.seed, p.id, "particles", size_t(p.loc.line)), k);
+      if (e.shape == EmitterShape::kTerrain) {
+        for (size_t t = 0; t < scene.terrains.size(); ++t)
+          if (scene.terrains[t].id == e.of) src.terrain = &built.terrains[t];
+      }
+      if (e.shape == EmitterShape::kPlant) {
+        const auto it = built.points.find(e.of);
+        const PlantPoints* pts = it == built.points.end() ? nullptr : &it->second;
+        const size_t n = !pts                           ? 0
+                         : e.part == PlantPart::kTips   ? pts->tips.size()
+                         : e.part == PlantPart::kLeaves ? pts->leaves.size()
+                                                        : pts->segmentPoints.size();
+        if (n == 0)
+          return Fail(
+              e.loc,
+              "the plant '" + e.of + "' has no " +
+                  (e.part == PlantPart::kTips     ? std::string("branch tips")
+                   : e.part == PlantPart::kLeaves ? std::string("leaves (polygons or surfaces)")
+                                                  : std::string("segments")) +
+                  " to emit from",
+              ErrorKind::kInput);
+        src.points = pts;
+        double sum = 0;
+        for (double len : pts->segmentLengths) src.cumulative.push_back(sum += len);
+      }
+      ps->sources.push_back(std::move(src));
+    }
+    if (p.draw.as == DrawAs::kMesh) {
+      auto mesh = loadMesh(p.draw);
+      if (!mesh) return mesh.error();
+      ps->drawMesh = *mesh;
+    }
+    if (!p.id.empty()) byId[p.id] = ps.get();
+    m.systems.push_back(std::move(ps));
+  }
+  for (auto& ps : m.systems)
+    for (const OnDeathDef& d : ps->def->onDeath) ps->onDeath.push_back({byId.at(d.emit), &d});
+
+  // Cloth.
+  for (const ClothDef& c : scene.cloths) {
+    particles::ClothDef d;
+    d.columns = c.columns;
+    d.rows = c.rows;
+    const Mat3 r = (Eigen::AngleAxisd(c.rotateDegrees.z() * kDegToRad, Vec3::UnitZ()) *
+                    Eigen::AngleAxisd(c.rotateDegrees.y() * kDegToRad, Vec3::UnitY()) *
+                    Eigen::AngleAxisd(c.rotateDegrees.x() * kDegToRad, Vec3::UnitX()))
+                       .toRotationMatrix();
+    d.origin = c.position;
+    d.u = r * Vec3(c.size.x(), 0, 0);
+    d.v = r * Vec3(0, -c.size.y(), 0);
+    d.mass = 0.2 * c.size.x() * c.size.y();  // 200 g/m^2: a flag's cotton
+    d.stretchCompliance = c.stretch > 0 ? 1 / c.stretch : 0;
+    d.bendCompliance = c.bend > 0 ? 1 / c.bend : 1e6;
+    d.damping = c.damping;
+    d.threads = threads;
+    d.solver = c.solver == ClothSolver::kImplicit ? particles::ClothSolver::kImplicit
+                                                  : particles::ClothSolver::kXPBD;
+    switch (c.pin) {
+      case Pin::kTop:
+        for (int i = 0; i < c.columns; ++i) d.pinned.push_back(i);
+        break;
+      case Pin::kLeft:
+        for (int j = 0; j < c.rows; ++j) d.pinned.push_back(j * c.columns);
+        break;
+      case Pin::kCorners:
+        d.pinned = {0, c.columns - 1};
+        break;
+      case Pin::kNone:
+        break;
+      case Pin::kIds:
+        d.pinned = c.pinIds;
+        break;
+    }
+    if (!c.wind || !scene.wind) d.windDrag = d.windLift = 0;
+    auto cloth = particles::Cloth::Create(d);
+    if (!cloth) return Fail(c.loc, cloth.error().message, ErrorKind::kInput);
+    ClothSheet sheet;
+    sheet.def = &c;
+    sheet.cloth = std::move(*cloth);
+    for (const ForceDef& f : c.forces) {
+      if (f.kind == ForceKind::kGravity)
+        sheet.gravity += f.g;
+      else
+        diags.Add(Warn(f.loc,
+                       "cloth feels gravity and the wind; this force is not simulated on "
+                       "cloth yet"));
+    }
+    for (const CollideDef& col : c.collides)
+      diags.Add(Warn(col.loc, "cloth collisions are not simulated yet (the cloth passes through)"));
+    m.cloths.push_back(std::move(sheet));
+  }
+
+  // Flocks: boids steering by the flocking rules, held in their bounds.
+  for (const FlockDef& f : scene.flocks) {
+    Flock flock;
+    flock.def = &f;
+    flock.system = std::make_unique<particles::System>(threads);
+    particles::FlockingDef fd;
+    const Vec3 extent = f.boundsMax - f.boundsMin;
+    fd.radius = std::max(1e-3, std::cbrt(extent.prod() / f.count) * 2.5);
+    fd.separationRadius = fd.radius * 0.4;
+    fd.cohesion = f.cohesion;
+    fd.separation = f.separation;
+    fd.alignment = f.alignment;
+    for (const std::string& id : f.avoid) {
+      const auto it = built.meshesOf.find(id);
+      if (id == "ground" || it == built.meshesOf.end()) continue;
+      for (size_t k : it->second) {
+        const BuiltMesh& bm = built.meshes[k];
+        if (std::find_if(scene.terrains.begin(), scene.terrains.end(),
+                         [&](const TerrainDef& t) { return t.id == id; }) != scene.terrains.end())
+          continue;  // terrain: the floor force below
+        mesh::Vec3f lo = bm.mesh->positions.empty() ? mesh::Vec3f::Zero() : bm.mesh->positions[0];
+        mesh::Vec3f hi = lo;
+        for (const mesh::Vec3f& p : bm.mesh->positions) {
+          lo = lo.cwiseMin(p);
+          hi = hi.cwiseMax(p);
+        }
+        for (const draw::Instance& inst : bm.instances) {
+          const Eigen::Matrix4d t = inst.transform.cast<double>();
+          const double s = t.block<3, 1>(0, 0).norm();
+          const Vec3 centre = (t * ((lo + hi) / 2).cast<double>().homogeneous()).head<3>();
+          fd.obstacles.push_back({centre, 0.5 * s * double((hi - lo).maxCoeff())});
+        }
+      }
+    }
+    if (!fd.obstacles.empty()) {
+      fd.avoid = 4 * f.speed;
+      fd.avoidDistance = 2;
+    }
+    auto flocking = particles::Flocking::Create(fd);
+    if (!flocking) return Fail(f.loc, flocking.error().message, ErrorKind::kInput);
+    flock.system->AddForce(*flocking);
+    // Bounds, cruising speed and the floor: steering accelerations.
+    const Vec3 lo = f.boundsMin, hi = f.boundsMax;
+    const double speed = f.speed;
+    const BuiltScene* b = &built;
+    const bool floor = !f.avoid.empty();
+    flock.system->AddForce(std::make_shared<particles::ForceFunction>(
+        [=](const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* force) {
+          for (size_t i = 0; i < s.size(); ++i) {
+            Vec3 a = Vec3::Zero();
+            for (int k = 0; k < 3; ++k) {
+              if (x[i][k] < lo[k]) a[k] += 4 * (lo[k] - x[i][k]);
+              if (x[i][k] > hi[k]) a[k] -= 4 * (x[i][k] - hi[k]);
+            }
+            const double sp = v[i].norm();
+            if (sp > 1e-9) a += 2 * (speed - sp) * v[i] / sp;
+            if (floor) {
+              const double ground = b->GroundHeight(x[i].x(), x[i].z()) + 1.5;
+              if (x[i].y() < ground) a.y() += 8 * (ground - x[i].y());
+            }
+            force[i] += s.mass[i] * a;
+          }
+        }));
+    if (Status s = addForces(*flock.system, f.forces, false, f.loc); !s.ok()) return s.error();
+    if (f.wind && wind) flock.system->AddForce(std::make_shared<WindDrag>(0.2, 0, wind));
+    const uint64_t seed = ElementSeed(scene.seed, f.id, "flock", size_t(f.loc.line));
+    for (int i = 0; i < f.count; ++i) {
+      auto u = [&](uint64_t k) { return ToUnit(CounterHash(seed, uint64_t(i), k)); };
+      const Vec3 x = lo + Vec3(u(0), u(1), u(2)).cwiseProduct(hi - lo);
+      const Vec3 v = speed * InCone(Vec3::UnitX(), 180, u(3), u(4));
+      flock.system->state.Add(x, v, 1.0);
+    }
+    if (f.draw.as == DrawAs::kMesh && !f.draw.mesh.empty()) {
+      auto mesh = loadMesh(f.draw);
+      if (!mesh) return mesh.error();
+      flock.drawMesh = *mesh;
+    } else {
+      flock.drawMesh = DartMesh();
+    }
+    m.flocks.push_back(std::move(flock));
+  }
+  return sim;
+}
+
+// --- drawing -------------------------------------------------------------------
+
+namespace {
+
+Vec3 ColorAt(const DrawDef& d, double age, double lifetime) {
+  if (!d.colorEnd) return d.color;
+  const double t = std::clamp(lifetime > 0 ? age / lifetime : 0.0, 0.0, 1.0);
+  return d.color + t * (*d.colorEnd - d.color);
+}
+
+// A model matrix turning +Z to `forward` (Y up), scaled.
+draw::Mat4f Facing(const Vec3& at, const Vec3& forward, double scale) {
+  Vec3 f = forward.norm() > 1e-9 ? forward.normalized() : Vec3::UnitZ();
+  Vec3 side = Vec3::UnitY().cross(f);
+  if (side.norm() < 1e-6) side = Vec3::UnitX();
+  side.normalize();
+  const Vec3 up = f.cross(side);
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.block<3, 1>(0, 0) = side * scale;
+  m.block<3, 1>(0, 1) = up * scale;
+  m.block<3, 1>(0, 2) = f * scale;
+  m.block<3, 1>(0, 3) = at;
+  return m.cast<float>();
+}
+
+}  // namespace
+
+void Simulation::AddToDrawList(draw::DrawList& list) const {
+  const Impl& m = *impl_;
+  for (const auto& ps : m.systems) {
+    const ParticlesDef& p = *ps->def;
+    const ParticleState& st = ps->system->state;
+    if (st.size() == 0) continue;
+    const DrawDef& d = p.draw;
+    if (d.as == DrawAs::kMesh && ps->drawMesh) {
+      draw::MeshDraw md;
+      md.mesh = ps->drawMesh;
+      md.palette = {mesh::Vec3f(1, 1, 1)};
+      // The mesh turns about its own centre.
+      mesh::Vec3f lo =
+          ps->drawMesh->positions.empty() ? mesh::Vec3f::Zero() : ps->drawMesh->positions[0];
+      mesh::Vec3f hi = lo;
+      for (const mesh::Vec3f& q : ps->drawMesh->positions) {
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+      }
+      const Vec3 pivot = ((lo + hi) / 2).cast<double>();
+      for (size_t i = 0; i < st.size(); ++i) {
+        const uint64_t h = CounterHash(uint64_t(p.loc.line), st.id[i]);
+        Eigen::Affine3d a = Eigen::Affine3d::Identity();
+        if (st.invMass[i] == 0) {
+          // At rest (stuck where it landed): lying flat, turned at random.
+          a.translate(st.position[i] + Vec3(0, 0.005, 0));
+          a.rotate(Eigen::AngleAxisd(2 * kPi * ToUnit(Mix64(h ^ 7)), Vec3::UnitY()));
+          a.rotate(Eigen::AngleAxisd(-kPi / 2, Vec3::UnitX()));
+        } else {
+          // Tumbling: a turn about an axis of the particle's own, growing
+          // with age.
+          const Vec3 axis = InCone(Vec3::UnitY(), 180, ToUnit(h), ToUnit(Mix64(h)));
+          const double angle =
+              d.spinDegrees * kDegToRad * st.age[i] + 2 * kPi * ToUnit(Mix64(h ^ 7));
+          a.translate(st.position[i]);
+          a.rotate(Eigen::AngleAxisd(angle, axis));
+        }
+        a.scale(d.size);
+        a.translate(-pivot);
+        md.instances.push_back(
+            {a.matrix().cast<float>(), ColorAt(d, st.age[i], st.lifetime[i]).cast<float>()});
+      }
+      list.meshes.push_back(std::move(md));
+      continue;
+    }
+    if (d.as == DrawAs::kTrails) {
+      draw::Lines l;
+      for (size_t i = 0; i < st.size(); ++i) {
+        const mesh::Vec3f c = ColorAt(d, st.age[i], st.lifetime[i]).cast<float>();
+        l.points.push_back((st.position[i] - st.velocity[i] * 0.06).cast<float>());
+        l.points.push_back(st.position[i].cast<float>());
+        l.colors.push_back(c * 0.3f);
+        l.colors.push_back(c);
+      }
+      list.lines.push_back(std::move(l));
+      continue;
+    }
+    draw::Sprites s;
+    s.blend = d.blend == Blend::kAdditive ? draw::Blend::kAdditive : draw::Blend::kAlpha;
+    for (size_t i = 0; i < st.size(); ++i) {
+      s.positions.push_back(st.position[i].cast<float>());
+      s.sizes.push_back(float(d.size));
+      s.colors.push_back(ColorAt(d, st.age[i], st.lifetime[i]).cast<float>());
+      s.alphas.push_back(float(d.alpha));
+    }
+    list.sprites.push_back(std::move(s));
+  }
+  for (const ClothSheet& c : m.cloths) {
+    auto mesh = std::make_shared<mesh::TriangleMesh>();
+    const std::vector<Vec3>& x = c.cloth->positions();
+    mesh->positions.reserve(x.size());
+    std::vector<Vec3> normals(x.size(), Vec3::Zero());
+    for (const auto& t : c.cloth->triangles()) {
+      const Vec3 n = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
+      for (uint32_t k : t) normals[k] += n;
+      mesh->indices.insert(mesh->indices.end(), {t[0], t[1], t[2]});
+      mesh->material.push_back(0);
+    }
+    for (size_t i = 0; i < x.size(); ++i) {
+      mesh->positions.push_back(x[i].cast<float>());
+      const double len = normals[i].norm();
+      mesh->normals.push_back(len > 0 ? (normals[i] / len).cast<float>() : mesh::Vec3f(0, 0, 1));
+      mesh->uvs.push_back({0, 0});
+    }
+    draw::MeshDraw md;
+    md.mesh = mesh;
+    md.palette = {c.def->color.cast<float>()};
+    md.instances.push_back({});
+    list.meshes.push_back(std::move(md));
+  }
+  for (const Flock& f : m.flocks) {
+    const ParticleState& st = f.system->state;
+    if (f.def->draw.as == DrawAs::kPoints || f.def->draw.as == DrawAs::kSprites) {
+      draw::Sprites s;
+      for (size_t i = 0; i < st.size(); ++i) {
+        s.positions.push_back(st.position[i].cast<float>());
+        s.sizes.push_back(float(f.def->draw.size));
+        s.colors.push_back(f.def->draw.color.cast<float>());
+      }
+      list.sprites.push_back(std::move(s));
+      continue;
+    }
+    draw::MeshDraw md;
+    md.mesh = f.drawMesh;
+    md.palette = {mesh::Vec3f(1, 1, 1)};
+    for (size_t i = 0; i < st.size(); ++i)
+      md.instances.push_back({Facing(st.position[i], st.velocity[i], f.def->draw.size),
+                              f.def->draw.color.cast<float>()});
+    list.meshes.push_back(std::move(md));
+  }
+}
+
+size_t Simulation::Count() const {
+  size_t n = 0;
+  for (const auto& ps : impl_->systems) n += ps->system->state.size();
+  for (const ClothSheet& c : impl_->cloths) n += c.cloth->positions().size();
+  for (const Flock& f : impl_->flocks) n += f.system->state.size();
+  return n;
+}
+
+void Simulation::WriteCsv(std::ostream& out) const {
+  char line[320];
+  out << "system,id,x,y,z,vx,vy,vz,age\n";
+  auto row = [&](const std::string& system, uint64_t id, const Vec3& x, const Vec3& v, double age) {
+    std::snprintf(line, sizeof line, "%s,%llu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", system.c_str(),
+                  static_cast<unsigned long long>(id), x.x(), x.y(), x.z(), v.x(), v.y(), v.z(),
+                  age);
+    out << line;
+  };
+  for (size_t k = 0; k < impl_->systems.size(); ++k) {
+    const auto& ps = impl_->systems[k];
+    const std::string name = ps->def->id.empty() ? "particles" + std::to_string(k) : ps->def->id;
+    const ParticleState& st = ps->system->state;
+    for (size_t i = 0; i < st.size(); ++i)
+      row(name, st.id[i], st.position[i], st.velocity[i], st.age[i]);
+  }
+  for (size_t k = 0; k < impl_->cloths.size(); ++k) {
+    const ClothSheet& c = impl_->cloths[k];
+    const std::string name = c.def->id.empty() ? "cloth" + std::to_string(k) : c.def->id;
+    for (size_t i = 0; i < c.cloth->positions().size(); ++i)
+      row(name, i, c.cloth->positions()[i], c.cloth->velocities()[i], impl_->time);
+  }
+  for (size_t k = 0; k < impl_->flocks.size(); ++k) {
+    const Flock& f = impl_->flocks[k];
+    const std::string name = f.def->id.empty() ? "flock" + std::to_string(k) : f.def->id;
+    const ParticleState& st = f.system->state;
+    for (size_t i = 0; i < st.size(); ++i)
+      row(name, st.id[i], st.position[i], st.velocity[i], st.age[i]);
+  }
+}
+
+}  // namespace sylva::scene

@@ -1,0 +1,227 @@
+// Reading cpfg files (docs/cpfg.md): what Sylva does not implement is said,
+// with its location, once per symbol; the rest reads as cpfg reads it.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "lsys/parser.h"
+#include "lsys_test_util.h"
+
+namespace sylva::lsys {
+namespace {
+
+using testing::DeriveText;
+using testing::MustParse;
+
+// "line:col message" of every diagnostic (all must be warnings).
+std::vector<std::string> Warnings(const std::string& text, const ParseOptions& opt = {}) {
+  ParseResult r = ParseGrammarText(text, "c.l", opt);
+  EXPECT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  std::vector<std::string> out;
+  for (const auto& d : r.diagnostics.items) {
+    EXPECT_EQ(d.severity, Severity::kWarning) << d.Format();
+    out.push_back(std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " +
+                  d.message);
+  }
+  return out;
+}
+
+std::string Joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += x + "\n";
+  return s;
+}
+
+TEST(Cpfg, UnimplementedCommandsWarnOncePerSymbolAtTheirFirstUse) {
+  auto w = Warnings(
+      "axiom: A\n"
+      "A --> F@Gs F@Gc(1)@Gc(2)@Ge A\n"
+      "F --> @Gs F @Tf(1) @Ts(2) @o(1) @c(1) @v @M(1,2) @O(2)\n");
+  const std::string all = Joined(w);
+  ASSERT_EQ(w.size(), 9u) << all;
+  EXPECT_EQ(w[0].rfind("2:8 '@Gs' (cpfg: start of a generalized cylinder) is not implemented", 0),
+            0u)
+      << all;
+  EXPECT_EQ(w[1].rfind("2:13 '@Gc'", 0), 0u) << all;  // once for @Gc(1) and @Gc(2)
+  EXPECT_EQ(w[2].rfind("2:25 '@Ge'", 0), 0u) << all;
+  EXPECT_EQ(w[3].rfind("3:13 '@Tf'", 0), 0u) << all;
+  EXPECT_EQ(w[4].rfind("3:20 '@Ts'", 0), 0u) << all;
+  EXPECT_EQ(w[5].rfind("3:27 '@o'", 0), 0u) << all;
+  EXPECT_EQ(w[6].rfind("3:33 '@c'", 0), 0u) << all;
+  EXPECT_EQ(w[7].rfind("3:39 '@v'", 0), 0u) << all;
+  EXPECT_EQ(w[8].rfind("3:42 '@M' (move to) needs 3 parameters", 0), 0u) << all;
+}
+
+TEST(Cpfg, QueryModulesWarnThatTheyAreNotAnswered) {
+  auto w = Warnings("axiom: A ?P(0,0,0)\nA --> F ?H(0,0,0) ?P(1,1,1)\n");
+  ASSERT_EQ(w.size(), 2u) << Joined(w);
+  EXPECT_EQ(w[0].rfind("1:10 query module '?P' is not answered yet", 0), 0u) << w[0];
+  EXPECT_EQ(w[1].rfind("2:9 query module '?H' is not answered yet", 0), 0u) << w[1];
+}
+
+TEST(Cpfg, SurfaceWithTwoScalesWarns) {
+  EXPECT_TRUE(Warnings("axiom: ~leaf(1) ~petal(1,2,3) ~flower\n").empty());
+  auto w = Warnings("axiom: F ~leaf(1,2)\n");
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0].rfind("1:10 surface '~leaf' takes 1 scale or 3", 0), 0u) << w[0];
+}
+
+TEST(Cpfg, TextAfterEndlsystemWarnsWhereItStarts) {
+  auto w = Warnings("axiom: F\nendlsystem\n\n  F --> FF\nG --> GG\n");
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0], "4:3 text after 'endlsystem' is ignored (Sylva reads one L-system a file)");
+  // ... and it is ignored: F is not rewritten.
+  EXPECT_EQ(DeriveText("axiom: F\nendlsystem\nF --> FF\n", 1), "F");
+}
+
+TEST(Cpfg, SecondLsystemBlockWarnsThatSubLsystemsAreNotSupported) {
+  auto w = Warnings("Lsystem: 1\naxiom: F\nendlsystem\nLsystem: 2\naxiom: G\nendlsystem\n");
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0].rfind("4:1 a second 'lsystem:' block (a cpfg sub-L-system) is not supported", 0),
+            0u)
+      << w[0];
+}
+
+TEST(Cpfg, BlankLinesAndCommentsAfterEndlsystemAreSilent) {
+  EXPECT_TRUE(Warnings("axiom: F\nendlsystem\n\n/* done */\n// end\n").empty());
+}
+
+TEST(Cpfg, OneLetterSurfaceNameWhenOnlyItIsKnown) {
+  ParseOptions opt;
+  opt.isSurface = [](const std::string& n) { return n == "l" || n == "leaf"; };
+  Grammar g = MustParse("axiom: ~lF ~leaf(2) ~leafF ~lx\n", opt);
+  // ~lF: l is a surface and lF is not, so ~l then F (cpfg); ~leaf is whole;
+  // ~leafF: leafF is not a surface, l is, so ~l then e a f F; ~lx: ~l x.
+  std::string names;
+  for (SymbolId s : g.axiom.symbols) names += g.symbols.name(s) + " ";
+  EXPECT_EQ(names, "~l F ~leaf ~l e a f F ~l x ");
+}
+
+TEST(Cpfg, SurfaceNamesAreWholeWithoutALibrary) {
+  Grammar g = MustParse("axiom: ~lF\n");
+  ASSERT_EQ(g.axiom.symbols.size(), 1u);
+  EXPECT_EQ(g.symbols.name(g.axiom.symbols[0]), "~lF");
+}
+
+TEST(Cpfg, ColourAndWidthSymbolsAreModules) {
+  EXPECT_EQ(DeriveText("axiom: A\nA --> ;(2)F,#!;,(1)#(3)A\n", 1), ";(2)F,#!;,(1)#(3)A");
+  EXPECT_EQ(DeriveText("axiom: A(1)\nA(x) --> F(x),A(x+1)\n", 2), "F(1),F(2),A(3)");
+}
+
+TEST(Cpfg, WidthIncrementMustBePositive) {
+  ParseResult r = ParseGrammarText("width increment: 0\naxiom: F\n", "c.l");
+  ASSERT_FALSE(r.grammar);
+  EXPECT_EQ(r.diagnostics.items[0].message, "width increment must be positive");
+  EXPECT_EQ(MustParse("width increment: 0.5\naxiom: F\n").widthIncrement, 0.5);
+}
+
+TEST(Cpfg, TrailingBackslashContinuesALine) {
+  EXPECT_EQ(DeriveText("axiom: A\nA --> B\\\n  C \\\nD\n", 1), "BCD");
+  // On any line: a #define, an axiom.
+  EXPECT_EQ(DeriveText("#define n \\\n 3\naxiom: A(n) \\\n B\n", 0), "A(3)B");
+}
+
+TEST(Cpfg, BackslashBeforeAStatementOrProductionIsTheRollModule) {
+  EXPECT_EQ(DeriveText("axiom: A\\\nA --> F\\\nB --> C\n", 1), "F\\\\");
+  EXPECT_EQ(DeriveText("axiom: A\\\n\n", 0), "A\\");  // last line, then blank
+  EXPECT_EQ(DeriveText("axiom: A\nA(n) \\\n--> B\nA --> C\n", 1), "C");
+}
+
+TEST(Cpfg, IndentedLinesContinueAProduction) {
+  EXPECT_EQ(DeriveText("axiom: A\nA --> B\n\t[+C]\n\tD\nB --> E\n", 1), "B[+C]D");
+  // The arrow on the line after the predecessor and condition.
+  EXPECT_EQ(DeriveText("axiom: A(2)\nA(n) : n > 0\n\t--> B A(n-1)\n", 3), "BBA(0)");
+  // A weight on its own line.
+  EXPECT_EQ(DeriveText("axiom: A\nA --> B\n    : 1\n", 1), "B");
+}
+
+TEST(Cpfg, IndentedProductionsAndStatementsStayLinesOfTheirOwn) {
+  EXPECT_EQ(DeriveText("axiom: A\n  A --> B\n  B --> C\n", 2), "C");
+  Grammar g = MustParse("axiom: A\nA --> B\n  derivation length: 2\n\tdecomposition\nB --> C\n");
+  EXPECT_EQ(g.derivationLength, 2);
+  EXPECT_EQ(g.decomposition.productions.size(), 1u);
+}
+
+TEST(Cpfg, ErrorsOnAContinuationLinePointAtThatLine) {
+  ParseResult r = ParseGrammarText("axiom: A\nA --> B\n\t[+C(1 +)]\n", "c.l");
+  ASSERT_FALSE(r.grammar);
+  const Diagnostic& d = r.diagnostics.items[0];
+  EXPECT_EQ(d.loc.line, 3) << d.Format();
+  EXPECT_EQ(d.loc.column, 9) << d.Format();
+  EXPECT_EQ(d.sourceLine, "\t[+C(1 +)]") << d.Format();
+
+  ParseResult b = ParseGrammarText("axiom: A\nA --> B \\\n C(2, @)\n", "c.l");
+  ASSERT_FALSE(b.grammar);
+  EXPECT_EQ(b.diagnostics.items[0].loc.line, 3) << b.diagnostics.items[0].Format();
+  EXPECT_EQ(b.diagnostics.items[0].loc.column, 7) << b.diagnostics.items[0].Format();
+}
+
+TEST(Cpfg, RunTimeErrorsOnAContinuationLinePointAtThatLine) {
+  Grammar g = MustParse("axiom: A(0)\nA(x) -->\n\tB(1/x)\n");
+  DeriveOptions opt;
+  opt.steps = 1;
+  auto r = Derive(g, opt);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().loc.line, 3) << r.error().Format();
+  EXPECT_EQ(r.error().loc.column, 5) << r.error().Format();
+  EXPECT_EQ(r.error().sourceLine, "\tB(1/x)") << r.error().Format();
+}
+
+TEST(Cpfg, NranIsTheNormalDistribution) {
+  const std::string a = DeriveText("seed: 3\naxiom: A(nran(5, 2), nran(0, 1))\n", 0);
+  EXPECT_EQ(a, DeriveText("seed: 3\naxiom: A(normal(5, 2), normal(0, 1))\n", 0));
+  EXPECT_NE(a, DeriveText("seed: 4\naxiom: A(nran(5, 2), nran(0, 1))\n", 0));
+}
+
+TEST(Cpfg, UnsupportedCpfgFunctionsAreNamedAsSuch) {
+  ParseResult r = ParseGrammarText("axiom: A\nA --> B(bran(1, 2))\n", "c.l");
+  ASSERT_FALSE(r.grammar);
+  const Diagnostic& d = r.diagnostics.items[0];
+  EXPECT_EQ(d.message, "cpfg function 'bran' is not supported by Sylva");
+  EXPECT_EQ(d.loc.line, 2);
+  EXPECT_EQ(d.loc.column, 9);
+}
+
+TEST(Cpfg, DefineWithArgumentsIsAFunction) {
+  EXPECT_EQ(DeriveText("#define sq(x) ((x)*(x))\n#define k 3\n#define lin(a, b) (a*k + b)\n"
+                       "axiom: A(2)\nA(n) --> B(sq(n+1), lin(n, sq(2)))\n",
+                       1),
+            "B(9,10)");
+  // A random argument is drawn once per use, as the preprocessor would.
+  const std::string twice = DeriveText("seed: 5\n#define d(x) (x - x)\naxiom: A(d(ran(1)))\n", 0);
+  EXPECT_NE(twice, "A(0)");
+}
+
+TEST(Cpfg, DefineWithArgumentsErrorsAreLocated) {
+  auto firstError = [](const std::string& text) {
+    ParseResult r = ParseGrammarText(text, "c.l");
+    EXPECT_FALSE(r.grammar);
+    if (r.diagnostics.items.empty()) return std::string("<none>");
+    const Diagnostic& d = r.diagnostics.items[0];
+    return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " + d.message;
+  };
+  EXPECT_EQ(firstError("#define f(x) (x + y)\naxiom: A\n"), "1:19 unknown name 'y' in expression");
+  EXPECT_EQ(firstError("#define f(x, x) x\naxiom: A\n"), "1:14 parameter 'x' appears twice");
+  EXPECT_EQ(firstError("#define f(x) x\naxiom: A(f(1, 2))\n"),
+            "2:10 'f' (#define) takes 1 argument, given 2");
+  EXPECT_EQ(firstError("#define f(x) x\n#define f(y) y\naxiom: A\n"),
+            "2:9 redefinition of 'f' (first defined at line 1)");
+  // A run-time error inside the body points at the call.
+  Grammar g = MustParse("#define inv(x) (1/x)\naxiom: A(0)\nA(n) --> B(inv(n))\n");
+  DeriveOptions opt;
+  opt.steps = 1;
+  auto r = Derive(g, opt);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().loc.line, 3) << r.error().Format();
+  EXPECT_EQ(r.error().loc.column, 12) << r.error().Format();
+}
+
+TEST(Cpfg, UnusedDefineWithArgumentsWarns) {
+  auto w = Warnings("#define f(x) x\naxiom: A\n");
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0], "1:9 constant 'f' is never used");
+}
+
+}  // namespace
+}  // namespace sylva::lsys
