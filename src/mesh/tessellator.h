@@ -20,7 +20,8 @@
 // plane (Newell's normal), so concave outlines work; they are one-sided with
 // the Newell normal (renderers and glTF draw them double-sided). Spheres are
 // UV spheres. Counts, for a chain of m segments at S sides: S(m+1)+... see
-// TubeTriangles().
+// TubeTriangles() (uniform detail; screen-space detail, below, merges rings,
+// drops caps and draws thin tubes as ribbons).
 #pragma once
 
 #include <functional>
@@ -64,12 +65,16 @@ struct TessellateOptions {
   // Screen-space detail (mesh/screen_detail.h, docs/lod.md): when set, it
   // replaces detail and detailFn. Each chain gets the sides its largest
   // projected radius needs for a silhouette error of view.eps pixels,
-  // joints the straight tube passes within eps/2 pixels of are merged, and
-  // tubes under a pixel wide get no caps. Spheres get the sides of their
-  // projected radius at their centre.
+  // joints the straight tube passes within eps/2 pixels of are merged,
+  // tubes under 3 eps (1.5 px) in radius become camera-facing ribbons (two
+  // triangles a span) and tubes under a pixel get no caps. Spheres get the
+  // sides of their projected radius at their centre. With view.shadowFrom
+  // set, what lies outside the view but may shade it gets the detail of
+  // the shadow map (view.shadowTexelsPerUnit) instead.
   std::optional<ScreenView> view;
   // With a view: drop primitives whose box lies outside the view frustum
-  // (a box straddling it is kept).
+  // and, with view.shadowFrom, whose shadow cannot fall in it either (a box
+  // straddling the frustum is kept).
   bool cull = true;
   // Threads for planning and writing chains; null: the calling thread.
   // The mesh is the same for any pool (offsets are fixed before writing).

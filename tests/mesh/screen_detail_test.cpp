@@ -252,6 +252,78 @@ TEST(ScreenDetail, FewerTrianglesThanUniformSixteenSidesAtOnePixelTwigs) {
       << a.triangleCount() << " screen-space vs " << b.triangleCount() << " uniform";
 }
 
+// Rings along a chain: a straight chain of equal radius keeps two; a bent
+// one keeps more the larger it is on screen, and every joint it drops lies
+// within eps/2 pixels of the tube that replaces it.
+TEST(ScreenDetail, RingsFollowCurvatureAndProjectedSize) {
+  auto chain = [](bool bent) {
+    PlantGeometry g;
+    const int n = 64;
+    auto at = [&](int k) {
+      const double a = 0.5 * kPi * k / n;
+      return bent ? Vec3(std::cos(a) - 1, std::sin(a), 0) : Vec3(0, double(k) / n, 0);
+    };
+    for (int k = 0; k < n; ++k) {
+      Segment s;
+      s.start = at(k);
+      s.end = at(k + 1);
+      s.left = Vec3(0, 0, 1);
+      s.radiusStart = s.radiusEnd = 0.05f;
+      g.segments.push_back(s);
+    }
+    g.branchCount = 1;
+    return g;
+  };
+  auto rings = [&](const PlantGeometry& g, double distance, double* worst) {
+    ScreenView view;
+    view.viewProjection =
+        LookAtPerspective(Vec3(-0.5, 0.5, distance), Vec3(-0.5, 0.5, 0), 40, 960.0 / 540);
+    TessellateOptions opt;
+    opt.view = view;
+    TriangleMesh m;
+    EXPECT_TRUE(Tessellate(g, opt, m).ok());
+    // Sides S and rings K from the counts: 2 S K triangles (caps
+    // included), (K + 2)(S + 1) vertices.
+    int S = 0;
+    for (int t = 3; t <= 256 && !S; ++t) {
+      const size_t K = m.triangleCount() / size_t(2 * t);
+      if (m.triangleCount() == K * size_t(2 * t) && m.vertexCount() == (K + 2) * size_t(t + 1))
+        S = t;
+    }
+    EXPECT_GT(S, 0) << "not a capped tube: " << m.vertexCount() << " vertices";
+    if (!S) return size_t(0);
+    // Ring centres: the mean of each ring's S vertices (the seam repeats the first).
+    const size_t ring = size_t(S + 1);
+    std::vector<Vec3> centres;
+    for (size_t r = 0; (r + 1) * ring <= m.vertexCount() - 2 * ring; ++r) {
+      Vec3 c = Vec3::Zero();
+      for (int j = 0; j < S; ++j) c += m.positions[r * ring + size_t(j)].cast<double>();
+      centres.push_back(c / S);
+    }
+    *worst = 0;
+    for (const Segment& s : g.segments) {  // every joint against the nearest kept span
+      double best = 1e300;
+      for (size_t k = 0; k + 1 < centres.size(); ++k) {
+        const Vec3 d = centres[k + 1] - centres[k], q = s.end - centres[k];
+        const double t = std::clamp(q.dot(d) / d.dot(d), 0.0, 1.0);
+        best = std::min(best, (q - t * d).norm() * PixelsPerUnit(view, s.end));
+      }
+      *worst = std::max(*worst, best);
+    }
+    return centres.size();
+  };
+  double worst = 0;
+  EXPECT_EQ(rings(chain(false), 3, &worst), 2u) << "a straight chain needs two rings";
+  const size_t far = rings(chain(true), 10, &worst);
+  EXPECT_LE(worst, 0.25 + 0.01) << "far: a dropped joint is " << worst << " px off";
+  const size_t near = rings(chain(true), 2, &worst);
+  EXPECT_LE(worst, 0.25 + 0.01) << "near: a dropped joint is " << worst << " px off";
+  EXPECT_LT(far, near) << "rings far " << far << ", near " << near;
+  EXPECT_LT(near, 65u) << "even near, a smooth arc should drop some joints";
+  EXPECT_GT(far, 2u) << "the arc's bend shows even far away";
+  RecordProperty("rings", std::to_string(far) + " far, " + std::to_string(near) + " near");
+}
+
 TEST(ScreenDetail, BoundsHoldEveryVertexAtAnyDetail) {
   auto p = testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 8, plant::Stage::kGeometry);
   ASSERT_TRUE(p);
