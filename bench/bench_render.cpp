@@ -6,7 +6,10 @@
 #include <random>
 #include <string>
 
+#include "core/parallel.h"
+#include "mesh/tessellator.h"
 #include "plant/plant.h"
+#include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
 
@@ -89,6 +92,35 @@ void BM_FrameMillionPoints(benchmark::State& state) {
       benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_FrameMillionPoints)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+// Screen-space tessellation (docs/lod.md) of ABOP 2.6a at n = 20 (about a
+// million segments) for the default 1920x1080 framing, on 1 and 2 threads
+// (issue 15: 2 threads at least 1.7 times one). Items: triangles.
+void BM_TessellateScreenSpace(benchmark::State& state) {
+  static const mesh::PlantGeometry geometry = [] {
+    plant::PlantSpec spec;
+    spec.path = std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys";
+    spec.steps = 20;
+    spec.until = plant::Stage::kGeometry;
+    return std::move(plant::BuildPlant(spec).plant->geometry);
+  }();
+  const mesh::Box box = mesh::TessellatedBounds(geometry, nullptr);
+  const render::Camera cam = render::Camera::Frame(box.lo, box.hi, 1920.0 / 1080, 30, 12, false);
+  mesh::TessellateOptions opt;
+  opt.view = mesh::ScreenView{cam.ViewProjection(1920.0 / 1080), 1920, 1080, 0.5};
+  ThreadPool pool(int(state.range(0)));
+  opt.pool = state.range(0) > 1 ? &pool : nullptr;
+  mesh::TriangleMesh m;
+  for (auto _ : state) {
+    m.Clear();
+    (void)mesh::Tessellate(geometry, opt, m);
+    benchmark::DoNotOptimize(m.indices.data());
+  }
+  state.SetItemsProcessed(int64_t(m.triangleCount()) * state.iterations());
+  state.counters["triangles"] = double(m.triangleCount());
+  state.counters["segments"] = double(geometry.segments.size());
+}
+BENCHMARK(BM_TessellateScreenSpace)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

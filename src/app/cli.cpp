@@ -131,8 +131,17 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   me->add_option("-o,--output", mesh.output, "mesh file: .obj (+ .mtl), .ply, .glb or .gltf")
       ->required();
   AddMaxTrianglesFlag(me, mesh.derive);
-  me->add_option("--sides", mesh.sides, "vertices around each branch tube (3-256, default 8)")
-      ->check(CLI::Range(3, 256));
+  CLI::Option* meSides =
+      me->add_option("--sides", mesh.sides, "vertices around each branch tube (3-256, default 8)")
+          ->check(CLI::Range(3, 256));
+  me->add_option("--lod-eps", mesh.lodEps,
+                 "screen-space detail for the view of --size and --camera: silhouette error in "
+                 "pixels (docs/lod.md); default: uniform --sides")
+      ->check(CLI::Range(1e-3, 1e6))
+      ->excludes(meSides);
+  me->add_option("--size", mesh.size, "with --lod-eps: image size WxH (default 960x540)");
+  me->add_option("--camera", mesh.camera,
+                 "with --lod-eps: azimuth,elevation,distance (as for render)");
 
   RenderCommand render;
   CLI::App* re = app.add_subcommand("render", "derive a grammar and render it to a PNG, headless");
@@ -145,8 +154,18 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   re->add_option("--camera", render.camera,
                  "azimuth,elevation,distance in degrees and units (distance 0: frame the plant)");
   AddMaxTrianglesFlag(re, render.derive);
-  re->add_option("--sides", render.sides, "vertices around each branch tube (3-256, default 12)")
-      ->check(CLI::Range(3, 256));
+  CLI::Option* reEps = re->add_option(
+      "--lod-eps", render.lodEps,
+      "screen-space detail: silhouette error of the tubes in pixels (default 0.5; docs/lod.md)");
+  reEps->check(CLI::Range(1e-3, 1e6));
+  re->add_option("--sides", render.sides,
+                 "uniform tubes of this many sides (3-256) instead of screen-space detail")
+      ->check(CLI::Range(3, 256))
+      ->excludes(reEps);
+  re->add_option("--supersample", render.supersample,
+                 "render K x K times larger and box-filter down (1-8, default 1)")
+      ->check(CLI::Range(1, 8));
+  re->add_flag("--stats", render.stats, "print `triangles: N` and the time of each stage");
 
   ViewCommand view;
   CLI::App* vi =
@@ -219,15 +238,19 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   try {
     if (d->parsed()) code = RunDerive(derive, out, err);
     if (c->parsed()) code = RunCheck(check, out, err);
-    if (me->parsed()) code = RunMesh(mesh, out, err);
+    if (me->parsed() && !mesh.lodEps) code = RunMesh(mesh, out, err);
     if (si->parsed() && simulate.output.empty()) code = RunSimulate(simulate, out, err, {});
-    if (re->parsed() || vi->parsed() || (si->parsed() && !simulate.output.empty())) {
+    if (re->parsed() || vi->parsed() || (si->parsed() && !simulate.output.empty()) ||
+        (me->parsed() && mesh.lodEps)) {
       if (!view.screenshot.empty() && view.frames == 0) view.frames = 3;
       const GraphicsCommands none;
       const GraphicsCommands& g = graphics ? *graphics : none;
       if (g.execGraphicsBinary) return ExecGraphics(args, out, err);
       if (re->parsed()) code = g.render ? g.render(render, out, err) : NotBuilt("render", err);
       if (vi->parsed()) code = g.view ? g.view(view, out, err) : NotBuilt("view", err);
+      if (me->parsed()) {
+        code = g.meshForView ? g.meshForView(mesh, out, err) : NotBuilt("mesh --lod-eps", err);
+      }
       if (si->parsed())
         code = g.simulate ? g.simulate(simulate, out, err) : NotBuilt("simulate -o", err);
     }

@@ -16,6 +16,7 @@ inline constexpr int kExitBadInput = 2;
 
 struct RenderCommand;
 struct ViewCommand;
+struct MeshCommand;
 struct SimulateCommand;
 
 // The commands that draw (render, view) need OpenGL, EGL, X11 and GLFW.
@@ -27,9 +28,11 @@ struct SimulateCommand;
 struct GraphicsCommands {
   int (*render)(const RenderCommand&, std::ostream& out, std::ostream& err) = nullptr;
   int (*view)(const ViewCommand&, std::ostream& out, std::ostream& err) = nullptr;
+  // `sylva mesh --lod-eps`: the view is framed by the renderer's camera.
+  int (*meshForView)(const MeshCommand&, std::ostream& out, std::ostream& err) = nullptr;
   int (*simulate)(const SimulateCommand&, std::ostream& out, std::ostream& err) = nullptr;
-  // Only the `sylva` executable sets this: render and view exec
-  // `sylva-graphics` with the same arguments (never in a test process).
+  // Only the `sylva` executable sets this: render, view, simulate with frames and mesh --lod-eps
+  // exec `sylva-graphics` with the same arguments (never in a test process).
   bool execGraphicsBinary = false;
 };
 

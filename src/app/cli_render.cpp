@@ -1,4 +1,5 @@
 // sylva render: grammar -> mesh or lines -> headless OpenGL -> PNG.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -6,6 +7,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "mesh/export.h"
 #include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
@@ -27,29 +29,134 @@ bool ParseCamera(const std::string& s, double v[3]) {
          v[1] > -90 && v[1] < 90;
 }
 
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// The view flags of render and mesh --lod-eps, parsed.
+struct ViewFlags {
+  int width = 0, height = 0;
+  bool explicitCamera = false;
+  double cam[3] = {0, 0, 0};
+};
+
+int ParseView(const std::string& size, const std::string& camera, ViewFlags& v, std::ostream& err) {
+  if (!ParseSize(size, &v.width, &v.height)) {
+    err << "sylva: error: --size '" << size << "': expected WxH from 1x1 to 8192x8192\n";
+    return kExitBadInput;
+  }
+  v.explicitCamera = !camera.empty();
+  if (v.explicitCamera && !ParseCamera(camera, v.cam)) {
+    err << "sylva: error: --camera '" << camera
+        << "': expected azimuth,elevation,distance as finite numbers, elevation in (-90, 90), "
+           "distance >= 0\n";
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
+// The camera that frames the plant (and the ground disc under a mesh), or
+// the one --camera gives. The box comes from the geometry, before
+// tessellation, so every detail (uniform or screen-space) sees one view.
+Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSpec& spec,
+                                     const ViewFlags& v, bool lines, mesh::Box* meshBox = nullptr) {
+  Vec3 lo = p.geometry.boundsMin, hi = p.geometry.boundsMax;
+  if (!lines) {
+    auto box = plant::MeshBounds(p, spec);
+    if (!box) return box.error();
+    if (meshBox) *meshBox = *box;
+    if ((box->lo.array() <= box->hi.array()).all()) {
+      lo = box->lo;
+      hi = box->hi;
+      // Frame the ground disc the renderer puts under the plant too.
+      const double r = 0.55 * (hi - lo).norm();
+      const Vec3 c((lo.x() + hi.x()) / 2, lo.y(), (lo.z() + hi.z()) / 2);
+      lo = lo.cwiseMin(c - Vec3(r, 0, r));
+      hi = hi.cwiseMax(c + Vec3(r, 0, r));
+    }
+  }
+  const double aspect = double(v.width) / v.height;
+  render::Camera camera =
+      render::Camera::Frame(lo, hi, aspect, v.explicitCamera ? v.cam[0] : (lines ? 0 : 30),
+                            v.explicitCamera ? v.cam[1] : (lines ? 0 : 12), lines);
+  if (v.explicitCamera && v.cam[2] > 0) camera.distance = v.cam[2];
+  return camera;
+}
+
+mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps) {
+  mesh::ScreenView view;
+  view.viewProjection = camera.ViewProjection(double(width) / height);
+  view.width = width;
+  view.height = height;
+  view.eps = eps;
+  return view;
+}
+
+// Box filter of K x K pixel blocks, averaged in linear light (sRGB decoded
+// and encoded again), alpha linearly.
+render::Image Downsample(const render::Image& big, int k) {
+  float toLinear[256];
+  for (int i = 0; i < 256; ++i) {
+    const float c = float(i) / 255.0f;
+    toLinear[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+  }
+  auto toSrgb = [](float l) {
+    const float c = l <= 0.0031308f ? l * 12.92f : 1.055f * std::pow(l, 1 / 2.4f) - 0.055f;
+    return uint8_t(std::clamp(c * 255.0f + 0.5f, 0.0f, 255.0f));
+  };
+  render::Image out;
+  out.width = big.width / k;
+  out.height = big.height / k;
+  out.rgba.resize(size_t(out.width) * size_t(out.height) * 4);
+  const float inv = 1.0f / float(k * k);
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) {
+      float sum[4] = {0, 0, 0, 0};
+      for (int dy = 0; dy < k; ++dy) {
+        for (int dx = 0; dx < k; ++dx) {
+          const uint8_t* p = big.Pixel(x * k + dx, y * k + dy);
+          for (int c = 0; c < 3; ++c) sum[c] += toLinear[p[c]];
+          sum[3] += float(p[3]);
+        }
+      }
+      uint8_t* q = &out.rgba[4 * (size_t(y) * size_t(out.width) + size_t(x))];
+      for (int c = 0; c < 3; ++c) q[c] = toSrgb(sum[c] * inv);
+      q[3] = uint8_t(std::clamp(sum[3] * inv + 0.5f, 0.0f, 255.0f));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
+  const auto tStart = Clock::now();
   if (IsSceneFile(cmd.derive.file)) return RunRenderScene(cmd, out, err);
   if (!render::IsImagePath(cmd.output)) {
     err << "sylva: error: " << cmd.output << ": unknown image format; use .png, .jpg or .jpeg\n";
     return kExitBadInput;
   }
-  int width = 0, height = 0;
-  if (!ParseSize(cmd.size, &width, &height)) {
-    err << "sylva: error: --size '" << cmd.size << "': expected WxH from 1x1 to 8192x8192\n";
+  ViewFlags v;
+  if (int e = ParseView(cmd.size, cmd.camera, v, err); e != kExitOk) return e;
+  const int K = cmd.supersample;
+  if (K < 1 || K > 8 || v.width * K > 8192 || v.height * K > 8192) {
+    err << "sylva: error: --supersample " << K << " with --size " << cmd.size
+        << ": the rendered image may be at most 8192x8192 (K from 1 to 8)\n";
     return kExitBadInput;
   }
-  double cam[3] = {0, 0, 0};
-  const bool explicitCamera = !cmd.camera.empty();
-  if (explicitCamera && !ParseCamera(cmd.camera, cam)) {
-    err << "sylva: error: --camera '" << cmd.camera
-        << "': expected azimuth,elevation,distance as finite numbers, elevation in (-90, 90), "
-           "distance >= 0\n";
+  const double lodEps = cmd.lodEps.value_or(0.5);
+  if (!(lodEps > 0) || !std::isfinite(lodEps)) {
+    err << "sylva: error: --lod-eps must be a positive number of pixels\n";
     return kExitBadInput;
   }
   int exit = kExitOk;
   auto spec = SpecFrom(cmd.derive, err, &exit);
   if (!spec) return exit;
-  spec->detail.sides = cmd.sides;
+  if (cmd.sides) spec->detail.sides = *cmd.sides;
   spec->until = plant::Stage::kGeometry;
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
@@ -60,7 +167,10 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   const bool lines = plant::IsLineFigure(*geometry);
   const mesh::TriangleMesh& m = plant->mesh;
   render::LineBatch batch;
-  Vec3 lo = geometry->boundsMin, hi = geometry->boundsMax;
+  mesh::Box bounds;
+  auto camera = FrameCamera(*plant, *spec, v, lines, &bounds);
+  if (!camera) return Report(camera.error(), err);
+  const int W = v.width * K, H = v.height * K;
   if (lines) {
     const float lineShade = plant->grammar.palette.empty() ? std::pow(0.6f, 2.2f) : 1.0f;
     for (const auto& s : geometry->segments) {
@@ -74,53 +184,105 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
       batch.colors.push_back(c);
     }
   } else {
+    // Screen-space detail unless --sides asks for uniform tubes; eps is in
+    // output pixels, so K times as many in the K-times larger image.
+    if (!cmd.sides) {
+      spec->view = ViewOf(*camera, W, H, lodEps * K);
+      // Shadows of what lies outside the view may fall inside it.
+      spec->view->shadowFrom = render::KeyLightDirection();
+      spec->view->shadowPlaneY = bounds.lo.y();
+      spec->view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(bounds);
+    }
     DiagnosticList warnings;
     Status s = plant::Tessellate(*plant, *spec, warnings);
     exit = Report(warnings, err, cmd.derive.maxErrors, cmd.derive.strict);
     if (!s.ok()) return Report(s.error(), err);
     if (exit != kExitOk) return exit;
-    if (m.vertexCount()) {
-      lo = hi = m.positions[0].cast<double>();
-      for (const auto& p : m.positions) {
-        lo = lo.cwiseMin(p.cast<double>());
-        hi = hi.cwiseMax(p.cast<double>());
-      }
-      // Frame the ground disc the renderer puts under the plant too.
-      const double r = 0.55 * (hi - lo).norm();
-      const Vec3 c((lo.x() + hi.x()) / 2, lo.y(), (lo.z() + hi.z()) / 2);
-      lo = lo.cwiseMin(c - Vec3(r, 0, r));
-      hi = hi.cwiseMax(c + Vec3(r, 0, r));
-    }
   }
-  const double aspect = double(width) / height;
-  render::Camera camera =
-      render::Camera::Frame(lo, hi, aspect, explicitCamera ? cam[0] : (lines ? 0 : 30),
-                            explicitCamera ? cam[1] : (lines ? 0 : 12), lines);
-  if (explicitCamera && cam[2] > 0) camera.distance = cam[2];
 
+  auto t0 = Clock::now();
   auto context = render::HeadlessContext::Create();
   if (!context) return Report(context.error(), err);
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer) return Report(renderer.error(), err);
-  if (Status s = (*renderer)->Resize(width, height); !s.ok()) return Report(s.error(), err);
+  if (Status s = (*renderer)->Resize(W, H); !s.ok()) return Report(s.error(), err);
+  const double contextMs = MsSince(t0);
+  t0 = Clock::now();
   if (lines) {
     (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
     (*renderer)->SetLines(batch);
   } else {
     (*renderer)->SetGround(true);
-    (*renderer)->SetMesh(m, palette);
+    // Ground and shadow map fitted to the whole plant, whatever was culled.
+    (*renderer)->SetMesh(m, palette, &bounds);
   }
-  (*renderer)->Draw(camera);
-  const render::Image image = (*renderer)->ReadPixels();
+  const double uploadMs = MsSince(t0);
+  t0 = Clock::now();
+  (*renderer)->Draw(*camera);
+  render::Image image = (*renderer)->ReadPixels();
+  const double drawMs = MsSince(t0);
+  t0 = Clock::now();
+  if (K > 1) image = Downsample(image, K);
+  const double downsampleMs = MsSince(t0);
+  t0 = Clock::now();
   if (Status s = render::WriteImage(image, cmd.output); !s.ok()) return Report(s.error(), err);
+  const double writeMs = MsSince(t0);
   char line[256];
   std::snprintf(line, sizeof line, "%s: %dx%d, %s, %zu triangles, %zu lines (%s)\n",
-                cmd.output.c_str(), width, height,
+                cmd.output.c_str(), v.width, v.height,
                 lines ? "lines, orthographic" : "mesh, perspective", m.triangleCount(),
                 batch.points.size() / 2, (*context)->Renderer().c_str());
   err << line;
+  if (cmd.stats) {
+    const plant::Timings& t = plant->time;
+    const std::string detail =
+        lines ? "lines"
+              : (cmd.sides ? "uniform " + std::to_string(*cmd.sides) + " sides" : "screen-space");
+    char buf[1024];
+    std::snprintf(buf, sizeof buf,
+                  "triangles: %zu\n"
+                  "detail: %s\n"
+                  "parse: %.1f ms\nderive: %.1f ms\ninterpret: %.1f ms\nturtle: %.1f ms\n"
+                  "tessellate: %.1f ms\ncontext: %.1f ms\nupload: %.1f ms\ndraw: %.1f ms\n"
+                  "downsample: %.1f ms\nwrite: %.1f ms\ntotal: %.1f ms\n",
+                  m.triangleCount(), detail.c_str(), t.parse, t.derive, t.interpret, t.turtle,
+                  t.tessellate, contextMs, uploadMs, drawMs, downsampleMs, writeMs,
+                  MsSince(tStart));
+    out << buf;
+  }
+  return exit;
+}
+
+int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   (void)out;
-  return kExitOk;
+  if (!mesh::FormatFromPath(cmd.output)) {
+    err << "sylva: error: " << cmd.output
+        << ": unknown mesh format; use .obj, .ply, .glb or .gltf\n";
+    return kExitBadInput;
+  }
+  ViewFlags v;
+  if (int e = ParseView(cmd.size, cmd.camera, v, err); e != kExitOk) return e;
+  const double eps = cmd.lodEps.value_or(0.5);
+  if (!(eps > 0) || !std::isfinite(eps)) {
+    err << "sylva: error: --lod-eps must be a positive number of pixels\n";
+    return kExitBadInput;
+  }
+  int exit = kExitOk;
+  auto spec = SpecFrom(cmd.derive, err, &exit);
+  if (!spec) return exit;
+  spec->until = plant::Stage::kGeometry;
+  auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
+  if (!plant) return exit;
+  // Framed as `sylva render` frames a mesh (never as a line figure).
+  auto camera = FrameCamera(*plant, *spec, v, false);
+  if (!camera) return Report(camera.error(), err);
+  spec->view = ViewOf(*camera, v.width, v.height, eps);
+  DiagnosticList warnings;
+  Status s = plant::Tessellate(*plant, *spec, warnings);
+  exit = Report(warnings, err, cmd.derive.maxErrors, cmd.derive.strict);
+  if (!s.ok()) return Report(s.error(), err);
+  if (exit != kExitOk) return exit;
+  return WriteMeshOf(cmd, *plant, err);
 }
 
 }  // namespace sylva::app

@@ -34,6 +34,11 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
     err << "sylva: error: --camera is for grammars; a scene sets its view with <camera>\n";
     return kExitBadInput;
   }
+  if (cmd.lodEps || cmd.supersample != 1 || cmd.stats) {
+    err << "sylva: error: --lod-eps, --supersample and --stats are for grammars; a scene's "
+           "plants are drawn with uniform --sides\n";
+    return kExitBadInput;
+  }
   if (cmd.derive.steps || cmd.derive.seed) {
     err << "sylva: error: -n and --seed are for grammars; a scene sets them on <plant> and "
            "<forest>\n";
@@ -45,7 +50,7 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
   if (!scene) return exit;
   scene::BuildOptions options;
   options.threads = cmd.derive.threads;
-  options.sides = cmd.sides;
+  options.sides = cmd.sides.value_or(12);  // scenes: uniform tubes (no screen-space detail yet)
   scene::BuildResult built = scene::Build(*scene, options);
   exit = Report(built.diagnostics, err, cmd.derive.maxErrors);
   if (!built.scene) return exit == kExitOk ? kExitRuntime : exit;

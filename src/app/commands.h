@@ -41,15 +41,23 @@ struct MeshCommand {
   DeriveFlags derive;
   std::string output;  // .obj .ply .glb .gltf
   int sides = 8;
+  // Screen-space detail for the view `size` and `camera` describe (as
+  // `sylva render` frames it); unset: uniform `sides`.
+  std::optional<double> lodEps;
+  std::string size = "960x540";
+  std::string camera;
 };
 
 struct RenderCommand {
   DeriveFlags derive;
   std::string output;  // .png
   std::string size = "960x540";
-  std::string camera;  // "azimuth,elevation,distance"; empty or distance 0: framed
-  int sides = 12;
-  double time = 0;  // scenes: simulated seconds before the picture
+  std::string camera;            // "azimuth,elevation,distance"; empty or distance 0: framed
+  std::optional<double> lodEps;  // screen-space detail tolerance, output pixels (0.5)
+  std::optional<int> sides;      // set: uniform sides, no screen-space detail
+  int supersample = 1;           // render K x K larger, box-filter down
+  bool stats = false;            // `triangles: N` and stage times on stdout
+  double time = 0;               // scenes: simulated seconds before the picture
 };
 
 int RunDerive(const DeriveCommand& cmd, std::ostream& out, std::ostream& err);
@@ -61,6 +69,10 @@ bool ParseSize(const std::string& s, int* w, int* h);
 // "azimuth,elevation,distance": finite, elevation in (-90, 90), distance >= 0.
 bool ParseCamera(const std::string& s, double v[3]);
 int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
+// `sylva mesh --lod-eps` (sylva-graphics: the view is framed by render::Camera).
+int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
+// Writes plant.mesh to cmd.output and its summary to `err` (both mesh runners).
+int WriteMeshOf(const MeshCommand& cmd, const plant::Plant& plant, std::ostream& err);
 
 // The plant spec the flags describe (steps, seed, -D, threads, limits);
 // nullopt with *exit set when a flag is malformed (printed to `err`).

@@ -9,6 +9,7 @@ const GraphicsCommands& LinkedGraphics() {
   static const GraphicsCommands commands = [] {
     GraphicsCommands c;
     c.render = &RunRender;
+    c.meshForView = &RunMeshForView;
     c.simulate = &RunSimulateWithFrames;
 #ifdef SYLVA_WITH_VIEWER
     c.view = &RunView;

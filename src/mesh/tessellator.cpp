@@ -6,6 +6,8 @@
 #include <type_traits>
 
 #include "core/memory.h"
+#include "core/parallel.h"
+#include "mesh/screen_detail.h"
 
 namespace sylva::mesh {
 namespace {
@@ -22,6 +24,13 @@ Vec3f F(const Vec3& v) {
 Vec3 AnyPerpendicular(const Vec3& t) {
   Vec3 a = std::abs(t.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
   return (a - t * t.dot(a)).normalized();
+}
+
+// Where a surface's vertex p lands (for bounds; the tessellation below
+// places it with the same arithmetic up to rounding).
+Vec3 SurfacePoint(const SurfaceInstance& si, const Vec3f& p) {
+  const Vec3 sp = p.cast<double>().cwiseProduct(si.scale);
+  return si.position + sp.x() * si.frame.left + sp.y() * si.frame.heading + sp.z() * si.frame.up;
 }
 
 int ClampSides(int s) {
@@ -52,13 +61,37 @@ std::vector<std::vector<uint32_t>> BuildChains(const PlantGeometry& g) {
   return chains;
 }
 
-void TessellateChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, int sides,
-                     TriangleMesh& out) {
+// The ring frames of a chain: joints P, tangents T, rotation-minimizing
+// normals N, radii R and the distance along the chain V.
+struct ChainFrames {
+  std::vector<Vec3> P, T, N;
+  std::vector<double> R, V;
+};
+
+// How much of a chain's frames to compute: the axis (P, R) for planning,
+// with tangents and lengths (T, V) for a ribbon, everything for a tube.
+enum class FramePart { kAxis, kTangents, kAll };
+
+void BuildFrames(const PlantGeometry& g, const std::vector<uint32_t>& chain, ChainFrames& f,
+                 FramePart part = FramePart::kAll) {
   const size_t m = chain.size();
-  std::vector<Vec3> P(m + 1), T(m + 1), N(m + 1);
-  std::vector<double> R(m + 1), V(m + 1);
+  auto& P = f.P;
+  auto& T = f.T;
+  auto& N = f.N;
+  auto& R = f.R;
+  auto& V = f.V;
+  P.resize(m + 1);
+  R.resize(m + 1);
   P[0] = g.segments[chain[0]].start;
   for (size_t k = 0; k < m; ++k) P[k + 1] = g.segments[chain[k]].end;
+  R[0] = g.segments[chain[0]].radiusStart;
+  for (size_t k = 1; k < m; ++k) R[k] = g.segments[chain[k]].radiusStart;
+  R[m] = g.segments[chain[m - 1]].radiusEnd;
+  double rmax = *std::max_element(R.begin(), R.end());
+  for (double& r : R) r = std::max(r, rmax * 1e-3);
+  if (part == FramePart::kAxis) return;
+  T.resize(m + 1);
+  V.resize(m + 1);
   auto dir = [&](size_t k) { return (P[k + 1] - P[k]).normalized(); };
   T[0] = dir(0);
   T[m] = dir(m - 1);
@@ -66,13 +99,10 @@ void TessellateChain(const PlantGeometry& g, const std::vector<uint32_t>& chain,
     Vec3 t = dir(k - 1) + dir(k);
     T[k] = t.norm() > 1e-9 ? t.normalized() : dir(k);
   }
-  R[0] = g.segments[chain[0]].radiusStart;
-  for (size_t k = 1; k < m; ++k) R[k] = g.segments[chain[k]].radiusStart;
-  R[m] = g.segments[chain[m - 1]].radiusEnd;
-  double rmax = *std::max_element(R.begin(), R.end());
-  for (double& r : R) r = std::max(r, rmax * 1e-3);
   V[0] = 0;
   for (size_t k = 0; k < m; ++k) V[k + 1] = V[k] + (P[k + 1] - P[k]).norm();
+  if (part == FramePart::kTangents) return;
+  N.resize(m + 1);
 
   // First normal: the turtle's L, made perpendicular to the tangent.
   Vec3 n0 = g.segments[chain[0]].left;
@@ -90,8 +120,129 @@ void TessellateChain(const PlantGeometry& g, const std::vector<uint32_t>& chain,
     n -= T[k + 1] * T[k + 1].dot(n);
     N[k + 1] = n.norm() > 1e-9 ? n.normalized() : AnyPerpendicular(T[k + 1]);
   }
+}
 
-  const int S = sides;
+// How one chain is drawn: its sides, the joints that get a ring (empty:
+// all of them) and whether its ends are capped.
+struct ChainPlan {
+  int sides = 0;  // 0: not drawn (zero width, or culled)
+  bool caps = true;
+  bool ribbon = false;  // a camera-facing strip: 2 vertices a ring, no caps
+  std::vector<uint32_t> joints;
+  size_t rings(size_t segments) const { return joints.empty() ? segments + 1 : joints.size(); }
+  size_t vertices(size_t segments) const {
+    if (ribbon) return 2 * rings(segments);
+    return (rings(segments) + (caps ? 2 : 0)) * size_t(sides + 1);
+  }
+  size_t triangles(size_t segments) const {
+    if (ribbon) return 2 * (rings(segments) - 1);
+    return 2 * size_t(sides) * (rings(segments) - 1) + (caps ? 2 * size_t(sides) : 0);
+  }
+};
+
+// Tubes thinner than this many eps in radius (1.5 px at eps 0.5) are drawn
+// as camera-facing ribbons: their silhouette is the tube's, and a 3-sided
+// prism would cost three times the triangles for no visible difference.
+constexpr double kRibbonPixels = 3;
+
+// Screen-space plan of a chain (docs/lod.md): the sides from the largest
+// projected radius (in shadow-map texels for a chain outside the view that
+// may shade it); a joint is dropped when the tube straight from the last
+// kept joint to a later one passes within eps/2 pixels of it (axis and
+// radius) and the colour does not change there; caps only on tubes at
+// least a pixel wide.
+void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
+               const ScreenView& view, bool shadowOnly, ChainPlan& plan) {
+  const size_t m = chain.size();
+  std::vector<double> ppu(m + 1);
+  double rPx = 0;
+  for (size_t k = 0; k <= m; ++k) {
+    ppu[k] = shadowOnly ? view.shadowTexelsPerUnit : PixelsPerUnit(view, f.P[k]);
+    rPx = std::max(rPx, f.R[k] * ppu[k]);
+  }
+  plan.sides = SidesForPixelRadius(rPx, view.eps);
+  plan.caps = !(rPx < 1);
+  // A ribbon faces the camera, not the light: never for a shadow caster.
+  plan.ribbon = !shadowOnly && rPx < kRibbonPixels * view.eps;
+  plan.joints.clear();
+  if (m < 2) return;
+  const double budget = view.eps / 2;
+  constexpr size_t kMaxSpan = 64;
+  auto fits = [&](size_t a, size_t b) {
+    const Vec3 d = f.P[b] - f.P[a];
+    const double len2 = d.dot(d);
+    for (size_t i = a + 1; i < b; ++i) {
+      if (g.segments[chain[i]].color != g.segments[chain[a]].color) return false;
+      const Vec3 q = f.P[i] - f.P[a];
+      const double t = len2 > 0 ? std::clamp(q.dot(d) / len2, 0.0, 1.0) : 0.0;
+      const double off = (q - t * d).norm();
+      const double dr = std::abs(f.R[i] - (f.R[a] + t * (f.R[b] - f.R[a])));
+      if (!((off + dr) * ppu[i] <= budget)) return false;
+    }
+    return true;
+  };
+  plan.joints.push_back(0);
+  size_t a = 0;
+  while (a < m) {
+    size_t b = a + 1;
+    while (b < m && b + 1 - a <= kMaxSpan && fits(a, b + 1)) ++b;
+    plan.joints.push_back(uint32_t(b));
+    a = b;
+  }
+  if (plan.joints.size() == m + 1) plan.joints.clear();  // every joint kept
+}
+
+// Writes the chain's vertices from out.positions[vbase] and its triangles
+// from triangle tbase on; the arrays are already sized.
+// A ribbon: at every kept joint two vertices, the axis point moved by the
+// radius either way along the direction perpendicular to both the axis and
+// the line of sight, with the normal turned toward the eye.
+void EmitRibbon(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
+                const ChainPlan& plan, const ScreenView& view, size_t vbase, size_t tbase,
+                TriangleMesh& out) {
+  const size_t m = chain.size();
+  const size_t K = plan.rings(m);
+  auto joint = [&](size_t r) { return plan.joints.empty() ? r : size_t(plan.joints[r]); };
+  Vec3f* pos = out.positions.data() + vbase;
+  Vec3f* nor = out.normals.data() + vbase;
+  Vec2f* uv = out.uvs.data() + vbase;
+  for (size_t r = 0; r < K; ++r) {
+    const size_t k = joint(r);
+    const Vec3 toEye = TowardEye(view, f.P[k]);
+    Vec3 side = f.T[k].cross(toEye);
+    side = side.norm() > 1e-9 ? Vec3(side.normalized()) : AnyPerpendicular(f.T[k]);
+    Vec3 normal = toEye - f.T[k] * f.T[k].dot(toEye);
+    normal = normal.norm() > 1e-9 ? Vec3(normal.normalized()) : f.T[k].cross(side);
+    const float v = float(f.V[k]);
+    for (int e = 0; e < 2; ++e) {
+      *pos++ = F(f.P[k] + side * (e ? f.R[k] : -f.R[k]));
+      *nor++ = F(normal);
+      *uv++ = Vec2f(float(e), v);
+    }
+  }
+  uint32_t* idx = out.indices.data() + 3 * tbase;
+  uint16_t* mat = out.material.data() + tbase;
+  for (size_t r = 0; r + 1 < K; ++r) {
+    const uint16_t sm = g.segments[chain[joint(r)]].color;
+    const uint32_t a = uint32_t(vbase + 2 * r), b = a + 1, c = a + 3, d = a + 2;
+    idx[0] = a;
+    idx[1] = b;
+    idx[2] = c;
+    idx[3] = a;
+    idx[4] = c;
+    idx[5] = d;
+    idx += 6;
+    *mat++ = sm;
+    *mat++ = sm;
+  }
+}
+
+void EmitChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
+               const ChainPlan& plan, size_t vbase, size_t tbase, TriangleMesh& out) {
+  const size_t m = chain.size();
+  const int S = plan.sides;
+  const size_t K = plan.rings(m);
+  auto joint = [&](size_t r) { return plan.joints.empty() ? r : size_t(plan.joints[r]); };
   std::vector<double> cs(S + 1), sn(S + 1);
   for (int j = 0; j < S; ++j) {
     cs[j] = std::cos(kTwoPi * j / S);
@@ -99,38 +250,30 @@ void TessellateChain(const PlantGeometry& g, const std::vector<uint32_t>& chain,
   }
   cs[S] = cs[0];  // the seam vertex repeats the first exactly (only u differs)
   sn[S] = sn[0];
-  // Sizes are known: resize once and write through pointers.
-  const uint32_t base = uint32_t(out.positions.size());
+  const uint32_t base = uint32_t(vbase);
   const size_t ring = size_t(S + 1);
-  const size_t nVerts = (m + 1) * ring + 2 * ring;
-  const size_t nTris = TubeTriangles(m, S);
-  const size_t triBase = out.material.size();
-  out.positions.resize(base + nVerts);
-  out.normals.resize(base + nVerts);
-  out.uvs.resize(base + nVerts);
-  out.indices.resize(3 * (triBase + nTris));
-  out.material.resize(triBase + nTris);
-  Vec3f* pos = out.positions.data() + base;
-  Vec3f* nor = out.normals.data() + base;
-  Vec2f* uv = out.uvs.data() + base;
-  uint32_t* idx = out.indices.data() + 3 * triBase;
-  uint16_t* mat = out.material.data() + triBase;
+  Vec3f* pos = out.positions.data() + vbase;
+  Vec3f* nor = out.normals.data() + vbase;
+  Vec2f* uv = out.uvs.data() + vbase;
+  uint32_t* idx = out.indices.data() + 3 * tbase;
+  uint16_t* mat = out.material.data() + tbase;
   // Tube rings: S + 1 vertices each (the seam is duplicated for u = 1).
   // N and B are orthonormal, so the radial direction is already unit.
-  for (size_t k = 0; k <= m; ++k) {
-    const Vec3 B = T[k].cross(N[k]);
-    const float v = float(V[k]);
+  for (size_t r = 0; r < K; ++r) {
+    const size_t k = joint(r);
+    const Vec3 B = f.T[k].cross(f.N[k]);
+    const float v = float(f.V[k]);
     for (int j = 0; j <= S; ++j) {
-      const Vec3 radial = N[k] * cs[j] + B * sn[j];
-      *pos++ = F(P[k] + radial * R[k]);
+      const Vec3 radial = f.N[k] * cs[j] + B * sn[j];
+      *pos++ = F(f.P[k] + radial * f.R[k]);
       *nor++ = F(radial);
       *uv++ = Vec2f(float(j) / float(S), v);
     }
   }
-  for (size_t k = 0; k < m; ++k) {
-    const uint16_t sm = g.segments[chain[k]].color;
+  for (size_t r = 0; r + 1 < K; ++r) {
+    const uint16_t sm = g.segments[chain[joint(r)]].color;
     for (int j = 0; j < S; ++j) {
-      const uint32_t a = base + uint32_t(k * ring) + uint32_t(j), b = a + 1, d = a + uint32_t(ring),
+      const uint32_t a = base + uint32_t(r * ring) + uint32_t(j), b = a + 1, d = a + uint32_t(ring),
                      c = d + 1;
       idx[0] = a;
       idx[1] = b;
@@ -145,14 +288,14 @@ void TessellateChain(const PlantGeometry& g, const std::vector<uint32_t>& chain,
   }
   // Caps: a centre and a ring of S vertices with the axis as normal.
   auto cap = [&](size_t k, bool tip) {
-    const Vec3 B = T[k].cross(N[k]);
-    const Vec3f normal = F(tip ? T[k] : Vec3(-T[k]));
+    const Vec3 B = f.T[k].cross(f.N[k]);
+    const Vec3f normal = F(tip ? f.T[k] : Vec3(-f.T[k]));
     const uint32_t center = uint32_t(pos - out.positions.data());
-    *pos++ = F(P[k]);
+    *pos++ = F(f.P[k]);
     *nor++ = normal;
     *uv++ = Vec2f(0.5f, 0.5f);
     for (int j = 0; j < S; ++j) {
-      *pos++ = F(P[k] + (N[k] * cs[j] + B * sn[j]) * R[k]);
+      *pos++ = F(f.P[k] + (f.N[k] * cs[j] + B * sn[j]) * f.R[k]);
       *nor++ = normal;
       *uv++ = Vec2f(float(0.5 + 0.5 * cs[j]), float(0.5 + 0.5 * sn[j]));
     }
@@ -166,8 +309,10 @@ void TessellateChain(const PlantGeometry& g, const std::vector<uint32_t>& chain,
       *mat++ = cm;
     }
   };
-  cap(0, false);
-  cap(m, true);
+  if (plan.caps) {
+    cap(0, false);
+    cap(m, true);
+  }
 }
 
 void TessellateSphere(const Sphere& s, int sides, TriangleMesh& out) {
@@ -206,7 +351,9 @@ void TessellateSphere(const Sphere& s, int sides, TriangleMesh& out) {
 
 Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
                   TessellateStats* stats) {
+  const ScreenView* view = options.view ? &*options.view : nullptr;
   auto detailFor = [&](const Vec3& c, double r) {
+    if (view) return SidesForPixelRadius(r * PixelsPerUnit(*view, c), view->eps);
     return ClampSides(options.detailFn ? options.detailFn(c, r).sides : options.detail.sides);
   };
   // Surfaces first: an unknown name fails before anything is appended.
@@ -218,37 +365,140 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     }
   }
   const auto chains = BuildChains(g);
+  // Culling: one hierarchy over the boxes of every chain (tube radius
+  // included), sphere, polygon and surface, in that order, and one over
+  // the same boxes swept away from the light (their shadows).
+  std::vector<uint8_t> inView, inShadow;
+  const size_t nc = chains.size(), ns = g.spheres.size(), np = g.polygons.size(),
+               nf = g.surfaces.size();
+  if (view) {
+    std::vector<Box> boxes(nc + ns + np + nf);
+    ForRanges(options.pool, nc, BalancedGrain(options.pool, nc, 1024),
+              [&](size_t begin, size_t end) {
+                for (size_t c = begin; c < end; ++c) {
+                  Box& b = boxes[c];
+                  b.Add(g.segments[chains[c][0]].start);
+                  double r = 0;
+                  for (uint32_t k : chains[c]) {
+                    const Segment& s = g.segments[k];
+                    b.Add(s.end);
+                    r = std::max({r, double(s.radiusStart), double(s.radiusEnd)});
+                  }
+                  b.Grow(r);
+                }
+              });
+    for (size_t i = 0; i < ns; ++i) {
+      boxes[nc + i].Add(g.spheres[i].center);
+      boxes[nc + i].Grow(g.spheres[i].radius);
+    }
+    for (size_t i = 0; i < np; ++i)
+      for (const Vec3& v : g.polygons[i].vertices) boxes[nc + ns + i].Add(v);
+    for (size_t i = 0; i < nf; ++i) {
+      const SurfaceInstance& si = g.surfaces[i];
+      const TriangleMesh& sm = options.surfaces->at(si.name);
+      Box& b = boxes[nc + ns + np + i];
+      for (const Vec3f& p : sm.positions) b.Add(SurfacePoint(si, p));
+      b.Grow(1e-6 * (1 + si.position.norm()));  // the tessellation's rounding
+    }
+    const Frustum frustum = Frustum::FromViewProjection(view->viewProjection);
+    // Everything inside (a framed plant): no hierarchy needed.
+    auto visibleIn = [&](const std::vector<Box>& b) {
+      Box all;
+      bool bounded = true;
+      for (const Box& x : b) {
+        all.Add(x);
+        bounded = bounded && x.lo.allFinite() && x.hi.allFinite();
+      }
+      if (bounded && frustum.Classify(all) == Frustum::Side::kInside) {
+        return std::vector<uint8_t>(b.size(), 1);
+      }
+      return BoundingHierarchy(b).Visible(frustum);
+    };
+    inView = visibleIn(boxes);
+    const Vec3 L = view->shadowFrom;
+    if (L.y() > 1e-6) {
+      // Only what is outside the view needs its shadow tested.
+      std::vector<uint32_t> outside;
+      std::vector<Box> swept;
+      for (size_t i = 0; i < boxes.size(); ++i) {
+        if (inView[i]) continue;
+        const Box& b = boxes[i];
+        Box s = b;
+        if (b.lo.y() <= b.hi.y()) {
+          const double t = std::max(0.0, (b.hi.y() - view->shadowPlaneY) / L.y());
+          s.Add(b.lo - t * L);
+          s.Add(b.hi - t * L);
+        }
+        outside.push_back(uint32_t(i));
+        swept.push_back(s);
+      }
+      inShadow = inView;
+      if (!outside.empty()) {
+        const std::vector<uint8_t> shaded = visibleIn(swept);
+        for (size_t k = 0; k < outside.size(); ++k) inShadow[outside[k]] = shaded[k];
+      }
+    }
+  }
+  auto shown = [&](size_t item) {
+    return !view || !options.cull || inView[item] || (!inShadow.empty() && inShadow[item]);
+  };
+  // Outside the view, with shadows: detail for the shadow map, not the view.
+  auto shadowOnly = [&](size_t item) { return view && !inShadow.empty() && !inView[item]; };
   // Choose every chain's detail first, so the arrays are sized exactly once.
-  std::vector<int> chainSides(chains.size(), 0);
-  size_t verts = 0, tris = 0;
-  for (size_t c = 0; c < chains.size(); ++c) {
+  std::vector<ChainPlan> plans(nc);
+  auto plan = [&](size_t c, ChainFrames& frames) {
     const auto& chain = chains[c];
-    Vec3 lo = g.segments[chain[0]].start, hi = lo;
     double rmax = 0;
+    for (uint32_t k : chain) rmax = std::max<double>(rmax, g.segments[k].radiusStart);
+    if (!(rmax > 0) || !shown(c)) return;  // zero width, or culled: nothing to draw
+    if (view) {
+      BuildFrames(g, chain, frames, FramePart::kAxis);
+      PlanChain(g, chain, frames, *view, shadowOnly(c), plans[c]);
+      return;
+    }
+    Vec3 lo = g.segments[chain[0]].start, hi = lo;
     for (uint32_t k : chain) {
       lo = lo.cwiseMin(g.segments[k].end);
       hi = hi.cwiseMax(g.segments[k].end);
-      rmax = std::max<double>(rmax, g.segments[k].radiusStart);
     }
-    if (!(rmax > 0)) continue;  // zero width: nothing to draw
-    const int S = detailFor((lo + hi) / 2, (hi - lo).norm() / 2 + rmax);
-    chainSides[c] = S;
-    verts += (chain.size() + 1) * size_t(S + 1) + 2 * size_t(S + 1);
-    tris += TubeTriangles(chain.size(), S);
+    plans[c].sides = detailFor((lo + hi) / 2, (hi - lo).norm() / 2 + rmax);
+  };
+  // A detailFn is the caller's and may not be thread-safe: plan on one thread then.
+  ThreadPool* pool = options.detailFn && !view ? nullptr : options.pool;
+  ForRanges(pool, nc, BalancedGrain(pool, nc, 256), [&](size_t begin, size_t end) {
+    ChainFrames frames;
+    for (size_t c = begin; c < end; ++c) plan(c, frames);
+  });
+  // Where each chain's vertices and triangles start (fixed before any is
+  // written, so the mesh is the same for any thread count).
+  std::vector<size_t> vOffset(nc + 1, 0), tOffset(nc + 1, 0);
+  for (size_t c = 0; c < nc; ++c) {
+    const bool drawn = plans[c].sides > 0;
+    vOffset[c + 1] = vOffset[c] + (drawn ? plans[c].vertices(chains[c].size()) : 0);
+    tOffset[c + 1] = tOffset[c] + (drawn ? plans[c].triangles(chains[c].size()) : 0);
   }
+  const size_t verts = vOffset[nc], tris = tOffset[nc];
   // Everything else counted too, before any memory is allocated: spheres
   // (S(2R - 2) triangles, R = max(2, S/2) rings), polygons (n - 2 at most),
   // surfaces (their mesh each).
   uint64_t total = tris;
-  for (const Sphere& s : g.spheres) {
-    if (!(s.radius > 0)) continue;
-    const uint64_t S = uint64_t(detailFor(s.center, s.radius)), R = std::max<uint64_t>(2, S / 2);
+  std::vector<int> sphereSides(ns, 0);
+  for (size_t i = 0; i < ns; ++i) {
+    const Sphere& s = g.spheres[i];
+    if (!(s.radius > 0) || !shown(nc + i)) continue;
+    sphereSides[i] = shadowOnly(nc + i)
+                         ? SidesForPixelRadius(s.radius * view->shadowTexelsPerUnit, view->eps)
+                         : detailFor(s.center, s.radius);
+    const uint64_t S = uint64_t(sphereSides[i]), R = std::max<uint64_t>(2, S / 2);
     total += S * (2 * R - 2);
   }
-  for (const Polygon& poly : g.polygons)
-    total += poly.vertices.size() >= 3 ? poly.vertices.size() - 2 : 0;
-  for (const SurfaceInstance& si : g.surfaces)
-    total += options.surfaces->at(si.name).triangleCount();
+  for (size_t i = 0; i < np; ++i) {
+    const Polygon& poly = g.polygons[i];
+    if (shown(nc + ns + i)) total += poly.vertices.size() >= 3 ? poly.vertices.size() - 2 : 0;
+  }
+  for (size_t i = 0; i < nf; ++i) {
+    if (shown(nc + ns + np + i)) total += options.surfaces->at(g.surfaces[i].name).triangleCount();
+  }
   const uint64_t limit = std::min<uint64_t>(options.maxTriangles, kMaxIndexedTriangles);
   if (out.triangleCount() + total > limit) {
     Diagnostic d;
@@ -274,13 +524,31 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   grow(out.uvs, verts);
   grow(out.indices, 3 * tris);
   grow(out.material, tris);
-  for (size_t c = 0; c < chains.size(); ++c) {
-    if (chainSides[c]) TessellateChain(g, chains[c], chainSides[c], out);
+  const size_t vbase = out.positions.size(), tbase = out.material.size();
+  out.positions.resize(vbase + verts);
+  out.normals.resize(vbase + verts);
+  out.uvs.resize(vbase + verts);
+  out.indices.resize(3 * (tbase + tris));
+  out.material.resize(tbase + tris);
+  ForRanges(options.pool, nc, BalancedGrain(options.pool, nc, 256), [&](size_t begin, size_t end) {
+    ChainFrames frames;
+    for (size_t c = begin; c < end; ++c) {
+      if (!plans[c].sides) continue;
+      BuildFrames(g, chains[c], frames, plans[c].ribbon ? FramePart::kTangents : FramePart::kAll);
+      if (plans[c].ribbon) {
+        EmitRibbon(g, chains[c], frames, plans[c], *view, vbase + vOffset[c], tbase + tOffset[c],
+                   out);
+        continue;
+      }
+      EmitChain(g, chains[c], frames, plans[c], vbase + vOffset[c], tbase + tOffset[c], out);
+    }
+  });
+  for (size_t i = 0; i < ns; ++i) {
+    if (sphereSides[i]) TessellateSphere(g.spheres[i], sphereSides[i], out);
   }
-  for (const Sphere& s : g.spheres) {
-    if (s.radius > 0) TessellateSphere(s, detailFor(s.center, s.radius), out);
-  }
-  for (const Polygon& poly : g.polygons) {
+  for (size_t i = 0; i < np; ++i) {
+    const Polygon& poly = g.polygons[i];
+    if (!shown(nc + ns + i)) continue;
     Vec3 normal;
     std::vector<uint32_t> polyTris = TriangulatePolygon(poly.vertices, &normal);
     if (polyTris.empty()) {
@@ -313,7 +581,9 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
       out.material.push_back(poly.color);
     }
   }
-  for (const SurfaceInstance& si : g.surfaces) {
+  for (size_t f = 0; f < nf; ++f) {
+    if (!shown(nc + ns + np + f)) continue;
+    const SurfaceInstance& si = g.surfaces[f];
     const TriangleMesh& s = options.surfaces->at(si.name);
     const uint32_t base = uint32_t(out.positions.size());
     // ~name(s) scales all axes alike (the common case, computed as it
@@ -336,8 +606,45 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     for (uint32_t i : s.indices) out.indices.push_back(base + i);
     for (size_t t = 0; t < s.triangleCount(); ++t) out.material.push_back(si.color);
   }
-  if (stats) stats->chains += chains.size();
+  if (stats) {
+    stats->chains += chains.size();
+    for (size_t i = 0; i < inView.size(); ++i) stats->culled += shown(i) ? 0 : 1;
+  }
   return {};
+}
+
+Box TessellatedBounds(const PlantGeometry& g,
+                      const std::unordered_map<std::string, TriangleMesh>* surfaces) {
+  Box box;
+  // A tube is the hull of its end discs: a disc of radius r across the
+  // unit axis t reaches r sqrt(1 - t_k^2) along axis k.
+  for (const Segment& s : g.segments) {
+    const Vec3 d = s.end - s.start;
+    const double len = d.norm();
+    if (!(len > 1e-12)) continue;
+    const Vec3 t = d / len;
+    const Vec3 reach = (Vec3::Ones() - t.cwiseProduct(t)).cwiseMax(0.0).cwiseSqrt();
+    box.Add(s.start - reach * s.radiusStart);
+    box.Add(s.start + reach * s.radiusStart);
+    box.Add(s.end - reach * s.radiusEnd);
+    box.Add(s.end + reach * s.radiusEnd);
+  }
+  for (const Sphere& s : g.spheres) {
+    Box b;
+    b.Add(s.center);
+    b.Grow(s.radius);
+    box.Add(b);
+  }
+  for (const Polygon& poly : g.polygons)
+    for (const Vec3& v : poly.vertices) box.Add(v);
+  for (const SurfaceInstance& si : g.surfaces) {
+    auto it = surfaces ? surfaces->find(si.name) : decltype(surfaces->end()){};
+    if (!surfaces || it == surfaces->end()) continue;
+    for (const Vec3f& p : it->second.positions) {
+      box.Add(SurfacePoint(si, p));
+    }
+  }
+  return box;
 }
 
 }  // namespace sylva::mesh

@@ -20,17 +20,24 @@
 // plane (Newell's normal), so concave outlines work; they are one-sided with
 // the Newell normal (renderers and glTF draw them double-sided). Spheres are
 // UV spheres. Counts, for a chain of m segments at S sides: S(m+1)+... see
-// TubeTriangles().
+// TubeTriangles() (uniform detail; screen-space detail, below, merges rings,
+// drops caps and draws thin tubes as ribbons).
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <unordered_map>
 
 #include "core/status.h"
 #include "mesh/plant_geometry.h"
+#include "mesh/screen_detail.h"
 #include "mesh/triangle_mesh.h"
 #include "mesh/triangulate.h"
+
+namespace sylva {
+class ThreadPool;
+}
 
 namespace sylva::mesh {
 
@@ -53,8 +60,26 @@ constexpr size_t TubeTriangles(size_t segments, int sides) {
 inline constexpr uint64_t kDefaultMaxTriangles = uint64_t(1) << 26;
 
 struct TessellateOptions {
-  Detail detail;  // used when detailFn is empty
+  Detail detail;  // used when detailFn is empty and there is no view
   DetailFn detailFn;
+  // Screen-space detail (mesh/screen_detail.h, docs/lod.md): when set, it
+  // replaces detail and detailFn. Each chain gets the sides its largest
+  // projected radius needs for a silhouette error of view.eps pixels,
+  // joints the straight tube passes within eps/2 pixels of are merged,
+  // tubes under 3 eps (1.5 px) in radius become camera-facing ribbons (two
+  // triangles a span) and tubes under a pixel get no caps. Spheres get the
+  // sides of their projected radius at their centre. With view.shadowFrom
+  // set, what lies outside the view but may shade it gets the detail of
+  // the shadow map (view.shadowTexelsPerUnit) instead.
+  std::optional<ScreenView> view;
+  // With a view: drop primitives whose box lies outside the view frustum
+  // and, with view.shadowFrom, whose shadow cannot fall in it either (a box
+  // straddling the frustum is kept).
+  bool cull = true;
+  // Threads for planning and writing chains; null: the calling thread.
+  // The mesh is the same for any pool (offsets are fixed before writing).
+  // A detailFn is always called from the calling thread.
+  ThreadPool* pool = nullptr;
   // The mesh this call appends may not exceed this many triangles; the
   // count is made before any memory is allocated.
   uint64_t maxTriangles = kDefaultMaxTriangles;
@@ -64,6 +89,7 @@ struct TessellateOptions {
 
 struct TessellateStats {
   size_t chains = 0, polygonsSkipped = 0;
+  size_t culled = 0;  // chains, spheres, polygons and surfaces outside the view
   std::vector<std::string> warnings;
 };
 
@@ -73,5 +99,14 @@ struct TessellateStats {
 // error with the count).
 Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
                   TessellateStats* stats = nullptr);
+
+// A box holding every triangle Tessellate can make of `g` at any detail:
+// the end discs of every segment (the ring at a bent joint tilts to the
+// mean of its two segments, so it may reach a hair further), spheres,
+// polygons, and the surfaces
+// placed (those `surfaces` has; others are skipped). For framing a camera
+// before tessellating. Empty (lo > hi) when `g` draws nothing.
+Box TessellatedBounds(const PlantGeometry& g,
+                      const std::unordered_map<std::string, TriangleMesh>* surfaces);
 
 }  // namespace sylva::mesh

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <utility>
 
+#include "core/parallel.h"
 #include "lsys/parser.h"
 #include "mesh/color.h"
 #include "plant/surface_library.h"
@@ -89,6 +90,19 @@ DiagnosticList Validate(const PlantSpec& spec) {
   if (spec.detail.sides < 3 || spec.detail.sides > 256) {
     list.Add(SpecError("sides " + std::to_string(spec.detail.sides) + " is outside 3..256"));
   }
+  if (spec.view) {
+    const mesh::ScreenView& v = *spec.view;
+    if (!(v.eps > 0 && v.eps <= 1e6)) {
+      list.Add(SpecError("lod eps " + std::to_string(v.eps) + " is outside (0, 1e6] pixels"));
+    }
+    if (v.width < 1 || v.height < 1 || v.width > 16384 || v.height > 16384) {
+      list.Add(SpecError("viewport " + std::to_string(v.width) + "x" + std::to_string(v.height) +
+                         " is outside 1x1..16384x16384"));
+    }
+    if (!v.viewProjection.allFinite()) {
+      list.Add(SpecError("the view-projection matrix has a non-finite entry"));
+    }
+  }
   if (spec.limits.maxTriangles < 1) list.Add(SpecError("max triangles 0 is outside 1.."));
   if (spec.limits.maxModules < 1 || spec.limits.maxModules > lsys::kMaxModulesCap) {
     list.Add(SpecError("max modules " + std::to_string(spec.limits.maxModules) + " is outside 1.." +
@@ -104,6 +118,12 @@ mesh::Palette PaletteOf(const lsys::Grammar& g) {
   return p;
 }
 
+Expected<mesh::Box> MeshBounds(const Plant& plant, const PlantSpec& spec) {
+  SurfaceLibrary surfaces(plant.grammar.path, spec.surfacePath, spec.readFile);
+  if (Status s = surfaces.LoadFor(plant.geometry, plant.grammar); !s.ok()) return s.error();
+  return mesh::TessellatedBounds(plant.geometry, &surfaces.meshes());
+}
+
 bool IsLineFigure(const mesh::PlantGeometry& geometry) {
   return geometry.planar && geometry.polygons.empty() && geometry.surfaces.empty() &&
          geometry.spheres.empty();
@@ -115,6 +135,10 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
   if (Status s = surfaces.LoadFor(plant.geometry, plant.grammar); !s.ok()) return s;
   mesh::TessellateOptions options;
   options.detail = spec.detail;
+  options.view = spec.view;
+  options.cull = spec.cull;
+  ThreadPool pool(spec.threads);
+  options.pool = &pool;
   options.surfaces = &surfaces.meshes();
   options.maxTriangles = spec.limits.maxTriangles;
   mesh::TessellateStats stats;

@@ -77,6 +77,10 @@ struct PlantSpec {
   Limits limits;
   turtle::DrawOptions draw;  // what the turtle records besides geometry
   mesh::Detail detail;       // tessellation detail (sides 3..256)
+  // Screen-space detail for one view (docs/lod.md); replaces `detail` when
+  // set. eps > 0 pixels, viewport 1..16384 pixels.
+  std::optional<mesh::ScreenView> view;
+  bool cull = true;  // with a view: drop what lies outside its frustum
   Stage until = Stage::kMesh;
   FileReader readFile;  // empty: the file system
   // Called after each derivation step, from the calling thread.
@@ -122,6 +126,12 @@ PlantResult BuildPlant(const PlantSpec& spec);
 // plant.mesh (replacing what it held) at spec.detail. Warnings go to
 // `diagnostics`; an error is returned.
 Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics);
+
+// The box every triangle of plant.geometry's mesh lies in, at any detail
+// (mesh::TessellatedBounds, with the plant's surfaces loaded): a camera can
+// be framed on it before tessellating. An error when a surface cannot be
+// loaded.
+Expected<mesh::Box> MeshBounds(const Plant& plant, const PlantSpec& spec);
 
 // True when the geometry is a flat line figure (every point in z = 0,
 // nothing but segments): ABOP's 2D figures, drawn as lines, not tubes.

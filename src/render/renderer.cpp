@@ -31,13 +31,16 @@ std::string FindShaderDir() {
   return (fs::path(SYLVA_DATA_DIR) / "shaders").string();
 }
 
+// Texels on a side of the key light's shadow map.
+constexpr int kShadowMapSize = 2048;
+
 struct Renderer::Gl {
   GLuint meshProgram = 0, lineProgram = 0, shadowProgram = 0;
   GLint meshViewProj = -1, meshEye = -1, lineViewProj = -1;
   GLint meshKeyDir = -1, meshLightViewProj = -1, meshShadow = -1, meshShadows = -1;
   GLint shadowLightViewProj = -1;
   GLuint shadowFbo = 0, shadowDepth = 0;
-  static constexpr int kShadowSize = 2048;
+  static constexpr int kShadowSize = kShadowMapSize;
   Eigen::Matrix4f lightViewProj = Eigen::Matrix4f::Identity();
   bool haveShadow = false;
   // Ground disc: its own small vertex array, drawn with the mesh program.
@@ -233,7 +236,8 @@ Status Renderer::Resize(int width, int height, int samples) {
   return {};
 }
 
-void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette) {
+void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette,
+                       const mesh::Box* bounds) {
   Gl& g = *gl_;
   // Per-vertex colour: the material of the first triangle using the vertex.
   std::vector<mesh::Vec3f> color(m.vertexCount(), mesh::Srgb(0.8f, 0.8f, 0.8f));
@@ -268,6 +272,10 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
       g.hi = g.hi.cwiseMax(p.cast<double>());
     }
   }
+  if (bounds && (bounds->lo.array() <= bounds->hi.array()).all()) {
+    g.lo = bounds->lo;
+    g.hi = bounds->hi;
+  }
   // Ground: a disc of 48 sectors under the mesh, 1.1 times its radius.
   {
     const Vec3 c((g.lo.x() + g.hi.x()) / 2, g.lo.y(), (g.lo.z() + g.hi.z()) / 2);
@@ -300,6 +308,19 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
 // mesh's bounding sphere, so the map is made once per mesh.
 static const Vec3 kKeyDir = Vec3(-0.5, 0.8, 0.6).normalized();
 
+Vec3 KeyLightDirection() {
+  return kKeyDir;
+}
+
+// The radius of the sphere the light's orthographic view covers.
+static double ShadowRadius(const Vec3& lo, const Vec3& hi) {
+  return std::max((hi - lo).norm() / 2, 1e-3) * 1.2;  // ground included
+}
+
+double ShadowTexelsPerUnit(const mesh::Box& bounds) {
+  return kShadowMapSize / (2 * ShadowRadius(bounds.lo, bounds.hi));
+}
+
 void Renderer::RenderShadowMap() {
   Gl& g = *gl_;
   g.haveShadow = false;
@@ -307,7 +328,7 @@ void Renderer::RenderShadowMap() {
   Camera light;
   light.orthographic = true;
   light.target = (g.lo + g.hi) / 2;
-  const double r = std::max((g.hi - g.lo).norm() / 2, 1e-3) * 1.2;  // ground included
+  const double r = ShadowRadius(g.lo, g.hi);
   light.distance = 3 * r;
   light.elevation = std::asin(kKeyDir.y()) * kRadToDeg;
   light.azimuth = std::atan2(kKeyDir.x(), kKeyDir.z()) * kRadToDeg;

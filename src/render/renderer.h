@@ -19,6 +19,7 @@
 #include "draw/draw_list.h"
 #include "mesh/color.h"
 #include "mesh/export.h"
+#include "mesh/screen_detail.h"
 #include "mesh/triangle_mesh.h"
 #include "render/camera.h"
 
@@ -51,6 +52,14 @@ struct PointBatch {
 // executable or one or two levels up, else the source tree's `shaders/`.
 std::string FindShaderDir();
 
+// Unit direction toward the key light, which casts the shadows (fixed in
+// world space).
+Vec3 KeyLightDirection();
+
+// Texels per world unit of the shadow map when the mesh's bounds (or the
+// bounds given to SetMesh) are `bounds`.
+double ShadowTexelsPerUnit(const mesh::Box& bounds);
+
 class Renderer {
  public:
   // Compiles the shaders in `shaderDir`; needs a current context.
@@ -66,7 +75,12 @@ class Renderer {
 
   // Replaces the mesh (uploaded once; drawing it again uploads nothing) and
   // renders its shadow map from the key light once.
-  void SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette);
+  // `bounds`, when given, replaces the mesh's own box as the box the ground
+  // disc and the shadow map are fitted to: a mesh tessellated for one view
+  // (culled, screen-space detail) then gets the ground and shadows of the
+  // whole plant.
+  void SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette,
+               const mesh::Box* bounds = nullptr);
   // A ground disc under the mesh that receives its shadow (off by default).
   void SetGround(bool on) { ground_ = on; }
   void SetShadows(bool on) { shadows_ = on; }

@@ -1,0 +1,367 @@
+#include "mesh/screen_detail.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "core/parallel.h"
+#include "mesh/tessellator.h"
+#include "plant/plant_test_util.h"
+
+namespace sylva::mesh {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A perspective view-projection (OpenGL conventions) looking from eye at target.
+Mat4 LookAtPerspective(const Vec3& eye, const Vec3& target, double fovYDeg, double aspect) {
+  const Vec3 f = (target - eye).normalized();
+  Vec3 up = std::abs(f.y()) > 0.99 ? Vec3::UnitZ() : Vec3::UnitY();
+  const Vec3 s = f.cross(up).normalized(), u = s.cross(f);
+  Mat4 v = Mat4::Identity();
+  v.block<1, 3>(0, 0) = s.transpose();
+  v.block<1, 3>(1, 0) = u.transpose();
+  v.block<1, 3>(2, 0) = -f.transpose();
+  v(0, 3) = -s.dot(eye);
+  v(1, 3) = -u.dot(eye);
+  v(2, 3) = f.dot(eye);
+  const double zn = 0.01, zf = 1000, t = 1 / std::tan(fovYDeg * kPi / 360);
+  Mat4 p = Mat4::Zero();
+  p(0, 0) = t / aspect;
+  p(1, 1) = t;
+  p(2, 2) = -(zf + zn) / (zf - zn);
+  p(2, 3) = -2 * zf * zn / (zf - zn);
+  p(3, 2) = -1;
+  return p * v;
+}
+
+Vec2 Pixel(const ScreenView& v, const Vec3& p) {
+  const Vec4 c = v.viewProjection * Vec4(p.x(), p.y(), p.z(), 1);
+  return Vec2((c.x() / c.w() * 0.5 + 0.5) * v.width, (0.5 - c.y() / c.w() * 0.5) * v.height);
+}
+
+TEST(ScreenDetail, SidesTableOfTheIssue) {
+  const std::pair<double, int> table[] = {{1, 3},   {2, 5},   {4, 7},   {8, 9},
+                                          {16, 13}, {32, 18}, {64, 26}, {128, 36}};
+  for (auto [r, n] : table) {
+    EXPECT_EQ(SidesForPixelRadius(r, 0.5), n) << "radius " << r << " px";
+  }
+  EXPECT_EQ(SidesForPixelRadius(0.01, 0.5), 3);
+  EXPECT_EQ(SidesForPixelRadius(1e9, 0.5), 256);
+  EXPECT_EQ(SidesForPixelRadius(std::nan(""), 0.5), 256);
+  EXPECT_EQ(SidesForPixelRadius(std::numeric_limits<double>::infinity(), 0.5), 256);
+}
+
+TEST(ScreenDetail, SidesAreTheFewestWithinEps) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> logR(-1, 3.5), epsD(0.1, 2);
+  for (int i = 0; i < 20000; ++i) {
+    const double r = std::pow(10, logR(rng)), eps = epsD(rng);
+    const int n = SidesForPixelRadius(r, eps);
+    const double err = r * (1 - std::cos(kPi / n));
+    if (n < 256) {
+      EXPECT_LE(err, eps * (1 + 1e-9)) << "r " << r << " eps " << eps << " n " << n;
+    }
+    if (n > 3) {
+      const double fewer = r * (1 - std::cos(kPi / (n - 1)));
+      EXPECT_GT(fewer, eps) << "r " << r << " eps " << eps << ": " << n - 1 << " sides suffice";
+    }
+  }
+}
+
+// A random cylinder (one segment) under a random perspective camera,
+// tessellated with screen-space detail: at both rings, the extent of the
+// tessellated cross-section across the projected axis is compared with
+// the true circle's (sampled finely). The difference is the silhouette error.
+TEST(ScreenDetail, MeasuredSilhouetteErrorOfRandomCylindersStaysUnderEps) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> u(-1, 1), u01(0, 1);
+  double worst = 0;
+  int ribbons = 0, tubes = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    PlantGeometry g;
+    Segment s;
+    Vec3 axis(u(rng), u(rng), u(rng));
+    if (axis.norm() < 0.1) axis = Vec3::UnitY();
+    axis.normalize();
+    const double len = 0.5 + 2 * u01(rng);
+    s.start = Vec3(u(rng), u(rng), u(rng)) * 0.3;
+    s.end = s.start + axis * len;
+    s.left = axis.unitOrthogonal();
+    const double radius = std::pow(10, -3 + 2.5 * u01(rng));
+    s.radiusStart = float(radius);
+    s.radiusEnd = float(radius * (0.5 + 0.5 * u01(rng)));
+    g.segments.push_back(s);
+    g.branchCount = 1;
+    ScreenView view;
+    view.width = 64 + int(1900 * u01(rng));
+    view.height = 64 + int(1000 * u01(rng));
+    view.eps = std::array<double, 3>{0.25, 0.5, 1.0}[trial % 3];
+    Vec3 dir(u(rng), u(rng), u(rng));
+    if (dir.norm() < 0.1) dir = Vec3::UnitZ();
+    const Vec3 eye = dir.normalized() * (4 + 20 * u01(rng));
+    view.viewProjection = LookAtPerspective(eye, Vec3(u(rng), u(rng), u(rng)) * 0.2,
+                                            20 + 60 * u01(rng), double(view.width) / view.height);
+    TessellateOptions opt;
+    opt.view = view;
+    opt.cull = false;
+    TriangleMesh m;
+    ASSERT_TRUE(Tessellate(g, opt, m).ok());
+    ASSERT_GT(m.vertexCount(), 0u);
+    const bool ribbon = m.vertexCount() == 4;
+    (ribbon ? ribbons : tubes)++;
+    const size_t ring = ribbon ? 2 : (m.vertexCount() - 2 * 0) / 2;
+    for (int end = 0; end < 2; ++end) {
+      const Vec3 P = end ? s.end : s.start;
+      const double R = end ? double(s.radiusEnd) : double(s.radiusStart);
+      // The screen direction across the projected axis.
+      const Vec2 a = Pixel(view, s.start), b = Pixel(view, s.end);
+      Vec2 across(-(b - a).y(), (b - a).x());
+      if (across.norm() < 1e-9) continue;  // seen end-on: no side silhouette
+      across.normalize();
+      const Vec3 N = axis.unitOrthogonal(), B = axis.cross(N);
+      double cMax = -1e300, cMin = 1e300;
+      for (int k = 0; k < 4096; ++k) {
+        const double th = 2 * kPi * k / 4096;
+        const double q = across.dot(Pixel(view, P + R * (N * std::cos(th) + B * std::sin(th))));
+        cMax = std::max(cMax, q);
+        cMin = std::min(cMin, q);
+      }
+      // The ring's vertices: tubes without caps have (S + 1) per ring, two
+      // rings; with caps the rings come first as well.
+      const size_t first = end ? ring : 0;
+      const size_t count = ribbon ? 2 : 0;
+      double pMax = -1e300, pMin = 1e300;
+      if (ribbon) {
+        for (size_t k = first; k < first + count; ++k) {
+          const double q = across.dot(Pixel(view, m.positions[k].cast<double>()));
+          pMax = std::max(pMax, q);
+          pMin = std::min(pMin, q);
+        }
+      } else {
+        // Ring vertices are those at distance R from P across the axis.
+        for (const Vec3f& pf : m.positions) {
+          const Vec3 p = pf.cast<double>();
+          const Vec3 d = p - P;
+          if (std::abs(d.dot(axis)) > 1e-5 * (1 + len)) continue;
+          if (std::abs(d.norm() - R) > 1e-4 * R + 1e-6) continue;
+          const double q = across.dot(Pixel(view, p));
+          pMax = std::max(pMax, q);
+          pMin = std::min(pMin, q);
+        }
+      }
+      ASSERT_LT(pMin, 1e300) << "no ring vertices found, trial " << trial;
+      const double err = std::max(std::abs(cMax - pMax), std::abs(cMin - pMin));
+      worst = std::max(worst, err / view.eps);
+      EXPECT_LE(err, view.eps) << "trial " << trial << " end " << end << ": radius "
+                               << R * PixelsPerUnit(view, P) << " px, " << m.vertexCount()
+                               << " vertices";
+    }
+  }
+  EXPECT_GT(ribbons, 20) << "the trials should cover ribbons";
+  EXPECT_GT(tubes, 20) << "the trials should cover tubes";
+  RecordProperty("worst_error_over_eps", std::to_string(worst));
+}
+
+TEST(ScreenDetail, HierarchyKeepsEveryBoxThatMeetsTheFrustum) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-30, 30), size(0.01, 3);
+  std::vector<Box> boxes(5000);
+  for (Box& b : boxes) {
+    const Vec3 c(u(rng), u(rng), u(rng));
+    b.Add(c);
+    b.Add(c + Vec3(size(rng), size(rng), size(rng)));
+  }
+  boxes[17].lo.y() = std::nan("");  // unbounded boxes are kept
+  const BoundingHierarchy h(boxes);
+  const Frustum f =
+      Frustum::FromViewProjection(LookAtPerspective(Vec3(0, 5, 40), Vec3(3, 0, 0), 30, 16.0 / 9));
+  const auto visible = h.Visible(f);
+  size_t kept = 0, outside = 0;
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    if (i == 17) {
+      EXPECT_TRUE(visible[i]);
+      continue;
+    }
+    const bool out = f.Classify(boxes[i]) == Frustum::Side::kOutside;
+    if (!out) {
+      EXPECT_TRUE(visible[i]) << "box " << i << " meets the frustum but was culled";
+    }
+    outside += out;
+    kept += visible[i];
+  }
+  EXPECT_GT(outside, 1000u);
+  EXPECT_LT(kept, boxes.size() - outside / 2) << "the hierarchy culls too little";
+}
+
+TEST(ScreenDetail, SameTrianglesForAnyThreadCount) {
+  auto p = testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 12, plant::Stage::kGeometry);
+  ASSERT_TRUE(p);
+  ScreenView view;
+  view.width = 960;
+  view.height = 540;
+  view.viewProjection = LookAtPerspective(Vec3(2, 3, 4), Vec3(0, 2.5, 0), 35, 960.0 / 540);
+  auto hash = [](const TriangleMesh& m) {
+    uint64_t h = 1469598103934665603ull;
+    auto mix = [&](const void* data, size_t bytes) {
+      const auto* c = static_cast<const unsigned char*>(data);
+      for (size_t i = 0; i < bytes; ++i) h = (h ^ c[i]) * 1099511628211ull;
+    };
+    mix(m.positions.data(), m.positions.size() * sizeof(Vec3f));
+    mix(m.normals.data(), m.normals.size() * sizeof(Vec3f));
+    mix(m.uvs.data(), m.uvs.size() * sizeof(Vec2f));
+    mix(m.indices.data(), m.indices.size() * 4);
+    mix(m.material.data(), m.material.size() * 2);
+    return h;
+  };
+  uint64_t first = 0;
+  size_t triangles = 0;
+  for (int threads : {1, 2, 3, 8}) {
+    ThreadPool pool(threads);
+    TessellateOptions opt;
+    opt.view = view;
+    opt.pool = threads > 1 ? &pool : nullptr;
+    TriangleMesh m;
+    ASSERT_TRUE(Tessellate(p->geometry, opt, m).ok());
+    if (threads == 1) {
+      first = hash(m);
+      triangles = m.triangleCount();
+    }
+    EXPECT_EQ(hash(m), first) << threads << " threads";
+    EXPECT_EQ(m.triangleCount(), triangles) << threads << " threads";
+  }
+  EXPECT_GT(triangles, 1000u);
+}
+
+TEST(ScreenDetail, FewerTrianglesThanUniformSixteenSidesAtOnePixelTwigs) {
+  auto p = testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 14, plant::Stage::kGeometry);
+  ASSERT_TRUE(p);
+  ScreenView view;
+  view.width = 960;
+  view.height = 540;
+  view.viewProjection = LookAtPerspective(Vec3(6, 5, 12), Vec3(0, 4, 0), 35, 960.0 / 540);
+  TessellateOptions lod, uniform;
+  lod.view = view;
+  uniform.detail.sides = 16;
+  TriangleMesh a, b;
+  ASSERT_TRUE(Tessellate(p->geometry, lod, a).ok());
+  ASSERT_TRUE(Tessellate(p->geometry, uniform, b).ok());
+  EXPECT_LT(double(a.triangleCount()), 0.1 * double(b.triangleCount()))
+      << a.triangleCount() << " screen-space vs " << b.triangleCount() << " uniform";
+}
+
+// Rings along a chain: a straight chain of equal radius keeps two; a bent
+// one keeps more the larger it is on screen, and every joint it drops lies
+// within eps/2 pixels of the tube that replaces it.
+TEST(ScreenDetail, RingsFollowCurvatureAndProjectedSize) {
+  auto chain = [](bool bent) {
+    PlantGeometry g;
+    const int n = 64;
+    auto at = [&](int k) {
+      const double a = 0.5 * kPi * k / n;
+      return bent ? Vec3(std::cos(a) - 1, std::sin(a), 0) : Vec3(0, double(k) / n, 0);
+    };
+    for (int k = 0; k < n; ++k) {
+      Segment s;
+      s.start = at(k);
+      s.end = at(k + 1);
+      s.left = Vec3(0, 0, 1);
+      s.radiusStart = s.radiusEnd = 0.05f;
+      g.segments.push_back(s);
+    }
+    g.branchCount = 1;
+    return g;
+  };
+  auto rings = [&](const PlantGeometry& g, double distance, double* worst) {
+    ScreenView view;
+    view.viewProjection =
+        LookAtPerspective(Vec3(-0.5, 0.5, distance), Vec3(-0.5, 0.5, 0), 40, 960.0 / 540);
+    TessellateOptions opt;
+    opt.view = view;
+    TriangleMesh m;
+    EXPECT_TRUE(Tessellate(g, opt, m).ok());
+    // Sides S and rings K from the counts: 2 S K triangles (caps
+    // included), (K + 2)(S + 1) vertices.
+    int S = 0;
+    for (int t = 3; t <= 256 && !S; ++t) {
+      const size_t K = m.triangleCount() / size_t(2 * t);
+      if (m.triangleCount() == K * size_t(2 * t) && m.vertexCount() == (K + 2) * size_t(t + 1))
+        S = t;
+    }
+    EXPECT_GT(S, 0) << "not a capped tube: " << m.vertexCount() << " vertices";
+    if (!S) return size_t(0);
+    // Ring centres: the mean of each ring's S vertices (the seam repeats the first).
+    const size_t ring = size_t(S + 1);
+    std::vector<Vec3> centres;
+    for (size_t r = 0; (r + 1) * ring <= m.vertexCount() - 2 * ring; ++r) {
+      Vec3 c = Vec3::Zero();
+      for (int j = 0; j < S; ++j) c += m.positions[r * ring + size_t(j)].cast<double>();
+      centres.push_back(c / S);
+    }
+    *worst = 0;
+    for (const Segment& s : g.segments) {  // every joint against the nearest kept span
+      double best = 1e300;
+      for (size_t k = 0; k + 1 < centres.size(); ++k) {
+        const Vec3 d = centres[k + 1] - centres[k], q = s.end - centres[k];
+        const double t = std::clamp(q.dot(d) / d.dot(d), 0.0, 1.0);
+        best = std::min(best, (q - t * d).norm() * PixelsPerUnit(view, s.end));
+      }
+      *worst = std::max(*worst, best);
+    }
+    return centres.size();
+  };
+  double worst = 0;
+  EXPECT_EQ(rings(chain(false), 3, &worst), 2u) << "a straight chain needs two rings";
+  const size_t far = rings(chain(true), 10, &worst);
+  EXPECT_LE(worst, 0.25 + 0.01) << "far: a dropped joint is " << worst << " px off";
+  const size_t near = rings(chain(true), 2, &worst);
+  EXPECT_LE(worst, 0.25 + 0.01) << "near: a dropped joint is " << worst << " px off";
+  EXPECT_LT(far, near) << "rings far " << far << ", near " << near;
+  EXPECT_LT(near, 65u) << "even near, a smooth arc should drop some joints";
+  EXPECT_GT(far, 2u) << "the arc's bend shows even far away";
+  RecordProperty("rings", std::to_string(far) + " far, " + std::to_string(near) + " near");
+}
+
+TEST(ScreenDetail, BoundsHoldEveryVertexAtAnyDetail) {
+  auto p = testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 8, plant::Stage::kGeometry);
+  ASSERT_TRUE(p);
+  const Box box = TessellatedBounds(p->geometry, nullptr);
+  TessellateOptions opt;
+  opt.detail.sides = 64;
+  TriangleMesh m;
+  ASSERT_TRUE(Tessellate(p->geometry, opt, m).ok());
+  Box mb;
+  for (const Vec3f& v : m.positions) mb.Add(v.cast<double>());
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LE(box.lo[k], mb.lo[k] + 1e-5) << "axis " << k;
+    EXPECT_GE(box.hi[k], mb.hi[k] - 1e-5) << "axis " << k;
+    EXPECT_NEAR(box.lo[k], mb.lo[k], 0.01) << "axis " << k << ": the box should be tight";
+    EXPECT_NEAR(box.hi[k], mb.hi[k], 0.01) << "axis " << k << ": the box should be tight";
+  }
+}
+
+}  // namespace
+}  // namespace sylva::mesh
+
+namespace sylva::plant {
+namespace {
+
+TEST(PlantSpec, BadScreenViewIsReported) {
+  PlantSpec spec;
+  spec.path = "x.lsys";
+  spec.view = mesh::ScreenView{};
+  EXPECT_TRUE(Validate(spec).items.empty()) << Validate(spec).FormatAll();
+  spec.view->eps = 0;
+  spec.view->width = 0;
+  spec.view->viewProjection(2, 1) = std::nan("");
+  const DiagnosticList list = Validate(spec);
+  ASSERT_EQ(list.items.size(), 3u) << list.FormatAll();
+  EXPECT_NE(list.items[0].message.find("lod eps"), std::string::npos) << list.FormatAll();
+  EXPECT_NE(list.items[1].message.find("viewport 0x540"), std::string::npos) << list.FormatAll();
+  EXPECT_NE(list.items[2].message.find("non-finite"), std::string::npos) << list.FormatAll();
+}
+
+}  // namespace
+}  // namespace sylva::plant
