@@ -41,6 +41,7 @@ struct MeshCommand {
   DeriveFlags derive;
   std::string output;  // .obj .ply .glb .gltf
   int sides = 8;
+  std::optional<double> time;  // scenes: simulated seconds (default 0)
 };
 
 struct RenderCommand {
@@ -61,6 +62,8 @@ bool ParseSize(const std::string& s, int* w, int* h);
 // "azimuth,elevation,distance": finite, elevation in (-90, 90), distance >= 0.
 bool ParseCamera(const std::string& s, double v[3]);
 int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
+// `sylva mesh scene.xml` (cli_mesh_scene.cpp): glTF with instances as nodes.
+int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 
 // The plant spec the flags describe (steps, seed, -D, threads, limits);
 // nullopt with *exit set when a flag is malformed (printed to `err`).
