@@ -44,9 +44,8 @@ std::pair<std::string, bool> ElementOf(const scene::Scene& s, const SourceLoc& l
 // instance and no `counter`, else "nodeName/N" with N counting from
 // *counter (forests number their trees across variants).
 void AddMesh(mesh::ExportScene& out, std::shared_ptr<const mesh::TriangleMesh> m,
-             const mesh::Palette& palette, const std::string& meshName,
-             const std::string& nodeName, const std::vector<draw::Instance>& instances,
-             size_t* counter = nullptr) {
+             const mesh::Palette& palette, const std::string& meshName, const std::string& nodeName,
+             const std::vector<draw::Instance>& instances, size_t* counter = nullptr) {
   const int index = int(out.meshes.size());
   out.meshes.push_back({std::move(m), palette, meshName});
   size_t own = 0;
@@ -79,13 +78,12 @@ mesh::ExportScene ToExport(const scene::Scene& s, const scene::BuiltScene& built
   }
   for (size_t i = 0; i < simulated.sprites.size(); ++i) {
     const draw::Sprites& p = simulated.sprites[i];
-    out.points.push_back({NameOf("points", p.name, i), mesh::PointMode::kPoints, p.positions,
-                          p.colors});
+    out.points.push_back(
+        {NameOf("points", p.name, i), mesh::PointMode::kPoints, p.positions, p.colors});
   }
   for (size_t i = 0; i < simulated.lines.size(); ++i) {
     const draw::Lines& l = simulated.lines[i];
-    out.points.push_back(
-        {NameOf("lines", l.name, i), mesh::PointMode::kLines, l.points, l.colors});
+    out.points.push_back({NameOf("lines", l.name, i), mesh::PointMode::kLines, l.points, l.colors});
   }
   return out;
 }
@@ -134,8 +132,8 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
 
   mesh::SceneExportStats stats;
   const mesh::ExportScene exported = ToExport(*scene, *built.scene, simulated);
-  if (Status s = mesh::WriteSceneGltf(exported, cmd.output, format == mesh::MeshFormat::kGlb,
-                                      &stats);
+  if (Status s =
+          mesh::WriteSceneGltf(exported, cmd.output, format == mesh::MeshFormat::kGlb, &stats);
       !s.ok())
     return Report(s.error(), err);
   const auto t3 = Clock::now();

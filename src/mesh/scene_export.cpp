@@ -57,17 +57,18 @@ std::optional<Trs> DecomposeTrs(const Mat4f& mf, std::string* why) {
   for (int i = 0; i < 3; ++i)
     for (int j = i + 1; j < 3; ++j)
       if (std::abs(r.col(i).dot(r.col(j))) > 1e-3)
-        return fail("the transform shears (its axes are not orthogonal), which glTF's "
-                    "translation, rotation and scale cannot express");
+        return fail(
+            "the transform shears (its axes are not orthogonal), which glTF's "
+            "translation, rotation and scale cannot express");
   if (zeros == 1) {
     for (int i = 0; i < 3; ++i)
       if (s[i] == 0) r.col(i) = r.col((i + 1) % 3).cross(r.col((i + 2) % 3));
   } else if (zeros == 2) {
     const Eigen::Vector3d x = r.col(kept);
-    const Eigen::Vector3d u = (std::abs(x.x()) < 0.9 ? Eigen::Vector3d::UnitX()
-                                                     : Eigen::Vector3d::UnitY())
-                                  .cross(x)
-                                  .normalized();
+    const Eigen::Vector3d u =
+        (std::abs(x.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY())
+            .cross(x)
+            .normalized();
     r.col((kept + 1) % 3) = u;
     r.col((kept + 2) % 3) = x.cross(u);
   }
@@ -139,11 +140,10 @@ class Writer {
     root.name = "Sylva";
     for (const SceneNode& n : scene_.nodes) {
       if (n.mesh < 0 || size_t(n.mesh) >= scene_.meshes.size())
-        return Error(path_, "node '" + n.name + "' names mesh " + std::to_string(n.mesh) +
-                                " of " + std::to_string(scene_.meshes.size()));
+        return Error(path_, "node '" + n.name + "' names mesh " + std::to_string(n.mesh) + " of " +
+                                std::to_string(scene_.meshes.size()));
       if (primitives_[size_t(n.mesh)].empty()) continue;  // no triangles
-      if (!n.tint.allFinite())
-        return Error(path_, "node '" + n.name + "': its tint is not finite");
+      if (!n.tint.allFinite()) return Error(path_, "node '" + n.name + "': its tint is not finite");
       std::string why;
       const std::optional<Trs> trs = DecomposeTrs(n.transform, &why);
       if (!trs) return Error(path_, "node '" + n.name + "': " + why);
@@ -331,8 +331,8 @@ class Writer {
       mesh.name += hex;
     }
     for (const auto& [prim, colorIndex] : primitives_[i]) {
-      const Vec3f c = sm.palette.empty() ? Srgb(0.8f, 0.8f, 0.8f)
-                                         : sm.palette[colorIndex % sm.palette.size()];
+      const Vec3f c =
+          sm.palette.empty() ? Srgb(0.8f, 0.8f, 0.8f) : sm.palette[colorIndex % sm.palette.size()];
       tinygltf::Primitive p = prim;
       p.material = Material(c.cwiseProduct(tint));
       mesh.primitives.push_back(std::move(p));

@@ -66,9 +66,9 @@ struct SceneMesh {
 
 struct SceneNode {
   std::string name;
-  int mesh = 0;                          // index into ExportScene::meshes
-  Mat4f transform = Mat4f::Identity();   // model to world
-  Vec3f tint{1, 1, 1};                   // multiplies the palette colours
+  int mesh = 0;                         // index into ExportScene::meshes
+  Mat4f transform = Mat4f::Identity();  // model to world
+  Vec3f tint{1, 1, 1};                  // multiplies the palette colours
 };
 
 enum class PointMode { kPoints, kLines };
@@ -90,11 +90,11 @@ struct ExportScene {
 
 // What WriteSceneGltf wrote, for the command's summary.
 struct SceneExportStats {
-  size_t nodes = 0;      // glTF nodes (mesh instances and point sets)
-  size_t meshes = 0;     // glTF meshes, tinted copies and point sets included
+  size_t nodes = 0;   // glTF nodes (mesh instances and point sets)
+  size_t meshes = 0;  // glTF meshes, tinted copies and point sets included
   size_t materials = 0;
-  size_t points = 0;     // vertices of POINTS primitives
-  size_t lines = 0;      // segments of LINES primitives
+  size_t points = 0;  // vertices of POINTS primitives
+  size_t lines = 0;   // segments of LINES primitives
 };
 
 // .glb when `binary`, else .gltf with the buffer embedded as a data URI.
