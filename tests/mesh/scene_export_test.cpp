@@ -38,12 +38,13 @@ TEST(DecomposeTrs, RecoversTranslationRotationAndScale) {
   const float dot = std::abs(trs->rotation.coeffs().dot(r.coeffs()));
   EXPECT_NEAR(dot, 1.0f, 1e-5f) << trs->rotation.coeffs().transpose();
   EXPECT_NEAR(trs->rotation.norm(), 1.0f, 1e-6f);
-  EXPECT_LT((Compose(trs->translation, trs->rotation, trs->scale) - Compose(t, r, s)).norm(), 1e-5f);
+  EXPECT_LT((Compose(trs->translation, trs->rotation, trs->scale) - Compose(t, r, s)).norm(),
+            1e-5f);
 }
 
 TEST(DecomposeTrs, MirrorBecomesANegativeScale) {
-  const Mat4f m = Compose(Vec3f(1, 2, 3), Quatf(Eigen::AngleAxisf(0.4f, Vec3f::UnitY())),
-                          Vec3f(1, -2, 3));
+  const Mat4f m =
+      Compose(Vec3f(1, 2, 3), Quatf(Eigen::AngleAxisf(0.4f, Vec3f::UnitY())), Vec3f(1, -2, 3));
   std::string why;
   const auto trs = DecomposeTrs(m, &why);
   ASSERT_TRUE(trs) << why;
@@ -99,7 +100,9 @@ std::shared_ptr<const TriangleMesh> Square() {
   return m;
 }
 
-std::filesystem::path Scratch() { return sylva::testing::ScratchDir("sylva_scene_export_"); }
+std::filesystem::path Scratch() {
+  return sylva::testing::ScratchDir("sylva_scene_export_");
+}
 
 json ReadJson(const std::string& path) {
   std::ifstream f(path);
@@ -167,7 +170,8 @@ TEST(WriteSceneGltf, BadInputIsAnErrorAndWritesNothing) {
     ExportScene points;
     Vec3f p(0, 0, 0);
     p[axis] = std::numeric_limits<float>::quiet_NaN();
-    points.points.push_back({"p", PointMode::kPoints, {Vec3f::Zero(), p}, {Vec3f::Ones(), Vec3f::Ones()}});
+    points.points.push_back(
+        {"p", PointMode::kPoints, {Vec3f::Zero(), p}, {Vec3f::Ones(), Vec3f::Ones()}});
     s = WriteSceneGltf(points, out, true);
     ASSERT_FALSE(s.ok()) << axis;
     EXPECT_NE(s.error().message.find("point 1 is not finite"), std::string::npos)
