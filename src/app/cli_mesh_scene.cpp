@@ -105,6 +105,11 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
            "<forest>\n";
     return kExitBadInput;
   }
+  if (cmd.derive.maxModules || cmd.derive.maxTriangles) {
+    err << "sylva: error: --max-modules and --max-triangles are for grammars; a scene is bounded "
+           "by its own sizes (docs/scene.md)\n";
+    return kExitBadInput;
+  }
   int exit = kExitOk;
   const auto scene = LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err,
                                &exit, cmd.derive.strict);

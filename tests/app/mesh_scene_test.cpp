@@ -190,8 +190,11 @@ TEST(CliMeshScene, SceneErrorIsExitTwoAndWritesNothing) {
 
 TEST(CliMeshScene, GrammarFlagsOnASceneAndTimeOnAGrammarAreExitTwo) {
   const std::string out = (Scratch() / "flags.glb").string();
-  auto steps = RunSylva({"mesh", Forest50(), "-n", "3", "-o", out});
-  EXPECT_EQ(steps.code, 2) << steps.err;
+  for (const char* flag : {"-n", "--seed", "--max-modules", "--max-triangles"}) {
+    auto r = RunSylva({"mesh", Forest50(), flag, "3", "-o", out});
+    EXPECT_EQ(r.code, 2) << flag << ": " << r.err;
+    EXPECT_NE(r.err.find("are for grammars"), std::string::npos) << r.err;
+  }
   auto time =
       RunSylva({"mesh", Source("grammars/abop/fig1_25_bush.lsys"), "--time", "1", "-o", out});
   EXPECT_EQ(time.code, 2) << time.err;
