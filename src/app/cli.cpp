@@ -131,12 +131,12 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   AddDeriveFlags(me, mesh.derive);
   me->add_option("-o,--output", mesh.output, "mesh file: .obj (+ .mtl), .ply, .glb or .gltf")
       ->required();
-  AddMaxTrianglesFlag(me, mesh.derive);
-  me->add_option("--sides", mesh.sides, "vertices around each branch tube (3-256, default 8)")
-      ->check(CLI::Range(3, 256));
   me->add_option("--time", mesh.time,
                  "scenes: simulate this many seconds and write the particles then (default 0)")
       ->check(CLI::Range(0.0, 1e6));
+  AddMaxTrianglesFlag(me, mesh.derive);
+  me->add_option("--sides", mesh.sides, "vertices around each branch tube (3-256, default 8)")
+      ->check(CLI::Range(3, 256));
 
   RenderCommand render;
   CLI::App* re = app.add_subcommand("render", "derive a grammar and render it to a PNG, headless");
