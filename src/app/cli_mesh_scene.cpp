@@ -5,8 +5,11 @@
 // boids as one node per particle, cloth as a mesh, sprites as POINTS and
 // trails as LINES with their colours. OBJ and PLY have no instances, so a
 // scene asks for .glb or .gltf.
+#include <unistd.h>
 #include <chrono>
+
 #include <cstdio>
+#include <iostream>
 #include <map>
 #include <ostream>
 
@@ -126,10 +129,23 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   scene::SimulationOptions simOptions;
   simOptions.threads = cmd.derive.threads;
   auto sim = scene::Simulation::Create(*scene, *built.scene, simOptions, simWarnings);
-  if (int e = Report(simWarnings, err, cmd.derive.maxErrors, cmd.derive.strict); e != kExitOk)
-    return e;
+  exit = Report(simWarnings, err, cmd.derive.maxErrors, cmd.derive.strict);
   if (!sim) return Report(sim.error(), err);
-  if (Status s = (*sim)->AdvanceTo(cmd.time.value_or(0)); !s.ok()) return Report(s.error(), err);
+  if (exit != kExitOk) return exit;
+  // On a terminal, progress every quarter of a simulated second (the steps
+  // taken are the same either way: AdvanceTo takes whole steps).
+  const double until = cmd.time.value_or(0);
+  if (&err == &std::cerr && isatty(2)) {
+    for (double t = 0.25; t < until; t += 0.25) {
+      if (Status s = (*sim)->AdvanceTo(t); !s.ok()) return Report(s.error(), err);
+      char progress[120];
+      std::snprintf(progress, sizeof progress, "\rsimulating: t = %.2f of %.2f s, %zu points",
+                    (*sim)->time(), until, (*sim)->Count());
+      err << progress << std::flush;
+    }
+    if (until > 0.25) err << "\n";
+  }
+  if (Status s = (*sim)->AdvanceTo(until); !s.ok()) return Report(s.error(), err);
   draw::DrawList simulated;
   (*sim)->AddToDrawList(simulated);
   if (Status s = simulated.Check(); !s.ok()) return Report(s.error(), err);

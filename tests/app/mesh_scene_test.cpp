@@ -202,5 +202,13 @@ TEST(CliMeshScene, GrammarFlagsOnASceneAndTimeOnAGrammarAreExitTwo) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+TEST(CliMeshScene, UnwritableOutputIsExitOne) {
+  auto r = RunSylva({"mesh", Forest50(), "-o", "/nonexistent-dir/forest.glb"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("/nonexistent-dir/forest.glb: error: cannot create output file"),
+            std::string::npos)
+      << r.err;
+}
+
 }  // namespace
 }  // namespace sylva::app
