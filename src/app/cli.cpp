@@ -126,10 +126,14 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   d->add_option("-o,--output", derive.output, "write the word to this file");
 
   MeshCommand mesh;
-  CLI::App* me = app.add_subcommand("mesh", "derive a grammar and write the plant mesh");
+  CLI::App* me = app.add_subcommand(
+      "mesh", "derive a grammar and write the plant mesh, or write a scene (.xml) as glTF");
   AddDeriveFlags(me, mesh.derive);
   me->add_option("-o,--output", mesh.output, "mesh file: .obj (+ .mtl), .ply, .glb or .gltf")
       ->required();
+  me->add_option("--time", mesh.time,
+                 "scenes: simulate this many seconds and write the particles then (default 0)")
+      ->check(CLI::Range(0.0, 1e6));
   AddMaxTrianglesFlag(me, mesh.derive);
   CLI::Option* meSides =
       me->add_option("--sides", mesh.sides, "vertices around each branch tube (3-256, default 8)")

@@ -1,4 +1,5 @@
-// sylva mesh: a plant (src/plant) written to a mesh file.
+// sylva mesh: a plant (src/plant) written to a mesh file; a scene goes to
+// cli_mesh_scene.cpp.
 #include <chrono>
 #include <cstdio>
 #include <ostream>
@@ -14,6 +15,11 @@ int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   if (!mesh::FormatFromPath(cmd.output)) {
     err << "sylva: error: " << cmd.output
         << ": unknown mesh format; use .obj, .ply, .glb or .gltf\n";
+    return kExitBadInput;
+  }
+  if (IsSceneFile(cmd.derive.file)) return RunMeshScene(cmd, out, err);
+  if (cmd.time) {
+    err << "sylva: error: --time is for scene files (.xml)\n";
     return kExitBadInput;
   }
   int exit = kExitOk;

@@ -255,6 +255,11 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
 
 int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   (void)out;
+  if (IsSceneFile(cmd.derive.file)) {
+    err << "sylva: error: --lod-eps is for grammars; a scene is written at uniform --sides (its "
+           "screen-space detail is not implemented yet)\n";
+    return kExitBadInput;
+  }
   if (!mesh::FormatFromPath(cmd.output)) {
     err << "sylva: error: " << cmd.output
         << ": unknown mesh format; use .obj, .ply, .glb or .gltf\n";

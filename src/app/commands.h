@@ -46,6 +46,7 @@ struct MeshCommand {
   std::optional<double> lodEps;
   std::string size = "960x540";
   std::string camera;
+  std::optional<double> time;  // scenes: simulated seconds (default 0)
 };
 
 struct RenderCommand {
@@ -73,6 +74,8 @@ int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 // Writes plant.mesh to cmd.output and its summary to `err` (both mesh runners).
 int WriteMeshOf(const MeshCommand& cmd, const plant::Plant& plant, std::ostream& err);
+// `sylva mesh scene.xml` (cli_mesh_scene.cpp): glTF with instances as nodes.
+int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 
 // The plant spec the flags describe (steps, seed, -D, threads, limits);
 // nullopt with *exit set when a flag is malformed (printed to `err`).

@@ -63,6 +63,7 @@ struct MeshDraw {
   mesh::Palette palette;  // material index -> colour; empty: light grey
   std::vector<Instance> instances;
   bool castsShadow = true;
+  std::string name;  // what it shows (an element id), for exporters; may be empty
 };
 
 enum class Blend { kAlpha, kAdditive };
@@ -74,11 +75,13 @@ struct Sprites {
   std::vector<Vec3f> colors;
   std::vector<float> alphas;  // empty: opaque
   Blend blend = Blend::kAlpha;
+  std::string name;  // as MeshDraw::name
 };
 
 struct Lines {
   std::vector<Vec3f> points;  // pairs: one segment per two points
   std::vector<Vec3f> colors;  // one per point
+  std::string name;           // as MeshDraw::name
 };
 
 struct DrawList {

@@ -19,6 +19,7 @@
 #include "core/atomic_file.h"
 #include "mesh/color.h"
 #include "mesh/export.h"
+#include "mesh/glb.h"
 
 namespace sylva::mesh {
 namespace {
@@ -209,35 +210,10 @@ Status WriteGltf(const TriangleMesh& m, const Palette& palette, const std::strin
   nlohmann::json doc = nlohmann::json::parse(stream.str(), nullptr, false);
   if (doc.is_discarded()) return SerialisationFailed(path);
   if (layout.total > 0) doc["buffers"] = nlohmann::json::array({{{"byteLength", layout.total}}});
-  std::string json = doc.dump();
-  while (json.size() % 4) json += ' ';
-  const size_t bin = (layout.total + 3) / 4 * 4;
-  const uint64_t length = 12 + 8 + json.size() + (layout.total ? 8 + bin : 0);
-  if (length > 0xFFFFFFFFull) {
-    Diagnostic d;
-    d.kind = ErrorKind::kRuntime;
-    d.loc.file = path;
-    d.message = "mesh too large for a .glb file (over 4 GiB); use fewer sides or steps";
-    return d;
-  }
-  if (Status s = f.Open(path); !s.ok()) return s;
-  auto u32 = [&](uint32_t v) { return f.Write(&v, 4); };
-  if (Status s = u32(0x46546C67u); !s.ok()) return s;  // "glTF"
-  if (Status s = u32(2); !s.ok()) return s;
-  if (Status s = u32(uint32_t(length)); !s.ok()) return s;
-  if (Status s = u32(uint32_t(json.size())); !s.ok()) return s;
-  if (Status s = u32(0x4E4F534Au); !s.ok()) return s;  // "JSON"
-  if (Status s = f.Write(json); !s.ok()) return s;
-  if (layout.total > 0) {
-    if (Status s = u32(uint32_t(bin)); !s.ok()) return s;
-    if (Status s = u32(0x004E4942u); !s.ok()) return s;  // "BIN\0"
-    if (Status s = EmitBuffer(m, groups, [&](const void* p, size_t n) { return f.Write(p, n); });
-        !s.ok())
-      return s;
-    static const char zeros[4] = {0, 0, 0, 0};
-    if (Status s = f.Write(zeros, bin - layout.total); !s.ok()) return s;
-  }
-  return f.Commit();
+  return WriteGlb(
+      path, doc.dump(), layout.total,
+      [&](const ByteSink& sink) { return EmitBuffer(m, groups, sink); },
+      "mesh too large for a .glb file (over 4 GiB); use fewer sides or steps");
 }
 
 }  // namespace sylva::mesh

@@ -867,6 +867,7 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
     const DrawDef& d = p.draw;
     if (d.as == DrawAs::kMesh && ps->drawMesh) {
       draw::MeshDraw md;
+      md.name = p.id;
       md.mesh = ps->drawMesh;
       md.palette = {mesh::Vec3f(1, 1, 1)};
       // The mesh turns about its own centre.
@@ -910,6 +911,7 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
     }
     if (d.as == DrawAs::kTrails) {
       draw::Lines l;
+      l.name = p.id;
       for (size_t i = 0; i < st.size(); ++i) {
         const mesh::Vec3f c = ColorAt(d, st.age[i], st.lifetime[i]).cast<float>();
         l.points.push_back((st.position[i] - st.velocity[i] * 0.06).cast<float>());
@@ -921,6 +923,7 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
       continue;
     }
     draw::Sprites s;
+    s.name = p.id;
     s.blend = d.blend == Blend::kAdditive ? draw::Blend::kAdditive : draw::Blend::kAlpha;
     for (size_t i = 0; i < st.size(); ++i) {
       s.positions.push_back(st.position[i].cast<float>());
@@ -948,6 +951,7 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
       mesh->uvs.push_back({0, 0});
     }
     draw::MeshDraw md;
+    md.name = c.def->id;
     md.mesh = mesh;
     md.palette = {c.def->color.cast<float>()};
     md.instances.push_back({});
@@ -957,6 +961,7 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
     const ParticleState& st = f.system->state;
     if (f.def->draw.as == DrawAs::kPoints || f.def->draw.as == DrawAs::kSprites) {
       draw::Sprites s;
+      s.name = f.def->id;
       for (size_t i = 0; i < st.size(); ++i) {
         s.positions.push_back(st.position[i].cast<float>());
         s.sizes.push_back(float(f.def->draw.size));
@@ -966,6 +971,7 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
       continue;
     }
     draw::MeshDraw md;
+    md.name = f.def->id;
     md.mesh = f.drawMesh;
     md.palette = {mesh::Vec3f(1, 1, 1)};
     for (size_t i = 0; i < st.size(); ++i)
