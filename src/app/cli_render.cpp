@@ -87,15 +87,6 @@ Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSp
   return camera;
 }
 
-mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps) {
-  mesh::ScreenView view;
-  view.viewProjection = camera.ViewProjection(double(width) / height);
-  view.width = width;
-  view.height = height;
-  view.eps = eps;
-  return view;
-}
-
 // Box filter of K x K pixel blocks, averaged in linear light (sRGB decoded
 // and encoded again), alpha linearly.
 render::Image Downsample(const render::Image& big, int k) {
@@ -132,6 +123,15 @@ render::Image Downsample(const render::Image& big, int k) {
 }
 
 }  // namespace
+
+mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps) {
+  mesh::ScreenView view;
+  view.viewProjection = camera.ViewProjection(double(width) / height);
+  view.width = width;
+  view.height = height;
+  view.eps = eps;
+  return view;
+}
 
 int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   const auto tStart = Clock::now();

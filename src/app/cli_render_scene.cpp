@@ -18,6 +18,9 @@
 
 namespace sylva::app {
 
+// cli_render.cpp: the screen view of a camera, for screen-space detail.
+mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps);
+
 int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
@@ -34,9 +37,18 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
     err << "sylva: error: --camera is for grammars; a scene sets its view with <camera>\n";
     return kExitBadInput;
   }
-  if (cmd.lodEps || cmd.supersample != 1 || cmd.stats) {
-    err << "sylva: error: --lod-eps, --supersample and --stats are for grammars; a scene's "
-           "plants are drawn with uniform --sides\n";
+  if (cmd.supersample != 1) {
+    err << "sylva: error: --supersample is for grammars\n";
+    return kExitBadInput;
+  }
+  if (cmd.lodEps && cmd.sides) {
+    err << "sylva: error: --lod-eps and --sides exclude each other (--sides turns screen-space "
+           "detail off)\n";
+    return kExitBadInput;
+  }
+  const double lodEps = cmd.lodEps.value_or(0.5);
+  if (!(lodEps > 0) || !std::isfinite(lodEps)) {
+    err << "sylva: error: --lod-eps must be a number above 0\n";
     return kExitBadInput;
   }
   if (cmd.derive.steps || cmd.derive.seed) {
@@ -45,12 +57,14 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
     return kExitBadInput;
   }
   int exit = kExitOk;
-  const auto scene =
-      LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err, &exit);
+  const auto scene = LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err,
+                               &exit, cmd.derive.strict);
   if (!scene) return exit;
   scene::BuildOptions options;
   options.threads = cmd.derive.threads;
-  options.sides = cmd.sides.value_or(12);  // scenes: uniform tubes (no screen-space detail yet)
+  // Uniform tubes for what collides (the same whatever the camera); the
+  // picture gets screen-space detail below unless --sides is given.
+  options.sides = cmd.sides.value_or(8);
   scene::BuildResult built = scene::Build(*scene, options);
   exit = Report(built.diagnostics, err, cmd.derive.maxErrors);
   if (!built.scene) return exit == kExitOk ? kExitRuntime : exit;
@@ -64,9 +78,19 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
   if (Status s = (*sim)->AdvanceTo(cmd.time); !s.ok()) return Report(s.error(), err);
   const auto t2 = Clock::now();
 
+  const render::Camera camera = SceneCamera(*scene, *built.scene, double(width) / height);
+  size_t staticTriangles = built.scene->trianglesDrawn;
+  if (!cmd.sides) {
+    DiagnosticList detailWarnings;
+    auto drawn =
+        scene::DetailForView(*built.scene, ViewOf(camera, width, height, lodEps), detailWarnings);
+    Report(detailWarnings, err, cmd.derive.maxErrors);
+    if (!drawn) return Report(drawn.error(), err);
+    staticTriangles = *drawn;
+  }
+  const auto t2b = Clock::now();
   draw::DrawList list = scene::MakeDrawList(*scene, *built.scene);
   (*sim)->AddToDrawList(list);
-  const render::Camera camera = SceneCamera(*scene, *built.scene, double(width) / height);
   auto context = render::HeadlessContext::Create();
   if (!context) return Report(context.error(), err);
   auto renderer = render::Renderer::Create(render::FindShaderDir());
@@ -76,17 +100,25 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
   const render::Image image = (*renderer)->ReadPixels();
   if (Status s = render::WriteImage(image, cmd.output); !s.ok()) return Report(s.error(), err);
   const auto t3 = Clock::now();
-  char line[400];
+  auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  char line[480];
   std::snprintf(line, sizeof line,
-                "%s: %dx%d at t = %.3f s, %zu meshes, %zu static triangles, %zu simulated "
-                "points; build %.2f s, simulate %.2f s, render %.2f s (%s)\n",
+                "%s: %dx%d at t = %.3f s, %zu meshes, %zu static triangles drawn (%s), %zu "
+                "simulated points; build %.2f s, simulate %.2f s, detail %.2f s, render %.2f s "
+                "(%s)\n",
                 cmd.output.c_str(), width, height, (*sim)->time(), list.meshes.size(),
-                built.scene->trianglesDrawn, (*sim)->Count(),
-                std::chrono::duration<double>(t1 - t0).count(),
-                std::chrono::duration<double>(t2 - t1).count(),
-                std::chrono::duration<double>(t3 - t2).count(), (*context)->Renderer().c_str());
-  err << line;
-  (void)out;
+                staticTriangles, cmd.sides ? "uniform sides" : "screen-space detail",
+                (*sim)->Count(), seconds(t0, t1), seconds(t1, t2), seconds(t2, t2b),
+                seconds(t2b, t3), (*context)->Renderer().c_str());
+  if (cmd.stats) {
+    std::snprintf(line, sizeof line,
+                  "triangles: %zu\nbuild: %.1f ms\nsimulate: %.1f ms\ndetail: %.1f ms\nrender: "
+                  "%.1f ms\n",
+                  staticTriangles, 1e3 * seconds(t0, t1), 1e3 * seconds(t1, t2),
+                  1e3 * seconds(t2, t2b), 1e3 * seconds(t2b, t3));
+    out << line;
+  }
+  if (!cmd.stats) err << line;
   return kExitOk;
 }
 

@@ -203,11 +203,13 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
   }
 
   for (const PlantDef& p : scene.plants) {
-    std::optional<plant::Plant> grown = Grow(SpecFor(p), options, p.grammarLoc, "plant", diags);
+    const plant::PlantSpec spec = SpecFor(p);
+    std::optional<plant::Plant> grown = Grow(spec, options, p.grammarLoc, "plant", diags);
     if (!grown) continue;
     BuiltMesh m;
     m.mesh = std::make_shared<mesh::TriangleMesh>(std::move(grown->mesh));
     m.palette = grown->palette;
+    m.spec = spec;
     Vec3 at = p.position;
     if (!p.positionHasY) at.y() = built.GroundHeight(at.x(), at.z());
     const double unit = p.height ? HeightScale(*m.mesh, *p.height, p.loc, diags) : 1;
@@ -219,6 +221,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       AddPoints(grown->geometry, m.instances[0].transform, built.points[p.id]);
       built.meshesOf[p.id].push_back(built.meshes.size());
     }
+    m.plant = std::make_shared<plant::Plant>(std::move(*grown));
     built.meshes.push_back(std::move(m));
   }
 
@@ -240,18 +243,20 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     std::vector<double> unit;
     std::vector<mesh::PlantGeometry> geometry;
     for (int v = 0; v < variants; ++v) {
-      std::optional<plant::Plant> grown =
-          Grow(SpecFor(f, forestSeed, v), options, f.grammarLoc, "forest", diags);
+      const plant::PlantSpec spec = SpecFor(f, forestSeed, v);
+      std::optional<plant::Plant> grown = Grow(spec, options, f.grammarLoc, "forest", diags);
       if (!grown) break;
       BuiltMesh m;
       m.mesh = std::make_shared<mesh::TriangleMesh>(std::move(grown->mesh));
       m.palette = grown->palette;
       m.loc = f.loc;
+      m.spec = spec;
       unit.push_back(f.height ? HeightScale(*m.mesh, *f.height, f.loc, diags) : 1);
       if (!f.id.empty()) {
-        geometry.push_back(std::move(grown->geometry));
+        geometry.push_back(grown->geometry);
         built.meshesOf[f.id].push_back(built.meshes.size());
       }
+      m.plant = std::make_shared<plant::Plant>(std::move(*grown));
       built.meshes.push_back(std::move(m));
     }
     if (int(built.meshes.size() - first) != variants) continue;
@@ -275,6 +280,44 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
 
   if (!diags.HasErrors()) result.scene = std::move(built);
   return result;
+}
+
+Expected<size_t> DetailForView(BuiltScene& built, const mesh::ScreenView& view,
+                               DiagnosticList& diagnostics) {
+  size_t drawn = 0;
+  for (BuiltMesh& m : built.meshes) {
+    if (!m.plant || m.instances.empty()) {
+      drawn += m.mesh->triangleCount() * m.instances.size();
+      continue;
+    }
+    // The instance that needs the most detail: the most pixels per unit at
+    // its origin, times its scale.
+    size_t best = 0;
+    double bestDensity = -1;
+    for (size_t i = 0; i < m.instances.size(); ++i) {
+      const Eigen::Matrix4d t = m.instances[i].transform.cast<double>();
+      const double density =
+          mesh::PixelsPerUnit(view, t.block<3, 1>(0, 3)) * t.block<3, 1>(0, 0).norm();
+      if (density > bestDensity) {
+        bestDensity = density;
+        best = i;
+      }
+    }
+    plant::PlantSpec spec = m.spec;
+    spec.view = view;
+    spec.view->viewProjection = view.viewProjection * m.instances[best].transform.cast<double>();
+    spec.cull = false;
+    // The plant's own mesh was moved to m.mesh; Tessellate fills it again.
+    if (Status s = plant::Tessellate(*m.plant, spec, diagnostics); !s.ok()) {
+      Diagnostic d = s.error();
+      if (d.loc.file.empty()) d.loc = m.loc;
+      return d;
+    }
+    drawn += m.plant->mesh.triangleCount() * m.instances.size();
+    m.drawMesh = std::make_shared<mesh::TriangleMesh>(std::move(m.plant->mesh));
+    m.plant->mesh = mesh::TriangleMesh();
+  }
+  return drawn;
 }
 
 draw::DrawList MakeDrawList(const Scene& scene, const BuiltScene& built) {
@@ -301,7 +344,7 @@ draw::DrawList MakeDrawList(const Scene& scene, const BuiltScene& built) {
   for (const BuiltMesh& m : built.meshes) {
     if (m.instances.empty()) continue;
     draw::MeshDraw d;
-    d.mesh = m.mesh;
+    d.mesh = m.drawMesh ? m.drawMesh : m.mesh;
     d.palette = m.palette;
     d.instances = m.instances;
     d.castsShadow = m.castsShadow;

@@ -19,7 +19,9 @@
 #include "core/diagnostic.h"
 #include "draw/draw_list.h"
 #include "mesh/export.h"
+#include "mesh/screen_detail.h"
 #include "mesh/triangle_mesh.h"
+#include "plant/plant.h"
 #include "scene/scene.h"
 #include "terrain/height_field.h"
 
@@ -32,7 +34,15 @@ struct BuildOptions {
 
 // One mesh with the places it is drawn.
 struct BuiltMesh {
+  // Uniform detail (BuildOptions::sides): what collides, what is exported
+  // and what `simulate` knows, whatever the camera.
   std::shared_ptr<const mesh::TriangleMesh> mesh;
+  // Screen-space detail for one view (DetailForView), drawn instead of
+  // `mesh` when set.
+  std::shared_ptr<const mesh::TriangleMesh> drawMesh;
+  // The plant it was tessellated from (null for terrain), for DetailForView.
+  std::shared_ptr<plant::Plant> plant;
+  plant::PlantSpec spec;
   mesh::Palette palette;
   std::vector<draw::Instance> instances;
   SourceLoc loc;            // the element it comes from
@@ -68,6 +78,14 @@ struct BuildResult {
 };
 
 BuildResult Build(const Scene& scene, const BuildOptions& options);
+
+// Tessellates every plant mesh again for `view` (world coordinates), as
+// `drawMesh`: each mesh at the detail its closest instance needs (the view
+// is taken into the plant's own frame through that instance's transform),
+// without culling, since one mesh serves every instance. Returns the
+// triangles drawn over all instances; warnings go to `diagnostics`.
+Expected<size_t> DetailForView(BuiltScene& built, const mesh::ScreenView& view,
+                               DiagnosticList& diagnostics);
 
 // The scene's terrain def for the terrain library, with its seed.
 terrain::TerrainDef TerrainDefOf(const TerrainDef& t, uint64_t seed);
