@@ -177,9 +177,18 @@ void BM_Cloth(benchmark::State& state, particles::ClothSolver solver) {
     return;
   }
   particles::Cloth& cloth = **made;
-  for (int i = 0; i < 30; ++i)
-    cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2));  // settle a little
-  for (auto _ : state) cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2));
+  for (int i = 0; i < 30; ++i) {
+    if (Status st = cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2)); !st.ok()) {
+      state.SkipWithError(st.error().message.c_str());  // settle a little
+      return;
+    }
+  }
+  for (auto _ : state) {
+    if (Status st = cloth.Step(1.0 / 60, Vec3(0, -9.81, 0), Vec3(0, 0, 2)); !st.ok()) {
+      state.SkipWithError(st.error().message.c_str());
+      return;
+    }
+  }
   state.counters["stretch"] = cloth.MaxStretch();
   state.SetItemsProcessed(int64_t(k) * k * state.iterations());
 }

@@ -103,7 +103,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (Status s = (*renderer)->Resize(width, height); !s.ok()) return Report(s.error(), err);
   if (lines) {
     (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
-    (*renderer)->SetLines(batch);
+    if (Status s = (*renderer)->SetLines(batch); !s.ok()) return Report(s.error(), err);
   } else {
     (*renderer)->SetGround(true);
     (*renderer)->SetMesh(m, palette);

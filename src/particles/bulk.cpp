@@ -139,8 +139,8 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       const Vec3f xf = RoundOutside(colliders_, x);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
-      const double mag = std::max(xf.cast<double>().cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
-      if (!(mag <= maxMagnitude)) faulted_.store(true, std::memory_order_relaxed);
+      if (!WithinLimit(xf.cast<double>(), v, maxMagnitude))
+        faulted_.store(true, std::memory_order_relaxed);
     }
   }
 }
@@ -196,8 +196,7 @@ Status BulkSystem::Fault() {
   if (!faulted_.load()) return {};
   for (size_t i = 0; i < state.size(); ++i) {
     const Vec3 x = state.position(i), v = state.velocity(i);
-    const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
-    if (m <= maxMagnitude) continue;
+    if (WithinLimit(x, v, maxMagnitude)) continue;
     fault_ = ExplosionDiagnostic("in bulk", steps, state.time, state.id[i], x, v, maxMagnitude);
     return *fault_;
   }

@@ -25,6 +25,7 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -307,7 +308,10 @@ class System {
   // Collisions, ageing and the fault check for particle i, then stores it.
   void Finish(size_t i, const Vec3& x0, const Vec3& v0, Vec3 x1, Vec3 v1, double h);
   void Collide(size_t i, Vec3 a, Vec3 va, Vec3& x, Vec3& v, double h);
-  void ImplicitEuler(double h);
+  Status ImplicitEuler(double h);
+  // The fault of a non-finite vector `a` of the implicit solve (naming its
+  // first non-finite particle).
+  Status NonFiniteSolve(const char* what, const Vec3* a, int iteration);
   // Sum of fn(begin, end) over the fixed chunks of [0, n) (1024 elements,
   // a multiple of 4), added in chunk order: the same bits for any thread
   // count.
@@ -334,6 +338,15 @@ class System {
   kernels::Kernel kernel_ = kernels::Best();
   std::atomic<bool> faulted_{false};  // set by Finish, read by CheckFaults
 };
+
+// Whether every component of x and v lies in [-limit, limit]. NaN fails:
+// each of the six is compared on its own, never through a maximum (which
+// drops a NaN in y or z).
+inline bool WithinLimit(const Vec3& x, const Vec3& v, double limit) {
+  bool ok = true;
+  for (int k = 0; k < 3; ++k) ok &= std::abs(x[k]) <= limit && std::abs(v[k]) <= limit;
+  return ok;
+}
 
 // The report of a particle whose position or velocity left the limit (or is
 // not finite), for both particle systems: the step, its start time and the
