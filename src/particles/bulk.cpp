@@ -136,6 +136,13 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
         s.lifetime[i] = std::min(s.lifetime[i], life);
       }
       if (out == ContactOutcome::kStuck) s.invMass[i] = 0;
+      if (out == ContactOutcome::kUnresolved) {
+        // The lowest index wins, whatever the thread count.
+        size_t seen = unresolved_.load(std::memory_order_relaxed);
+        while (i < seen && !unresolved_.compare_exchange_weak(seen, i)) {
+        }
+        faulted_.store(true, std::memory_order_relaxed);
+      }
       const Vec3f xf = RoundOutside(colliders_, x);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
@@ -194,6 +201,11 @@ Status BulkSystem::Step(double h) {
 
 Status BulkSystem::Fault() {
   if (!faulted_.load()) return {};
+  if (const size_t i = unresolved_.exchange(SIZE_MAX); i != SIZE_MAX) {
+    fault_ =
+        UnresolvedContactDiagnostic("in bulk", steps, state.time, state.id[i], state.position(i));
+    return *fault_;
+  }
   for (size_t i = 0; i < state.size(); ++i) {
     const Vec3 x = state.position(i), v = state.velocity(i);
     if (WithinLimit(x, v, maxMagnitude)) continue;

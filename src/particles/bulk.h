@@ -145,6 +145,8 @@ class BulkSystem {
   kernels::Kernel kernel_ = kernels::Best();
   std::optional<Diagnostic> fault_;
   std::atomic<bool> faulted_{false};
+  // The lowest index of a particle whose contacts were unresolved, or SIZE_MAX.
+  std::atomic<size_t> unresolved_{SIZE_MAX};
 };
 
 }  // namespace sylva::particles

@@ -421,71 +421,189 @@ bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n) const {
 
 // --- contact response ---
 
+namespace {
+
+// The first time t in [0, T] where d0 + b t + c t^2 / 2 reaches 0, given
+// d0 > 0 and d(T) < 0 (so there is exactly one root in between); the
+// stable form of the quadratic formula, clamped against rounding.
+double FirstRoot(double d0, double b, double c, double T) {
+  const double A = 0.5 * c;
+  double t;
+  if (std::abs(A) * T <= 1e-12 * std::abs(b)) {
+    t = -d0 / b;
+  } else {
+    const double disc = std::max(0.0, b * b - 4 * A * d0);
+    const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+    const double r0 = q / A, r1 = q != 0 ? d0 / q : r0;
+    // The smaller root in [0, T] (the other lies outside it).
+    t = (r0 >= 0 && r0 <= T) ? r0 : r1;
+    if (r0 >= 0 && r0 <= T && r1 >= 0 && r1 <= T) t = std::min(r0, r1);
+  }
+  return std::clamp(std::isfinite(t) ? t : 0.0, 0.0, T);
+}
+
+// Removes the inward part of u against a resting contact of normal n and
+// against the earlier resting contacts of the step: u ends tangent to all
+// (along their crease, or zero in a corner of three).
+Vec3 Tangent(const Vec3& u, const Vec3& n, const Vec3* earlier, int count) {
+  Vec3 out = u - std::min(u.dot(n), 0.0) * n;
+  for (int k = 0; k < count; ++k) {
+    const Vec3& m = earlier[k];
+    if (out.dot(m) >= 0) continue;
+    const Vec3 crease = n.cross(m);
+    const double c2 = crease.squaredNorm();
+    if (c2 < 1e-24) {  // parallel surfaces: both normals agree
+      out -= out.dot(m) * m;
+      continue;
+    }
+    out = crease * (u.dot(crease) / c2);
+    for (int j = 0; j < count; ++j) {
+      if (out.dot(earlier[j]) < -1e-12 * out.norm()) return Vec3::Zero();  // a corner
+    }
+    return out;
+  }
+  return out;
+}
+
+}  // namespace
+
 ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
                                  Vec3& v, double h) {
-  Vec3 dv = v - va;  // velocity change from the forces over the segment
+  // The step as a path of constant acceleration acc from a, through x at
+  // t = h: p(t) = a + t w + t^2 acc / 2. The integrator's end velocity
+  // differs from the path's by a constant offset (symplectic Euler's v is
+  // the path's velocity half a step later: offset -h acc / 2), which the
+  // contacts leave alone. So a bounce reflects the path's own velocity at
+  // the time of impact, and at restitution 1 keeps the energy the
+  // integrator conserves.
+  const Vec3 forces = (v - va) / h;  // the acceleration the forces give this step
+  Vec3 acc = forces;
+  Vec3 w = (x - a) / h - 0.5 * h * acc;
+  Vec3 offset = v - (w + h * acc);
   double rem = h;
   int contacts = 0;
-  for (int iter = 0; iter < 4; ++iter) {
+  // Resting contacts of this step: their normals and colliders.
+  Vec3 resting[2], restingPoint[2];
+  const Collider* restingOn[2] = {nullptr, nullptr};
+  int restingCount = 0;
+  bool grazed = false;
+  for (;;) {
     Contact best;
     best.s = 2;
     const Collider* hit = nullptr;
+    const double tol = 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff());
+    const double wtol = 1e-12 * std::max(1.0, w.cwiseAbs().maxCoeff());
     for (const Collider& c : colliders) {
       Contact ct;
-      if (c.Intersect(a, x, &ct) && ct.s < best.s) {
-        best = ct;
-        hit = &c;
+      if (!c.Intersect(a, x, &ct) || ct.s >= best.s) continue;
+      // A path that starts on the surface and stays on it within rounding
+      // (sliding along it, or along a crease) meets nothing: the projection
+      // below puts its end exactly on the surface.
+      if (ct.normal.dot(ct.point - x) <= tol && w.dot(ct.normal) >= -wtol) {
+        grazed = true;
+        continue;
       }
+      // A sphere the particle rests on this step: the path left along its
+      // tangent, which the surface bends away from; the projection below
+      // puts the end back on it.
+      if (c.kind == Collider::Kind::kSphere && (&c == restingOn[0] || &c == restingOn[1])) {
+        grazed = true;
+        continue;
+      }
+      best = ct;
+      hit = &c;
     }
     if (!hit) break;
-    ++contacts;
     const Vec3& n = best.normal;
-    const Vec3 vc = va + best.s * dv;  // velocity at contact
-    const double tRest = (1 - best.s) * rem;
-    const Vec3 restDv = (1 - best.s) * dv;
+    if (++contacts > kMaxContacts) {
+      // Stopped at its last contact point, which is on a surface.
+      x = a;
+      v = Vec3::Zero();
+      return ContactOutcome::kUnresolved;
+    }
+    // Time of impact along the path. On a flat face (plane, polygon, box,
+    // triangle) it is exact: the root of the path against the face's
+    // plane; on a sphere, the chord's fraction of the remaining time.
+    double t = best.s * rem;
+    Vec3 point = best.point;
+    if (hit->kind != Collider::Kind::kSphere && best.s > 0) {
+      const double d0 = n.dot(a - point), d1 = n.dot(x - point);
+      if (d0 > 0 && d1 < 0) {
+        t = FirstRoot(d0, n.dot(w), n.dot(acc), rem);
+        point = a + t * w + (0.5 * t * t) * acc;
+        point -= n.dot(point - best.point) * n;  // on the face (its skin, if thin)
+      }
+    }
+    const Vec3 wc = w + t * acc;  // the path's velocity at the contact
+    const double r = rem - t;
     if (hit->response == Response::kKill) {
-      x = best.point;
-      v = vc;
+      x = point;
+      v = wc + offset;
       return ContactOutcome::kKilled;
     }
     if (hit->response == Response::kStick) {
-      x = best.point;
+      x = point;
       v = Vec3::Zero();
       return ContactOutcome::kStuck;
     }
-    const double vn = vc.dot(n);
+    const double vn = wc.dot(n);
     const double approach = -vn;
-    // Speed gained toward the surface over the rest of the segment: a
-    // slower approach is resting or sliding contact, not a bounce.
-    const double gained = std::max(0.0, -dv.dot(n));
-    Vec3 out;
-    if (approach > gained) {
+    // Speed a step gains toward the surface: a slower approach is resting
+    // or sliding contact, not a bounce.
+    const double gained = std::max(0.0, -h * forces.dot(n));
+    // A contact where a resting contact of this step left the particle
+    // touches two surfaces at once: it rests on both (slides along their
+    // crease). Past kInelasticContacts contacts in one step the particle is
+    // caught in a crevice (an inelastic particle in a wedge would bounce
+    // without end, nearer and nearer its crease): every further contact is
+    // resting or sliding, which ends on the crease.
+    const bool twoSurfaces = best.s == 0 && restingCount > 0;
+    if (twoSurfaces) {
+      // On both surfaces: the point of their crease nearest the particle
+      // (projecting on each in turn would only approach it).
+      const Vec3& m = resting[restingCount - 1];
+      const double c = n.dot(m), det = 1 - c * c;
+      if (det > 1e-12) {
+        const double pn = n.dot(best.point - a), pm = m.dot(restingPoint[restingCount - 1] - a);
+        const double alpha = (pn - c * pm) / det, beta = (pm - c * pn) / det;
+        point = a + alpha * n + beta * m;
+      }
+    }
+    if (approach > gained && !twoSurfaces && contacts <= kInelasticContacts) {
       // Bounce: reverse the normal speed times e; Coulomb friction takes at
       // most mu times the normal impulse from the tangential speed.
       const double jn = (1 + hit->restitution) * approach;
-      out = Friction(vc - vn * n, hit->friction * jn) + hit->restitution * approach * n;
-      x = best.point + tRest * (out + 0.5 * restDv);
-      v = out + restDv;
-      va = out;
-      dv = restDv;
+      w = Friction(wc - vn * n, hit->friction * jn) + hit->restitution * approach * n;
+      x = point + r * w + (0.5 * r * r) * acc;
+      v = w + r * acc + offset;
     } else {
       // Resting or sliding: the surface removes the inward normal velocity
-      // the step would end with (its impulse is what gravity pressed in),
-      // and friction removes up to mu times that from the tangential one.
-      const Vec3 end = vc + restDv;
+      // the step would end with (its impulse is what the forces pressed
+      // in), and friction removes up to mu times that from the tangential
+      // one. Against earlier resting contacts of this step, the velocity
+      // slides along their crease.
+      const Vec3 end = v;
       const double en = end.dot(n);
       const double jn = std::max(0.0, -en);
-      out = Friction(end - en * n, hit->friction * jn) + std::max(en, 0.0) * n;
-      x = best.point + tRest * out;
+      Vec3 out = Tangent(end, n, resting, restingCount);
+      const Vec3 along = out - std::max(out.dot(n), 0.0) * n;
+      out = Friction(along, hit->friction * jn) + (out - along);
+      if (restingCount < 2) {
+        resting[restingCount] = n;
+        restingPoint[restingCount] = point;
+        restingOn[restingCount++] = hit;
+      }
+      x = point + r * out;
       v = out;
-      va = out;
-      dv = Vec3::Zero();
+      w = out;
+      acc = Vec3::Zero();
+      offset = Vec3::Zero();
     }
-    a = best.point;
-    rem = tRest;
+    a = point;
+    rem = r;
   }
   // Never leave a particle inside a solid.
-  if (contacts == 0) return ContactOutcome::kNone;
+  if (contacts == 0 && !grazed) return ContactOutcome::kNone;
   for (const Collider& c : colliders) {
     Vec3 sp, sn;
     if (c.Project(x, &sp, &sn)) {

@@ -360,6 +360,14 @@ uint64_t System::Hash() const {
     case ContactOutcome::kStuck:
       state.invMass[i] = 0;
       break;
+    case ContactOutcome::kUnresolved: {
+      // The lowest index wins, whatever the thread count.
+      size_t seen = unresolved_.load(std::memory_order_relaxed);
+      while (i < seen && !unresolved_.compare_exchange_weak(seen, i)) {
+      }
+      faulted_.store(true, std::memory_order_relaxed);
+      break;
+    }
     case ContactOutcome::kNone:
     case ContactOutcome::kResponded:
       break;
@@ -399,8 +407,26 @@ Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32
   return d;
 }
 
+Diagnostic UnresolvedContactDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
+                                       const Vec3& x) {
+  std::ostringstream o;
+  o << "particles: " << what << " step " << step << " (from t = " << t << " s): particle id " << id
+    << " still met a collider after " << kMaxContacts
+    << " contacts in one step (a crevice narrower than the step resolves); it was stopped at its "
+       "last contact point "
+    << Format(x) << "; try a smaller step";
+  Diagnostic d = MakeError({}, o.str());
+  d.kind = ErrorKind::kRuntime;
+  return d;
+}
+
 Status System::CheckFaults(const char* what) {
   if (!faulted_.load()) return {};
+  if (const size_t i = unresolved_.exchange(SIZE_MAX); i != SIZE_MAX) {
+    fault_ =
+        UnresolvedContactDiagnostic(what, state.step, state.time, state.id[i], state.position[i]);
+    return *fault_;
+  }
   for (size_t i = 0; i < state.size(); ++i) {
     const Vec3 &x = state.position[i], &v = state.velocity[i];
     if (WithinLimit(x, v, maxMagnitude)) continue;

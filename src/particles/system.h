@@ -337,6 +337,8 @@ class System {
   std::vector<size_t> pinned_;  // and its immovable particles
   kernels::Kernel kernel_ = kernels::Best();
   std::atomic<bool> faulted_{false};  // set by Finish, read by CheckFaults
+  // The lowest index of a particle whose contacts were unresolved, or SIZE_MAX.
+  std::atomic<size_t> unresolved_{SIZE_MAX};
 };
 
 // Whether every component of x and v lies in [-limit, limit]. NaN fails:
@@ -353,5 +355,9 @@ inline bool WithinLimit(const Vec3& x, const Vec3& v, double limit) {
 // particle's id, position and velocity.
 Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
                                const Vec3& x, const Vec3& v, double limit);
+// The report of a particle whose contacts RespondToContacts left unresolved
+// (ContactOutcome::kUnresolved), stopped at x.
+Diagnostic UnresolvedContactDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
+                                       const Vec3& x);
 
 }  // namespace sylva::particles
