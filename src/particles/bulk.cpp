@@ -21,10 +21,11 @@ Vec3f Round(const Vec3& x) {
 
 // x rounded to single precision on the side of every collider that x (the
 // double-precision contact response) is on: rounding a point on a surface
-// may move it across (thin panels and meshes have a skin of only 1e-9
-// relative), and a particle must never end a step behind a surface. A
-// rounded point that crosses one is pushed off it along the contact normal
-// by a few single-precision ulps and rounded again.
+// may move it across or onto it (thin panels and meshes have a skin of only
+// 1e-9 relative), and a particle must never end a step behind a surface, nor
+// on a thin one, where the next step could not tell its side. A rounded
+// point that crosses or touches one is pushed off it along the contact
+// normal by a few single-precision ulps and rounded again.
 Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x) {
   Vec3f xf = Round(x);
   const double skin = 4 * double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
@@ -32,10 +33,14 @@ Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x) {
   for (int tries = 0; tries < 4; ++tries) {
     const Vec3 r = xf.cast<double>();
     if (r == x) return xf;
+    // The rounding's displacement, doubled: a rounded point exactly on a
+    // thin surface counts as across it (from there a path could leave on
+    // either side).
+    const Vec3 beyond = r + (r - x);
     bool crossed = false;
     for (const Collider& c : colliders) {
       Contact ct;
-      if (c.Intersect(x, r, &ct)) {
+      if (c.Intersect(x, beyond, &ct)) {
         base += skin * ct.normal;
         xf = Round(base);
         crossed = true;
