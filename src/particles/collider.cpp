@@ -15,7 +15,7 @@ Vec3 Skin(const Vec3& p, const Vec3& n) {
   return p + n * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff()));
 }
 
-Vec3 Friction(const Vec3& vt, double maxChange) {
+[[gnu::always_inline]] inline Vec3 Friction(const Vec3& vt, double maxChange) {
   const double len = vt.norm();
   if (len <= maxChange) return Vec3::Zero();
   return vt * (1 - maxChange / len);
@@ -426,7 +426,7 @@ namespace {
 // The first time t in [0, T] where d0 + b t + c t^2 / 2 reaches 0, given
 // d0 > 0 and d(T) < 0 (so there is exactly one root in between); the
 // stable form of the quadratic formula, clamped against rounding.
-double FirstRoot(double d0, double b, double c, double T) {
+[[gnu::noinline]] double FirstRoot(double d0, double b, double c, double T) {
   const double A = 0.5 * c;
   double t;
   if (std::abs(A) * T <= 1e-12 * std::abs(b)) {
@@ -445,7 +445,7 @@ double FirstRoot(double d0, double b, double c, double T) {
 // Removes the inward part of u against a resting contact of normal n and
 // against the earlier resting contacts of the step: u ends tangent to all
 // (along their crease, or zero in a corner of three).
-Vec3 Tangent(const Vec3& u, const Vec3& n, const Vec3* earlier, int count) {
+[[gnu::noinline]] Vec3 Tangent(const Vec3& u, const Vec3& n, const Vec3* earlier, int count) {
   Vec3 out = u - std::min(u.dot(n), 0.0) * n;
   for (int k = 0; k < count; ++k) {
     const Vec3& m = earlier[k];
@@ -465,24 +465,37 @@ Vec3 Tangent(const Vec3& u, const Vec3& n, const Vec3* earlier, int count) {
   return out;
 }
 
+// On two surfaces at once (normals n and m, through pn and pm): the point of
+// their crease nearest a (projecting on each in turn would only approach
+// it); `fallback` if they are parallel.
+[[gnu::noinline]] Vec3 CreasePoint(const Vec3& a, const Vec3& n, const Vec3& pn, const Vec3& m,
+                                   const Vec3& pm, const Vec3& fallback) {
+  const double c = n.dot(m), det = 1 - c * c;
+  if (!(det > 1e-12)) return fallback;
+  const double dn = n.dot(pn - a), dm = m.dot(pm - a);
+  return a + ((dn - c * dm) / det) * n + ((dm - c * dn) / det) * m;
+}
+
 }  // namespace
 
 ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
                                  Vec3& v, double h) {
-  // The step as a path of constant acceleration acc from a, through x at
-  // t = h: p(t) = a + t w + t^2 acc / 2. The integrator's end velocity
-  // differs from the path's by a constant offset (symplectic Euler's v is
-  // the path's velocity half a step later: offset -h acc / 2), which the
-  // contacts leave alone. So a bounce reflects the path's own velocity at
-  // the time of impact, and at restitution 1 keeps the energy the
-  // integrator conserves.
-  const Vec3 forces = (v - va) / h;  // the acceleration the forces give this step
-  Vec3 acc = forces;
-  Vec3 w = (x - a) / h - 0.5 * h * acc;
-  Vec3 offset = v - (w + h * acc);
-  double rem = h;
+  // The step as a path of constant acceleration from a, through x at its
+  // end: p(tau) = a + tau u + tau^2 A / 2 for tau = t / h in [0, 1], with
+  // u = h w (w the path's velocity at a) and A = h^2 acc, so that nothing
+  // here divides by h until a bounce needs the velocity back. The
+  // integrator's end velocity differs from the path's by a constant offset
+  // (symplectic Euler's v is the path's velocity half a step later: offset
+  // -h acc / 2), which the contacts leave alone. So a bounce reflects the
+  // path's own velocity at the time of impact, and at restitution 1 keeps
+  // the energy the integrator conserves.
+  const Vec3 dv = v - va;  // what the forces give over the step (h acc)
+  Vec3 A = h * dv;
+  Vec3 u = (x - a) - 0.5 * A;
+  Vec3 hOffset = h * v - (u + A);  // h times the offset
+  double rem = 1;                  // of the step, as a fraction of h
   int contacts = 0;
-  // Resting contacts of this step: their normals and colliders.
+  // Resting contacts of this step: their normals, points and colliders.
   Vec3 resting[2], restingPoint[2];
   const Collider* restingOn[2] = {nullptr, nullptr};
   int restingCount = 0;
@@ -491,15 +504,14 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     Contact best;
     best.s = 2;
     const Collider* hit = nullptr;
-    const double tol = 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff());
-    const double wtol = 1e-12 * std::max(1.0, w.cwiseAbs().maxCoeff());
     for (const Collider& c : colliders) {
       Contact ct;
       if (!c.Intersect(a, x, &ct) || ct.s >= best.s) continue;
       // A path that starts on the surface and stays on it within rounding
       // (sliding along it, or along a crease) meets nothing: the projection
       // below puts its end exactly on the surface.
-      if (ct.normal.dot(ct.point - x) <= tol && w.dot(ct.normal) >= -wtol) {
+      if (ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
+          u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff())) {
         grazed = true;
         continue;
       }
@@ -515,7 +527,7 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     }
     if (!hit) break;
     const Vec3& n = best.normal;
-    if (++contacts > kMaxContacts) {
+    if (++contacts > kMaxContacts) [[unlikely]] {
       // Stopped at its last contact point, which is on a surface.
       x = a;
       v = Vec3::Zero();
@@ -524,33 +536,32 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     // Time of impact along the path. On a flat face (plane, polygon, box,
     // triangle) it is exact: the root of the path against the face's
     // plane; on a sphere, the chord's fraction of the remaining time.
-    double t = best.s * rem;
+    double tau = best.s * rem;
     Vec3 point = best.point;
     if (hit->kind != Collider::Kind::kSphere && best.s > 0) {
       const double d0 = n.dot(a - point), d1 = n.dot(x - point);
       if (d0 > 0 && d1 < 0) {
-        t = FirstRoot(d0, n.dot(w), n.dot(acc), rem);
-        point = a + t * w + (0.5 * t * t) * acc;
+        tau = FirstRoot(d0, n.dot(u), n.dot(A), rem);
+        point = a + tau * u + (0.5 * tau * tau) * A;
         point -= n.dot(point - best.point) * n;  // on the face (its skin, if thin)
       }
     }
-    const Vec3 wc = w + t * acc;  // the path's velocity at the contact
-    const double r = rem - t;
-    if (hit->response == Response::kKill) {
+    const Vec3 uc = u + tau * A;  // h times the path's velocity at the contact
+    const double r = rem - tau;
+    if (hit->response == Response::kKill) [[unlikely]] {
       x = point;
-      v = wc + offset;
+      v = (uc + hOffset) * (1 / h);
       return ContactOutcome::kKilled;
     }
-    if (hit->response == Response::kStick) {
+    if (hit->response == Response::kStick) [[unlikely]] {
       x = point;
       v = Vec3::Zero();
       return ContactOutcome::kStuck;
     }
-    const double vn = wc.dot(n);
-    const double approach = -vn;
-    // Speed a step gains toward the surface: a slower approach is resting
-    // or sliding contact, not a bounce.
-    const double gained = std::max(0.0, -h * forces.dot(n));
+    const double un = uc.dot(n);
+    // Speed a step gains toward the surface (times h): a slower approach is
+    // resting or sliding contact, not a bounce.
+    const double gained = std::max(0.0, -h * dv.dot(n));
     // A contact where a resting contact of this step left the particle
     // touches two surfaces at once: it rests on both (slides along their
     // crease). Past kInelasticContacts contacts in one step the particle is
@@ -558,24 +569,18 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     // without end, nearer and nearer its crease): every further contact is
     // resting or sliding, which ends on the crease.
     const bool twoSurfaces = best.s == 0 && restingCount > 0;
-    if (twoSurfaces) {
-      // On both surfaces: the point of their crease nearest the particle
-      // (projecting on each in turn would only approach it).
-      const Vec3& m = resting[restingCount - 1];
-      const double c = n.dot(m), det = 1 - c * c;
-      if (det > 1e-12) {
-        const double pn = n.dot(best.point - a), pm = m.dot(restingPoint[restingCount - 1] - a);
-        const double alpha = (pn - c * pm) / det, beta = (pm - c * pn) / det;
-        point = a + alpha * n + beta * m;
-      }
+    if (twoSurfaces) [[unlikely]] {
+      point = CreasePoint(a, n, best.point, resting[restingCount - 1],
+                          restingPoint[restingCount - 1], point);
     }
-    if (approach > gained && !twoSurfaces && contacts <= kInelasticContacts) {
+    if (-un > gained && !twoSurfaces && contacts <= kInelasticContacts) {
       // Bounce: reverse the normal speed times e; Coulomb friction takes at
-      // most mu times the normal impulse from the tangential speed.
-      const double jn = (1 + hit->restitution) * approach;
-      w = Friction(wc - vn * n, hit->friction * jn) + hit->restitution * approach * n;
-      x = point + r * w + (0.5 * r * r) * acc;
-      v = w + r * acc + offset;
+      // most mu times the normal impulse from the tangential speed (all
+      // scaled by h, which Friction is indifferent to).
+      const double jn = (1 + hit->restitution) * -un;
+      u = Friction(uc - un * n, hit->friction * jn) + hit->restitution * -un * n;
+      x = point + r * u + (0.5 * r * r) * A;
+      v = (u + r * A + hOffset) * (1 / h);
     } else {
       // Resting or sliding: the surface removes the inward normal velocity
       // the step would end with (its impulse is what the forces pressed
@@ -585,19 +590,24 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
       const Vec3 end = v;
       const double en = end.dot(n);
       const double jn = std::max(0.0, -en);
-      Vec3 out = Tangent(end, n, resting, restingCount);
-      const Vec3 along = out - std::max(out.dot(n), 0.0) * n;
-      out = Friction(along, hit->friction * jn) + (out - along);
+      Vec3 out;
+      if (restingCount == 0) {
+        out = Friction(end - en * n, hit->friction * jn) + std::max(en, 0.0) * n;
+      } else {
+        out = Tangent(end, n, resting, restingCount);
+        const Vec3 along = out - std::max(out.dot(n), 0.0) * n;
+        out = Friction(along, hit->friction * jn) + (out - along);
+      }
       if (restingCount < 2) {
         resting[restingCount] = n;
         restingPoint[restingCount] = point;
         restingOn[restingCount++] = hit;
       }
-      x = point + r * out;
+      u = h * out;
+      x = point + r * u;
       v = out;
-      w = out;
-      acc = Vec3::Zero();
-      offset = Vec3::Zero();
+      A = Vec3::Zero();
+      hOffset = Vec3::Zero();
     }
     a = point;
     rem = r;

@@ -388,7 +388,7 @@ uint64_t System::Hash() const {
     }
   }
   state.age[i] += h;
-  if (!WithinLimit(x1, v1, maxMagnitude)) faulted_.store(true, std::memory_order_relaxed);
+  if (!MaybeWithinLimit(x1, v1, limit2_)) faulted_.store(true, std::memory_order_relaxed);
   state.position[i] = x1;
   state.velocity[i] = v1;
 }
@@ -463,6 +463,7 @@ Status System::CheckStep(const char* what, double h) const {
 Status System::Step(double h, Integrator integrator) {
   if (fault_) return *fault_;
   SYLVA_CHECK_OK(CheckStep("System.Step h", h));
+  limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
   const size_t n = state.size();
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
@@ -751,6 +752,7 @@ void System::ParticleCollisions() {
 Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats* stats) {
   if (fault_) return *fault_;
   SYLVA_CHECK_OK(CheckStep("System.StepAdaptive dt", dt));
+  limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.rtol", opt.rtol, 0, 1));
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.atol", opt.atol, 0, 1e12));
   if (!(opt.rtol > 0 || opt.atol > 0))

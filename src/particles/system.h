@@ -337,6 +337,7 @@ class System {
   std::vector<size_t> pinned_;  // and its immovable particles
   kernels::Kernel kernel_ = kernels::Best();
   std::atomic<bool> faulted_{false};  // set by Finish, read by CheckFaults
+  double limit2_ = 0;                 // maxMagnitude squared (at most DBL_MAX), for Finish
   // The lowest index of a particle whose contacts were unresolved, or SIZE_MAX.
   std::atomic<size_t> unresolved_{SIZE_MAX};
 };
@@ -348,6 +349,15 @@ inline bool WithinLimit(const Vec3& x, const Vec3& v, double limit) {
   bool ok = true;
   for (int k = 0; k < 3; ++k) ok &= std::abs(x[k]) <= limit && std::abs(v[k]) <= limit;
   return ok;
+}
+
+// A cheap screen for WithinLimit in the per-particle loops: false whenever
+// WithinLimit is (a NaN or infinity makes the sum NaN or infinite, a
+// component beyond the limit makes it exceed limit2), and rarely otherwise;
+// the fault scan then applies WithinLimit itself. limit2 is the limit
+// squared, at most DBL_MAX.
+inline bool MaybeWithinLimit(const Vec3& x, const Vec3& v, double limit2) {
+  return x.squaredNorm() + v.squaredNorm() <= limit2;
 }
 
 // The report of a particle whose position or velocity left the limit (or is
