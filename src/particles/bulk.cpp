@@ -151,7 +151,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       const Vec3f xf = RoundOutside(colliders_, x);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
-      if (!WithinLimit(xf.cast<double>(), v, maxMagnitude))
+      if (!MaybeWithinLimit(xf.cast<double>(), v, limit2_))
         faulted_.store(true, std::memory_order_relaxed);
     }
   }
@@ -192,6 +192,7 @@ Status BulkSystem::Step(double h) {
                               float(h),
                               limit};
   faulted_ = false;
+  limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
   const size_t n = state.size();
   // Ranges of whole chunks, a few a thread.
   const size_t grain =

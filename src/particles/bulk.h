@@ -145,6 +145,7 @@ class BulkSystem {
   kernels::Kernel kernel_ = kernels::Best();
   std::optional<Diagnostic> fault_;
   std::atomic<bool> faulted_{false};
+  double limit2_ = 0;  // maxMagnitude squared (at most DBL_MAX), the contact path's fault screen
   // The lowest index of a particle whose contacts were unresolved, or SIZE_MAX.
   std::atomic<size_t> unresolved_{SIZE_MAX};
 };

@@ -476,6 +476,52 @@ namespace {
   return a + ((dn - c * dm) / det) * n + ((dm - c * dn) / det) * m;
 }
 
+// The first contact on the chord a -> x that the response must handle
+// (null if none), skipping what needs none: a path that starts on the
+// surface and stays on it within rounding (sliding along it, or along a
+// crease; *grazed is set, and the final projection puts its end exactly on
+// the surface), and a sphere the particle rests on this step (the path left
+// along its tangent, which the surface bends away from; the projection puts
+// the end back on it). u is h times the path's velocity at a.
+[[gnu::always_inline]] inline const Collider* FindContact(const std::vector<Collider>& colliders,
+                                                          const Vec3& a, const Vec3& x,
+                                                          const Vec3& u,
+                                                          const Collider* const* restingOn,
+                                                          Contact* best, bool* grazed) {
+  best->s = 2;
+  const Collider* hit = nullptr;
+  for (const Collider& c : colliders) {
+    Contact ct;
+    if (!c.Intersect(a, x, &ct) || ct.s >= best->s) continue;
+    if (ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
+        u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff())) {
+      *grazed = true;
+      continue;
+    }
+    if (c.kind == Collider::Kind::kSphere && (&c == restingOn[0] || &c == restingOn[1])) {
+      *grazed = true;
+      continue;
+    }
+    *best = ct;
+    hit = &c;
+  }
+  return hit;
+}
+
+// Projects x out of every half-space solid it ended in, removing the
+// velocity into it.
+[[gnu::always_inline]] inline void ProjectOut(const std::vector<Collider>& colliders, Vec3& x,
+                                              Vec3& v) {
+  for (const Collider& c : colliders) {
+    Vec3 sp, sn;
+    if (c.Project(x, &sp, &sn)) {
+      x = sp;
+      const double vn = v.dot(sn);
+      if (vn < 0) v -= vn * sn;
+    }
+  }
+}
+
 }  // namespace
 
 ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
@@ -492,6 +538,39 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
   const Vec3 dv = v - va;  // what the forces give over the step (h acc)
   Vec3 A = h * dv;
   Vec3 u = (x - a) - 0.5 * A;
+  // The common case first, a particle lying on a surface: one resting
+  // contact at the start of the step and nothing more on its path. The
+  // same operations as the loop below takes for it, without its
+  // bookkeeping; anything else goes to the loop.
+  {
+    const Collider* none[2] = {nullptr, nullptr};
+    Contact c0;
+    bool grazed0 = false;
+    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0);
+    if (!hit) {
+      if (!grazed0) return ContactOutcome::kNone;
+      ProjectOut(colliders, x, v);
+      return ContactOutcome::kResponded;
+    }
+    const Vec3& n = c0.normal;
+    if (c0.s == 0 && hit->response == Response::kBounce &&
+        !(-u.dot(n) > std::max(0.0, -h * dv.dot(n)))) {
+      const double en = v.dot(n);
+      const double jn = std::max(0.0, -en);
+      const Vec3 out = Friction(v - en * n, hit->friction * jn) + std::max(en, 0.0) * n;
+      const Vec3 u1 = h * out;
+      const Vec3 x1 = c0.point + u1;
+      const Collider* resting0[2] = {hit, nullptr};
+      Contact c1;
+      bool grazed1 = false;
+      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1)) {
+        x = x1;
+        v = out;
+        ProjectOut(colliders, x, v);
+        return ContactOutcome::kResponded;
+      }
+    }
+  }
   Vec3 hOffset = h * v - (u + A);  // h times the offset
   double rem = 1;                  // of the step, as a fraction of h
   int contacts = 0;
@@ -502,29 +581,7 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
   bool grazed = false;
   for (;;) {
     Contact best;
-    best.s = 2;
-    const Collider* hit = nullptr;
-    for (const Collider& c : colliders) {
-      Contact ct;
-      if (!c.Intersect(a, x, &ct) || ct.s >= best.s) continue;
-      // A path that starts on the surface and stays on it within rounding
-      // (sliding along it, or along a crease) meets nothing: the projection
-      // below puts its end exactly on the surface.
-      if (ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
-          u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff())) {
-        grazed = true;
-        continue;
-      }
-      // A sphere the particle rests on this step: the path left along its
-      // tangent, which the surface bends away from; the projection below
-      // puts the end back on it.
-      if (c.kind == Collider::Kind::kSphere && (&c == restingOn[0] || &c == restingOn[1])) {
-        grazed = true;
-        continue;
-      }
-      best = ct;
-      hit = &c;
-    }
+    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed);
     if (!hit) break;
     const Vec3& n = best.normal;
     if (++contacts > kMaxContacts) [[unlikely]] {
@@ -614,14 +671,7 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
   }
   // Never leave a particle inside a solid.
   if (contacts == 0 && !grazed) return ContactOutcome::kNone;
-  for (const Collider& c : colliders) {
-    Vec3 sp, sn;
-    if (c.Project(x, &sp, &sn)) {
-      x = sp;
-      const double vn = v.dot(sn);
-      if (vn < 0) v -= vn * sn;
-    }
-  }
+  ProjectOut(colliders, x, v);
   return ContactOutcome::kResponded;
 }
 
