@@ -18,9 +18,13 @@
 // is written by exactly one thread in an order fixed by the particle index,
 // so a run is bit-identical whatever the thread count.
 //
-// Faults. A step that leaves a non-finite value or a coordinate or speed
-// beyond `System::maxMagnitude` returns an error naming the step and the
-// particle id; the system then refuses to step again.
+// Faults. A step that leaves a non-finite value (in any of x, y, z of a
+// position or velocity) or a coordinate or speed beyond
+// `System::maxMagnitude`, or a particle whose contacts are still unresolved
+// after kMaxContacts (collider.h), returns an error naming the step and the
+// particle id; the system then refuses to step again. Implicit Euler also
+// reports a system that is not positive definite (nothing moves; a smaller
+// step may succeed).
 #pragma once
 
 #include <array>
@@ -287,6 +291,7 @@ class System {
   // h in (0, 1e6] s (NaN, 0, negative: a Diagnostic, nothing moves); the
   // settings above (maxMagnitude 1e-300..1e300, cgTolerance 0..1,
   // cgMaxIterations 1..1e7) and every force's Check are verified first.
+  // Faults are reported as described at the top of this file.
   [[nodiscard]] Status Step(double h, Integrator integrator);
   // Advances by dt with adaptive Dormand-Prince RK45 substeps: dt as h
   // above; options rtol 0..1, atol 0..1e12 (not both 0), minStep
