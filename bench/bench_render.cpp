@@ -51,7 +51,7 @@ void BM_FrameMillionTrianglePlant(benchmark::State& state) {
   }
   Gl& gl = Context();
   (void)gl.renderer->SetPoints({});  // an empty batch is always valid
-  gl.renderer->SetLines({});
+  (void)gl.renderer->SetLines({});   // an empty batch is always valid
   gl.renderer->SetMesh(m, mesh::DefaultPalette());
   const render::Camera cam = render::Camera::Frame(lo, hi, 16.0 / 9, 30, 12, false);
   for (auto _ : state) {

@@ -97,7 +97,10 @@ int main(int argc, char** argv) {
     std::fputs(st.error().Format().c_str(), stderr);
     return 1;
   }
-  (*renderer)->SetLines(edges);
+  if (Status st = (*renderer)->SetLines(edges); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->Draw(
       render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 480.0 / 360, 30, 20, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {

@@ -84,7 +84,10 @@ int main(int argc, char** argv) {
   for (int step = 0; step * h < seconds; ++step) {
     if (sys.time < seconds * 0.6) {
       const uint32_t first = sys.state.nextId;
-      launcher.Emit(sys.state, h);
+      if (Status st = launcher.Emit(sys.state, h); !st.ok()) {
+        std::fputs(st.error().Format().c_str(), stderr);
+        return 1;
+      }
       for (uint32_t id = first; id < sys.state.nextId; ++id) kind[id] = kRocket;
     }
     if (Status st = sys.Step(h, particles::Integrator::kSymplecticEuler); !st.ok()) {

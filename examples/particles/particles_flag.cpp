@@ -48,7 +48,12 @@ int main(int argc, char** argv) {
   const double h = 1.0 / 60;
   for (int i = 0; i * h < seconds; ++i) {
     const double gust = 1 + 0.4 * std::sin(2.1 * i * h) + 0.2 * std::sin(5.3 * i * h);
-    flag.Step(h, Vec3(0, -9.81, 0), Vec3(7 * gust, 0, 1.5 * std::sin(1.3 * i * h)));
+    const Status st =
+        flag.Step(h, Vec3(0, -9.81, 0), Vec3(7 * gust, 0, 1.5 * std::sin(1.3 * i * h)));
+    if (!st.ok()) {
+      std::fputs(st.error().Format().c_str(), stderr);
+      return 1;
+    }
   }
   double stretch = 0;
   for (const auto& c : flag.constraints()) {

@@ -67,7 +67,10 @@ int main(int argc, char** argv) {
         Vec3(0.6 * std::sin(0.8 * snow.time()), 0, 0.3 * std::cos(0.5 * snow.time()));
     if (int(born.size()) < flakes) {
       const size_t first = born.size();
-      emitter.Emit(born, h);
+      if (Status st = emitter.Emit(born, h); !st.ok()) {
+        std::fputs(st.error().Format().c_str(), stderr);
+        return 1;
+      }
       if (int(born.size()) > flakes) {
         // Keep exactly the requested count.
         for (auto* a : {&born.position, &born.velocity}) a->resize(size_t(flakes));
@@ -145,7 +148,10 @@ int main(int argc, char** argv) {
     std::fputs(st.error().Format().c_str(), stderr);
     return 1;
   }
-  (*renderer)->SetLines(lines);
+  if (Status st = (*renderer)->SetLines(lines); !st.ok()) {
+    std::fputs(st.error().Format().c_str(), stderr);
+    return 1;
+  }
   (*renderer)->Draw(
       render::Camera::Frame(Vec3(-2, 0, -2), Vec3(2, 3, 2), 480.0 / 360, 25, 15, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {

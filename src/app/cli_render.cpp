@@ -210,7 +210,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   t0 = Clock::now();
   if (lines) {
     (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
-    (*renderer)->SetLines(batch);
+    if (Status s = (*renderer)->SetLines(batch); !s.ok()) return Report(s.error(), err);
   } else {
     (*renderer)->SetGround(true);
     // Ground and shadow map fitted to the whole plant, whatever was culled.

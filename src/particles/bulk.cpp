@@ -21,10 +21,11 @@ Vec3f Round(const Vec3& x) {
 
 // x rounded to single precision on the side of every collider that x (the
 // double-precision contact response) is on: rounding a point on a surface
-// may move it across (thin panels and meshes have a skin of only 1e-9
-// relative), and a particle must never end a step behind a surface. A
-// rounded point that crosses one is pushed off it along the contact normal
-// by a few single-precision ulps and rounded again.
+// may move it across or onto it (thin panels and meshes have a skin of only
+// 1e-9 relative), and a particle must never end a step behind a surface, nor
+// on a thin one, where the next step could not tell its side. A rounded
+// point that crosses or touches one is pushed off it along the contact
+// normal by a few single-precision ulps and rounded again.
 Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x) {
   Vec3f xf = Round(x);
   const double skin = 4 * double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
@@ -32,10 +33,14 @@ Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x) {
   for (int tries = 0; tries < 4; ++tries) {
     const Vec3 r = xf.cast<double>();
     if (r == x) return xf;
+    // The rounding's displacement, doubled: a rounded point exactly on a
+    // thin surface counts as across it (from there a path could leave on
+    // either side).
+    const Vec3 beyond = r + (r - x);
     bool crossed = false;
     for (const Collider& c : colliders) {
       Contact ct;
-      if (c.Intersect(x, r, &ct)) {
+      if (c.Intersect(x, beyond, &ct)) {
         base += skin * ct.normal;
         xf = Round(base);
         crossed = true;
@@ -136,11 +141,18 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
         s.lifetime[i] = std::min(s.lifetime[i], life);
       }
       if (out == ContactOutcome::kStuck) s.invMass[i] = 0;
+      if (out == ContactOutcome::kUnresolved) {
+        // The lowest index wins, whatever the thread count.
+        size_t seen = unresolved_.load(std::memory_order_relaxed);
+        while (i < seen && !unresolved_.compare_exchange_weak(seen, i)) {
+        }
+        faulted_.store(true, std::memory_order_relaxed);
+      }
       const Vec3f xf = RoundOutside(colliders_, x);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
-      const double mag = std::max(xf.cast<double>().cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
-      if (!(mag <= maxMagnitude)) faulted_.store(true, std::memory_order_relaxed);
+      if (!MaybeWithinLimit(xf.cast<double>(), v, limit2_))
+        faulted_.store(true, std::memory_order_relaxed);
     }
   }
 }
@@ -180,6 +192,7 @@ Status BulkSystem::Step(double h) {
                               float(h),
                               limit};
   faulted_ = false;
+  limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
   const size_t n = state.size();
   // Ranges of whole chunks, a few a thread.
   const size_t grain =
@@ -194,10 +207,14 @@ Status BulkSystem::Step(double h) {
 
 Status BulkSystem::Fault() {
   if (!faulted_.load()) return {};
+  if (const size_t i = unresolved_.exchange(SIZE_MAX); i != SIZE_MAX) {
+    fault_ =
+        UnresolvedContactDiagnostic("in bulk", steps, state.time, state.id[i], state.position(i));
+    return *fault_;
+  }
   for (size_t i = 0; i < state.size(); ++i) {
     const Vec3 x = state.position(i), v = state.velocity(i);
-    const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
-    if (m <= maxMagnitude) continue;
+    if (WithinLimit(x, v, maxMagnitude)) continue;
     fault_ = ExplosionDiagnostic("in bulk", steps, state.time, state.id[i], x, v, maxMagnitude);
     return *fault_;
   }

@@ -111,9 +111,10 @@ class BulkSystem {
 
   // One symplectic Euler step of length h: fields, integration, collisions,
   // ageing. h in (0, 1e6] s; `fields` and maxMagnitude are checked first
-  // (a Diagnostic, nothing moves). A coordinate or speed beyond maxMagnitude (or not finite) is
-  // reported with the step and the particle's id, and the system then
-  // refuses to step again.
+  // (a Diagnostic, nothing moves). A coordinate or speed beyond maxMagnitude
+  // (or not finite, in any component), or contacts still unresolved after
+  // kMaxContacts, is reported with the step and the particle's id, and the
+  // system then refuses to step again.
   [[nodiscard]] Status Step(double h);
 
   // Appends particles [begin, size) of `born` (an Emitter's output) with
@@ -145,6 +146,9 @@ class BulkSystem {
   kernels::Kernel kernel_ = kernels::Best();
   std::optional<Diagnostic> fault_;
   std::atomic<bool> faulted_{false};
+  double limit2_ = 0;  // maxMagnitude squared (at most DBL_MAX), the contact path's fault screen
+  // The lowest index of a particle whose contacts were unresolved, or SIZE_MAX.
+  std::atomic<size_t> unresolved_{SIZE_MAX};
 };
 
 }  // namespace sylva::particles

@@ -1,6 +1,7 @@
 #include "particles/cloth.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 
@@ -229,23 +230,55 @@ double Cloth::MaxStretch() const {
   return worst;
 }
 
-void Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
+Status Cloth::FindNonFinite(const char* when) {
+  for (size_t i = 0; i < x_.size(); ++i) {
+    if (x_[i].allFinite() && v_[i].allFinite()) continue;
+    const int c = int(i % size_t(def_.columns)), r = int(i / size_t(def_.columns));
+    Diagnostic d = check::Error(
+        check::Cat("cloth: frame ", std::to_string(frames_), ": particle ", std::to_string(i),
+                   " (column ", std::to_string(c), ", row ", std::to_string(r), ") has position ",
+                   check::Vec(x_[i]), " and velocity ", check::Vec(v_[i]), " (not finite) ", when,
+                   " the frame; the cloth refuses further frames"));
+    d.kind = ErrorKind::kRuntime;
+    fault_ = d;
+    return d;
+  }
+  return {};
+}
+
+Status Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
   gravity_ = gravity;
   wind_ = wind;
-  implicit_->state.position = x_;  // the caller may have moved particles
+  SYLVA_CHECK_OK(FindNonFinite("before"));  // the caller may have moved particles
+  implicit_->state.position = x_;
   implicit_->state.velocity = v_;
   const int subs = def_.implicitSubsteps;
   for (int s = 0; s < subs; ++s) {
-    // Cloth is well-behaved input; a fault here is a bug in the set-up.
-    if (!implicit_->Step(dt / subs, Integrator::kImplicitEuler).ok()) break;
+    if (Status st = implicit_->Step(dt / subs, Integrator::kImplicitEuler); !st.ok()) {
+      Diagnostic d = st.error();
+      d.message = "cloth: frame " + std::to_string(frames_) + ", implicit substep " +
+                  std::to_string(s) + ": " + d.message;
+      fault_ = d;
+      return d;
+    }
   }
   x_ = implicit_->state.position;
   v_ = implicit_->state.velocity;
+  return FindNonFinite("after");
 }
 
-void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
-  SYLVA_ASSERT(dt > 0 && dt <= 1e6);
-  if (implicit_) return StepImplicit(dt, gravity, wind);
+Status Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
+  if (fault_) return *fault_;
+  if (!(dt > 0 && dt <= 1e6))
+    return check::Error("Cloth.Step dt " + check::Num(dt) + " is outside (0, 1e+06] s");
+  SYLVA_CHECK_OK(check::Finite("Cloth.Step gravity", gravity, 1e12, "m/s^2"));
+  SYLVA_CHECK_OK(check::Finite("Cloth.Step wind", wind, 1e12, "m/s"));
+  Status st = implicit_ ? StepImplicit(dt, gravity, wind) : StepXpbd(dt, gravity, wind);
+  ++frames_;
+  return st;
+}
+
+Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
   const int subs = def_.substeps;
   const double h = dt / subs;
   const size_t n = x_.size();
@@ -286,14 +319,20 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
                               std::max(0.0, 1 - def_.damping * h)};
   auto pad = [](const Vec3& p) { return xpbd::Point4{{p.x(), p.y(), p.z(), 0}}; };
   const size_t grain = BalancedGrain(pool, n, 512, 4096);
+  // Non-finite particles are flagged as the state is loaded and stored.
+  std::atomic<bool> bad{false};
   ForRanges(pool, n, grain, [&](size_t b, size_t e) {
+    bool ok = true;
     for (size_t i = b; i < e; ++i) {
+      ok &= x_[i].allFinite() & v_[i].allFinite();
       x4_[i] = pad(x_[i]);
       v4_[i] = pad(v_[i]);
       fext4_[i] = pad(fext_[i]);
     }
+    if (!ok) bad.store(true, std::memory_order_relaxed);
     xpbd::PredictRange(parts, b, e);
   });
+  if (bad.load()) return FindNonFinite("before");
   for (int s = 0; s < subs; ++s) {
     for (int it = 0; it < def_.iterations; ++it) {
       // Colour by colour: no two constraints of a colour share a particle,
@@ -318,12 +357,16 @@ void Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
     ForRanges(pool, n, grain, [&](size_t b, size_t e) {
       xpbd::FinishRange(kernel_, parts, !last, b, e);
       if (!last) return;
+      bool ok = true;
       for (size_t i = b; i < e; ++i) {
         x_[i] = Vec3(x4_[i].p[0], x4_[i].p[1], x4_[i].p[2]);
         v_[i] = Vec3(v4_[i].p[0], v4_[i].p[1], v4_[i].p[2]);
+        ok &= x_[i].allFinite() & v_[i].allFinite();
       }
+      if (!ok) bad.store(true, std::memory_order_relaxed);
     });
   }
+  return bad.load() ? FindNonFinite("after") : Status{};
 }
 
 }  // namespace sylva::particles

@@ -35,6 +35,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/math.h"
@@ -89,8 +90,16 @@ class Cloth {
   static Expected<std::unique_ptr<Cloth>> Create(const ClothDef& def);
   Cloth(const Cloth&) = delete;
   Cloth& operator=(const Cloth&) = delete;
-  // One frame of dt seconds, 0 < dt <= 1e6 (asserted: the caller's clock).
-  void Step(double dt, const Vec3& gravity, const Vec3& wind = Vec3::Zero());
+  // One frame of dt seconds. dt in (0, 1e6] s, gravity (m/s^2) and wind
+  // (m/s) each component within +-1e12: otherwise a Diagnostic and nothing
+  // moves. A particle whose position or velocity is not finite, before the
+  // frame (the caller moved it there) or after it, is reported with the
+  // frame number and its index; the cloth then refuses to step again. The
+  // implicit solver's failures (a non-positive-definite system) come back
+  // the same way.
+  [[nodiscard]] Status Step(double dt, const Vec3& gravity, const Vec3& wind = Vec3::Zero());
+  // Frames stepped so far.
+  uint64_t frames() const { return frames_; }
 
   const std::vector<Vec3>& positions() const { return x_; }
   std::vector<Vec3>& mutablePositions() { return x_; }
@@ -110,7 +119,11 @@ class Cloth {
 
  private:
   explicit Cloth(const ClothDef& def);
-  void StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
+  Status StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
+  Status StepXpbd(double dt, const Vec3& gravity, const Vec3& wind);
+  // The fault of the first particle whose position or velocity is not
+  // finite (`when`: before or after the frame), or ok if there is none.
+  Status FindNonFinite(const char* when);
   std::vector<xpbd::Tether> tethers_;  // xpbd::kTethers a particle
   std::vector<size_t> colorStart_;     // constraints_ sorted by colour
   std::unique_ptr<ThreadPool> pool_;
@@ -130,6 +143,8 @@ class Cloth {
   bool lastColourShared_ = false;  // the colouring ran out: its last colour may share particles
   std::vector<double> lambda_;
   std::vector<std::array<uint32_t, 3>> tris_;
+  uint64_t frames_ = 0;
+  std::optional<Diagnostic> fault_;
 };
 
 }  // namespace sylva::particles

@@ -15,7 +15,7 @@ Vec3 Skin(const Vec3& p, const Vec3& n) {
   return p + n * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff()));
 }
 
-Vec3 Friction(const Vec3& vt, double maxChange) {
+[[gnu::always_inline]] inline Vec3 Friction(const Vec3& vt, double maxChange) {
   const double len = vt.norm();
   if (len <= maxChange) return Vec3::Zero();
   return vt * (1 - maxChange / len);
@@ -421,71 +421,97 @@ bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n) const {
 
 // --- contact response ---
 
-ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
-                                 Vec3& v, double h) {
-  Vec3 dv = v - va;  // velocity change from the forces over the segment
-  double rem = h;
-  int contacts = 0;
-  for (int iter = 0; iter < 4; ++iter) {
-    Contact best;
-    best.s = 2;
-    const Collider* hit = nullptr;
-    for (const Collider& c : colliders) {
-      Contact ct;
-      if (c.Intersect(a, x, &ct) && ct.s < best.s) {
-        best = ct;
-        hit = &c;
-      }
-    }
-    if (!hit) break;
-    ++contacts;
-    const Vec3& n = best.normal;
-    const Vec3 vc = va + best.s * dv;  // velocity at contact
-    const double tRest = (1 - best.s) * rem;
-    const Vec3 restDv = (1 - best.s) * dv;
-    if (hit->response == Response::kKill) {
-      x = best.point;
-      v = vc;
-      return ContactOutcome::kKilled;
-    }
-    if (hit->response == Response::kStick) {
-      x = best.point;
-      v = Vec3::Zero();
-      return ContactOutcome::kStuck;
-    }
-    const double vn = vc.dot(n);
-    const double approach = -vn;
-    // Speed gained toward the surface over the rest of the segment: a
-    // slower approach is resting or sliding contact, not a bounce.
-    const double gained = std::max(0.0, -dv.dot(n));
-    Vec3 out;
-    if (approach > gained) {
-      // Bounce: reverse the normal speed times e; Coulomb friction takes at
-      // most mu times the normal impulse from the tangential speed.
-      const double jn = (1 + hit->restitution) * approach;
-      out = Friction(vc - vn * n, hit->friction * jn) + hit->restitution * approach * n;
-      x = best.point + tRest * (out + 0.5 * restDv);
-      v = out + restDv;
-      va = out;
-      dv = restDv;
-    } else {
-      // Resting or sliding: the surface removes the inward normal velocity
-      // the step would end with (its impulse is what gravity pressed in),
-      // and friction removes up to mu times that from the tangential one.
-      const Vec3 end = vc + restDv;
-      const double en = end.dot(n);
-      const double jn = std::max(0.0, -en);
-      out = Friction(end - en * n, hit->friction * jn) + std::max(en, 0.0) * n;
-      x = best.point + tRest * out;
-      v = out;
-      va = out;
-      dv = Vec3::Zero();
-    }
-    a = best.point;
-    rem = tRest;
+namespace {
+
+// The first time t in [0, T] where d0 + b t + c t^2 / 2 reaches 0, given
+// d0 > 0 and d(T) < 0 (so there is exactly one root in between); the
+// stable form of the quadratic formula, clamped against rounding.
+[[gnu::noinline]] double FirstRoot(double d0, double b, double c, double T) {
+  const double A = 0.5 * c;
+  double t;
+  if (std::abs(A) * T <= 1e-12 * std::abs(b)) {
+    t = -d0 / b;
+  } else {
+    const double disc = std::max(0.0, b * b - 4 * A * d0);
+    const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+    const double r0 = q / A, r1 = q != 0 ? d0 / q : r0;
+    // The smaller root in [0, T] (the other lies outside it).
+    t = (r0 >= 0 && r0 <= T) ? r0 : r1;
+    if (r0 >= 0 && r0 <= T && r1 >= 0 && r1 <= T) t = std::min(r0, r1);
   }
-  // Never leave a particle inside a solid.
-  if (contacts == 0) return ContactOutcome::kNone;
+  return std::clamp(std::isfinite(t) ? t : 0.0, 0.0, T);
+}
+
+// Removes the inward part of u against a resting contact of normal n and
+// against the earlier resting contacts of the step: u ends tangent to all
+// (along their crease, or zero in a corner of three).
+[[gnu::noinline]] Vec3 Tangent(const Vec3& u, const Vec3& n, const Vec3* earlier, int count) {
+  Vec3 out = u - std::min(u.dot(n), 0.0) * n;
+  for (int k = 0; k < count; ++k) {
+    const Vec3& m = earlier[k];
+    if (out.dot(m) >= 0) continue;
+    const Vec3 crease = n.cross(m);
+    const double c2 = crease.squaredNorm();
+    if (c2 < 1e-24) {  // parallel surfaces: both normals agree
+      out -= out.dot(m) * m;
+      continue;
+    }
+    out = crease * (u.dot(crease) / c2);
+    for (int j = 0; j < count; ++j) {
+      if (out.dot(earlier[j]) < -1e-12 * out.norm()) return Vec3::Zero();  // a corner
+    }
+    return out;
+  }
+  return out;
+}
+
+// On two surfaces at once (normals n and m, through pn and pm): the point of
+// their crease nearest a (projecting on each in turn would only approach
+// it); `fallback` if they are parallel.
+[[gnu::noinline]] Vec3 CreasePoint(const Vec3& a, const Vec3& n, const Vec3& pn, const Vec3& m,
+                                   const Vec3& pm, const Vec3& fallback) {
+  const double c = n.dot(m), det = 1 - c * c;
+  if (!(det > 1e-12)) return fallback;
+  const double dn = n.dot(pn - a), dm = m.dot(pm - a);
+  return a + ((dn - c * dm) / det) * n + ((dm - c * dn) / det) * m;
+}
+
+// The first contact on the chord a -> x that the response must handle
+// (null if none), skipping what needs none: a path that starts on the
+// surface and stays on it within rounding (sliding along it, or along a
+// crease; *grazed is set, and the final projection puts its end exactly on
+// the surface), and a sphere the particle rests on this step (the path left
+// along its tangent, which the surface bends away from; the projection puts
+// the end back on it). u is h times the path's velocity at a.
+[[gnu::always_inline]] inline const Collider* FindContact(const std::vector<Collider>& colliders,
+                                                          const Vec3& a, const Vec3& x,
+                                                          const Vec3& u,
+                                                          const Collider* const* restingOn,
+                                                          Contact* best, bool* grazed) {
+  best->s = 2;
+  const Collider* hit = nullptr;
+  for (const Collider& c : colliders) {
+    Contact ct;
+    if (!c.Intersect(a, x, &ct) || ct.s >= best->s) continue;
+    if (ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
+        u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff())) {
+      *grazed = true;
+      continue;
+    }
+    if (c.kind == Collider::Kind::kSphere && (&c == restingOn[0] || &c == restingOn[1])) {
+      *grazed = true;
+      continue;
+    }
+    *best = ct;
+    hit = &c;
+  }
+  return hit;
+}
+
+// Projects x out of every half-space solid it ended in, removing the
+// velocity into it.
+[[gnu::always_inline]] inline void ProjectOut(const std::vector<Collider>& colliders, Vec3& x,
+                                              Vec3& v) {
   for (const Collider& c : colliders) {
     Vec3 sp, sn;
     if (c.Project(x, &sp, &sn)) {
@@ -494,6 +520,158 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
       if (vn < 0) v -= vn * sn;
     }
   }
+}
+
+}  // namespace
+
+ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
+                                 Vec3& v, double h) {
+  // The step as a path of constant acceleration from a, through x at its
+  // end: p(tau) = a + tau u + tau^2 A / 2 for tau = t / h in [0, 1], with
+  // u = h w (w the path's velocity at a) and A = h^2 acc, so that nothing
+  // here divides by h until a bounce needs the velocity back. The
+  // integrator's end velocity differs from the path's by a constant offset
+  // (symplectic Euler's v is the path's velocity half a step later: offset
+  // -h acc / 2), which the contacts leave alone. So a bounce reflects the
+  // path's own velocity at the time of impact, and at restitution 1 keeps
+  // the energy the integrator conserves.
+  const Vec3 dv = v - va;  // what the forces give over the step (h acc)
+  Vec3 A = h * dv;
+  Vec3 u = (x - a) - 0.5 * A;
+  // The common case first, a particle lying on a surface: one resting
+  // contact at the start of the step and nothing more on its path. The
+  // same operations as the loop below takes for it, without its
+  // bookkeeping; anything else goes to the loop.
+  {
+    const Collider* none[2] = {nullptr, nullptr};
+    Contact c0;
+    bool grazed0 = false;
+    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0);
+    if (!hit) {
+      if (!grazed0) return ContactOutcome::kNone;
+      ProjectOut(colliders, x, v);
+      return ContactOutcome::kResponded;
+    }
+    const Vec3& n = c0.normal;
+    if (c0.s == 0 && hit->response == Response::kBounce &&
+        !(-u.dot(n) > std::max(0.0, -h * dv.dot(n)))) {
+      const double en = v.dot(n);
+      const double jn = std::max(0.0, -en);
+      const Vec3 out = Friction(v - en * n, hit->friction * jn) + std::max(en, 0.0) * n;
+      const Vec3 u1 = h * out;
+      const Vec3 x1 = c0.point + u1;
+      const Collider* resting0[2] = {hit, nullptr};
+      Contact c1;
+      bool grazed1 = false;
+      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1)) {
+        x = x1;
+        v = out;
+        ProjectOut(colliders, x, v);
+        return ContactOutcome::kResponded;
+      }
+    }
+  }
+  Vec3 hOffset = h * v - (u + A);  // h times the offset
+  double rem = 1;                  // of the step, as a fraction of h
+  int contacts = 0;
+  // Resting contacts of this step: their normals, points and colliders.
+  Vec3 resting[2], restingPoint[2];
+  const Collider* restingOn[2] = {nullptr, nullptr};
+  int restingCount = 0;
+  bool grazed = false;
+  for (;;) {
+    Contact best;
+    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed);
+    if (!hit) break;
+    const Vec3& n = best.normal;
+    if (++contacts > kMaxContacts) [[unlikely]] {
+      // Stopped at its last contact point, which is on a surface.
+      x = a;
+      v = Vec3::Zero();
+      return ContactOutcome::kUnresolved;
+    }
+    // Time of impact along the path. On a flat face (plane, polygon, box,
+    // triangle) it is exact: the root of the path against the face's
+    // plane; on a sphere, the chord's fraction of the remaining time.
+    double tau = best.s * rem;
+    Vec3 point = best.point;
+    if (hit->kind != Collider::Kind::kSphere && best.s > 0) {
+      const double d0 = n.dot(a - point), d1 = n.dot(x - point);
+      if (d0 > 0 && d1 < 0) {
+        tau = FirstRoot(d0, n.dot(u), n.dot(A), rem);
+        point = a + tau * u + (0.5 * tau * tau) * A;
+        point -= n.dot(point - best.point) * n;  // on the face (its skin, if thin)
+      }
+    }
+    const Vec3 uc = u + tau * A;  // h times the path's velocity at the contact
+    const double r = rem - tau;
+    if (hit->response == Response::kKill) [[unlikely]] {
+      x = point;
+      v = (uc + hOffset) * (1 / h);
+      return ContactOutcome::kKilled;
+    }
+    if (hit->response == Response::kStick) [[unlikely]] {
+      x = point;
+      v = Vec3::Zero();
+      return ContactOutcome::kStuck;
+    }
+    const double un = uc.dot(n);
+    // Speed a step gains toward the surface (times h): a slower approach is
+    // resting or sliding contact, not a bounce.
+    const double gained = std::max(0.0, -h * dv.dot(n));
+    // A contact where a resting contact of this step left the particle
+    // touches two surfaces at once: it rests on both (slides along their
+    // crease). Past kInelasticContacts contacts in one step the particle is
+    // caught in a crevice (an inelastic particle in a wedge would bounce
+    // without end, nearer and nearer its crease): every further contact is
+    // resting or sliding, which ends on the crease.
+    const bool twoSurfaces = best.s == 0 && restingCount > 0;
+    if (twoSurfaces) [[unlikely]] {
+      point = CreasePoint(a, n, best.point, resting[restingCount - 1],
+                          restingPoint[restingCount - 1], point);
+    }
+    if (-un > gained && !twoSurfaces && contacts <= kInelasticContacts) {
+      // Bounce: reverse the normal speed times e; Coulomb friction takes at
+      // most mu times the normal impulse from the tangential speed (all
+      // scaled by h, which Friction is indifferent to).
+      const double jn = (1 + hit->restitution) * -un;
+      u = Friction(uc - un * n, hit->friction * jn) + hit->restitution * -un * n;
+      x = point + r * u + (0.5 * r * r) * A;
+      v = (u + r * A + hOffset) * (1 / h);
+    } else {
+      // Resting or sliding: the surface removes the inward normal velocity
+      // the step would end with (its impulse is what the forces pressed
+      // in), and friction removes up to mu times that from the tangential
+      // one. Against earlier resting contacts of this step, the velocity
+      // slides along their crease.
+      const Vec3 end = v;
+      const double en = end.dot(n);
+      const double jn = std::max(0.0, -en);
+      Vec3 out;
+      if (restingCount == 0) {
+        out = Friction(end - en * n, hit->friction * jn) + std::max(en, 0.0) * n;
+      } else {
+        out = Tangent(end, n, resting, restingCount);
+        const Vec3 along = out - std::max(out.dot(n), 0.0) * n;
+        out = Friction(along, hit->friction * jn) + (out - along);
+      }
+      if (restingCount < 2) {
+        resting[restingCount] = n;
+        restingPoint[restingCount] = point;
+        restingOn[restingCount++] = hit;
+      }
+      u = h * out;
+      x = point + r * u;
+      v = out;
+      A = Vec3::Zero();
+      hOffset = Vec3::Zero();
+    }
+    a = point;
+    rem = r;
+  }
+  // Never leave a particle inside a solid.
+  if (contacts == 0 && !grazed) return ContactOutcome::kNone;
+  ProjectOut(colliders, x, v);
   return ContactOutcome::kResponded;
 }
 

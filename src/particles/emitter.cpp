@@ -55,13 +55,18 @@ void Emitter::Spawn(ParticleState& s) {
   s.radius.back() = def_.radiusStart;
 }
 
-int Emitter::Emit(ParticleState& s, double h) {
-  SYLVA_ASSERT(h >= 0 && h <= 1e6 && def_.rate * h < 2147483647.0);
-  carry_ += def_.rate * h;
-  const int n = int(std::floor(carry_ + 1e-9));
-  carry_ -= n;
+Status Emitter::Emit(ParticleState& s, double h) {
+  using namespace check;
+  SYLVA_CHECK_OK(Range("Emitter.Emit h", h, 0, 1e6, "s"));
+  const double due = carry_ + def_.rate * h;
+  if (!(due < 2147483647.0)) {
+    return Error("Emitter.Emit: rate " + Num(def_.rate) + " particles/s for h " + Num(h) +
+                 " s is " + Num(due) + " particles, more than 2^31 - 1 in one call");
+  }
+  const int n = int(std::floor(due + 1e-9));
+  carry_ = due - n;
   for (int i = 0; i < n; ++i) Spawn(s);
-  return n;
+  return {};
 }
 
 void Emitter::Burst(ParticleState& s, int n) {

@@ -35,10 +35,10 @@ class Emitter {
   // An emitter of a valid definition, or the Diagnostic of Validate.
   static Expected<Emitter> Create(const EmitterDef& def);
   // Emits the particles due over the next h seconds (the fractional part
-  // carries over, so the count after time T is floor(rate T)). Returns the
-  // number emitted. h in 0..1e6 s and rate h below 2^31 (asserted: the
-  // caller's clock, not user input).
-  int Emit(ParticleState& s, double h);
+  // carries over, so the count after time T is floor(rate T)); s.size()
+  // tells how many. h in 0..1e6 s and rate h below 2^31 particles, else a
+  // Diagnostic (naming h or the count) and nothing is emitted.
+  [[nodiscard]] Status Emit(ParticleState& s, double h);
   // Emits n particles at once (a firework's burst).
   void Burst(ParticleState& s, int n);
   // Colour of a particle of this emitter at the given age.

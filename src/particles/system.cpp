@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -359,6 +360,14 @@ uint64_t System::Hash() const {
     case ContactOutcome::kStuck:
       state.invMass[i] = 0;
       break;
+    case ContactOutcome::kUnresolved: {
+      // The lowest index wins, whatever the thread count.
+      size_t seen = unresolved_.load(std::memory_order_relaxed);
+      while (i < seen && !unresolved_.compare_exchange_weak(seen, i)) {
+      }
+      faulted_.store(true, std::memory_order_relaxed);
+      break;
+    }
     case ContactOutcome::kNone:
     case ContactOutcome::kResponded:
       break;
@@ -379,21 +388,33 @@ uint64_t System::Hash() const {
     }
   }
   state.age[i] += h;
-  const double m = std::max(x1.cwiseAbs().maxCoeff(), v1.cwiseAbs().maxCoeff());
-  if (!(m <= maxMagnitude)) faulted_.store(true, std::memory_order_relaxed);  // NaN fails too
+  if (!MaybeWithinLimit(x1, v1, limit2_)) faulted_.store(true, std::memory_order_relaxed);
   state.position[i] = x1;
   state.velocity[i] = v1;
 }
 
 Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
                                const Vec3& x, const Vec3& v, double limit) {
-  const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
+  const bool finite = x.allFinite() && v.allFinite();
   std::ostringstream o;
   o << "particles: " << what << " step " << step << " (from t = " << t << " s): particle id " << id
     << " has position " << Format(x) << " and velocity " << Format(v)
-    << (std::isfinite(m) ? " beyond the limit of " : " (not finite)");
-  if (std::isfinite(m)) o << limit;
+    << (finite ? " beyond the limit of " : " (not finite)");
+  if (finite) o << limit;
   o << "; the state exploded: try a smaller step, a stabler integrator or softer forces";
+  Diagnostic d = MakeError({}, o.str());
+  d.kind = ErrorKind::kRuntime;
+  return d;
+}
+
+Diagnostic UnresolvedContactDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
+                                       const Vec3& x) {
+  std::ostringstream o;
+  o << "particles: " << what << " step " << step << " (from t = " << t << " s): particle id " << id
+    << " still met a collider after " << kMaxContacts
+    << " contacts in one step (a crevice narrower than the step resolves); it was stopped at its "
+       "last contact point "
+    << Format(x) << "; try a smaller step";
   Diagnostic d = MakeError({}, o.str());
   d.kind = ErrorKind::kRuntime;
   return d;
@@ -401,10 +422,14 @@ Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32
 
 Status System::CheckFaults(const char* what) {
   if (!faulted_.load()) return {};
+  if (const size_t i = unresolved_.exchange(SIZE_MAX); i != SIZE_MAX) {
+    fault_ =
+        UnresolvedContactDiagnostic(what, state.step, state.time, state.id[i], state.position[i]);
+    return *fault_;
+  }
   for (size_t i = 0; i < state.size(); ++i) {
     const Vec3 &x = state.position[i], &v = state.velocity[i];
-    const double m = std::max(x.cwiseAbs().maxCoeff(), v.cwiseAbs().maxCoeff());
-    if (m <= maxMagnitude) continue;
+    if (WithinLimit(x, v, maxMagnitude)) continue;
     fault_ = ExplosionDiagnostic(what, state.step, state.time, state.id[i], x, v, maxMagnitude);
     return *fault_;
   }
@@ -438,6 +463,7 @@ Status System::CheckStep(const char* what, double h) const {
 Status System::Step(double h, Integrator integrator) {
   if (fault_) return *fault_;
   SYLVA_CHECK_OK(CheckStep("System.Step h", h));
+  limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
   const size_t n = state.size();
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
@@ -500,7 +526,7 @@ Status System::Step(double h, Integrator integrator) {
       break;
     }
     case Integrator::kImplicitEuler:
-      ImplicitEuler(h);
+      SYLVA_CHECK_OK(ImplicitEuler(h));
       break;
   }
   if (pairRadius_ > 0) ParticleCollisions();
@@ -536,7 +562,13 @@ std::array<double, K> System::SumChunks(size_t n, Fn&& fn) const {
 // solved matrix-free by Jacobi-preconditioned conjugate gradients;
 // immovable particles are filtered out of the residual and the search
 // direction. Vector passes run on the pool, fused, with sums in chunk order.
-void System::ImplicitEuler(double h) {
+//
+// Failures come back before anything moves: a non-finite right-hand side,
+// preconditioner or product names the first particle where it is not finite
+// (and faults the system, as an explosion does); a search direction with
+// p.Ap <= 0 means the operator is not positive definite at this step (a
+// force's Jacobian outweighs the masses), which a smaller step may cure.
+Status System::ImplicitEuler(double h) {
   const size_t n = state.size();
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
@@ -562,10 +594,19 @@ void System::ImplicitEuler(double h) {
   // Jacobi preconditioner: the inverse of the operator's diagonal.
   for (const auto& f : forces_) f->AddJacobianDiagonal(state, X.data(), V.data(), -h * h, -h, inv);
   // dv = 0, r = b (filtered), p = M^-1 r, q = A p's mass term.
-  const auto start = SumChunks<2>(n, [&](size_t bb, size_t e) {
-    std::array<double, 2> s{};
+  // A movable particle's diagonal must be positive and finite (counted in
+  // s[2] otherwise).
+  const auto start = SumChunks<3>(n, [&](size_t bb, size_t e) {
+    std::array<double, 3> s{};
     for (size_t i = bb; i < e; ++i) {
-      for (int k = 0; k < 3; ++k) inv[i][k] = w[i] > 0 && inv[i][k] > 0 ? 1 / inv[i][k] : 0;
+      for (int k = 0; k < 3; ++k) {
+        if (w[i] == 0) {
+          inv[i][k] = 0;
+          continue;
+        }
+        s[2] += !(inv[i][k] > 0 && inv[i][k] <= DBL_MAX);
+        inv[i][k] = 1 / inv[i][k];
+      }
       if (w[i] == 0) b[i] = Vec3::Zero();
       dv[i] = Vec3::Zero();
       r[i] = b[i];
@@ -579,6 +620,23 @@ void System::ImplicitEuler(double h) {
   double rz = start[0];
   const double bnorm = std::sqrt(start[1]);
   solve_ = {0, 0};
+  if (!(bnorm <= DBL_MAX)) return NonFiniteSolve("right-hand side h (f + h df/dx v)", b, 0);
+  if (start[2] > 0) {
+    size_t i = 0;
+    while (i < n && (w[i] == 0 || ((inv[i].array() > 0).all() && inv[i].allFinite()))) ++i;
+    // The inverse is NaN or 0 where the diagonal is NaN or infinite.
+    if (i == n || inv[i].hasNaN() || (inv[i].array() == 0).any())
+      return NonFiniteSolve("diagonal", inv, 0);
+    std::ostringstream o;
+    o << "particles: in step " << state.step << " (from t = " << state.time
+      << " s): the implicit Euler system M - h df/dv - h^2 df/dx is not positive definite (its "
+         "diagonal at particle id "
+      << state.id[i] << " has inverse " << Format(inv[i]) << ") at h = " << h
+      << " s; try a smaller step; nothing moved";
+    Diagnostic d = MakeError({}, o.str());
+    d.kind = ErrorKind::kRuntime;
+    return d;
+  }
   if (bnorm > 0) {
     // The iterations' vector passes run on the flat arrays of 3n doubles
     // (kernels.h). Pinned particles take no part: q is zero there.
@@ -601,7 +659,19 @@ void System::ImplicitEuler(double h) {
       const double pq = SumChunks<1>(n3, [&](size_t bb, size_t e) {
         return std::array<double, 1>{kernels::Dot(kernel_, pf, qf, bb, e)};
       })[0];
-      if (!(pq > 0)) break;  // not positive definite along p (or NaN)
+      if (!(std::abs(pq) <= DBL_MAX)) return NonFiniteSolve("product A p", q, it);
+      if (!(pq > 0)) {
+        std::ostringstream o;
+        o << "particles: in step " << state.step << " (from t = " << state.time
+          << " s): the implicit Euler system M - h df/dv - h^2 df/dx is not positive definite "
+             "(p.Ap = "
+          << pq << " at conjugate-gradient iteration " << it
+          << "): a force's Jacobian outweighs the masses at h = " << h
+          << " s; try a smaller step; nothing moved";
+        Diagnostic d = MakeError({}, o.str());
+        d.kind = ErrorKind::kRuntime;
+        return d;
+      }
       const double alpha = rz / pq;
       const auto sums = SumChunks<2>(n3, [&](size_t bb, size_t e) {
         const kernels::CgSums c = kernels::CgStep(kernel_, alpha, pf, qf, zf, dvf, rf, bb, e);
@@ -610,6 +680,7 @@ void System::ImplicitEuler(double h) {
       const double beta = sums[0] / rz;
       rz = sums[0];
       rnorm = std::sqrt(sums[1]);
+      if (!(rnorm <= DBL_MAX && std::abs(rz) <= DBL_MAX)) return NonFiniteSolve("residual", r, it);
       ++it;
       if (it < cgMaxIterations && rnorm > cgTolerance * bnorm) {
         ForRanges(pool_.get(), n3, BalancedGrain(pool_.get(), n3, 1536, 3 * kChunk),
@@ -629,6 +700,22 @@ void System::ImplicitEuler(double h) {
       Finish(i, X[i], V[i], X[i] + h * v1, v1, h);
     }
   });
+  return {};
+}
+
+Status System::NonFiniteSolve(const char* what, const Vec3* a, int iteration) {
+  size_t i = 0;
+  while (i < state.size() && a[i].allFinite()) ++i;
+  std::ostringstream o;
+  o << "particles: in step " << state.step << " (from t = " << state.time
+    << " s): implicit Euler's " << what << " is not finite";
+  if (i < state.size()) o << " at particle id " << state.id[i] << ": " << Format(a[i]);
+  o << " (conjugate-gradient iteration " << iteration
+    << "); a force or its Jacobian is not finite; nothing moved";
+  Diagnostic d = MakeError({}, o.str());
+  d.kind = ErrorKind::kRuntime;
+  fault_ = d;
+  return d;
 }
 
 void System::ParticleCollisions() {
@@ -665,6 +752,7 @@ void System::ParticleCollisions() {
 Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats* stats) {
   if (fault_) return *fault_;
   SYLVA_CHECK_OK(CheckStep("System.StepAdaptive dt", dt));
+  limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.rtol", opt.rtol, 0, 1));
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.atol", opt.atol, 0, 1e12));
   if (!(opt.rtol > 0 || opt.atol > 0))
@@ -734,6 +822,9 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
       Accelerations(xs, vs, KV[s]);
     }
     // x_, v_ hold the 7th stage point, which is the fifth-order solution.
+    // The error norm: the largest scaled component. A NaN or an infinity in
+    // any component is a fault of that particle, never a maximum that
+    // drops it.
     double err = 0;
     for (size_t i = 0; i < n; ++i) {
       Vec3 ex = Vec3::Zero(), ev = Vec3::Zero();
@@ -741,11 +832,27 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
         ex += (B5[l] - B4[l]) * KX[l][i];
         ev += (B5[l] - B4[l]) * KV[l][i];
       }
+      double ei = 0;
       for (int k = 0; k < 3; ++k) {
         const double sx = opt.atol + opt.rtol * std::max(std::abs(X[i][k]), std::abs(x_[i][k]));
         const double sv = opt.atol + opt.rtol * std::max(std::abs(V[i][k]), std::abs(v_[i][k]));
-        err = std::max({err, std::abs(h * ex[k]) / sx, std::abs(h * ev[k]) / sv});
+        const double cx = std::abs(h * ex[k]) / sx, cv = std::abs(h * ev[k]) / sv;
+        ei = cx > ei ? cx : ei;
+        ei = cv > ei ? cv : ei;
+        if (!(cx <= DBL_MAX && cv <= DBL_MAX && x_[i].allFinite() && v_[i].allFinite())) {
+          fault_ = ExplosionDiagnostic("in adaptive", steps, time, state.id[i], x_[i], v_[i],
+                                       maxMagnitude);
+          if (x_[i].allFinite() && v_[i].allFinite()) {
+            fault_->message = "particles: in adaptive step " + std::to_string(steps) +
+                              " (from t = " + check::Num(time) + " s): particle id " +
+                              std::to_string(state.id[i]) + " has an error estimate (" +
+                              check::Num(h * ex[k]) + " m, " + check::Num(h * ev[k]) +
+                              " m/s) that is not finite; the forces are not finite";
+          }
+          return *fault_;
+        }
       }
+      err = std::max(err, ei);
     }
     if (err <= 1) {
       faulted_ = false;

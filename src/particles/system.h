@@ -18,13 +18,18 @@
 // is written by exactly one thread in an order fixed by the particle index,
 // so a run is bit-identical whatever the thread count.
 //
-// Faults. A step that leaves a non-finite value or a coordinate or speed
-// beyond `System::maxMagnitude` returns an error naming the step and the
-// particle id; the system then refuses to step again.
+// Faults. A step that leaves a non-finite value (in any of x, y, z of a
+// position or velocity) or a coordinate or speed beyond
+// `System::maxMagnitude`, or a particle whose contacts are still unresolved
+// after kMaxContacts (collider.h), returns an error naming the step and the
+// particle id; the system then refuses to step again. Implicit Euler also
+// reports a system that is not positive definite (nothing moves; a smaller
+// step may succeed).
 #pragma once
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -286,6 +291,7 @@ class System {
   // h in (0, 1e6] s (NaN, 0, negative: a Diagnostic, nothing moves); the
   // settings above (maxMagnitude 1e-300..1e300, cgTolerance 0..1,
   // cgMaxIterations 1..1e7) and every force's Check are verified first.
+  // Faults are reported as described at the top of this file.
   [[nodiscard]] Status Step(double h, Integrator integrator);
   // Advances by dt with adaptive Dormand-Prince RK45 substeps: dt as h
   // above; options rtol 0..1, atol 0..1e12 (not both 0), minStep
@@ -307,7 +313,10 @@ class System {
   // Collisions, ageing and the fault check for particle i, then stores it.
   void Finish(size_t i, const Vec3& x0, const Vec3& v0, Vec3 x1, Vec3 v1, double h);
   void Collide(size_t i, Vec3 a, Vec3 va, Vec3& x, Vec3& v, double h);
-  void ImplicitEuler(double h);
+  Status ImplicitEuler(double h);
+  // The fault of a non-finite vector `a` of the implicit solve (naming its
+  // first non-finite particle).
+  Status NonFiniteSolve(const char* what, const Vec3* a, int iteration);
   // Sum of fn(begin, end) over the fixed chunks of [0, n) (1024 elements,
   // a multiple of 4), added in chunk order: the same bits for any thread
   // count.
@@ -333,12 +342,37 @@ class System {
   std::vector<size_t> pinned_;  // and its immovable particles
   kernels::Kernel kernel_ = kernels::Best();
   std::atomic<bool> faulted_{false};  // set by Finish, read by CheckFaults
+  double limit2_ = 0;                 // maxMagnitude squared (at most DBL_MAX), for Finish
+  // The lowest index of a particle whose contacts were unresolved, or SIZE_MAX.
+  std::atomic<size_t> unresolved_{SIZE_MAX};
 };
+
+// Whether every component of x and v lies in [-limit, limit]. NaN fails:
+// each of the six is compared on its own, never through a maximum (which
+// drops a NaN in y or z).
+inline bool WithinLimit(const Vec3& x, const Vec3& v, double limit) {
+  bool ok = true;
+  for (int k = 0; k < 3; ++k) ok &= std::abs(x[k]) <= limit && std::abs(v[k]) <= limit;
+  return ok;
+}
+
+// A cheap screen for WithinLimit in the per-particle loops: false whenever
+// WithinLimit is (a NaN or infinity makes the sum NaN or infinite, a
+// component beyond the limit makes it exceed limit2), and rarely otherwise;
+// the fault scan then applies WithinLimit itself. limit2 is the limit
+// squared, at most DBL_MAX.
+inline bool MaybeWithinLimit(const Vec3& x, const Vec3& v, double limit2) {
+  return x.squaredNorm() + v.squaredNorm() <= limit2;
+}
 
 // The report of a particle whose position or velocity left the limit (or is
 // not finite), for both particle systems: the step, its start time and the
 // particle's id, position and velocity.
 Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
                                const Vec3& x, const Vec3& v, double limit);
+// The report of a particle whose contacts RespondToContacts left unresolved
+// (ContactOutcome::kUnresolved), stopped at x.
+Diagnostic UnresolvedContactDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
+                                       const Vec3& x);
 
 }  // namespace sylva::particles

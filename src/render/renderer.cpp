@@ -350,7 +350,13 @@ void Renderer::RenderShadowMap() {
   g.haveShadow = true;
 }
 
-void Renderer::SetLines(const LineBatch& lines) {
+Status Renderer::SetLines(const LineBatch& lines) {
+  if (lines.colors.size() != lines.points.size()) {
+    Diagnostic d;
+    d.message = "LineBatch has " + std::to_string(lines.points.size()) + " points but " +
+                std::to_string(lines.colors.size()) + " colors (one a point)";
+    return d;
+  }
   Gl& g = *gl_;
   glBindVertexArray(g.lineVao);
   const void* data[2] = {lines.points.data(), lines.colors.data()};
@@ -362,6 +368,7 @@ void Renderer::SetLines(const LineBatch& lines) {
   }
   g.lineVertexCount = GLsizei(lines.points.size());
   glBindVertexArray(0);
+  return {};
 }
 
 Status Renderer::SetPoints(const PointBatch& points) {

@@ -84,7 +84,10 @@ class Renderer {
   // A ground disc under the mesh that receives its shadow (off by default).
   void SetGround(bool on) { ground_ = on; }
   void SetShadows(bool on) { shadows_ = on; }
-  void SetLines(const LineBatch& lines);
+  // Replaces the lines. colors must have one entry per point (else a
+  // Diagnostic naming the lengths, and the lines are unchanged: a shorter
+  // array used to be read past its end).
+  [[nodiscard]] Status SetLines(const LineBatch& lines);
   // Replaces the points. sizes and colors must have one entry per position
   // (else a Diagnostic naming the lengths, and the points are unchanged: a
   // shorter array used to be read past its end).

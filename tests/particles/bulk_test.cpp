@@ -296,7 +296,7 @@ TEST(Bulk, EmittedParticlesKeepTheirIdsAndTheLivingTheirOrder) {
   b.fields.gravity = Vec3(0, -kG, 0);
   for (int k = 0; k < 100; ++k) {
     const size_t first = born.size();
-    emitter.Emit(born, 0.01);
+    ASSERT_OK(emitter.Emit(born, 0.01));
     b.Append(born, first);
     BULK_STEP_OK(b, 0.01);
     b.RemoveDead();

@@ -18,7 +18,7 @@ TEST(Emitter, CountIsRateTimesTimeWithinOne) {
     ParticleState s;
     const double h = 1.0 / 60;
     const int steps = 150;  // 2.5 s
-    for (int i = 0; i < steps; ++i) e.Emit(s, h);
+    for (int i = 0; i < steps; ++i) ASSERT_OK(e.Emit(s, h));
     EXPECT_NEAR(double(s.size()), rate * steps * h, 1.0)
         << "rate " << rate << ": emitted " << s.size();
   }
@@ -34,7 +34,7 @@ TEST(Emitter, EveryAgeStaysWithinItsLifetime) {
   System sys;
   size_t removed = 0;
   for (int i = 0; i < 240; ++i) {
-    e.Emit(sys.state, 1.0 / 120);
+    ASSERT_OK(e.Emit(sys.state, 1.0 / 120));
     ASSERT_TRUE(sys.Step(1.0 / 120, Integrator::kSymplecticEuler).ok());
     removed += RemoveDead(sys.state);
     for (size_t k = 0; k < sys.state.size(); ++k) {

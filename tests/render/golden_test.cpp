@@ -72,7 +72,7 @@ class Golden : public testing::RenderFixture {
     ASSERT_TRUE(p);
     const mesh::PlantGeometry* g = &p->geometry;
     renderer_->SetMesh({}, {});
-    renderer_->SetLines({});
+    ASSERT_TRUE(renderer_->SetLines({}).ok());
     ASSERT_TRUE(renderer_->SetPoints({}).ok());
     if (lines) {
       LineBatch b;
@@ -83,7 +83,7 @@ class Golden : public testing::RenderFixture {
         b.colors.push_back(mesh::Srgb(0.2f, 0.15f, 0.1f));
       }
       renderer_->SetBackground(mesh::Vec3f(1, 1, 1));
-      renderer_->SetLines(b);
+      ASSERT_TRUE(renderer_->SetLines(b).ok());
       renderer_->Draw(Camera::Frame(g->boundsMin, g->boundsMax, double(kW) / kH, 0, 0, true));
       return;
     }
@@ -121,7 +121,7 @@ TEST_F(Golden, PointBatch) {
     pts.colors.push_back(mesh::Srgb(0.9f, 0.5f + 0.4f * u(rng), 0.2f));
   }
   renderer_->SetMesh({}, {});
-  renderer_->SetLines({});
+  ASSERT_TRUE(renderer_->SetLines({}).ok());
   renderer_->SetBackground(mesh::Srgb(0.1f, 0.1f, 0.15f));
   ASSERT_TRUE(renderer_->SetPoints(pts).ok());
   renderer_->Draw(Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), double(kW) / kH, 30, 20, false));

@@ -144,7 +144,7 @@ TEST_F(Render, TwoDimensionalCurvesDrawAsLinesWithinTheirBounds) {
   Camera cam = Camera::Frame(g.boundsMin, g.boundsMax, 1.0, 0, 0, true);
   ASSERT_TRUE(renderer_->Resize(W, H).ok());
   renderer_->SetBackground(mesh::Vec3f(1, 1, 1));
-  renderer_->SetLines(lines);
+  ASSERT_TRUE(renderer_->SetLines(lines).ok());
   renderer_->Draw(cam);
   Image img = renderer_->ReadPixels();
   const uint8_t white[3] = {255, 255, 255};
@@ -247,6 +247,18 @@ TEST_F(Render, PointBatchOfUnequalLengthsIsADiagnosticNotAnOverRead) {
   pts.sizes = {1.0f, 1.0f, 1.0f};
   pts.colors.pop_back();
   EXPECT_FALSE(renderer_->SetPoints(pts).ok()) << "3 positions, 2 colours accepted";
+}
+
+TEST_F(Render, LineBatchWithFewerColoursIsADiagnosticNotAnOverRead) {
+  LineBatch lines;
+  lines.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  lines.colors = {{1, 0, 0}};  // before: glBufferData read 48 bytes from a 12-byte array
+  const Status st = renderer_->SetLines(lines);
+  ASSERT_FALSE(st.ok()) << "4 points, 1 colour accepted";
+  EXPECT_NE(st.error().message.find("4 points but 1 colors"), std::string::npos)
+      << st.error().message;
+  lines.colors.assign(4, {1, 0, 0});
+  EXPECT_TRUE(renderer_->SetLines(lines).ok());
 }
 
 TEST_F(Render, PointBatchDrawsRoundSpritesOfTheirWorldSize) {

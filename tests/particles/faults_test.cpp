@@ -1,0 +1,175 @@
+// Errors are reported, never swallowed: a non-finite number in any
+// component (x, y or z) of a position or velocity, a non-positive-definite
+// implicit system, a bad frame step for cloth or an emitter, each comes back
+// as a Diagnostic naming the step and the particle.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "particles/bulk.h"
+#include "particles/cloth.h"
+#include "particles/emitter.h"
+#include "particles/helpers.h"
+#include "particles/system.h"
+
+namespace sylva::particles {
+namespace {
+
+const double kNaN = std::numeric_limits<double>::quiet_NaN();
+const double kInf = std::numeric_limits<double>::infinity();
+
+// The status is an error whose message holds every one of `parts`.
+void ExpectError(const Status& st, std::initializer_list<const char*> parts,
+                 const std::string& context) {
+  ASSERT_FALSE(st.ok()) << context << ": accepted";
+  for (const char* p : parts) {
+    EXPECT_NE(st.error().message.find(p), std::string::npos)
+        << context << ": no \"" << p << "\" in: " << st.error().message;
+  }
+}
+
+// Ten particles at rest; a force puts `bad` into component k of particle 7's
+// force at step 3.
+void AddBadForceAtStep3(System& s, int k, double bad) {
+  for (int i = 0; i < 10; ++i) s.state.Add(Vec3(i, 0, 0), Vec3::Zero());
+  s.AddForce(std::make_shared<ForceFunction>(
+      [k, bad](const ParticleState& st, const Vec3*, const Vec3*, Vec3* f) {
+        if (st.step == 3) f[7][k] = bad;
+      }));
+}
+
+TEST(Faults, NonFiniteInAnyComponentIsReportedWithStepAndIdByEveryIntegrator) {
+  for (Integrator in : {Integrator::kExplicitEuler, Integrator::kSymplecticEuler,
+                        Integrator::kMidpoint, Integrator::kRK4, Integrator::kImplicitEuler}) {
+    for (int k = 0; k < 3; ++k) {
+      for (double bad : {kNaN, kInf, -kInf}) {
+        const std::string ctx = "integrator " + std::to_string(int(in)) + ", component " +
+                                std::to_string(k) + ", " + std::to_string(bad);
+        System s;
+        AddBadForceAtStep3(s, k, bad);
+        for (int i = 0; i < 3; ++i) ASSERT_TRUE(s.Step(0.01, in).ok()) << ctx << " step " << i;
+        ExpectError(s.Step(0.01, in), {"step 3", "particle id 7", "not finite"}, ctx);
+        EXPECT_FALSE(s.Step(0.01, in).ok()) << ctx << ": a faulted system steps again";
+      }
+    }
+  }
+}
+
+TEST(Faults, NonFiniteVelocityComponentIsReported) {
+  // Explicit Euler moves x by the old velocity: NaN in vz alone reaches the
+  // position's z and the velocity's z, nothing else.
+  for (int k = 0; k < 3; ++k) {
+    System s;
+    for (int i = 0; i < 3; ++i) s.state.Add(Vec3(i, 0, 0), Vec3::Zero());
+    s.state.velocity[2][k] = kNaN;
+    ExpectError(s.Step(0.01, Integrator::kExplicitEuler), {"step 0", "particle id 2", "not finite"},
+                "velocity component " + std::to_string(k));
+  }
+}
+
+TEST(Faults, AdaptiveRK45ReportsANonFiniteDerivativeWithTheParticle) {
+  for (int k = 0; k < 3; ++k) {
+    System s;
+    for (int i = 0; i < 10; ++i) s.state.Add(Vec3(i, 0, 0), Vec3::Zero());
+    s.AddForce(std::make_shared<ForceFunction>(
+        [k](const ParticleState& st, const Vec3*, const Vec3*, Vec3* f) {
+          if (st.time > 0.05) f[7][k] = kNaN;
+        }));
+    ExpectError(s.StepAdaptive(0.1, AdaptiveOptions{}), {"particle id 7", "not finite"},
+                "component " + std::to_string(k));
+    EXPECT_FALSE(std::isnan(s.state.position[7][k])) << "the NaN was stored";
+  }
+}
+
+// An anti-spring toward nothing: f = +k x, with its Jacobian df/dx = +k I,
+// which makes M - h^2 df/dx negative definite once h^2 k > m.
+class AntiSpring : public Force {
+ public:
+  explicit AntiSpring(double k) : k_(k) {}
+  void Accumulate(const ParticleState& s, const Vec3* x, const Vec3*, Vec3* f) const override {
+    for (size_t i = 0; i < s.size(); ++i) f[i] += k_ * x[i];
+  }
+  void AddJacobianProduct(const ParticleState& s, const Vec3*, const Vec3*, double cx, double,
+                          const Vec3* p, Vec3* y) const override {
+    for (size_t i = 0; i < s.size(); ++i) y[i] += cx * k_ * p[i];
+  }
+
+ private:
+  double k_;
+};
+
+TEST(Faults, ImplicitSolveReportsANonPositiveDefiniteSystem) {
+  System s;
+  s.state.Add(Vec3(1, 0.5, 0.25), Vec3::Zero(), 1);
+  s.AddForce(std::make_shared<AntiSpring>(1e4));  // h^2 k = 100 m at h = 0.1
+  const Vec3 before = s.state.position[0];
+  ExpectError(s.Step(0.1, Integrator::kImplicitEuler), {"step 0", "not positive definite"},
+              "h^2 k = 100 m");
+  EXPECT_EQ(s.state.position[0], before) << "a failed solve moved the particle";
+  EXPECT_EQ(s.steps, 0u) << "a failed solve counted as a step";
+  // A step small enough for the system to stay positive definite works.
+  System t;
+  t.state.Add(Vec3(1, 0.5, 0.25), Vec3::Zero(), 1);
+  t.AddForce(std::make_shared<AntiSpring>(1e4));
+  EXPECT_OK(t.Step(1e-3, Integrator::kImplicitEuler));
+}
+
+TEST(Faults, BulkReportsNonFiniteInAnyComponent) {
+  for (int a = 0; a < 6; ++a) {
+    for (float bad : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
+      const std::string ctx = "array " + std::to_string(a) + ", " + std::to_string(bad);
+      BulkSystem b;
+      for (int i = 0; i < 20; ++i) b.state.Add(Vec3(i, 1, 0), Vec3::Zero());
+      b.fields.gravity = Vec3(0, -9.81, 0);
+      ASSERT_OK(b.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0))));
+      for (int i = 0; i < 2; ++i) ASSERT_OK(b.Step(0.01));
+      (*b.state.FloatArrays()[size_t(a)])[13] = bad;
+      ExpectError(b.Step(0.01), {"step 2", "particle id 13", "not finite"}, ctx);
+      EXPECT_FALSE(b.Step(0.01).ok()) << ctx << ": a faulted system steps again";
+    }
+  }
+}
+
+ClothDef SmallCloth(ClothSolver solver) {
+  ClothDef def;
+  def.columns = def.rows = 6;
+  def.pinned = {0, 5};
+  def.solver = solver;
+  return def;
+}
+
+TEST(Cloth, StepReportsBadStepsBadFieldsAndNonFiniteParticles) {
+  for (ClothSolver solver : {ClothSolver::kXPBD, ClothSolver::kImplicit}) {
+    const std::string ctx = solver == ClothSolver::kXPBD ? "XPBD" : "implicit";
+    auto cloth = testing::Made(Cloth::Create(SmallCloth(solver)));
+    const Vec3 g(0, -9.81, 0);
+    ExpectError(cloth->Step(0, g), {"Cloth.Step dt", "0"}, ctx);
+    ExpectError(cloth->Step(-1, g), {"Cloth.Step dt", "-1"}, ctx);
+    ExpectError(cloth->Step(kNaN, g), {"Cloth.Step dt", "nan"}, ctx);
+    ExpectError(cloth->Step(1.0 / 60, Vec3(0, 0, kNaN)), {"Cloth.Step gravity", "nan"}, ctx);
+    ExpectError(cloth->Step(1.0 / 60, g, Vec3(0, kInf, 0)), {"Cloth.Step wind", "inf"}, ctx);
+    for (int i = 0; i < 3; ++i) ASSERT_OK(cloth->Step(1.0 / 60, g));
+    cloth->mutablePositions()[20].z() = kNaN;
+    ExpectError(cloth->Step(1.0 / 60, g), {"frame 3", "particle 20", "not finite"}, ctx);
+    EXPECT_FALSE(cloth->Step(1.0 / 60, g).ok()) << ctx << ": a faulted cloth steps again";
+  }
+}
+
+TEST(Emitter, EmitReportsBadStepsAndCountsThatOverflow) {
+  EmitterDef def;
+  def.rate = 1e9;  // the largest rate: 1e10 particles in 10 s would overflow the count
+  Emitter e = testing::Made(Emitter::Create(def));
+  ParticleState s;
+  ExpectError(e.Emit(s, 10), {"Emitter.Emit", "1e+10"}, "rate 1e9 for 10 s");
+  ExpectError(e.Emit(s, kInf), {"Emitter.Emit h", "inf"}, "h inf");
+  ExpectError(e.Emit(s, kNaN), {"Emitter.Emit h", "nan"}, "h nan");
+  ExpectError(e.Emit(s, -1), {"Emitter.Emit h", "-1"}, "h -1");
+  EXPECT_EQ(s.size(), 0u) << "a rejected Emit emitted";
+  EXPECT_OK(e.Emit(s, 1e-6));
+  EXPECT_EQ(s.size(), 1000u);
+}
+
+}  // namespace
+}  // namespace sylva::particles
