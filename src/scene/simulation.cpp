@@ -447,12 +447,12 @@ Status Simulation::Impl::Step() {
       for (const Vec3& p : c.cloth->positions()) centre += p;
       w = wind.At(centre / double(c.cloth->positions().size()), time);
     }
-    c.cloth->Step(h, c.gravity, w);
-    for (const Vec3& p : c.cloth->positions())
-      if (!p.allFinite())
-        return Fail(c.def->loc, "<cloth> at t = " + std::to_string(time) +
-                                    " s: a vertex position is not finite (the cloth exploded; "
-                                    "lower the step or raise the solver's substeps)");
+    if (Status s = c.cloth->Step(h, c.gravity, w); !s.ok()) {
+      Diagnostic d = s.error();
+      d.loc = c.def->loc;
+      d.message = "<cloth> at t = " + std::to_string(time) + " s: " + d.message;
+      return d;
+    }
   }
   for (Flock& f : flocks) {
     if (Status s = f.system->Step(h, particles::Integrator::kSymplecticEuler); !s.ok()) {
