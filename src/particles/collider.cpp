@@ -5,7 +5,9 @@
 #include <numeric>
 
 #include "core/assert.h"
+#include "particles/capsules.h"
 #include "particles/def_check.h"
+#include "particles/segment_box.h"
 
 namespace sylva::particles {
 namespace {
@@ -55,23 +57,6 @@ bool Roots(double A, double B, double C, double* r0, double* r1) {
 Vec3 UnitOr(const Vec3& d, const Vec3& fallback) {
   const double len = d.norm();
   return len > 0 ? Vec3(d / len) : fallback;
-}
-
-bool SegmentBox(const Vec3& a, const Vec3& d, const Vec3& lo, const Vec3& hi, double tmax) {
-  double t0 = 0, t1 = tmax;
-  for (int k = 0; k < 3; ++k) {
-    if (d[k] == 0) {
-      if (a[k] < lo[k] || a[k] > hi[k]) return false;
-      continue;
-    }
-    const double inv = 1 / d[k];
-    double ta = (lo[k] - a[k]) * inv, tb = (hi[k] - a[k]) * inv;
-    if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return false;
-  }
-  return true;
 }
 
 }  // namespace
@@ -205,6 +190,9 @@ Status Validate(const Collider& c) {
     case Collider::Kind::kMesh:
       if (!c.mesh) return Error("Collider.mesh is null");
       break;
+    case Collider::Kind::kCapsules:
+      if (!c.capsules) return Error("Collider.capsules is null");
+      break;
   }
   SYLVA_CHECK_OK(Range("Collider.restitution", c.restitution, 0, 1));
   SYLVA_CHECK_OK(Range("Collider.friction", c.friction, 0, 1e3));
@@ -253,6 +241,13 @@ Collider Collider::Mesh(std::shared_ptr<const TriangleBvh> bvh) {
   Collider c;
   c.kind = Kind::kMesh;
   c.mesh = std::move(bvh);
+  return c;
+}
+
+Collider Collider::Capsules(std::shared_ptr<const CapsuleBvh> bvh) {
+  Collider c;
+  c.kind = Kind::kCapsules;
+  c.capsules = std::move(bvh);
   return c;
 }
 
@@ -361,6 +356,8 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
     }
     case Kind::kMesh:
       return mesh && mesh->Intersect(a, b, c);
+    case Kind::kCapsules:
+      return capsules && capsules->Intersect(a, b, c);
   }
   return false;
 }
@@ -414,6 +411,7 @@ bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n) const {
     }
     case Kind::kPolygon:
     case Kind::kMesh:
+    case Kind::kCapsules:  // entered from outside; a point inside is not projected
       return false;
   }
   return false;

@@ -15,6 +15,8 @@
 //   box      axis-aligned; outside (an obstacle) or inside (a container)
 //   polygon  convex and planar, two-sided (a thin panel)
 //   mesh     triangles with a bounding-volume hierarchy, two-sided
+//   capsules segments with a radius (a plant's branches), with a bounding-
+//            volume hierarchy (capsules.h); solid, entered from outside
 //
 // Thin two-sided surfaces (polygon, mesh) leave a contact point a small skin
 // (1e-9 relative) on the particle's side, so rounding can never put it on
@@ -33,6 +35,8 @@
 #include "core/status.h"
 
 namespace sylva::particles {
+
+class CapsuleBvh;
 
 // What happens to a particle that hits a collider.
 enum class Response {
@@ -76,7 +80,7 @@ class TriangleBvh {
 // number (a zero or NaN normal, a negative radius) is a Diagnostic there,
 // never a collider that silently does nothing. Ranges (m unless said):
 struct Collider {
-  enum class Kind { kPlane, kSphere, kBox, kPolygon, kMesh };
+  enum class Kind { kPlane, kSphere, kBox, kPolygon, kMesh, kCapsules };
   Kind kind = Kind::kPlane;
   // plane / polygon: point and unit normal; sphere: centre = point, radius;
   // box: lo, hi. Every coordinate within +-1e12.
@@ -86,6 +90,7 @@ struct Collider {
   bool inside = false;                      // sphere and box: keep particles inside
   std::vector<Vec3> polygon;                // convex, counter-clockwise about normal, >= 3 vertices
   std::shared_ptr<const TriangleBvh> mesh;  // not null for kMesh
+  std::shared_ptr<const CapsuleBvh> capsules;  // not null for kCapsules
   // Material.
   double restitution = 1;  // e: normal speed out / in, 0..1
   double friction = 0;     // Coulomb mu, 0..1e3: tangential impulse <= mu * normal impulse
@@ -98,6 +103,7 @@ struct Collider {
   static Collider Box(const Vec3& lo, const Vec3& hi, bool inside = false);
   static Collider Polygon(std::vector<Vec3> convexVertices);  // normal from the winding
   static Collider Mesh(std::shared_ptr<const TriangleBvh> bvh);
+  static Collider Capsules(std::shared_ptr<const CapsuleBvh> bvh);
   Collider& Restitution(double e) {
     restitution = e;
     return *this;
@@ -219,6 +225,7 @@ inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n) const {
       return (d0 <= 0 && d1 >= 0) || (d0 >= 0 && d1 <= 0);
     }
     case Kind::kMesh:
+    case Kind::kCapsules:
       return true;
   }
   return true;

@@ -94,12 +94,17 @@ void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t, PlantPoints& 
     if (!starts.count(s.end)) out.tips.push_back(world(s.end));
     out.segmentPoints.push_back(world((s.start + s.end) / 2));
     out.segmentLengths.push_back((s.end - s.start).norm() * scale);
+    out.capsules.push_back(particles::Capsule{
+        world(s.start), world(s.end), double(std::max(s.radiusStart, s.radiusEnd)) * scale});
   }
   for (const mesh::Polygon& p : g.polygons) {
     if (p.vertices.empty()) continue;
     Vec3 c = Vec3::Zero();
     for (const Vec3& v : p.vertices) c += v;
     out.leaves.push_back(world(c / double(p.vertices.size())));
+    for (size_t k = 1; k + 1 < p.vertices.size(); ++k)
+      out.leafTriangles.push_back(
+          {world(p.vertices[0]), world(p.vertices[k]), world(p.vertices[k + 1])});
   }
   for (const mesh::SurfaceInstance& s : g.surfaces) out.leaves.push_back(world(s.position));
 }

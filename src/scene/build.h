@@ -11,6 +11,7 @@
 // reads the built world (colliders, emitters on plants and terrain).
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <optional>
@@ -21,6 +22,7 @@
 #include "mesh/export.h"
 #include "mesh/screen_detail.h"
 #include "mesh/triangle_mesh.h"
+#include "particles/capsules.h"
 #include "plant/plant.h"
 #include "scene/scene.h"
 #include "terrain/height_field.h"
@@ -56,6 +58,10 @@ struct BuiltMesh {
 struct PlantPoints {
   std::vector<Vec3> tips, segmentPoints, leaves;
   std::vector<double> segmentLengths;
+  // What particles collide with: a capsule per segment (its larger end
+  // radius) and the leaves' polygons as triangles, in world space.
+  std::vector<particles::Capsule> capsules;
+  std::vector<std::array<Vec3, 3>> leafTriangles;
 };
 
 struct BuiltScene {

@@ -305,7 +305,26 @@ struct Simulation::Impl {
   std::vector<std::unique_ptr<ParticleSystem>> systems;
   std::vector<ClothSheet> cloths;
   std::vector<Flock> flocks;
-  std::map<std::string, std::shared_ptr<const particles::TriangleBvh>> bvhs;
+  std::map<std::string, std::shared_ptr<const particles::TriangleBvh>> bvhs, leafBvhs;
+  std::map<std::string, std::shared_ptr<const particles::CapsuleBvh>> capsuleBvhs;
+  std::shared_ptr<const particles::CapsuleBvh> CapsulesOf(const std::string& id) {
+    auto& slot = capsuleBvhs[id];
+    if (!slot) slot = std::make_shared<const particles::CapsuleBvh>(built->points.at(id).capsules);
+    return slot;
+  }
+  std::shared_ptr<const particles::TriangleBvh> LeavesOf(const std::string& id) {
+    auto& slot = leafBvhs[id];
+    if (slot) return slot;
+    std::vector<Vec3> v;
+    std::vector<std::array<uint32_t, 3>> t;
+    for (const auto& tri : built->points.at(id).leafTriangles) {
+      const uint32_t base = uint32_t(v.size());
+      v.insert(v.end(), tri.begin(), tri.end());
+      t.push_back({base, base + 1, base + 2});
+    }
+    slot = std::make_shared<const particles::TriangleBvh>(std::move(v), std::move(t));
+    return slot;
+  }
 
   Status AddColliders(particles::System& system, const std::vector<CollideDef>& collides,
                       DiagnosticList& diags);
@@ -356,6 +375,24 @@ Status Simulation::Impl::AddColliders(particles::System& system,
         if (isCloth) {
           diags.Add(
               Warn(c.withLoc, "collisions with a cloth ('" + id + "') are not simulated yet"));
+          continue;
+        }
+        const auto pts = built->points.find(id);
+        if (pts != built->points.end()) {
+          // A plant or forest: capsules for the branches, triangles for the
+          // leaves.
+          std::vector<particles::Collider> parts;
+          parts.push_back(particles::Collider::Capsules(CapsulesOf(id)));
+          if (!pts->second.leafTriangles.empty())
+            parts.push_back(particles::Collider::Mesh(LeavesOf(id)));
+          for (particles::Collider& part : parts) {
+            part.Restitution(c.restitution).Friction(std::min(c.friction, 1e3)).Respond(response);
+            if (Status s = system.AddCollider(part); !s.ok()) {
+              Diagnostic d = s.error();
+              d.loc = c.loc;
+              return d;
+            }
+          }
           continue;
         }
         collider = particles::Collider::Mesh(BvhOf(id));
