@@ -15,6 +15,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "core/parallel.h"
 #include "mesh/scene_export.h"
 #include "scene/build.h"
 #include "scene/simulation.h"
@@ -122,8 +123,10 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   const auto scene = LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err,
                                &exit, cmd.derive.strict);
   if (!scene) return exit;
+  // One pool for the command: derivation, tessellation and simulation.
+  ThreadPool pool(cmd.derive.threads);
   scene::BuildOptions options;
-  options.threads = cmd.derive.threads;
+  options.pool = &pool;
   options.sides = cmd.sides;
   scene::BuildResult built = scene::Build(*scene, options);
   exit = Report(built.diagnostics, err, cmd.derive.maxErrors, cmd.derive.strict);
@@ -132,7 +135,7 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   const auto t1 = Clock::now();
   DiagnosticList simWarnings;
   scene::SimulationOptions simOptions;
-  simOptions.threads = cmd.derive.threads;
+  simOptions.pool = &pool;
   auto sim = scene::Simulation::Create(*scene, *built.scene, simOptions, simWarnings);
   exit = Report(simWarnings, err, cmd.derive.maxErrors, cmd.derive.strict);
   if (!sim) return Report(sim.error(), err);

@@ -10,6 +10,7 @@
 #include "app/cli.h"
 #include "app/commands.h"
 #include "app/scene_camera.h"
+#include "core/parallel.h"
 #include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
@@ -60,8 +61,10 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
   const auto scene = LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err,
                                &exit, cmd.derive.strict);
   if (!scene) return exit;
+  // One pool for the command: derivation, tessellation and simulation.
+  ThreadPool pool(cmd.derive.threads);
   scene::BuildOptions options;
-  options.threads = cmd.derive.threads;
+  options.pool = &pool;
   // Uniform tubes for what collides (the same whatever the camera); the
   // picture gets screen-space detail below unless --sides is given.
   options.sides = cmd.sides.value_or(8);
@@ -71,7 +74,7 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
   const auto t1 = Clock::now();
   DiagnosticList simWarnings;
   scene::SimulationOptions simOptions;
-  simOptions.threads = cmd.derive.threads;
+  simOptions.pool = &pool;
   auto sim = scene::Simulation::Create(*scene, *built.scene, simOptions, simWarnings);
   exit = Report(simWarnings, err, cmd.derive.maxErrors);
   if (!sim) return Report(sim.error(), err);

@@ -14,6 +14,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "core/parallel.h"
 #include "scene/plants.h"
 #include "scene/reader.h"
 
@@ -87,15 +88,17 @@ int RunSimulate(const SimulateCommand& cmd, std::ostream& out, std::ostream& err
   const scene::Scene& sc = *loaded;
   const double duration = cmd.duration.value_or(sc.simulation.duration);
   const double fps = cmd.fps.value_or(sc.simulation.fps);
+  // One pool for the command: derivation, tessellation and simulation.
+  ThreadPool pool(cmd.threads);
   scene::BuildOptions buildOptions;
-  buildOptions.threads = cmd.threads;
+  buildOptions.pool = &pool;
   scene::BuildResult built = scene::Build(sc, buildOptions);
   exit = Report(built.diagnostics, err, cmd.maxErrors, cmd.strict);
   if (!built.scene) return exit == kExitOk ? kExitRuntime : exit;
   if (exit != kExitOk) return exit;
   DiagnosticList warnings;
   scene::SimulationOptions simOptions;
-  simOptions.threads = cmd.threads;
+  simOptions.pool = &pool;
   auto sim = scene::Simulation::Create(sc, *built.scene, simOptions, warnings);
   exit = Report(warnings, err, cmd.maxErrors, cmd.strict);
   if (!sim) return Report(sim.error(), err);

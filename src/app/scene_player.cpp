@@ -1,5 +1,6 @@
 // The viewer's scene clock: see scene_player.h.
 #include "app/scene_player.h"
+#include "core/parallel.h"
 
 #include <algorithm>
 #include <chrono>
@@ -33,8 +34,10 @@ static SceneLoad LoadUnsafe(const std::string& path, const std::vector<std::stri
   for (const scene::ParticlesDef& p : s->particles)
     if (!p.draw.mesh.empty() && p.draw.mesh[0] != '~') watch(p.draw.mesh);
 
+  // The viewer's process pool: the loading worker and the window's clock
+  // share it (a ParallelFor that finds it busy runs on its caller).
   scene::BuildOptions options;
-  options.threads = threads;
+  options.pool = &SharedPool(threads);
   scene::BuildResult built = scene::Build(*s, options);
   const int code = Report(built.diagnostics, err, 0, strict);
   load.diagnostics = err.str();
@@ -84,7 +87,7 @@ double ScenePlayer::time() const {
 ScenePlayer::Created ScenePlayer::MakeSimulation() const {
   DiagnosticList warnings;  // reported when the scene was loaded
   scene::SimulationOptions options;
-  options.threads = loaded_->threads;
+  options.pool = &SharedPool(loaded_->threads);
   return scene::Simulation::Create(loaded_->scene, loaded_->built, options, warnings);
 }
 

@@ -88,20 +88,36 @@ void ThreadPool::WorkerLoop() {
   }
 }
 
+ThreadPool& SharedPool(int threads) {
+  static ThreadPool pool(threads);
+  return pool;
+}
+
 void ThreadPool::ParallelFor(size_t n, const std::function<void(size_t)>& fn) {
   if (n == 0) return;
   if (threads_ == 1 || n == 1) {
-    for (size_t i = 0; i < n; ++i) fn(i);
+    RunSerially(n, fn);
     return;
-  }
-  if (workers_.empty()) {
-    for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { WorkerLoop(); });
   }
   if (n >= std::numeric_limits<uint32_t>::max()) {  // the claim word holds 32-bit indices
     const size_t half = n / 2;
     ParallelFor(half, fn);
     ParallelFor(n - half, [&](size_t i) { fn(half + i); });
     return;
+  }
+  // One call at a time: a second caller (another thread, or a task of this
+  // call) runs its loop itself instead of waiting or corrupting this one.
+  bool expected = false;
+  if (!busy_.compare_exchange_strong(expected, true, std::memory_order_acquire)) {
+    RunSerially(n, fn);
+    return;
+  }
+  struct Release {
+    std::atomic<bool>& busy;
+    ~Release() { busy.store(false, std::memory_order_release); }
+  } release{busy_};
+  if (workers_.empty()) {
+    for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { WorkerLoop(); });
   }
   fn_.store(&fn, std::memory_order_release);
   count_.store(n, std::memory_order_release);

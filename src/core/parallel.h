@@ -12,6 +12,13 @@
 // and the next index, so a worker that wakes late can never claim an index
 // of a later call; idle workers spin for a short while (kSpin) before they
 // sleep on a condition variable.
+//
+// One pool serves a whole process (SharedPool below): derivation,
+// tessellation, particles and cloth all take a ThreadPool*, so a scene that
+// runs them together does not start a pool each and oversubscribe the
+// cores. A ParallelFor issued while the pool is already running one (from
+// another thread, or nested inside a task) runs on its caller alone: the
+// same results, since no result depends on which thread ran which index.
 #pragma once
 
 #include <algorithm>
@@ -40,6 +47,10 @@ class ThreadPool {
   static int HardwareThreads();
 
  private:
+  void RunSerially(size_t n, const std::function<void(size_t)>& fn) {
+    for (size_t i = 0; i < n; ++i) fn(i);
+  }
+  std::atomic<bool> busy_{false};  // a ParallelFor is running
   void WorkerLoop();
   // Runs indices of generation `gen` until none is left or the pool has
   // moved on to a later call.
@@ -63,6 +74,10 @@ class ThreadPool {
   std::atomic<int> sleepers_{0};
   std::atomic<bool> stop_{false};
 };
+
+// The process's pool, made on first use with `threads` workers (0: every
+// hardware thread); later calls return the same pool whatever they ask.
+ThreadPool& SharedPool(int threads = 0);
 
 // Runs fn(begin, end) over [0, n) in ranges of `grain`, on the pool when
 // there is one and more than one range, else on the caller.

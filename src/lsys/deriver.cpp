@@ -757,13 +757,15 @@ struct Derivation::State {
       : g(grammar),
         seed(o.seed.value_or(grammar.seed)),
         maxModules(std::min(o.maxModules, kMaxModulesCap)),
-        pool(o.threads),
+        ownPool(o.pool ? 1 : o.threads),
+        pool(o.pool ? *o.pool : ownPool),
         table(BuildStaticTable(grammar, grammar.main)) {}
 
   const Grammar& g;
   const uint64_t seed;
   const uint64_t maxModules;
-  ThreadPool pool;
+  ThreadPool ownPool;  // unused (one thread, no workers) with a shared pool
+  ThreadPool& pool;
   const StaticTable table;
   Scratch scratch;
   Word word, next;
@@ -882,7 +884,8 @@ Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
 Expected<Word> Interpret(const Grammar& g, const Word& word, const DeriveOptions& options) {
   Word w = word;
   if (g.interpretation.empty()) return w;
-  ThreadPool pool(options.threads);
+  ThreadPool ownPool(options.pool ? 1 : options.threads);
+  ThreadPool& pool = options.pool ? *options.pool : ownPool;
   const uint64_t seed = options.seed.value_or(g.seed);
   const uint64_t maxModules = std::min(options.maxModules, kMaxModulesCap);
   Scratch scratch;

@@ -29,6 +29,10 @@
 #include "lsys/parser.h"
 #include "lsys/word.h"
 
+namespace sylva {
+class ThreadPool;
+}
+
 namespace sylva::lsys {
 
 // 2^28 modules: 512 MiB of symbols for a parameter-free word.
@@ -42,6 +46,10 @@ struct DeriveOptions {
   int steps = -1;                // -1: the grammar's derivation length
   std::optional<uint64_t> seed;  // overrides `seed:`
   int threads = 0;               // 0: all hardware threads
+  // When set, the derivation runs on this pool (shared with the process:
+  // core/parallel.h SharedPool; not owned, outliving the derivation) and
+  // `threads` is not used. The word is the same either way.
+  ThreadPool* pool = nullptr;
   uint64_t maxModules = kDefaultMaxModules;
   // Called after each step (from the calling thread).
   std::function<void(int step, int steps, uint64_t modules)> progress;

@@ -95,7 +95,14 @@ BulkSystem::~BulkSystem() = default;
 
 void BulkSystem::SetThreads(int threads) {
   threads_ = threads <= 0 ? ThreadPool::HardwareThreads() : threads;
-  pool_ = threads_ > 1 ? std::make_unique<ThreadPool>(threads_) : nullptr;
+  ownPool_ = threads_ > 1 ? std::make_unique<ThreadPool>(threads_) : nullptr;
+  pool_ = ownPool_.get();
+}
+
+void BulkSystem::UsePool(ThreadPool* pool) {
+  ownPool_.reset();
+  pool_ = pool && pool->threads() > 1 ? pool : nullptr;
+  threads_ = pool ? pool->threads() : 1;
 }
 
 int BulkSystem::threads() const {
@@ -196,9 +203,9 @@ Status BulkSystem::Step(double h) {
   const size_t n = state.size();
   // Ranges of whole chunks, a few a thread.
   const size_t grain =
-      (BalancedGrain(pool_.get(), n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
+      (BalancedGrain(pool_, n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
   // Contacts see the step the kernel took (h rounded to a float).
-  ForRanges(pool_.get(), n, grain, [&](size_t b, size_t e) { StepRange(b, e, double(q.h), q); });
+  ForRanges(pool_, n, grain, [&](size_t b, size_t e) { StepRange(b, e, double(q.h), q); });
   Status status = Fault();
   state.time += h;
   ++steps;

@@ -104,6 +104,8 @@ class BulkSystem {
 
   // 0 = every hardware thread.
   void SetThreads(int threads);
+  // Runs on a shared `pool` (not owned, outliving the system); null: serial.
+  void UsePool(ThreadPool* pool);
   int threads() const;
   // Adds a collider that passes Validate(Collider), else its Diagnostic.
   [[nodiscard]] Status AddCollider(Collider c);
@@ -141,7 +143,8 @@ class BulkSystem {
   Status Fault();
 
   std::vector<Collider> colliders_;
-  std::unique_ptr<ThreadPool> pool_;
+  std::unique_ptr<ThreadPool> ownPool_;
+  ThreadPool* pool_ = nullptr;  // own or shared; null: serial
   int threads_ = 1;
   kernels::Kernel kernel_ = kernels::Best();
   std::optional<Diagnostic> fault_;

@@ -50,9 +50,8 @@ bool IntersectCapsule(const Capsule& cap, const Vec3& a, const Vec3& b, double* 
   const double baba = ba.squaredNorm(), bad = ba.dot(d), baoa = ba.dot(oa);
   // Side: the path's distance from the axis, scaled by |ba|^2.
   double t;
-  if (baba > 0 &&
-      Entry(baba * d.squaredNorm() - bad * bad, baba * d.dot(oa) - baoa * bad,
-            baba * oa.squaredNorm() - baoa * baoa - r2 * baba, &t)) {
+  if (baba > 0 && Entry(baba * d.squaredNorm() - bad * bad, baba * d.dot(oa) - baoa * bad,
+                        baba * oa.squaredNorm() - baoa * baoa - r2 * baba, &t)) {
     const double y = baoa + t * bad;
     if (y > 0 && y < baba) best = t;
   }

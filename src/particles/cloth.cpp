@@ -145,12 +145,16 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
       }
     }
   }
-  if (def_.threads != 1 && def_.solver == ClothSolver::kXPBD) {  // the implicit solver has its own
+  if (def_.pool && def_.solver == ClothSolver::kXPBD) {
+    pool_ = def_.pool->threads() > 1 ? def_.pool : nullptr;
+  } else if (def_.threads != 1 && def_.solver == ClothSolver::kXPBD) {  // implicit: its own
     const int threads = def_.threads <= 0 ? ThreadPool::HardwareThreads() : def_.threads;
-    if (threads > 1) pool_ = std::make_unique<ThreadPool>(threads);
+    if (threads > 1) ownPool_ = std::make_unique<ThreadPool>(threads);
+    pool_ = ownPool_.get();
   }
   if (def_.solver == ClothSolver::kImplicit) {
-    implicit_ = std::make_unique<System>(def_.threads);
+    implicit_ = std::make_unique<System>(def_.pool ? 1 : def_.threads);
+    if (def_.pool) implicit_->UsePool(def_.pool);
     implicit_->cgMaxIterations = def_.cgIterations;
     implicit_->cgTolerance = 1e-12;
     for (size_t i = 0; i < n; ++i)
@@ -282,7 +286,7 @@ Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
   const int subs = def_.substeps;
   const double h = dt / subs;
   const size_t n = x_.size();
-  ThreadPool* pool = pool_.get();
+  ThreadPool* pool = pool_;
   // Wind once a frame (it changes slowly next to the substeps).
   fext_.assign(n, Vec3::Zero());
   AddWind(pool, x_.data(), v_.data(), wind, fext_.data());

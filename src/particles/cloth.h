@@ -72,6 +72,9 @@ struct ClothDef {
   // pins, at their rest distance (XPBD only).
   bool longRangeAttachments = true;
   int threads = 1;  // 0..256, 0 = every hardware thread
+  // When set, the cloth runs on this pool (shared with the process, not
+  // owned, outliving the cloth) and `threads` is not used.
+  ThreadPool* pool = nullptr;
   ClothSolver solver = ClothSolver::kXPBD;
   // Implicit solver only.
   double implicitStiffness = 2000;  // N/m for constraints of compliance 0, 1e-12..1e12
@@ -126,7 +129,8 @@ class Cloth {
   Status FindNonFinite(const char* when);
   std::vector<xpbd::Tether> tethers_;  // xpbd::kTethers a particle
   std::vector<size_t> colorStart_;     // constraints_ sorted by colour
-  std::unique_ptr<ThreadPool> pool_;
+  std::unique_ptr<ThreadPool> ownPool_;
+  ThreadPool* pool_ = nullptr;  // own or def.pool; null: serial
   void AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f);
   class ExternalForce;          // gravity, damping and wind for the implicit solver
   std::vector<Vec3> triForce_;  // AddWind's per-triangle forces

@@ -8,8 +8,7 @@
 
 namespace sylva::particles {
 
-inline bool SegmentBox(const Vec3& a, const Vec3& d, const Vec3& lo, const Vec3& hi,
-                       double tmax) {
+inline bool SegmentBox(const Vec3& a, const Vec3& d, const Vec3& lo, const Vec3& hi, double tmax) {
   double t0 = 0, t1 = tmax;
   for (int k = 0; k < 3; ++k) {
     if (d[k] == 0) {

@@ -254,8 +254,16 @@ System::~System() = default;
 
 void System::SetThreads(int threads) {
   threads_ = threads <= 0 ? ThreadPool::HardwareThreads() : threads;
-  pool_ = threads_ > 1 ? std::make_unique<ThreadPool>(threads_) : nullptr;
-  for (auto& f : forces_) f->set_pool(pool_.get());
+  ownPool_ = threads_ > 1 ? std::make_unique<ThreadPool>(threads_) : nullptr;
+  pool_ = ownPool_.get();
+  for (auto& f : forces_) f->set_pool(pool_);
+}
+
+void System::UsePool(ThreadPool* pool) {
+  ownPool_.reset();
+  pool_ = pool && pool->threads() > 1 ? pool : nullptr;
+  threads_ = pool ? pool->threads() : 1;
+  for (auto& f : forces_) f->set_pool(pool_);
 }
 
 int System::threads() const {
@@ -263,7 +271,7 @@ int System::threads() const {
 }
 
 void System::AddForce(std::shared_ptr<Force> f) {
-  f->set_pool(pool_.get());
+  f->set_pool(pool_);
   hasNonLocal_ |= !f->local();
   forces_.push_back(std::move(f));
 }
@@ -290,7 +298,7 @@ void System::ForChunks(size_t n, Fn&& fn) const {
     for (size_t b = 0; b < n; b += kChunk) fn(b, std::min(n, b + kChunk));
     return;
   }
-  ForRanges(pool_.get(), n, BalancedGrain(pool_.get(), n, 256, kChunk), fn);
+  ForRanges(pool_, n, BalancedGrain(pool_, n, 256, kChunk), fn);
 }
 
 void System::NonLocalForces(const Vec3* x, const Vec3* v) const {
@@ -546,7 +554,7 @@ std::array<double, K> System::SumChunks(size_t n, Fn&& fn) const {
   thread_local std::vector<std::array<double, K>> partial;
   std::vector<std::array<double, K>>& part = partial;  // the caller's, shared with the pool
   part.assign(chunks, std::array<double, K>{});
-  ForRanges(pool_.get(), chunks, BalancedGrain(pool_.get(), chunks, 1), [&](size_t cb, size_t ce) {
+  ForRanges(pool_, chunks, BalancedGrain(pool_, chunks, 1), [&](size_t cb, size_t ce) {
     for (size_t c = cb; c < ce; ++c) part[c] = fn(c * kSumChunk, std::min(n, (c + 1) * kSumChunk));
   });
   std::array<double, K> sum{};
@@ -683,13 +691,12 @@ Status System::ImplicitEuler(double h) {
       if (!(rnorm <= DBL_MAX && std::abs(rz) <= DBL_MAX)) return NonFiniteSolve("residual", r, it);
       ++it;
       if (it < cgMaxIterations && rnorm > cgTolerance * bnorm) {
-        ForRanges(pool_.get(), n3, BalancedGrain(pool_.get(), n3, 1536, 3 * kChunk),
-                  [&](size_t bb, size_t e) {
-                    for (size_t k = bb; k < e; ++k) {
-                      pf[k] = rf[k] * zf[k] + beta * pf[k];
-                      qf[k] = m3[k] * pf[k];
-                    }
-                  });
+        ForRanges(pool_, n3, BalancedGrain(pool_, n3, 1536, 3 * kChunk), [&](size_t bb, size_t e) {
+          for (size_t k = bb; k < e; ++k) {
+            pf[k] = rf[k] * zf[k] + beta * pf[k];
+            qf[k] = m3[k] * pf[k];
+          }
+        });
       }
     }
     solve_ = {it, rnorm / bnorm};
@@ -723,7 +730,7 @@ void System::ParticleCollisions() {
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
   const double reach = 2 * pairRadius_;
-  pairGrid_->Build(X.data(), n, reach, pool_.get());
+  pairGrid_->Build(X.data(), n, reach, pool_);
   const double* w = state.invMass.data();
   // Gauss-Seidel over the pairs in index order: serial, so deterministic.
   for (size_t i = 0; i < n; ++i) {

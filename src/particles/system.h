@@ -269,8 +269,12 @@ class System {
   double cgTolerance = 1e-10;
   int cgMaxIterations = 200;
 
-  // 0 = every hardware thread.
+  // 0 = every hardware thread. Starts a pool of the system's own.
   void SetThreads(int threads);
+  // Runs on `pool` (not owned; it must outlive the system), shared with the
+  // rest of the process (core/parallel.h SharedPool); null: serial. The
+  // results are the same as with SetThreads of any count.
+  void UsePool(ThreadPool* pool);
   int threads() const;
   void AddForce(std::shared_ptr<Force> f);
   // Adds a collider that passes Validate(Collider), else its Diagnostic.
@@ -328,7 +332,8 @@ class System {
 
   std::vector<std::shared_ptr<Force>> forces_;
   std::vector<Collider> colliders_;
-  std::unique_ptr<ThreadPool> pool_;
+  std::unique_ptr<ThreadPool> ownPool_;  // SetThreads' pool
+  ThreadPool* pool_ = nullptr;           // the pool in use (own or shared), null: serial
   int threads_ = 1;
   bool hasNonLocal_ = false;
   double pairRadius_ = 0, pairRestitution_ = 1;

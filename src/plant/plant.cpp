@@ -71,6 +71,7 @@ lsys::DeriveOptions DeriveOptionsOf(const PlantSpec& spec) {
   lsys::DeriveOptions o;
   o.seed = spec.seed;
   o.threads = spec.threads;
+  o.pool = spec.pool;
   o.maxModules = spec.limits.maxModules;
   return o;
 }
@@ -137,8 +138,8 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
   options.detail = spec.detail;
   options.view = spec.view;
   options.cull = spec.cull;
-  ThreadPool pool(spec.threads);
-  options.pool = &pool;
+  ThreadPool ownPool(spec.pool ? 1 : spec.threads);
+  options.pool = spec.pool ? spec.pool : &ownPool;
   options.surfaces = &surfaces.meshes();
   options.maxTriangles = spec.limits.maxTriangles;
   mesh::TessellateStats stats;

@@ -74,6 +74,10 @@ struct PlantSpec {
   // surfaces/ folder and the bundled grammars/surfaces (SurfaceLibrary).
   std::vector<std::string> surfacePath;
   int threads = 0;  // derivation threads; 0: all hardware threads; at most 256
+  // When set, derivation, interpretation and tessellation run on this pool
+  // (the process's, core/parallel.h SharedPool; not owned) and `threads` is
+  // not used. The plant is the same either way.
+  ThreadPool* pool = nullptr;
   Limits limits;
   turtle::DrawOptions draw;  // what the turtle records besides geometry
   mesh::Detail detail;       // tessellation detail (sides 3..256)

@@ -22,6 +22,7 @@ std::optional<plant::Plant> Grow(plant::PlantSpec spec, const BuildOptions& opti
                                  const SourceLoc& where, const char* element,
                                  DiagnosticList& diags) {
   spec.threads = options.threads;
+  spec.pool = options.pool;
   spec.detail.sides = options.sides;
   spec.until = plant::Stage::kMesh;
   plant::PlantResult r = plant::BuildPlant(spec);

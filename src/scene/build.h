@@ -30,7 +30,10 @@
 namespace sylva::scene {
 
 struct BuildOptions {
-  int threads = 0;  // derivation threads; 0: all cores
+  // The process's pool (core/parallel.h SharedPool), shared by derivation
+  // and tessellation; null: a pool of `threads` for each plant.
+  ThreadPool* pool = nullptr;
+  int threads = 0;  // derivation threads without a pool; 0: all cores
   int sides = 8;    // tube sides of every plant (uniform detail)
 };
 

@@ -646,7 +646,8 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
   for (const ParticlesDef& p : scene.particles) {
     auto ps = std::make_unique<ParticleSystem>();
     ps->def = &p;
-    ps->system = std::make_unique<particles::System>(threads);
+    ps->system = std::make_unique<particles::System>(options.pool ? 1 : threads);
+    if (options.pool) ps->system->UsePool(options.pool);
     switch (p.integrator) {
       case Integrator::kSymplectic:
         ps->integrator = particles::Integrator::kSymplecticEuler;
@@ -747,6 +748,7 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
     d.bendCompliance = c.bend > 0 ? 1 / c.bend : 1e6;
     d.damping = c.damping;
     d.threads = threads;
+    d.pool = options.pool;
     d.solver = c.solver == ClothSolver::kImplicit ? particles::ClothSolver::kImplicit
                                                   : particles::ClothSolver::kXPBD;
     switch (c.pin) {
@@ -788,7 +790,8 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
   for (const FlockDef& f : scene.flocks) {
     Flock flock;
     flock.def = &f;
-    flock.system = std::make_unique<particles::System>(threads);
+    flock.system = std::make_unique<particles::System>(options.pool ? 1 : threads);
+    if (options.pool) flock.system->UsePool(options.pool);
     particles::FlockingDef fd;
     const Vec3 extent = f.boundsMax - f.boundsMin;
     fd.radius = std::max(1e-3, std::cbrt(extent.prod() / f.count) * 2.5);

@@ -32,7 +32,10 @@
 namespace sylva::scene {
 
 struct SimulationOptions {
-  int threads = 1;  // per particle system; 0: all cores
+  // The process's pool (core/parallel.h SharedPool), shared by every
+  // particle system, cloth and flock; null: a pool of `threads` each.
+  ThreadPool* pool = nullptr;
+  int threads = 1;  // without a pool; 0: all cores
 };
 
 class Simulation {

@@ -77,3 +77,34 @@ TEST(PodBuffer, LargeBuffersGrowInPlaceAndKeepContents) {
 }
 
 }  // namespace sylva
+
+namespace sylva {
+namespace {
+
+// One pool serves the whole process: a second caller on another thread, or
+// a task that calls ParallelFor again, runs its loop itself, and every
+// index of every call runs exactly once.
+TEST(ThreadPool, ConcurrentAndNestedCallersEachRunEveryIndexOnce) {
+  ThreadPool pool(4);
+  constexpr size_t kN = 20000;
+  std::vector<std::atomic<int>> a(kN), b(kN), nested(64 * 64);
+  std::thread other([&] {
+    for (int round = 0; round < 50; ++round)
+      pool.ParallelFor(kN, [&](size_t i) { b[i].fetch_add(1, std::memory_order_relaxed); });
+  });
+  for (int round = 0; round < 50; ++round)
+    pool.ParallelFor(kN, [&](size_t i) { a[i].fetch_add(1, std::memory_order_relaxed); });
+  other.join();
+  pool.ParallelFor(64, [&](size_t i) {
+    pool.ParallelFor(64, [&](size_t j) { nested[i * 64 + j].fetch_add(1); });
+  });
+  for (size_t i = 0; i < kN; ++i) {
+    ASSERT_EQ(a[i].load(), 50) << "index " << i << " of the first caller";
+    ASSERT_EQ(b[i].load(), 50) << "index " << i << " of the second caller";
+  }
+  for (size_t i = 0; i < nested.size(); ++i) ASSERT_EQ(nested[i].load(), 1) << "nested " << i;
+  EXPECT_EQ(&SharedPool(3), &SharedPool(1)) << "one shared pool a process";
+}
+
+}  // namespace
+}  // namespace sylva
