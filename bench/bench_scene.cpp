@@ -171,7 +171,9 @@ void BM_SnowStep(benchmark::State& state) {
     }
   }
   state.counters["particles"] = double(live);
-  state.counters["triangles"] = double(w->built.trianglesDrawn);
+  size_t capsules = 0;
+  for (const auto& [id, points] : w->built.points) capsules += points.capsules.size();
+  state.counters["capsules"] = double(capsules);  // what the snow collides with
   state.SetItemsProcessed(int64_t(live) * state.iterations());
 }
 // Timed from 1.5 s (all born, all still falling: drag holds them near

@@ -51,12 +51,74 @@ struct Wind {
   Vec3 At(const Vec3& x, double t) const { return gusts ? gusts->Velocity(x, t) : mean; }
 };
 
+// The gust field sampled once a step on a grid over a system's particles
+// (spacing a quarter of the eddy size, at most 48 nodes an axis) and
+// interpolated trilinearly: a particle's wind then costs a few multiplies
+// instead of sixteen cosines. Before Prepare, and off the grid, the exact
+// field is used.
+struct WindGrid {
+  const Wind* wind = nullptr;
+  bool valid = false;
+  Vec3 origin = Vec3::Zero();
+  double spacing = 1;
+  int nx = 0, ny = 0, nz = 0;
+  std::vector<Vec3> samples;
+
+  void Prepare(const ParticleState& s, double t, double eddy) {
+    valid = false;
+    if (!wind || !wind->gusts || s.size() == 0) return;
+    Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+    for (size_t i = 0; i < s.size(); ++i) {
+      if (s.invMass[i] == 0) continue;
+      lo = lo.cwiseMin(s.position[i]);
+      hi = hi.cwiseMax(s.position[i]);
+    }
+    if (!lo.allFinite() || !hi.allFinite() || !(lo.array() <= hi.array()).all()) return;
+    spacing = eddy / 4;
+    lo.array() -= 2 * spacing;  // room for a step's motion
+    hi.array() += 2 * spacing;
+    const Vec3 extent = hi - lo;
+    if (extent.maxCoeff() / spacing > 47) spacing = extent.maxCoeff() / 47;
+    nx = int(std::ceil(extent.x() / spacing)) + 1;
+    ny = int(std::ceil(extent.y() / spacing)) + 1;
+    nz = int(std::ceil(extent.z() / spacing)) + 1;
+    origin = lo;
+    samples.resize(size_t(nx) * size_t(ny) * size_t(nz));
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i)
+          samples[(size_t(k) * size_t(ny) + size_t(j)) * size_t(nx) + size_t(i)] =
+              wind->At(origin + spacing * Vec3(i, j, k), t);
+    valid = true;
+  }
+
+  Vec3 At(const Vec3& x, double t) const {
+    if (!valid) return wind->At(x, t);
+    const Vec3 g = (x - origin) / spacing;
+    if (!g.allFinite()) return wind->At(x, t);
+    const double gx = std::floor(g.x()), gy = std::floor(g.y()), gz = std::floor(g.z());
+    if (!(gx >= 0 && gy >= 0 && gz >= 0 && gx + 1 < nx && gy + 1 < ny && gz + 1 < nz))
+      return wind->At(x, t);
+    const int i = int(gx), j = int(gy), k = int(gz);
+    const double fx = g.x() - gx, fy = g.y() - gy, fz = g.z() - gz;
+    auto at = [&](int di, int dj, int dk) -> const Vec3& {
+      return samples[(size_t(k + dk) * size_t(ny) + size_t(j + dj)) * size_t(nx) + size_t(i + di)];
+    };
+    const Vec3 x00 = at(0, 0, 0) + fx * (at(1, 0, 0) - at(0, 0, 0));
+    const Vec3 x10 = at(0, 1, 0) + fx * (at(1, 1, 0) - at(0, 1, 0));
+    const Vec3 x01 = at(0, 0, 1) + fx * (at(1, 0, 1) - at(0, 0, 1));
+    const Vec3 x11 = at(0, 1, 1) + fx * (at(1, 1, 1) - at(0, 1, 1));
+    const Vec3 y0 = x00 + fy * (x10 - x00), y1 = x01 + fy * (x11 - x01);
+    return y0 + fz * (y1 - y0);
+  }
+};
+
 // Drag relative to the wind: f = -(k1 + k2 |u|) u with u = v - wind(x, t).
 // Immovable particles (stuck where they landed) feel no force, so the wind,
 // the dearest part of a step, is not sampled for them.
 class WindDrag : public particles::LocalForce {
  public:
-  WindDrag(double linear, double quadratic, const Wind* wind)
+  WindDrag(double linear, double quadratic, const WindGrid* wind)
       : k1_(linear), k2_(quadratic), wind_(wind) {}
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override {
@@ -69,7 +131,7 @@ class WindDrag : public particles::LocalForce {
 
  private:
   double k1_, k2_;
-  const Wind* wind_;
+  const WindGrid* wind_;
 };
 
 // An acceleration field a(x, t), applied as m a.
@@ -216,7 +278,8 @@ struct ParticleSystem {
     const OnDeathDef* def;
   };
   std::vector<Death> onDeath;
-  uint64_t dropped = 0;                                // births refused at `max`
+  uint64_t dropped = 0;  // births refused at `max`
+  std::unique_ptr<WindGrid> windGrid = std::make_unique<WindGrid>();
   std::shared_ptr<const mesh::TriangleMesh> drawMesh;  // as="mesh"
   // Leaves (draw as="mesh" with spin): orientation by particle id.
   bool flutter = false;
@@ -269,6 +332,7 @@ struct ClothSheet {
 
 struct Flock {
   const FlockDef* def = nullptr;
+  std::unique_ptr<WindGrid> windGrid = std::make_unique<WindGrid>();
   std::unique_ptr<particles::System> system;
   std::shared_ptr<const mesh::TriangleMesh> drawMesh;
 };
@@ -443,6 +507,8 @@ Status Simulation::Impl::Step() {
       const double hs = h / sub;
       if (Status s = Emit(*ps, hs); !s.ok()) return s;
       if (ps->flutter) ps->TurnLeaves(hs, hasWind ? &wind : nullptr, time);
+      if (hasWind && scene->wind)
+        ps->windGrid->Prepare(ps->system->state, ps->system->time, scene->wind->scale);
       Status s = ps->adaptive ? ps->system->StepAdaptive(hs, particles::AdaptiveOptions{})
                               : ps->system->Step(hs, ps->integrator);
       if (!s.ok()) {
@@ -572,7 +638,7 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
   };
 
   auto addForces = [&](particles::System& system, const std::vector<ForceDef>& forces, bool windOn,
-                       const SourceLoc& loc) -> Status {
+                       const SourceLoc& loc, const WindGrid* windGrid) -> Status {
     bool drag = false;
     for (const ForceDef& f : forces) {
       switch (f.kind) {
@@ -582,7 +648,7 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
         case ForceKind::kDrag:
           drag = true;
           system.AddForce(std::make_shared<WindDrag>(f.quadratic ? 0 : f.k, f.quadratic ? f.k : 0,
-                                                     windOn ? wind : nullptr));
+                                                     windOn && wind ? windGrid : nullptr));
           break;
         case ForceKind::kAttractor: {
           Vec3 c = f.position.value_or(Vec3::Zero());
@@ -668,7 +734,9 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
         ps->adaptive = true;
         break;
     }
-    if (Status s = addForces(*ps->system, p.forces, p.wind, p.loc); !s.ok()) return s.error();
+    ps->windGrid->wind = wind;
+    if (Status s = addForces(*ps->system, p.forces, p.wind, p.loc, ps->windGrid.get()); !s.ok())
+      return s.error();
     if (Status s = m.AddColliders(*ps->system, p.collides, diags); !s.ok()) return s.error();
     if (p.selfCollideRestitution) {
       const double radius = p.emitters.empty() ? 0.05 : std::max(p.emitters[0].radius, 1e-6);
@@ -850,8 +918,11 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
             force[i] += s.mass[i] * a;
           }
         }));
-    if (Status s = addForces(*flock.system, f.forces, false, f.loc); !s.ok()) return s.error();
-    if (f.wind && wind) flock.system->AddForce(std::make_shared<WindDrag>(0.2, 0, wind));
+    flock.windGrid->wind = wind;  // never prepared: boids sample the exact field
+    if (Status s = addForces(*flock.system, f.forces, false, f.loc, nullptr); !s.ok())
+      return s.error();
+    if (f.wind && wind)
+      flock.system->AddForce(std::make_shared<WindDrag>(0.2, 0, flock.windGrid.get()));
     const uint64_t seed = ElementSeed(scene.seed, f.id, "flock", size_t(f.loc.line));
     for (int i = 0; i < f.count; ++i) {
       auto u = [&](uint64_t k) { return ToUnit(CounterHash(seed, uint64_t(i), k)); };
