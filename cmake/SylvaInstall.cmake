@@ -31,6 +31,10 @@ if(TARGET sylva-graphics)
 endif()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/grammars ${PROJECT_SOURCE_DIR}/shaders
   DESTINATION ${CMAKE_INSTALL_DATADIR}/sylva)
+# The example scenes: `sylva view` with no file opens one; their grammar
+# paths (../../grammars) lead to share/sylva/grammars from there.
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/scenes
+  DESTINATION ${CMAKE_INSTALL_DATADIR}/sylva/examples)
 
 set(SYLVA_PACKAGE_RENDER ${SYLVA_BUILD_RENDER})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/SylvaConfig.cmake.in

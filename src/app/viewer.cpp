@@ -112,9 +112,15 @@ Result RunJobSafely(const Job& job) {
   }
 }
 
+// With no file: the bundled autumn scene (SCENE.md: `sylva view` with no
+// argument opens one of the example scenes), or the ABOP tree where the
+// examples are not installed.
 std::string DefaultGrammar() {
-  return (fs::path(plant::BundledDataDir()) / "grammars" / "abop" / "fig2_06a_monopodial.lsys")
-      .string();
+  const fs::path data = plant::BundledDataDir();
+  std::error_code ec;
+  const fs::path scene = data / "examples" / "scenes" / "autumn.xml";
+  if (fs::is_regular_file(scene, ec)) return scene.string();
+  return (data / "grammars" / "abop" / "fig2_06a_monopodial.lsys").string();
 }
 
 // What the panel shows of the newest results.
@@ -201,7 +207,11 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     err << path << ": error: cannot read file\n";
     return kExitBadInput;
   }
-  if (IsSceneFile(path)) return RunViewScene(cmd, width, height, out, err);
+  if (IsSceneFile(path)) {
+    ViewCommand scene = cmd;
+    scene.file = path;  // the bundled scene when no file was given
+    return RunViewScene(scene, width, height, out, err);
+  }
   if (cmd.time || !cmd.defines.empty() || cmd.threads) {
     err << "sylva: error: --time, -D and --threads are for scenes (.xml); a grammar's #defines "
            "have sliders in the viewer\n";

@@ -113,3 +113,9 @@ cp "$src/grammars/abop/fig2_07a_sympodial.lsys" "$work/tree.lsys"
 for _ in $(seq 100); do [[ $(loads) -gt $n ]] && break; sleep 0.1; done
 [[ $(loads) -gt $n ]] || { echo "the fixed grammar did not load again"; cat "$work/view.err"; exit 1; }
 echo "viewer reloaded the scene and its grammar, reported errors and kept running"
+
+# With no file the viewer opens the bundled autumn scene (SCENE.md).
+"$sylva" view --screenshot "$work/default.png" --frames 3 --size 480x270 2>"$work/default.err"
+grep -q "at t = 0 s" "$work/default.err" || { echo "no file: not a scene"; cat "$work/default.err"; exit 1; }
+[[ -s "$work/default.png" ]]
+echo "with no file the viewer opened the bundled scene"
