@@ -115,7 +115,7 @@ for _ in $(seq 100); do [[ $(loads) -gt $n ]] && break; sleep 0.1; done
 echo "viewer reloaded the scene and its grammar, reported errors and kept running"
 
 # With no file the viewer opens the bundled autumn scene (SCENE.md).
-"$sylva" view --screenshot "$work/default.png" --frames 3 --size 480x270 2>"$work/default.err"
+"$sylva" view --screenshot "$work/default.png" --frames 3 --size 480x270 >"$work/default.err" 2>&1
 grep -q "at t = 0 s" "$work/default.err" || { echo "no file: not a scene"; cat "$work/default.err"; exit 1; }
 [[ -s "$work/default.png" ]]
 echo "with no file the viewer opened the bundled scene"
