@@ -22,18 +22,25 @@ namespace sylva::app {
 // cli_render.cpp: the screen view of a camera, for screen-space detail.
 mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps);
 
+// An image path (.png, .jpg) and a size WxH for it, or exit 2 saying which.
+static int CheckPicture(const std::string& output, const std::string& size, int* width, int* height,
+                        std::ostream& err) {
+  if (!render::IsImagePath(output)) {
+    err << "sylva: error: " << output << ": unknown image format; use .png, .jpg or .jpeg\n";
+    return kExitBadInput;
+  }
+  if (!ParseSize(size, width, height)) {
+    err << "sylva: error: --size '" << size << "': expected WxH from 1x1 to 8192x8192\n";
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
 int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  if (!render::IsImagePath(cmd.output)) {
-    err << "sylva: error: " << cmd.output << ": unknown image format; use .png, .jpg or .jpeg\n";
-    return kExitBadInput;
-  }
   int width = 0, height = 0;
-  if (!ParseSize(cmd.size, &width, &height)) {
-    err << "sylva: error: --size '" << cmd.size << "': expected WxH from 1x1 to 8192x8192\n";
-    return kExitBadInput;
-  }
+  if (int e = CheckPicture(cmd.output, cmd.size, &width, &height, err); e != kExitOk) return e;
   if (!cmd.camera.empty()) {
     err << "sylva: error: --camera is for grammars; a scene sets its view with <camera>\n";
     return kExitBadInput;
@@ -125,21 +132,10 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
   return kExitOk;
 }
 
-}  // namespace sylva::app
-
-namespace sylva::app {
-
 int RunSimulateWithFrames(const SimulateCommand& cmd, std::ostream& out, std::ostream& err) {
   if (cmd.output.empty()) return RunSimulate(cmd, out, err, {});
-  if (!render::IsImagePath(cmd.output)) {
-    err << "sylva: error: " << cmd.output << ": unknown image format; use .png, .jpg or .jpeg\n";
-    return kExitBadInput;
-  }
   int width = 0, height = 0;
-  if (!ParseSize(cmd.size, &width, &height)) {
-    err << "sylva: error: --size '" << cmd.size << "': expected WxH from 1x1 to 8192x8192\n";
-    return kExitBadInput;
-  }
+  if (int e = CheckPicture(cmd.output, cmd.size, &width, &height, err); e != kExitOk) return e;
   // The context and renderer are made at the first frame, after the scene
   // has loaded (a bad scene fails without touching OpenGL).
   std::unique_ptr<render::HeadlessContext> context;
