@@ -142,7 +142,9 @@ TEST(SceneSimulation, EmittersPlaceParticlesInsideTheirShapesAtTheirRates) {
       EXPECT_TRUE((r.x - Vec3(1, 2, 3)).cwiseAbs().cwiseQuotient(Vec3(1, 2, 3)).maxCoeff() <= 1)
           << "box particle at " << r.x.transpose();
     }
-    if (r.system == "sphere") EXPECT_LE((r.x - Vec3(0, 5, 0)).norm(), 1.0) << r.x.transpose();
+    if (r.system == "sphere") {
+      EXPECT_LE((r.x - Vec3(0, 5, 0)).norm(), 1.0) << r.x.transpose();
+    }
     if (r.system == "disc") {
       EXPECT_EQ(r.x.y(), 1.0);
       EXPECT_LE(Vec2(r.x.x(), r.x.z()).norm(), 2.0) << r.x.transpose();
