@@ -74,6 +74,91 @@ CapsuleBvh::CapsuleBvh(std::vector<Capsule> capsules) {
       ++dropped_;
   }
   if (!capsules_.empty()) Build(0, uint32_t(capsules_.size()), 1);
+  BuildGrid();
+}
+
+void CapsuleBvh::BuildGrid() {
+  if (nodes_.empty()) return;
+  const Vec3 lo = nodes_[0].lo, hi = nodes_[0].hi;
+  const Vec3 extent = (hi - lo).cwiseMax(Vec3::Constant(1e-9));
+  // About four cells a capsule, at most 256 an axis.
+  double cell = std::cbrt(extent.prod() / (4.0 * double(capsules_.size())));
+  cell = std::max({cell, extent.maxCoeff() / 256, 1e-9});
+  for (int k = 0; k < 3; ++k) dims_[k] = std::clamp(int(std::ceil(extent[k] / cell)), 1, 256);
+  cell_ = cell;
+  gridLo_ = lo;
+  const size_t cells = size_t(dims_[0]) * size_t(dims_[1]) * size_t(dims_[2]);
+  auto range = [&](const Capsule& c, int lo3[3], int hi3[3]) {
+    const Vec3 a = (c.a.cwiseMin(c.b) - Vec3::Constant(c.radius) - gridLo_) / cell_;
+    const Vec3 b = (c.a.cwiseMax(c.b) + Vec3::Constant(c.radius) - gridLo_) / cell_;
+    for (int k = 0; k < 3; ++k) {
+      lo3[k] = std::clamp(int(std::floor(a[k])), 0, dims_[k] - 1);
+      hi3[k] = std::clamp(int(std::floor(b[k])), 0, dims_[k] - 1);
+    }
+  };
+  // Counting pass, prefix sums, then the lists, capsule by capsule (so
+  // each cell lists its capsules in order: the answer does not depend on
+  // how the grid was filled).
+  std::vector<uint32_t> count(cells + 1, 0);
+  size_t total = 0;
+  for (const Capsule& c : capsules_) {
+    int l[3], h[3];
+    range(c, l, h);
+    const size_t n = size_t(h[0] - l[0] + 1) * size_t(h[1] - l[1] + 1) * size_t(h[2] - l[2] + 1);
+    total += n;
+    if (total > (size_t(1) << 28)) {  // a capsule list past 1 GiB: keep the hierarchy alone
+      dims_[0] = dims_[1] = dims_[2] = 0;
+      return;
+    }
+    for (int k = l[2]; k <= h[2]; ++k)
+      for (int j = l[1]; j <= h[1]; ++j)
+        for (int i = l[0]; i <= h[0]; ++i)
+          ++count[(size_t(k) * size_t(dims_[1]) + size_t(j)) * size_t(dims_[0]) + size_t(i) + 1];
+  }
+  for (size_t i = 1; i <= cells; ++i) count[i] += count[i - 1];
+  start_ = count;
+  items_.resize(total);
+  for (uint32_t ci = 0; ci < capsules_.size(); ++ci) {
+    int l[3], h[3];
+    range(capsules_[ci], l, h);
+    for (int k = l[2]; k <= h[2]; ++k)
+      for (int j = l[1]; j <= h[1]; ++j)
+        for (int i = l[0]; i <= h[0]; ++i)
+          items_[count[(size_t(k) * size_t(dims_[1]) + size_t(j)) * size_t(dims_[0]) +
+                       size_t(i)]++] = ci;
+  }
+}
+
+bool CapsuleBvh::IntersectGrid(const Vec3& a, const Vec3& b, Contact* c) const {
+  const Vec3 lo = (a.cwiseMin(b) - gridLo_) / cell_, hi = (a.cwiseMax(b) - gridLo_) / cell_;
+  int l[3], h[3];
+  for (int k = 0; k < 3; ++k) {
+    if (hi[k] < 0 || lo[k] >= dims_[k]) return false;  // wholly outside the grid: no capsule
+    l[k] = std::max(0, int(std::floor(lo[k])));
+    h[k] = std::min(dims_[k] - 1, int(std::floor(hi[k])));
+  }
+  double best = 2;
+  Vec3 bestNormal = Vec3::Zero();
+  for (int k = l[2]; k <= h[2]; ++k)
+    for (int j = l[1]; j <= h[1]; ++j)
+      for (int i = l[0]; i <= h[0]; ++i) {
+        const size_t cellIndex =
+            (size_t(k) * size_t(dims_[1]) + size_t(j)) * size_t(dims_[0]) + size_t(i);
+        for (uint32_t t = start_[cellIndex]; t < start_[cellIndex + 1]; ++t) {
+          double s;
+          Vec3 n;
+          if (IntersectCapsule(capsules_[items_[t]], a, b, &s, &n) && s < best) {
+            best = s;
+            bestNormal = n;
+          }
+        }
+      }
+  if (best > 1) return false;
+  c->s = best;
+  c->normal = bestNormal;
+  const Vec3 p = a + best * (b - a);
+  c->point = p + bestNormal * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff()));
+  return true;
 }
 
 uint32_t CapsuleBvh::Build(uint32_t first, uint32_t count, int depth) {
@@ -113,6 +198,11 @@ uint32_t CapsuleBvh::Build(uint32_t first, uint32_t count, int depth) {
 
 bool CapsuleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
   if (nodes_.empty()) return false;
+  // A short path (its box within 8 cells): the grid's lists.
+  if (dims_[0] > 0) {
+    const Vec3 span = (b - a).cwiseAbs() / cell_;
+    if (span.allFinite() && (span.array() + 1).prod() <= 8.5) return IntersectGrid(a, b, c);
+  }
   const Vec3 d = b - a;
   double best = 2;
   Vec3 bestNormal = Vec3::Zero();
