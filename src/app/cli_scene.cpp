@@ -104,6 +104,15 @@ int RunSimulate(const SimulateCommand& cmd, std::ostream& out, std::ostream& err
   if (!sim) return Report(sim.error(), err);
   if (exit != kExitOk) return exit;
 
+  // Bounded before any work: the steps the clock takes and the frames.
+  const double steps = duration / (*sim)->stepLength();
+  if (steps > scene::kMaxStepsPerAdvance || duration * fps > 1e6) {
+    err << "sylva: error: --duration " << duration << " s would take " << uint64_t(steps)
+        << " simulation steps and " << uint64_t(duration * fps)
+        << " frames, more than the limits (1e7 steps, 1e6 frames); lower --duration, --fps or "
+           "the scene's fps and substeps\n";
+    return kExitBadInput;
+  }
   const int frames = int(std::floor(duration * fps + 1e-9)) + 1;
   const bool progress = isatty(2);
   for (int k = 0; k < frames; ++k) {

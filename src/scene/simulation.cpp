@@ -526,8 +526,8 @@ Status Simulation::Impl::Step() {
         if (st.age[i] < st.lifetime[i]) continue;
         for (int c = 0; c < death.def->count; ++c) {
           if (target.size() >= death.target->def->max) {
-            ++death.target->dropped;
-            continue;
+            death.target->dropped += uint64_t(death.def->count - c);  // full: no loop over them
+            break;
           }
           Birth b{st.position[i], Vec3::Zero(), 1, 1};
           if (!death.target->sources.empty()) {
@@ -580,6 +580,18 @@ double Simulation::stepLength() const {
 }
 
 Status Simulation::AdvanceTo(double t) {
+  // A bound a user can see: past it the run would take hours, not finish.
+  const double steps = (t - impl_->time) / impl_->h;
+  if (steps > kMaxStepsPerAdvance) {
+    Diagnostic d = MakeError(
+        impl_->scene->simulation.loc,
+        "reaching t = " + std::to_string(t) + " s would take " + std::to_string(uint64_t(steps)) +
+            " steps of 1/(fps x substeps) "
+            "s, more than the limit of " +
+            std::to_string(uint64_t(kMaxStepsPerAdvance)) + "; lower the time, fps or substeps");
+    d.kind = ErrorKind::kInput;
+    return d;
+  }
   while (impl_->time + impl_->h / 2 < t)
     if (Status s = impl_->Step(); !s.ok()) return s;
   return {};

@@ -38,6 +38,8 @@ struct SimulationOptions {
   int threads = 1;  // without a pool; 0: all cores
 };
 
+inline constexpr double kMaxStepsPerAdvance = 1e7;
+
 class Simulation {
  public:
   // Builds the systems; warnings (features read but not simulated) go to
@@ -50,7 +52,8 @@ class Simulation {
   double time() const;
   double stepLength() const;
   // Steps until time() >= t (to within half a step). An explosion or a
-  // failed step is an error naming the element and the time.
+  // failed step is an error naming the element and the time; more than
+  // kMaxStepsPerAdvance steps is an input error before any step.
   [[nodiscard]] Status AdvanceTo(double t);
   // Particles as sprites, lines or instanced meshes; cloth as meshes; boids
   // as instanced meshes.

@@ -279,3 +279,21 @@ TEST(SceneSimulation, LeavesFlutterAndGlideWhileSpritesFallStraight) {
 
 }  // namespace
 }  // namespace sylva::scene
+
+namespace sylva::scene {
+namespace {
+
+TEST(SceneSimulation, AnEndlessRunIsAnErrorBeforeAnyStep) {
+  auto run = Start(R"(<scene version="1">
+    <particles id="p" max="10"><emitter rate="1" lifetime="1"/></particles>
+    <simulation fps="1000" substeps="1000"/>
+  </scene>)");
+  ASSERT_TRUE(run);
+  const Status s = run->sim->AdvanceTo(1e6);  // 1e12 steps
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().message.find("more than the limit"), std::string::npos) << s.error().message;
+  EXPECT_EQ(run->sim->time(), 0) << "no step was taken";
+}
+
+}  // namespace
+}  // namespace sylva::scene
