@@ -11,6 +11,7 @@ uniform vec3 uKeyDir;             // toward the key light
 uniform mat4 uLightViewProj;
 uniform sampler2DShadow uShadow;  // depth from the key light
 uniform int uShadows;
+uniform int uWire;                // 1: a wireframe overlay pass, flat dark lines
 out vec4 fragColor;
 
 // The exact sRGB transfer function (IEC 61966-2-1).
@@ -33,6 +34,10 @@ float KeyVisibility(vec3 n) {
   return sum / 9.0;
 }
 void main() {
+  if (uWire == 1) {
+    fragColor = vec4(0.08, 0.08, 0.10, 1.0);
+    return;
+  }
   vec3 n = normalize(vNormal);
   vec3 toEye = normalize(uEye - vPosition);
   if (dot(n, toEye) < 0.0) n = -n;

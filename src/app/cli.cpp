@@ -170,6 +170,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                  "render K x K times larger and box-filter down (1-8, default 1)")
       ->check(CLI::Range(1, 8));
   re->add_flag("--stats", render.stats, "print `triangles: N` and the time of each stage");
+  re->add_flag("--wireframe", render.wireframe, "draw the triangles' edges over the mesh");
 
   ViewCommand view;
   CLI::App* vi =

@@ -213,6 +213,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     if (Status s = (*renderer)->SetLines(batch); !s.ok()) return Report(s.error(), err);
   } else {
     (*renderer)->SetGround(true);
+    (*renderer)->SetWireframe(cmd.wireframe);
     // Ground and shadow map fitted to the whole plant, whatever was culled.
     (*renderer)->SetMesh(m, palette, &bounds);
   }

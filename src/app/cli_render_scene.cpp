@@ -45,8 +45,8 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
     err << "sylva: error: --camera is for grammars; a scene sets its view with <camera>\n";
     return kExitBadInput;
   }
-  if (cmd.supersample != 1) {
-    err << "sylva: error: --supersample is for grammars\n";
+  if (cmd.supersample != 1 || cmd.wireframe) {
+    err << "sylva: error: --supersample and --wireframe are for grammars\n";
     return kExitBadInput;
   }
   if (cmd.lodEps && cmd.sides) {

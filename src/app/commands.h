@@ -58,6 +58,7 @@ struct RenderCommand {
   std::optional<int> sides;      // set: uniform sides, no screen-space detail
   int supersample = 1;           // render K x K larger, box-filter down
   bool stats = false;            // `triangles: N` and stage times on stdout
+  bool wireframe = false;        // triangle edges over the mesh
   double time = 0;               // scenes: simulated seconds before the picture
 };
 

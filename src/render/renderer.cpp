@@ -38,6 +38,7 @@ struct Renderer::Gl {
   GLuint meshProgram = 0, lineProgram = 0, shadowProgram = 0;
   GLint meshViewProj = -1, meshEye = -1, lineViewProj = -1;
   GLint meshKeyDir = -1, meshLightViewProj = -1, meshShadow = -1, meshShadows = -1;
+  GLint meshWire = -1;
   GLint shadowLightViewProj = -1;
   GLuint shadowFbo = 0, shadowDepth = 0;
   static constexpr int kShadowSize = kShadowMapSize;
@@ -126,6 +127,7 @@ Expected<std::unique_ptr<Renderer>> Renderer::Create(const std::string& shaderDi
   g.meshLightViewProj = glGetUniformLocation(g.meshProgram, "uLightViewProj");
   g.meshShadow = glGetUniformLocation(g.meshProgram, "uShadow");
   g.meshShadows = glGetUniformLocation(g.meshProgram, "uShadows");
+  g.meshWire = glGetUniformLocation(g.meshProgram, "uWire");
   auto shadow = CompileProgram(shaderDir, "shadow");
   if (!shadow) return shadow.error();
   g.shadowProgram = *shadow;
@@ -423,7 +425,19 @@ void Renderer::Draw(const Camera& camera) {
     glBindTexture(GL_TEXTURE_2D, g.shadowDepth);
     glUniform1i(g.meshShadow, 0);
     glBindVertexArray(g.meshVao);
+    glUniform1i(g.meshWire, 0);
     glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
+    if (wireframe_) {
+      // The triangles' edges over the shaded mesh, pulled toward the eye.
+      glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+      glEnable(GL_POLYGON_OFFSET_LINE);
+      glPolygonOffset(-1.0f, -1.0f);
+      glUniform1i(g.meshWire, 1);
+      glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
+      glUniform1i(g.meshWire, 0);
+      glDisable(GL_POLYGON_OFFSET_LINE);
+      glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    }
     if (ground_) {
       glBindVertexArray(g.groundVao);
       glDrawArrays(GL_TRIANGLES, 0, g.groundCount);

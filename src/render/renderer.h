@@ -84,6 +84,8 @@ class Renderer {
   // A ground disc under the mesh that receives its shadow (off by default).
   void SetGround(bool on) { ground_ = on; }
   void SetShadows(bool on) { shadows_ = on; }
+  // Draws the mesh's triangle edges over it (docs/lod.md's pictures).
+  void SetWireframe(bool on) { wireframe_ = on; }
   // Replaces the lines. colors must have one entry per point (else a
   // Diagnostic naming the lengths, and the lines are unchanged: a shorter
   // array used to be read past its end).
@@ -115,7 +117,7 @@ class Renderer {
   std::unique_ptr<Gl> gl_;
   int width_ = 0, height_ = 0;
   mesh::Vec3f background_ = mesh::Srgb(0.94f, 0.95f, 0.96f);  // linear
-  bool ground_ = false, shadows_ = true;
+  bool ground_ = false, shadows_ = true, wireframe_ = false;
   void RenderShadowMap();
   unsigned MultisampleFramebuffer() const;
   unsigned ResolveFramebuffer() const;
