@@ -115,5 +115,28 @@ TEST(SceneSimulate, WritesEveryFrameAndTheFinalStateAsCsv) {
       << "by 3 s the first shells (born at 0.67 s, living 1.6 to 1.9 s) have burst";
 }
 
+TEST(RenderCli, WireframeDrawsTheTrianglesEdges) {
+  const fs::path dir = sylva::testing::ScratchDir("sylva_wire_");
+  const std::string grammar =
+      std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys";
+  std::string err;
+  const std::string plain = (dir / "plain.png").string(), wire = (dir / "wire.png").string();
+  for (const auto& [out, flag] : {std::pair{plain, ""}, std::pair{wire, "--wireframe"}}) {
+    std::vector<std::string> args = {"render",  grammar,    "-n",      "8",  "--size",
+                                     "320x180", "--camera", "30,12,3", "-o", out};
+    if (*flag) args.push_back(flag);
+    ASSERT_EQ(Sylva(args, &err), 0) << err;
+  }
+  const Pixels a = Load(plain), b = Load(wire);
+  ASSERT_EQ(a.rgba.size(), b.rgba.size());
+  size_t darkA = 0, darkB = 0;
+  for (size_t i = 0; i < a.rgba.size(); i += 4) {
+    darkA += a.rgba[i] + a.rgba[i + 1] + a.rgba[i + 2] < 3 * 40;
+    darkB += b.rgba[i] + b.rgba[i + 1] + b.rgba[i + 2] < 3 * 40;
+  }
+  EXPECT_GT(darkB, darkA + 200) << "near-black pixels: " << darkA << " without the wireframe, "
+                                << darkB << " with it";
+}
+
 }  // namespace
 }  // namespace sylva::render
