@@ -206,19 +206,8 @@ bool CapsuleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
   const Vec3 d = b - a;
   double best = 2;
   Vec3 bestNormal = Vec3::Zero();
-  uint32_t stack[128];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (!SegmentBox(a, d, node.lo, node.hi, std::min(best, 1.0))) continue;
-    if (node.count == 0) {
-      if (top + 2 > 128) continue;  // cannot happen for depth < 64
-      stack[top++] = node.left;
-      stack[top++] = node.right;
-      continue;
-    }
-    for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+  WalkSegment(nodes_, a, d, best, [&](uint32_t first, uint32_t count) {
+    for (uint32_t i = first; i < first + count; ++i) {
       double s;
       Vec3 n;
       if (IntersectCapsule(capsules_[i], a, b, &s, &n) && s < best) {
@@ -226,7 +215,7 @@ bool CapsuleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
         bestNormal = n;
       }
     }
-  }
+  });
   if (best > 1) return false;
   c->s = best;
   c->normal = bestNormal;

@@ -116,19 +116,8 @@ bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
   const Vec3 d = b - a;
   double best = 2;
   Vec3 bestNormal = Vec3::Zero();
-  uint32_t stack[128];
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (!SegmentBox(a, d, node.lo, node.hi, std::min(best, 1.0))) continue;
-    if (node.count == 0) {
-      if (top + 2 > 128) continue;  // cannot happen for depth < 64
-      stack[top++] = node.left;
-      stack[top++] = node.right;
-      continue;
-    }
-    for (uint32_t i = node.first; i < node.first + node.count; ++i) {
+  WalkSegment(nodes_, a, d, best, [&](uint32_t first, uint32_t count) {
+    for (uint32_t i = first; i < first + count; ++i) {
       const Vec3 &v0 = v_[tris_[i][0]], &v1 = v_[tris_[i][1]], &v2 = v_[tris_[i][2]];
       const Vec3 n = (v1 - v0).cross(v2 - v0);
       const double nn = n.squaredNorm();
@@ -144,7 +133,7 @@ bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
       best = s;
       bestNormal = side * n / std::sqrt(nn);
     }
-  }
+  });
   if (best > 1) return false;
   c->s = best;
   c->normal = bestNormal;
