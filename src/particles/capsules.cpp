@@ -162,38 +162,13 @@ bool CapsuleBvh::IntersectGrid(const Vec3& a, const Vec3& b, Contact* c) const {
 }
 
 uint32_t CapsuleBvh::Build(uint32_t first, uint32_t count, int depth) {
-  depth_ = std::max(depth_, depth);
-  Node node;
-  node.lo = Vec3::Constant(HUGE_VAL);
-  node.hi = Vec3::Constant(-HUGE_VAL);
-  Vec3 clo = node.lo, chi = node.hi;
-  for (uint32_t i = first; i < first + count; ++i) {
-    const Capsule& c = capsules_[i];
-    node.lo = node.lo.cwiseMin(c.a.cwiseMin(c.b) - Vec3::Constant(c.radius));
-    node.hi = node.hi.cwiseMax(c.a.cwiseMax(c.b) + Vec3::Constant(c.radius));
-    const Vec3 centre = (c.a + c.b) / 2;
-    clo = clo.cwiseMin(centre);
-    chi = chi.cwiseMax(centre);
-  }
-  const uint32_t index = uint32_t(nodes_.size());
-  nodes_.push_back(node);
-  if (count <= 4) {
-    nodes_[index].first = first;
-    nodes_[index].count = count;
-    return index;
-  }
-  int axis;
-  (chi - clo).maxCoeff(&axis);
-  const uint32_t mid = first + count / 2;
-  std::nth_element(capsules_.begin() + first, capsules_.begin() + mid,
-                   capsules_.begin() + first + count, [&](const Capsule& x, const Capsule& y) {
-                     return x.a[axis] + x.b[axis] < y.a[axis] + y.b[axis];
-                   });
-  const uint32_t left = Build(first, mid - first, depth + 1);
-  const uint32_t right = Build(mid, first + count - mid, depth + 1);
-  nodes_[index].left = left;
-  nodes_[index].right = right;
-  return index;
+  return BuildMedianSplit(
+      nodes_, capsules_, first, count, depth, depth_,
+      [](const Capsule& c, Vec3& lo, Vec3& hi) {
+        lo = lo.cwiseMin(c.a.cwiseMin(c.b) - Vec3::Constant(c.radius));
+        hi = hi.cwiseMax(c.a.cwiseMax(c.b) + Vec3::Constant(c.radius));
+      },
+      [](const Capsule& c) { return Vec3(c.a + c.b); });
 }
 
 bool CapsuleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {

@@ -72,43 +72,15 @@ TriangleBvh::TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint
 }
 
 uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
-  depth_ = std::max(depth_, depth);
-  Node node;
-  node.lo = Vec3::Constant(HUGE_VAL);
-  node.hi = Vec3::Constant(-HUGE_VAL);
-  Vec3 clo = node.lo, chi = node.hi;
-  for (uint32_t i = first; i < first + count; ++i) {
-    Vec3 c = Vec3::Zero();
-    for (uint32_t k : tris_[i]) {
-      node.lo = node.lo.cwiseMin(v_[k]);
-      node.hi = node.hi.cwiseMax(v_[k]);
-      c += v_[k];
-    }
-    clo = clo.cwiseMin(c);
-    chi = chi.cwiseMax(c);
-  }
-  const uint32_t index = uint32_t(nodes_.size());
-  nodes_.push_back(node);
-  if (count <= 4) {
-    nodes_[index].first = first;
-    nodes_[index].count = count;
-    return index;
-  }
-  int axis;
-  (chi - clo).maxCoeff(&axis);
-  const uint32_t mid = first + count / 2;
-  auto key = [&](const std::array<uint32_t, 3>& t) {
-    return v_[t[0]][axis] + v_[t[1]][axis] + v_[t[2]][axis];
-  };
-  std::nth_element(tris_.begin() + first, tris_.begin() + mid, tris_.begin() + first + count,
-                   [&](const auto& x, const auto& y) { return key(x) < key(y); });
-  const uint32_t left = Build(first, mid - first, depth + 1);
-  const uint32_t right = Build(mid, first + count - mid, depth + 1);
-  nodes_[index].first = 0;
-  nodes_[index].count = 0;
-  nodes_[index].left = left;
-  nodes_[index].right = right;
-  return index;
+  return BuildMedianSplit(
+      nodes_, tris_, first, count, depth, depth_,
+      [&](const std::array<uint32_t, 3>& t, Vec3& lo, Vec3& hi) {
+        for (uint32_t k : t) {
+          lo = lo.cwiseMin(v_[k]);
+          hi = hi.cwiseMax(v_[k]);
+        }
+      },
+      [&](const std::array<uint32_t, 3>& t) { return Vec3(v_[t[0]] + v_[t[1]] + v_[t[2]]); });
 }
 
 bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -26,6 +27,49 @@ inline bool SegmentBox(const Vec3& a, const Vec3& d, const Vec3& lo, const Vec3&
     if (t0 > t1) return false;
   }
   return true;
+}
+
+// Builds the node over items [first, first + count) and those below it:
+// median split on the longest axis of the items' centres, at most 4 items a
+// leaf. bounds(item, lo, hi) grows a box by an item; centre(item) is a
+// point inside it (any fixed multiple of it sorts the same). Returns the
+// node's index; `depth` tracks the deepest level.
+template <typename Node, typename Item, typename Bounds, typename Centre>
+uint32_t BuildMedianSplit(std::vector<Node>& nodes, std::vector<Item>& items, uint32_t first,
+                          uint32_t count, int level, int& depth, const Bounds& bounds,
+                          const Centre& centre) {
+  depth = std::max(depth, level);
+  Node node;
+  node.lo = Vec3::Constant(HUGE_VAL);
+  node.hi = Vec3::Constant(-HUGE_VAL);
+  Vec3 clo = node.lo, chi = node.hi;
+  for (uint32_t i = first; i < first + count; ++i) {
+    bounds(items[i], node.lo, node.hi);
+    const Vec3 c = centre(items[i]);
+    clo = clo.cwiseMin(c);
+    chi = chi.cwiseMax(c);
+  }
+  const uint32_t index = uint32_t(nodes.size());
+  nodes.push_back(node);
+  if (count <= 4) {
+    nodes[index].first = first;
+    nodes[index].count = count;
+    return index;
+  }
+  int axis;
+  (chi - clo).maxCoeff(&axis);
+  const uint32_t mid = first + count / 2;
+  std::nth_element(items.begin() + first, items.begin() + mid, items.begin() + first + count,
+                   [&](const Item& x, const Item& y) { return centre(x)[axis] < centre(y)[axis]; });
+  const uint32_t left =
+      BuildMedianSplit(nodes, items, first, mid - first, level + 1, depth, bounds, centre);
+  const uint32_t right =
+      BuildMedianSplit(nodes, items, mid, first + count - mid, level + 1, depth, bounds, centre);
+  nodes[index].first = 0;
+  nodes[index].count = 0;
+  nodes[index].left = left;
+  nodes[index].right = right;
+  return index;
 }
 
 // Visits the leaves of a hierarchy (nodes with lo, hi, first, count, left,
