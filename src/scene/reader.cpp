@@ -914,7 +914,11 @@ ForestDef Reader::ReadForest(const Elem& e) {
   a.Ref("on", f.on, {"terrain"}, true);
   std::vector<double> area;
   if (a.Numbers("area", area, 4)) {
-    if (area[2] > area[0] && area[3] > area[1])
+    bool inRange = true;
+    for (double x : area) inRange = inRange && std::abs(x) <= 1e7;
+    if (!inRange)
+      a.Error("area", "'area' coordinates are metres within -1e7..1e7");
+    else if (area[2] > area[0] && area[3] > area[1])
       f.area = Vec4(area[0], area[1], area[2], area[3]);
     else
       a.Error("area", "'area' is 'x0 z0 x1 z1' with x1 > x0 and z1 > z0");
