@@ -177,6 +177,10 @@ std::vector<Vec2> ScatterPoisson(const ForestDef& f, uint64_t seed) {
   return out;
 }
 
+// A transform is drawn in floats: past about 3e38 it is not a number.
+constexpr const char* kBeyondFloat =
+    "the position, scale or height put this plant beyond what a float holds (about 3e38)";
+
 BuildResult Build(const Scene& scene, const BuildOptions& options) {
   BuildResult result;
   DiagnosticList& diags = result.diagnostics;
@@ -229,6 +233,10 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     const double unit = p.height ? HeightScale(*m.mesh, *p.height, p.loc, diags) : 1;
     m.instances.push_back({draw::Transform(at, p.rotateDegrees, p.scale * unit), {1, 1, 1}});
     m.loc = p.loc;
+    if (!m.instances[0].transform.allFinite()) {
+      diags.Add(AtElement(p.loc, kBeyondFloat));
+      continue;
+    }
     GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
     built.trianglesDrawn += m.mesh->triangleCount();
     if (!p.id.empty()) {
@@ -285,6 +293,10 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       BuiltMesh& m = built.meshes[first + size_t(v)];
       m.instances.push_back(
           {draw::Transform(Vec3(spots[k].x(), y, spots[k].y()), yaw, s), {1, 1, 1}});
+      if (!m.instances.back().transform.allFinite()) {
+        diags.Add(AtElement(f.loc, kBeyondFloat));
+        break;
+      }
       GrowBounds(*m.mesh, m.instances.back().transform, built.lo, built.hi, any);
       built.trianglesDrawn += m.mesh->triangleCount();
       if (!f.id.empty())

@@ -37,9 +37,9 @@ size_t Trees(const BuiltScene& built) {
 TEST(SceneBuild, ForestOnAnAreaTooSmallForItsSpacingPlacesTreesWithoutCrashing) {
   // The spacing from count and area underflowed to 0 and the grid divided by
   // it (a crash in ScatterPoisson).
-  const BuildResult b = ReadAndBuild("<forest grammar=\"" +
-                                     Grammar("abop/fig2_07a_sympodial.lsys") +
-                                     "\" count=\"20\" area=\"0 0 1e-300 1e-300\" steps=\"2\"/>");
+  const BuildResult b =
+      ReadAndBuild("<forest grammar=\"" + Grammar("abop/fig2_07a_sympodial.lsys") +
+                   "\" count=\"20\" area=\"0 0 1e-300 1e-300\" steps=\"2\"/>");
   ASSERT_TRUE(b.scene) << b.diagnostics.FormatAll();
   EXPECT_EQ(Trees(*b.scene), 20u) << "trees placed";
 }
@@ -57,10 +57,10 @@ TEST(SceneBuild, ForestWithATinyMinDistanceOverAWideAreaKeepsItsGridBounded) {
 }
 
 TEST(SceneBuild, ForestsKeepTheirMinDistance) {
-  const BuildResult b = ReadAndBuild("<forest grammar=\"" +
-                                     Grammar("abop/fig2_07a_sympodial.lsys") +
-                                     "\" count=\"400\" area=\"-20 -20 20 20\" min-distance=\"1.5\" "
-                                     "variants=\"1\" steps=\"2\"/>");
+  const BuildResult b =
+      ReadAndBuild("<forest grammar=\"" + Grammar("abop/fig2_07a_sympodial.lsys") +
+                   "\" count=\"400\" area=\"-20 -20 20 20\" min-distance=\"1.5\" "
+                   "variants=\"1\" steps=\"2\"/>");
   ASSERT_TRUE(b.scene) << b.diagnostics.FormatAll();
   std::vector<draw::Vec3f> at;
   for (const BuiltMesh& m : b.scene->meshes)
@@ -68,7 +68,8 @@ TEST(SceneBuild, ForestsKeepTheirMinDistance) {
   ASSERT_GT(at.size(), 100u);
   double closest = 1e9;
   for (size_t i = 0; i < at.size(); ++i)
-    for (size_t j = i + 1; j < at.size(); ++j) closest = std::min(closest, double((at[i] - at[j]).norm()));
+    for (size_t j = i + 1; j < at.size(); ++j)
+      closest = std::min(closest, double((at[i] - at[j]).norm()));
   EXPECT_GE(closest, 1.5 - 1e-5) << "closest pair of " << at.size() << " trees";
 }
 
@@ -78,6 +79,23 @@ TEST(SceneBuild, TerrainOutsideTheGeneratorsRangeIsAnErrorWithAMessage) {
   EXPECT_TRUE(b.diagnostics.HasErrors()) << b.diagnostics.FormatAll();
   EXPECT_NE(b.diagnostics.FormatAll().find("s.xml:3"), std::string::npos)
       << b.diagnostics.FormatAll();
+}
+
+TEST(SceneBuild, PlantsBeyondFloatRangeAreErrorsAtTheirElement) {
+  // They built and then failed in the renderer's draw-list check with no
+  // location ("mesh draw 0, instance 0 has a number that is not finite").
+  const std::string g = Grammar("abop/fig2_07a_sympodial.lsys");
+  for (const std::string& e :
+       {"<plant grammar=\"" + g + "\" position=\"1e300 0 0\" steps=\"2\"/>",
+        "<plant grammar=\"" + g + "\" height=\"1e300\" steps=\"2\"/>",
+        "<forest grammar=\"" + g + "\" count=\"3\" scale=\"1e300 1e300\" steps=\"2\"/>"}) {
+    const BuildResult b = ReadAndBuild(e);
+    EXPECT_FALSE(b.scene) << e;
+    EXPECT_NE(b.diagnostics.FormatAll().find("s.xml:3:1: error: the position, scale or height"),
+              std::string::npos)
+        << e << "\n"
+        << b.diagnostics.FormatAll();
+  }
 }
 
 }  // namespace
