@@ -941,7 +941,7 @@ ForestDef Reader::ReadForest(const Elem& e) {
   f.defines = ReadDefines(e);
   // An instance is a transform and a variant index; the variants' meshes
   // are counted when they are built.
-  AddSize(e, "count", uint64_t(f.count) * 128, "<forest count>");
+  AddSize(e, "count", uint64_t(f.count) * 512, "<forest count>");
   return f;
 }
 
@@ -1263,7 +1263,7 @@ ClothDef Reader::ReadCloth(const Elem& e) {
                c.forces.push_back(ReadForce(ch));
            });
   // Vertex state and about six constraints a vertex.
-  AddSize(e, "resolution", uint64_t(c.columns) * uint64_t(c.rows) * 400, "<cloth resolution>");
+  AddSize(e, "resolution", uint64_t(c.columns) * uint64_t(c.rows) * 800, "<cloth resolution>");
   return c;
 }
 
@@ -1300,7 +1300,7 @@ FlockDef Reader::ReadFlock(const Elem& e) {
                f.forces.push_back(ReadForce(c));
              }
            });
-  AddSize(e, "count", uint64_t(f.count) * 200, "<flock count>");
+  AddSize(e, "count", uint64_t(f.count) * 256, "<flock count>");
   return f;
 }
 
