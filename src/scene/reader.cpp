@@ -846,7 +846,7 @@ TerrainDef Reader::ReadTerrain(const Elem& e) {
     a.Error("resolution",
             "diamond-square needs a resolution of 2^k + 1 (129, 257, 513 ...), found " +
                 std::to_string(t.resolution));
-  AddSize(e, "resolution", uint64_t(t.resolution) * uint64_t(t.resolution) * 64,
+  AddSize(e, "resolution", uint64_t(t.resolution) * uint64_t(t.resolution) * 128,
           "<terrain resolution>");
   NoChildren(e);
   return t;

@@ -263,15 +263,16 @@ TEST(SceneReader, DeclaredSizesBeyondMemoryAreRefusedBeforeBuilding) {
   EXPECT_TRUE(ReadScene("s.xml", o).scene) << "the same scene fits in 1 TiB";
 }
 
-TEST(SceneReader, MemoryEstimateCoversWhatClothFlockAndForestReallyTake) {
-  // Measured peaks of `sylva simulate`: 757 bytes per cloth vertex, 234 per
-  // boid, 470 per tree; the estimate said 400, 200 and 128, so a scene that
-  // could not fit was let through to be killed.
+TEST(SceneReader, MemoryEstimateCoversWhatTerrainClothFlockAndForestReallyTake) {
+  // Measured peaks of `sylva simulate`: 109 bytes per terrain vertex, 757
+  // per cloth vertex, 234 per boid, 470 per tree; the estimate said 64, 400,
+  // 200 and 128, so a scene that could not fit was let through to be killed.
   struct Case {
     const char* element;
     double realBytes;
   };
-  for (const Case& c : {Case{"<cloth resolution=\"2400 2400\"/>", 757.0 * 2400 * 2400},
+  for (const Case& c : {Case{"<terrain resolution=\"4097\"/>", 109.0 * 4097 * 4097},
+                        Case{"<cloth resolution=\"2400 2400\"/>", 757.0 * 2400 * 2400},
                         Case{"<flock count=\"20000000\"/>", 234.0 * 2e7},
                         Case{"<forest grammar=\"g.lsys\" count=\"10000000\"/>", 470.0 * 1e7}}) {
     Files f;
