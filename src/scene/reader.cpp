@@ -794,7 +794,7 @@ LightDef Reader::ReadLight(const Elem& e) {
   a.Vector("direction", l.direction, true);
   a.Vector("position", l.position);
   a.Color("color", l.color);
-  a.Number("intensity", l.intensity, kNonNegative);
+  a.Number("intensity", l.intensity, Between(0, 1e9));
   if (l.type == LightType::kPoint && a.Has("direction"))
     a.Error("direction", "a point light has a 'position', not a 'direction'");
   if (l.type == LightType::kPoint && !a.Has("position"))
@@ -1113,7 +1113,7 @@ DrawDef Reader::ReadDraw(const Elem& e) {
     Add(e.file->AtElement(e.node,
                           "<draw as=\"mesh\"> needs 'mesh' (a surface '~leaf' or an .obj)"));
   if (d.as != DrawAs::kMesh && a.Has("mesh")) a.Error("mesh", "'mesh' is for as=\"mesh\"");
-  a.Number("size", d.size, kPositive);
+  a.Number("size", d.size, Range{0, 1e6, true, false});
   // color: one colour, or two (start and end of life).
   if (std::optional<std::string> t = a.Text("color")) {
     const size_t first = t->find_first_not_of(" \t\r\n");
@@ -1147,7 +1147,7 @@ DrawDef Reader::ReadDraw(const Elem& e) {
   }
   a.Number("alpha", d.alpha, Between(0, 1));
   a.Enum("blend", d.blend, {{"alpha", Blend::kAlpha}, {"additive", Blend::kAdditive}});
-  a.Number("spin", d.spinDegrees);
+  a.Number("spin", d.spinDegrees, Between(-1e6, 1e6));
   NoChildren(e);
   return d;
 }

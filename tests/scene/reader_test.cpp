@@ -101,6 +101,13 @@ std::vector<BadCase> BadCases() {
        "needs 'of'"},
       {"draw_mesh_needs_mesh", "<particles><emitter/><draw as=\"mesh\"/></particles>\n", "2:22",
        "needs 'mesh'"},
+      // Past these the renderer's floats overflowed: an error with no location.
+      {"light_intensity_huge", "<light intensity=\"1e300\"/>\n", "2:19", "between 0 and"},
+      {"draw_size_huge", "<particles><emitter/><draw size=\"1e300\"/></particles>\n", "2:34",
+       "1e300"},
+      {"draw_spin_huge",
+       "<particles><emitter/><draw as=\"mesh\" mesh=\"~leaf\" spin=\"1e300\"/></particles>\n",
+       "2:57", "between -1e+06 and 1e+06"},
   };
 }
 
