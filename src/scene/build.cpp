@@ -140,10 +140,10 @@ std::vector<Vec2> ScatterPoisson(const ForestDef& f, uint64_t seed) {
   // list of the points in it, so that every point within r of a candidate
   // lies in its 3 x 3 cells: candidate k is drawn from the counter-based
   // stream (seed, k), so the result does not depend on anything but the def.
-  // The grid has at most kMaxCells cells whatever the area and r (a tiny r
+  // The grid has at most max(2^22, 4 count) cells whatever the area and r (a tiny r
   // over a wide area once overflowed the cell count; an r of 0 divided by
   // 0); the grid only speeds the test up, so its size changes no result.
-  constexpr double kMaxCells = double(1 << 22);
+  const double kMaxCells = std::max(double(1 << 22), 4.0 * double(f.count));
   const Vec2 a0(f.area[0], f.area[1]), a1(f.area[2], f.area[3]);
   const Vec2 extent = a1 - a0;
   const double r = f.minDistance > 0
