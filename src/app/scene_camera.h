@@ -1,6 +1,7 @@
 // The camera a scene file asks for (<camera>: position and target, or an
 // orbit about the target), as the renderer's orbit camera; without one, a
-// view that frames everything built. Used by render and view.
+// view that frames everything built (10 m about the origin when nothing
+// is: a scene of particles, cloth or boids only). Used by render and view.
 #pragma once
 
 #include "render/camera.h"

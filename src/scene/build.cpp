@@ -136,37 +136,50 @@ double BuiltScene::GroundHeight(double x, double z) const {
 }
 
 std::vector<Vec2> ScatterPoisson(const ForestDef& f, uint64_t seed) {
-  // Dart throwing with a background grid of cell r / sqrt(2) (one point a
-  // cell): candidate k is drawn from the counter-based stream (seed, k), so
-  // the result does not depend on anything but the def.
+  // Dart throwing with a background grid of cells at least r wide, each a
+  // list of the points in it, so that every point within r of a candidate
+  // lies in its 3 x 3 cells: candidate k is drawn from the counter-based
+  // stream (seed, k), so the result does not depend on anything but the def.
+  // The grid has at most max(2^22, 4 count) cells whatever the area and r (a tiny r
+  // over a wide area once overflowed the cell count; an r of 0 divided by
+  // 0); the grid only speeds the test up, so its size changes no result.
+  const double kMaxCells = std::max(double(1 << 22), 4.0 * double(f.count));
   const Vec2 a0(f.area[0], f.area[1]), a1(f.area[2], f.area[3]);
   const Vec2 extent = a1 - a0;
   const double r = f.minDistance > 0
                        ? f.minDistance
                        : 0.7 * std::sqrt(extent.x() * extent.y() / std::max(1, f.count));
-  const double cell = r / std::sqrt(2.0);
+  double cell = std::max(r, extent.maxCoeff() / kMaxCells);
+  if (!(cell > 0)) cell = 1;  // r = 0 (or an underflow): any grid does
+  while (std::ceil(extent.x() / cell) * std::ceil(extent.y() / cell) > kMaxCells) cell *= 2;
   const int nx = std::max(1, int(std::ceil(extent.x() / cell)));
   const int nz = std::max(1, int(std::ceil(extent.y() / cell)));
-  std::vector<int> grid(size_t(nx) * size_t(nz), -1);
+  std::vector<int> head(size_t(nx) * size_t(nz), -1);  // a cell's last point
+  std::vector<int> next;                               // the point before it in its cell
   std::vector<Vec2> out;
   const uint64_t attempts = uint64_t(f.count) * 30 + 100;
   for (uint64_t k = 0; k < attempts && int(out.size()) < f.count; ++k) {
     const Vec2 p(a0.x() + extent.x() * ToUnit(CounterHash(seed, 0x5ca7, k, 0)),
                  a0.y() + extent.y() * ToUnit(CounterHash(seed, 0x5ca7, k, 1)));
-    const int ci = std::min(nx - 1, int((p.x() - a0.x()) / cell));
-    const int cj = std::min(nz - 1, int((p.y() - a0.y()) / cell));
+    const int ci = std::clamp(int((p.x() - a0.x()) / cell), 0, nx - 1);
+    const int cj = std::clamp(int((p.y() - a0.y()) / cell), 0, nz - 1);
     bool ok = true;
-    for (int j = std::max(0, cj - 2); ok && j <= std::min(nz - 1, cj + 2); ++j)
-      for (int i = std::max(0, ci - 2); ok && i <= std::min(nx - 1, ci + 2); ++i) {
-        const int q = grid[size_t(j) * size_t(nx) + size_t(i)];
-        if (q >= 0 && (out[size_t(q)] - p).norm() < r) ok = false;
-      }
+    for (int j = std::max(0, cj - 1); ok && j <= std::min(nz - 1, cj + 1); ++j)
+      for (int i = std::max(0, ci - 1); ok && i <= std::min(nx - 1, ci + 1); ++i)
+        for (int q = head[size_t(j) * size_t(nx) + size_t(i)]; ok && q >= 0; q = next[size_t(q)])
+          if ((out[size_t(q)] - p).norm() < r) ok = false;
     if (!ok) continue;
-    grid[size_t(cj) * size_t(nx) + size_t(ci)] = int(out.size());
+    int& h = head[size_t(cj) * size_t(nx) + size_t(ci)];
+    next.push_back(h);
+    h = int(out.size());
     out.push_back(p);
   }
   return out;
 }
+
+// A transform is drawn in floats: past about 3e38 it is not a number.
+constexpr const char* kBeyondFloat =
+    "the position, scale or height put this plant beyond what a float holds (about 3e38)";
 
 BuildResult Build(const Scene& scene, const BuildOptions& options) {
   BuildResult result;
@@ -203,10 +216,9 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     built.meshes.push_back(std::move(m));
     built.terrains.push_back(std::move(*field));
   }
-  if (diags.HasErrors()) {
-    result.diagnostics = std::move(diags);
-    return result;
-  }
+  // `diags` is result.diagnostics: moving it onto itself emptied it, so a
+  // terrain error left the command failing without a word.
+  if (diags.HasErrors()) return result;
 
   for (const PlantDef& p : scene.plants) {
     const plant::PlantSpec spec = SpecFor(p);
@@ -221,6 +233,10 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     const double unit = p.height ? HeightScale(*m.mesh, *p.height, p.loc, diags) : 1;
     m.instances.push_back({draw::Transform(at, p.rotateDegrees, p.scale * unit), {1, 1, 1}});
     m.loc = p.loc;
+    if (!m.instances[0].transform.allFinite()) {
+      diags.Add(AtElement(p.loc, kBeyondFloat));
+      continue;
+    }
     GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
     built.trianglesDrawn += m.mesh->triangleCount();
     if (!p.id.empty()) {
@@ -277,6 +293,10 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       BuiltMesh& m = built.meshes[first + size_t(v)];
       m.instances.push_back(
           {draw::Transform(Vec3(spots[k].x(), y, spots[k].y()), yaw, s), {1, 1, 1}});
+      if (!m.instances.back().transform.allFinite()) {
+        diags.Add(AtElement(f.loc, kBeyondFloat));
+        break;
+      }
       GrowBounds(*m.mesh, m.instances.back().transform, built.lo, built.hi, any);
       built.trianglesDrawn += m.mesh->triangleCount();
       if (!f.id.empty())

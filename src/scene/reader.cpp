@@ -794,7 +794,7 @@ LightDef Reader::ReadLight(const Elem& e) {
   a.Vector("direction", l.direction, true);
   a.Vector("position", l.position);
   a.Color("color", l.color);
-  a.Number("intensity", l.intensity, kNonNegative);
+  a.Number("intensity", l.intensity, Between(0, 1e9));
   if (l.type == LightType::kPoint && a.Has("direction"))
     a.Error("direction", "a point light has a 'position', not a 'direction'");
   if (l.type == LightType::kPoint && !a.Has("position"))
@@ -846,7 +846,7 @@ TerrainDef Reader::ReadTerrain(const Elem& e) {
     a.Error("resolution",
             "diamond-square needs a resolution of 2^k + 1 (129, 257, 513 ...), found " +
                 std::to_string(t.resolution));
-  AddSize(e, "resolution", uint64_t(t.resolution) * uint64_t(t.resolution) * 64,
+  AddSize(e, "resolution", uint64_t(t.resolution) * uint64_t(t.resolution) * 128,
           "<terrain resolution>");
   NoChildren(e);
   return t;
@@ -914,7 +914,11 @@ ForestDef Reader::ReadForest(const Elem& e) {
   a.Ref("on", f.on, {"terrain"}, true);
   std::vector<double> area;
   if (a.Numbers("area", area, 4)) {
-    if (area[2] > area[0] && area[3] > area[1])
+    bool inRange = true;
+    for (double x : area) inRange = inRange && std::abs(x) <= 1e7;
+    if (!inRange)
+      a.Error("area", "'area' coordinates are metres within -1e7..1e7");
+    else if (area[2] > area[0] && area[3] > area[1])
       f.area = Vec4(area[0], area[1], area[2], area[3]);
     else
       a.Error("area", "'area' is 'x0 z0 x1 z1' with x1 > x0 and z1 > z0");
@@ -937,7 +941,7 @@ ForestDef Reader::ReadForest(const Elem& e) {
   f.defines = ReadDefines(e);
   // An instance is a transform and a variant index; the variants' meshes
   // are counted when they are built.
-  AddSize(e, "count", uint64_t(f.count) * 128, "<forest count>");
+  AddSize(e, "count", uint64_t(f.count) * 512, "<forest count>");
   return f;
 }
 
@@ -1109,7 +1113,7 @@ DrawDef Reader::ReadDraw(const Elem& e) {
     Add(e.file->AtElement(e.node,
                           "<draw as=\"mesh\"> needs 'mesh' (a surface '~leaf' or an .obj)"));
   if (d.as != DrawAs::kMesh && a.Has("mesh")) a.Error("mesh", "'mesh' is for as=\"mesh\"");
-  a.Number("size", d.size, kPositive);
+  a.Number("size", d.size, Range{0, 1e6, true, false});
   // color: one colour, or two (start and end of life).
   if (std::optional<std::string> t = a.Text("color")) {
     const size_t first = t->find_first_not_of(" \t\r\n");
@@ -1143,7 +1147,7 @@ DrawDef Reader::ReadDraw(const Elem& e) {
   }
   a.Number("alpha", d.alpha, Between(0, 1));
   a.Enum("blend", d.blend, {{"alpha", Blend::kAlpha}, {"additive", Blend::kAdditive}});
-  a.Number("spin", d.spinDegrees);
+  a.Number("spin", d.spinDegrees, Between(-1e6, 1e6));
   NoChildren(e);
   return d;
 }
@@ -1259,7 +1263,7 @@ ClothDef Reader::ReadCloth(const Elem& e) {
                c.forces.push_back(ReadForce(ch));
            });
   // Vertex state and about six constraints a vertex.
-  AddSize(e, "resolution", uint64_t(c.columns) * uint64_t(c.rows) * 400, "<cloth resolution>");
+  AddSize(e, "resolution", uint64_t(c.columns) * uint64_t(c.rows) * 800, "<cloth resolution>");
   return c;
 }
 
@@ -1296,7 +1300,7 @@ FlockDef Reader::ReadFlock(const Elem& e) {
                f.forces.push_back(ReadForce(c));
              }
            });
-  AddSize(e, "count", uint64_t(f.count) * 200, "<flock count>");
+  AddSize(e, "count", uint64_t(f.count) * 256, "<flock count>");
   return f;
 }
 

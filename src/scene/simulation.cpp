@@ -493,7 +493,14 @@ Status Simulation::Impl::Emit(ParticleSystem& ps, double step) {
       const double remaining =
           j < fromRate ? step * (1 - (double(j) + 0.5) / double(std::max<uint64_t>(fromRate, 1)))
                        : 0;
-      st.Add(b.x + b.v * remaining, b.v, b.mass, b.lifetime);
+      // The advance into the step must not pass through a collider (a
+      // particle born 0.5 m over a terrain at 100 m/s went through it): one
+      // that would is born at the emitter, and the step meets the collider.
+      Vec3 at = b.x + b.v * remaining;
+      particles::Contact contact;
+      for (const particles::Collider& c : ps.system->colliders())
+        if (at != b.x && c.Intersect(b.x, at, &contact)) at = b.x;
+      st.Add(at, b.v, b.mass, b.lifetime);
       st.age.back() = remaining;
     }
   }
