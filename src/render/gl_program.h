@@ -3,7 +3,11 @@
 
 #include <string>
 
+#include <vector>
+
 #include "core/status.h"
+#include "mesh/export.h"
+#include "mesh/triangle_mesh.h"
 
 namespace sylva::render {
 
@@ -13,5 +17,14 @@ Expected<unsigned> CompileProgram(const std::string& dir, const std::string& nam
 // Same, with the vertex shader and fragment shader named separately.
 Expected<unsigned> CompileProgram(const std::string& dir, const std::string& vert,
                                   const std::string& frag);
+
+// Per-vertex colour: the material of the first triangle using the vertex
+// (light grey without a palette).
+std::vector<mesh::Vec3f> VertexColors(const mesh::TriangleMesh& m, const mesh::Palette& palette);
+
+// Fills buffers[0..2] with positions, normals and `colors` (3 floats each)
+// as vertex attributes 0..2 of the bound vertex array.
+void UploadVertexAttributes(const unsigned buffers[3], const mesh::TriangleMesh& m,
+                            const std::vector<mesh::Vec3f>& colors);
 
 }  // namespace sylva::render

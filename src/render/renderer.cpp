@@ -65,6 +65,32 @@ static Diagnostic ShaderError(const std::string& file, const std::string& messag
   return d;
 }
 
+std::vector<mesh::Vec3f> VertexColors(const mesh::TriangleMesh& m, const mesh::Palette& palette) {
+  std::vector<mesh::Vec3f> color(m.vertexCount(), mesh::Srgb(0.8f, 0.8f, 0.8f));
+  if (palette.empty()) return color;
+  std::vector<uint8_t> seen(m.vertexCount(), 0);
+  for (size_t t = 0; t < m.triangleCount(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t i = m.indices[3 * t + size_t(e)];
+      if (!seen[i]) {
+        seen[i] = 1;
+        color[i] = palette[m.material[t] % palette.size()];
+      }
+    }
+  return color;
+}
+
+void UploadVertexAttributes(const unsigned buffers[3], const mesh::TriangleMesh& m,
+                            const std::vector<mesh::Vec3f>& colors) {
+  const void* data[3] = {m.positions.data(), m.normals.data(), colors.data()};
+  for (int k = 0; k < 3; ++k) {
+    glBindBuffer(GL_ARRAY_BUFFER, buffers[k]);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertexCount() * 12), data[k], GL_STATIC_DRAW);
+    glEnableVertexAttribArray(GLuint(k));
+    glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
+  }
+}
+
 Expected<unsigned> CompileProgram(const std::string& dir, const std::string& name) {
   return CompileProgram(dir, name + ".vert", name + ".frag");
 }
@@ -241,26 +267,9 @@ Status Renderer::Resize(int width, int height, int samples) {
 void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette,
                        const mesh::Box* bounds) {
   Gl& g = *gl_;
-  // Per-vertex colour: the material of the first triangle using the vertex.
-  std::vector<mesh::Vec3f> color(m.vertexCount(), mesh::Srgb(0.8f, 0.8f, 0.8f));
-  std::vector<uint8_t> seen(m.vertexCount(), 0);
-  for (size_t t = 0; t < m.triangleCount(); ++t) {
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t i = m.indices[3 * t + e];
-      if (!seen[i] && !palette.empty()) {
-        seen[i] = 1;
-        color[i] = palette[m.material[t] % palette.size()];
-      }
-    }
-  }
+  const std::vector<mesh::Vec3f> color = VertexColors(m, palette);
   glBindVertexArray(g.meshVao);
-  const void* data[3] = {m.positions.data(), m.normals.data(), color.data()};
-  for (int k = 0; k < 3; ++k) {
-    glBindBuffer(GL_ARRAY_BUFFER, g.meshBuffers[k]);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertexCount() * 12), data[k], GL_STATIC_DRAW);
-    glEnableVertexAttribArray(GLuint(k));
-    glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
-  }
+  UploadVertexAttributes(g.meshBuffers, m, color);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.meshIndex);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
                GL_STATIC_DRAW);

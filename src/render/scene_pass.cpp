@@ -30,22 +30,6 @@ void DeleteMesh(GpuMesh& m) {
   glDeleteVertexArrays(1, &m.vao);
 }
 
-// Per-vertex colour from the material of the first triangle using it.
-std::vector<mesh::Vec3f> VertexColors(const mesh::TriangleMesh& m, const mesh::Palette& palette) {
-  std::vector<mesh::Vec3f> color(m.vertexCount(), mesh::Srgb(0.8f, 0.8f, 0.8f));
-  if (palette.empty()) return color;
-  std::vector<uint8_t> seen(m.vertexCount(), 0);
-  for (size_t t = 0; t < m.triangleCount(); ++t)
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t i = m.indices[3 * t + size_t(e)];
-      if (!seen[i]) {
-        seen[i] = 1;
-        color[i] = palette[m.material[t] % palette.size()];
-      }
-    }
-  return color;
-}
-
 // Instance layout: a 4x4 matrix (columns at locations 3..6) and a tint (7).
 struct GpuInstance {
   float model[16];
@@ -149,13 +133,7 @@ struct Renderer::ScenePass {
     glGenBuffers(1, &g.index);
     glGenBuffers(1, &g.instances);
     glBindVertexArray(g.vao);
-    const void* data[3] = {m.positions.data(), m.normals.data(), color.data()};
-    for (int k = 0; k < 3; ++k) {
-      glBindBuffer(GL_ARRAY_BUFFER, g.buffers[k]);
-      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.vertexCount() * 12), data[k], GL_STATIC_DRAW);
-      glEnableVertexAttribArray(GLuint(k));
-      glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
-    }
+    UploadVertexAttributes(g.buffers, m, color);
     glBindBuffer(GL_ARRAY_BUFFER, g.instances);
     for (int c = 0; c < 4; ++c) {
       glEnableVertexAttribArray(GLuint(3 + c));
