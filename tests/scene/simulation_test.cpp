@@ -312,5 +312,39 @@ TEST(SceneSimulation, AnEndlessRunIsAnErrorBeforeAnyStep) {
   EXPECT_EQ(run->sim->time(), 0) << "no step was taken";
 }
 
+TEST(SceneSimulation, AnAttractorFollowsTheFlockOrClothItIsOf) {
+  // Moths drawn to a flock that cruises in a box around x = 25, and dust
+  // drawn to a cloth hanging around x = -20: each system's centroid moves
+  // toward the element its attractor is `of` (before, both used the origin).
+  auto run = Start(R"(<scene version="1">
+    <flock id="birds" count="50" bounds="20 4 -5 30 8 5" speed="2"/>
+    <cloth id="sheet" position="-21 6 -1" size="2 2" resolution="6 6" pin="top"/>
+    <particles id="moths" max="20">
+      <emitter shape="point" at="0 5 0" burst="20" lifetime="100 100"/>
+      <attractor of="birds" strength="400" falloff="linear"/>
+    </particles>
+    <particles id="dust" max="20">
+      <emitter shape="point" at="0 5 0" burst="20" lifetime="100 100"/>
+      <attractor of="sheet" strength="400" falloff="linear"/>
+    </particles>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(1.0).ok());
+  Vec3 moths = Vec3::Zero(), dust = Vec3::Zero();
+  int nm = 0, nd = 0;
+  for (const Row& r : Rows(*run->sim)) {
+    if (r.system == "moths") moths += r.x, ++nm;
+    if (r.system == "dust") dust += r.x, ++nd;
+  }
+  ASSERT_EQ(nm, 20);
+  ASSERT_EQ(nd, 20);
+  moths /= nm;
+  dust /= nd;
+  // Linear falloff: 400 / 25 = 16 m/s^2 at the start, 1 s from rest.
+  EXPECT_GT(moths.x(), 5) << "moths' centroid " << moths.transpose();
+  EXPECT_LT(dust.x(), -5) << "dust's centroid " << dust.transpose();
+  EXPECT_NEAR(moths.z(), 0, 1) << "moths' centroid " << moths.transpose();
+}
+
 }  // namespace
 }  // namespace sylva::scene
