@@ -125,6 +125,37 @@ TEST(SceneSimulation, SnowThatLandsOnABranchStaysThere) {
   EXPECT_EQ(kept, rest.size()) << "resting flakes that moved: " << rest.size() - kept;
 }
 
+TEST(SceneSimulation, SnowRestsOnTheSurfacesAPlantPlaces) {
+  // A stem whose leaves and flower are the bundled surfaces ~leaf and
+  // ~flower (no polygons): snow lands on them, away from the stem's axis.
+  // Surfaces did not collide before: flakes passed through every leaf.
+  auto run = Start(R"(<scene version="1">
+    <plant id="stem" grammar=")" +
+                   Grammar("plants/leafy_stem.lsys") +
+                   R"(" steps="6" height="3"/>
+    <particles id="snow" max="20000">
+      <emitter shape="box" at="0 4 0" size="3 0.2 3" rate="20000" direction="0 -1 0"
+               speed="1" lifetime="100"/>
+      <gravity/>
+      <collide with="stem ground" stick="true"/>
+    </particles>
+    <simulation fps="30" substeps="2"/>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(2).ok());
+  size_t onLeaves = 0, below = 0, n = 0;
+  for (const Row& r : Rows(*run->sim)) {
+    ++n;
+    if (r.x.y() < -1e-9) ++below;
+    const double fromAxis = std::hypot(r.x.x(), r.x.z());
+    if (r.v.norm() == 0 && r.x.y() > 0.05 && fromAxis > 0.2) ++onLeaves;
+  }
+  EXPECT_EQ(below, 0u) << "flakes below the ground";
+  EXPECT_GT(onLeaves, 100u) << "flakes resting on leaves (above the ground, 0.2 m or more from "
+                               "the stem) of "
+                            << n;
+}
+
 TEST(SceneSimulation, FastParticlesBornOverATerrainDoNotPassThroughIt) {
   // A birth is advanced into its step (no bands in a stream): at 100 m/s
   // that advance carried 270 of 300 particles through a terrain 0.5 m below.
