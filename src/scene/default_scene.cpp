@@ -16,8 +16,7 @@ mesh::Vec3f LightOnTheGround(const std::vector<draw::Light>& lights) {
   for (const draw::Light& l : lights) {
     const mesh::Vec3f c = l.color * l.intensity;
     if (l.type == draw::Light::Type::kAmbient) sum += c;  // 0.55 + 0.45 n.y at n = +y
-    if (l.type == draw::Light::Type::kSun)
-      sum += c * std::max(0.0f, -l.direction.normalized().y());
+    if (l.type == draw::Light::Type::kSun) sum += c * std::max(0.0f, -l.direction.normalized().y());
   }
   return sum;
 }
