@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <unordered_map>
 
@@ -287,10 +288,78 @@ struct ParticleSystem {
   std::unique_ptr<LeafStates> leaves;
   double plateK = 0;  // drag along the normal, N s/m
   uint64_t leafSeed = 0;
+  // <springs>: joined by particle id, so a spring survives the renumbering
+  // of RemoveDead; `springs` holds them at the current indices.
+  struct Joint {
+    uint32_t a, b;
+    double rest;
+  };
+  const SpringsDef* springsDef = nullptr;
+  std::shared_ptr<particles::Springs> springs;
+  std::vector<Joint> joints;
+  std::optional<uint32_t> lastBorn;  // chain: the id of the latest birth
+  // Joins particle i, just born, as `between` says.
+  Status Join(size_t i);
+  // After RemoveDead: the springs of living particles at their new indices.
+  Status Renumber();
   // Turns each leaf by the flow's torque and its spin; new ones get a
   // random orientation and spin, dead ones are forgotten.
   void TurnLeaves(double h, const Wind* wind, double time);
 };
+
+Status ParticleSystem::Join(size_t i) {
+  const ParticleState& st = system->state;
+  const SpringsDef& d = *springsDef;
+  auto join = [&](size_t j) -> Status {
+    const double rest = d.rest.value_or((st.position[i] - st.position[j]).norm());
+    joints.push_back({st.id[j], st.id[i], rest});
+    return springs->Add(uint32_t(j), uint32_t(i), rest, d.k, d.damping);
+  };
+  if (d.between == SpringTopology::kChain) {
+    // The latest birth is the last particle before i, if it still lives
+    // (births are appended; RemoveDead keeps the order).
+    const bool chained = lastBorn && i > 0 && st.id[i - 1] == *lastBorn;
+    lastBorn = st.id[i];
+    return chained ? join(i - 1) : Status{};
+  }
+  // Nearest (and for `grid` every particle within 1.5 times the nearest
+  // distance, at most 6): a linear scan, bounded by `max` (Create).
+  double best = HUGE_VAL;
+  size_t nearest = i;
+  for (size_t j = 0; j < i; ++j) {
+    const double d2 = (st.position[j] - st.position[i]).squaredNorm();
+    if (d2 < best) best = d2, nearest = j;
+  }
+  if (nearest == i) return {};
+  if (d.between == SpringTopology::kNearest) return join(nearest);
+  const double reach = 2.25 * best;  // (1.5 x)^2
+  int joined = 0;
+  for (size_t j = 0; j < i && joined < 6; ++j) {
+    if ((st.position[j] - st.position[i]).squaredNorm() > reach) continue;
+    if (Status s = join(j); !s.ok()) return s;
+    ++joined;
+  }
+  return {};
+}
+
+Status ParticleSystem::Renumber() {
+  const ParticleState& st = system->state;
+  std::unordered_map<uint32_t, uint32_t> index;
+  index.reserve(st.size());
+  for (size_t i = 0; i < st.size(); ++i) index.emplace(st.id[i], uint32_t(i));
+  springs->Clear();
+  size_t kept = 0;
+  for (const Joint& j : joints) {
+    const auto a = index.find(j.a), b = index.find(j.b);
+    if (a == index.end() || b == index.end()) continue;  // an end died: the spring goes
+    joints[kept++] = j;
+    if (Status s = springs->Add(a->second, b->second, j.rest, springsDef->k, springsDef->damping);
+        !s.ok())
+      return s;
+  }
+  joints.resize(kept);
+  return {};
+}
 
 void ParticleSystem::TurnLeaves(double h, const Wind* wind, double time) {
   const ParticleState& st = system->state;
@@ -514,6 +583,13 @@ Status Simulation::Impl::Emit(ParticleSystem& ps, double step) {
         if (at != b.x && c.Intersect(b.x, at, &contact)) at = b.x;
       st.Add(at, b.v, b.mass, b.lifetime);
       st.age.back() = remaining;
+      if (ps.springs) {
+        if (Status s = ps.Join(st.size() - 1); !s.ok()) {
+          Diagnostic d = s.error();
+          d.loc = ps.springsDef->loc;
+          return d;
+        }
+      }
     }
   }
   return {};
@@ -602,7 +678,15 @@ Status Simulation::Impl::Step() {
         }
       }
     }
+    const size_t before = st.size();
     particles::RemoveDead(st);
+    if (ps->springs && st.size() != before) {
+      if (Status s = ps->Renumber(); !s.ok()) {
+        Diagnostic d = s.error();
+        d.loc = ps->springsDef->loc;
+        return d;
+      }
+    }
   }
   for (ClothSheet& c : cloths) {
     Vec3 w = Vec3::Zero();
@@ -808,8 +892,21 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
           !s.ok())
         return Fail(p.loc, s.error().message, ErrorKind::kInput);
     }
-    for (const SpringsDef& sp : p.springs)
-      diags.Add(Warn(sp.loc, "<springs> in a scene are not simulated yet"));
+    if (p.springs.size() > 1)
+      return Fail(p.springs[1].loc, "one <springs> per <particles>", ErrorKind::kInput);
+    if (!p.springs.empty()) {
+      const SpringsDef& sp = p.springs[0];
+      // Nearest and grid scan every living particle at each birth.
+      if (sp.between != SpringTopology::kChain && p.max > 20000)
+        return Fail(sp.loc,
+                    "springs between nearest particles scan them all at each birth: at most "
+                    "20000 particles (the <particles> max is " +
+                        std::to_string(p.max) + ")",
+                    ErrorKind::kInput);
+      ps->springsDef = &sp;
+      ps->springs = std::make_shared<particles::Springs>();
+      ps->system->AddForce(ps->springs);
+    }
     for (size_t k = 0; k < p.emitters.size(); ++k) {
       const EmitterDef& e = p.emitters[k];
       Source src;

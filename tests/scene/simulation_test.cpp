@@ -156,6 +156,67 @@ TEST(SceneSimulation, SnowRestsOnTheSurfacesAPlantPlaces) {
                             << n;
 }
 
+TEST(SceneSimulation, ChainSpringsHoldParticlesBornTogether) {
+  // 20 particles burst in random directions at 1 m/s: alone they fly
+  // apart; joined in a chain (each to the one born before it) they stay
+  // near the distances they were born at. Dying ends take their springs
+  // with them (the second system dies early; no step fails).
+  const std::string body = R"(
+      <emitter shape="box" at="0 5 0" size="1 1 1" burst="20" speed="1" spread="180"
+               lifetime="100 100"/>)";
+  auto run = Start(R"(<scene version="1">
+    <particles id="rope" max="20">)" +
+                   body + R"(
+      <springs between="chain" k="2000" damping="4"/>
+    </particles>
+    <particles id="free" max="20">)" +
+                   body + R"(
+    </particles>
+    <particles id="short" max="200">
+      <emitter shape="point" at="0 1 0" rate="100" speed="0.5" spread="180" lifetime="0.2 0.6"/>
+      <springs between="grid" k="50" damping="1"/>
+    </particles>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(3).ok());
+  const std::vector<Row> rows = Rows(*run->sim);
+  double ropeStretch = 0, freeStretch = 0;
+  for (const char* system : {"rope", "free"}) {
+    std::vector<Vec3> now;
+    for (const Row& r : rows)
+      if (r.system == system) now.push_back(r.x);
+    ASSERT_EQ(now.size(), 20u) << system;
+    double sum = 0;
+    for (size_t i = 1; i < now.size(); ++i) sum += (now[i] - now[i - 1]).norm();
+    (std::string(system) == "rope" ? ropeStretch : freeStretch) = sum / 19;
+  }
+  // Born within a 1 m box: consecutive distances about 0.66 m. After 3 s
+  // the free ones are metres apart; the rope's stay under 1.5 m.
+  EXPECT_LT(ropeStretch, 1.5) << "mean distance of consecutive rope particles after 3 s";
+  EXPECT_GT(freeStretch, 2.0) << "mean distance of consecutive free particles after 3 s";
+}
+
+TEST(SceneSimulation, NearestSpringsAreBoundedByTheSystemSize) {
+  const auto dir = sylva::testing::ScratchDir("sylva_scene_sim_");
+  const std::string path = (dir / "s.xml").string();
+  std::ofstream(path) << R"(<scene version="1">
+    <particles id="web" max="100000">
+      <emitter rate="10"/>
+      <springs between="nearest"/>
+    </particles>
+  </scene>)";
+  ReadResult r = ReadScene(path);
+  ASSERT_TRUE(r.scene) << r.diagnostics.FormatAll();
+  BuildResult b = Build(*r.scene, {});
+  ASSERT_TRUE(b.scene);
+  DiagnosticList warnings;
+  auto sim = Simulation::Create(*r.scene, *b.scene, {}, warnings);
+  ASSERT_FALSE(sim.ok()) << "a nearest-springs system of 100,000 must be refused";
+  EXPECT_NE(sim.error().message.find("at most 20000 particles"), std::string::npos)
+      << sim.error().message;
+  EXPECT_EQ(sim.error().loc.line, 4) << sim.error().Format();
+}
+
 TEST(SceneSimulation, FastParticlesBornOverATerrainDoNotPassThroughIt) {
   // A birth is advanced into its step (no bands in a stream): at 100 m/s
   // that advance carried 270 of 300 particles through a terrain 0.5 m below.
