@@ -176,8 +176,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   CLI::App* vi =
       app.add_subcommand("view", "open the interactive viewer (reloads the file when it changes)");
   vi->add_option("file", view.file,
-                 "grammar file (.lsys) or scene file (.xml, played); default: a bundled ABOP "
-                 "tree");
+                 "grammar file (.lsys) or scene file (.xml, played); default: the bundled "
+                 "autumn scene");
   vi->add_option("--screenshot", view.screenshot,
                  "save this picture (.png, .jpg) after --frames frames and quit");
   vi->add_option("--frames", view.frames, "frames to draw before the screenshot")
@@ -187,9 +187,12 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   vi->add_option("--time", view.time, "scenes: start paused at this time in seconds")
       ->check(CLI::Range(0.0, 1e6));
   vi->add_option("-D,--define", view.defines,
-                 "scenes: override a <default>: NAME=VALUE (repeatable)");
-  vi->add_option("--threads", view.threads, "scenes: worker threads (default: all cores)")
+                 "override a grammar's #define or a scene's <default>: NAME=VALUE (repeatable)");
+  vi->add_option("--threads", view.threads, "worker threads (default: all cores)")
       ->check(CLI::Range(0, 256));
+  vi->add_option("-n,--steps", view.steps, "grammars: the derivation step to start at")
+      ->check(CLI::Range(0, lsys::kMaxDerivationLengthForDerive));
+  vi->add_option("--seed", view.seed, "grammars: the seed to start with");
 
   DeriveFlags check;
   CLI::App* c = app.add_subcommand(
@@ -226,10 +229,9 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     app.parse(rev);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) {
+      // app.help() is the selected subcommand's help when one is given
+      // (`sylva view --help`), printed once.
       out << (e.get_name() == "CallForVersion" ? std::string(e.what()) + "\n" : app.help());
-      if (e.get_name() == "CallForHelp") {
-        for (auto* sub : app.get_subcommands()) out << sub->help();
-      }
       return kExitOk;
     }
     err << "sylva: error: " << e.what() << "\n";

@@ -15,8 +15,8 @@
 
 namespace sylva::app {
 
-static bool ParseDefines(const std::vector<std::string>& defs,
-                         std::map<std::string, double>* overrides, std::ostream& err) {
+bool ParseDefines(const std::vector<std::string>& defs, std::map<std::string, double>* overrides,
+                  std::ostream& err) {
   for (const auto& d : defs) {
     size_t eq = d.find('=');
     std::string name = d.substr(0, eq);

@@ -121,6 +121,23 @@ render::Image Downsample(const render::Image& big, int k) {
 
 }  // namespace
 
+draw::Lines LinesOf(const plant::Plant& plant) {
+  draw::Lines out;
+  const mesh::Palette& palette = plant.palette;
+  const float lineShade = plant.grammar.palette.empty() ? std::pow(0.6f, 2.2f) : 1.0f;
+  for (const auto& s : plant.geometry.segments) {
+    // A grammar's own palette is drawn as written; the default palette is
+    // darkened (to 0.6 of its sRGB value) so lines read on white.
+    const mesh::Vec3f c =
+        palette.empty() ? mesh::Vec3f(0, 0, 0) : palette[s.color % palette.size()] * lineShade;
+    out.points.push_back(s.start.cast<float>());
+    out.points.push_back(s.end.cast<float>());
+    out.colors.push_back(c);
+    out.colors.push_back(c);
+  }
+  return out;
+}
+
 mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps) {
   mesh::ScreenView view;
   view.viewProjection = camera.ViewProjection(double(width) / height);
@@ -168,17 +185,9 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (!camera) return Report(camera.error(), err);
   const int W = v.width * K, H = v.height * K;
   if (lines) {
-    const float lineShade = plant->grammar.palette.empty() ? std::pow(0.6f, 2.2f) : 1.0f;
-    for (const auto& s : geometry->segments) {
-      // A grammar's own palette is drawn as written; the default palette is
-      // darkened (to 0.6 of its sRGB value) so lines read on white.
-      const mesh::Vec3f c =
-          palette.empty() ? mesh::Vec3f(0, 0, 0) : palette[s.color % palette.size()] * lineShade;
-      batch.points.push_back(s.start.cast<float>());
-      batch.points.push_back(s.end.cast<float>());
-      batch.colors.push_back(c);
-      batch.colors.push_back(c);
-    }
+    draw::Lines figure = LinesOf(*plant);
+    batch.points = std::move(figure.points);
+    batch.colors = std::move(figure.colors);
   } else {
     // Screen-space detail unless --sides asks for uniform tubes; eps is in
     // output pixels, so K times as many in the K-times larger image.

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -12,6 +13,7 @@
 
 #include "core/diagnostic.h"
 #include "core/parallel.h"
+#include "draw/draw_list.h"
 #include "plant/plant.h"
 #include "scene/build.h"
 #include "scene/scene.h"
@@ -83,6 +85,13 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 // The plant spec the flags describe (steps, seed, -D, threads, limits);
 // nullopt with *exit set when a flag is malformed (printed to `err`).
 std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit);
+// -D NAME=VALUE arguments into `overrides`; false (the error printed) on a
+// bad name or number.
+bool ParseDefines(const std::vector<std::string>& defs, std::map<std::string, double>* overrides,
+                  std::ostream& err);
+// A 2D figure (plant::IsLineFigure) as lines: the grammar's palette as
+// written, the default one darkened so lines read on white.
+draw::Lines LinesOf(const plant::Plant& plant);
 
 // Builds the plant up to `spec.until`, printing its diagnostics (at most
 // maxErrors of them, 0: all); nullopt with *exit set on an error (or, with

@@ -10,6 +10,7 @@
 // the compiler's message.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -60,8 +61,9 @@ Vec3 KeyLightDirection();
 // the sphere of this radius about the centre of lo..hi (the list's
 // shadowBounds, else what casts shadows).
 double SunShadowRadius(const Vec3& lo, const Vec3& hi);
-// Texels per world unit of that shadow map when it is fitted to `bounds`
-// (screen-space detail keeps what casts a shadow of a texel or more).
+// Texels per world unit of that shadow map (at the default size) when it
+// is fitted to `bounds` (screen-space detail keeps what casts a shadow of a
+// texel or more).
 double ShadowTexelsPerUnit(const mesh::Box& bounds);
 
 class Renderer {
@@ -85,6 +87,11 @@ class Renderer {
   void SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette,
                const mesh::Box* bounds = nullptr);
   void SetShadows(bool on) { shadows_ = on; }
+  // Texels on a side of Draw(DrawList)'s shadow map (256..8192). The
+  // default suits a still picture; the viewer takes 2048, whose samples
+  // cost llvmpipe a third of the frame time of 4096.
+  static constexpr int kDefaultShadowMapSize = 4096;
+  void SetShadowMapSize(int texels) { shadowMapSize_ = std::clamp(texels, 256, 8192); }
   // Draws the mesh's triangle edges over it (docs/lod.md's pictures).
   void SetWireframe(bool on) { wireframe_ = on; }
   // Replaces the lines. colors must have one entry per point (else a
@@ -119,6 +126,7 @@ class Renderer {
   int width_ = 0, height_ = 0;
   mesh::Vec3f background_ = mesh::Srgb(0.94f, 0.95f, 0.96f);  // linear
   bool shadows_ = true, wireframe_ = false;
+  int shadowMapSize_ = kDefaultShadowMapSize;
   void RenderShadowMap();
   unsigned MultisampleFramebuffer() const;
   unsigned ResolveFramebuffer() const;

@@ -37,9 +37,6 @@ struct GpuInstance {
 };
 static_assert(sizeof(GpuInstance) == 76, "instance layout");
 
-// Texels on a side of the first sun's shadow map.
-constexpr int kSceneShadowSize = 4096;
-
 // FNV-1a over bytes, continuing from `h`.
 constexpr uint64_t kFnvBasis = 1469598103934665603ull;
 uint64_t Fnv(uint64_t h, const void* data, size_t n) {
@@ -58,7 +55,7 @@ struct Renderer::ScenePass {
   GLint skyInverse = -1, skyTop = -1, skyHorizon = -1;
   GLint spriteViewProj = -1, spriteScale = -1, lineViewProj = -1;
   GLuint shadowFbo = 0, shadowDepth = 0, emptyVao = 0;
-  static constexpr int kShadowSize = kSceneShadowSize;
+  int shadowSize = 0;      // texels on a side of the depth texture allocated
   uint64_t shadowKey = 0;  // what the shadow map shows (see Draw)
   bool shadowValid = false;
   std::unordered_map<const mesh::TriangleMesh*, GpuMesh> meshes;
@@ -109,8 +106,6 @@ struct Renderer::ScenePass {
     lineViewProj = glGetUniformLocation(lineProgram, "uViewProj");
     glGenTextures(1, &shadowDepth);
     glBindTexture(GL_TEXTURE_2D, shadowDepth);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, kShadowSize, kShadowSize, 0,
-                 GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -129,6 +124,16 @@ struct Renderer::ScenePass {
     glGenVertexArrays(1, &lineVao);
     glGenBuffers(2, lineBuffers);
     return {};
+  }
+
+  // (Re)allocates the shadow map at `size` texels a side.
+  void SizeShadowMap(int size) {
+    if (size == shadowSize) return;
+    glBindTexture(GL_TEXTURE_2D, shadowDepth);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, size, size, 0, GL_DEPTH_COMPONENT,
+                 GL_FLOAT, nullptr);
+    shadowSize = size;
+    shadowValid = false;
   }
 
   GpuMesh& Upload(const draw::MeshDraw& d) {
@@ -197,7 +202,7 @@ double SunShadowRadius(const Vec3& lo, const Vec3& hi) {
 }
 
 double ShadowTexelsPerUnit(const mesh::Box& bounds) {
-  return kSceneShadowSize / (2 * SunShadowRadius(bounds.lo, bounds.hi));
+  return Renderer::kDefaultShadowMapSize / (2 * SunShadowRadius(bounds.lo, bounds.hi));
 }
 
 void Renderer::DestroyScenePass(ScenePass* pass) {
@@ -215,6 +220,7 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     scene_ = pass;
   }
   ScenePass& p = *scene_;
+  p.SizeShadowMap(shadowMapSize_);
   for (auto& [k, m] : p.meshes) m.used = false;
   std::vector<GpuMesh*> gpu;
   for (const draw::MeshDraw& d : list.meshes) {
@@ -272,7 +278,7 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     p.shadowKey = shadowKey;
     p.shadowValid = true;
     glBindFramebuffer(GL_FRAMEBUFFER, p.shadowFbo);
-    glViewport(0, 0, ScenePass::kShadowSize, ScenePass::kShadowSize);
+    glViewport(0, 0, p.shadowSize, p.shadowSize);
     glClear(GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glEnable(GL_POLYGON_OFFSET_FILL);

@@ -124,6 +124,19 @@ TEST(Cli, HelpIsExitZero) {
   EXPECT_NE(r.out.find("derive"), std::string::npos);
 }
 
+TEST(Cli, ACommandsHelpIsPrintedOnce) {
+  for (const char* command : {"view", "render", "derive"}) {
+    auto r = RunSylva({command, "--help"});
+    EXPECT_EQ(r.code, 0) << command;
+    size_t count = 0;
+    for (size_t at = r.out.find("Usage:"); at != std::string::npos;
+         at = r.out.find("Usage:", at + 1))
+      ++count;
+    EXPECT_EQ(count, 1u) << command << " --help printed its usage " << count << " times:\n"
+                         << r.out;
+  }
+}
+
 }  // namespace
 }  // namespace sylva::app
 
