@@ -76,10 +76,17 @@ Expected<std::unique_ptr<Environment>> MakeLight(const lsys::EnvironmentStatemen
                            "' in 'environment: light': Sylva has box(x0, y0, z0, x1, y1, z1)",
                        len);
       }
-      if (it.values.size() != 6 || !AllFinite(it.values))
-        return ErrorAt(g, it.loc, "'box' takes 6 finite numbers: x0, y0, z0, x1, y1, z1", len);
       const auto& v = it.values;
-      def.walls.push_back(LightBox{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5])});
+      if ((v.size() != 6 && v.size() != 7) || !AllFinite(v)) {
+        return ErrorAt(g, it.loc,
+                       "'box' takes 6 or 7 finite numbers: x0, y0, z0, x1, y1, z1 and the shadow "
+                       "of each voxel",
+                       len);
+      }
+      if (v.size() == 7 && !(v[6] > 0 && v[6] <= 1e6))
+        return ErrorAt(g, it.loc, "a box's shadow must be in (0, 1e6]", len);
+      def.walls.push_back(
+          LightBox{Vec3(v[0], v[1], v[2]), Vec3(v[3], v[4], v[5]), v.size() == 7 ? v[6] : -1});
       continue;
     }
     if (!it.keyValue) {

@@ -88,8 +88,8 @@ Status LightGrid::Update(std::span<const Vec3> buds) {
   shadow_.assign(size_t(cells), 0.0f);
   opaque_.assign(size_t(cells), 0);
 
-  // Walls: every voxel of a wall that can reach the grid casts like a bud
-  // of strength 1; those inside the grid are opaque.
+  // Walls: every voxel of a wall that can reach the grid casts like a bud;
+  // those inside the grid are opaque.
   for (const LightBox& w : def_.walls) {
     int64_t wlo[3], whi[3];
     bool empty = false;
@@ -103,10 +103,11 @@ Status LightGrid::Update(std::span<const Vec3> buds) {
       whi[a] = int64_t(h) - origin_[a];
     }
     if (empty) continue;
+    const double strength = w.shadow >= 0 ? w.shadow : def_.shadow;
     for (int64_t y = wlo[1]; y <= whi[1]; ++y) {
       for (int64_t z = wlo[2]; z <= whi[2]; ++z) {
         for (int64_t x = wlo[0]; x <= whi[0]; ++x) {
-          Cast(x, y, z, 1.0);
+          Cast(x, y, z, strength);
           if (x >= 0 && x < size_[0] && y >= 0 && y < size_[1] && z >= 0 && z < size_[2])
             opaque_[size_t((y * size_[2] + z) * size_[0] + x)] = 1;
         }

@@ -11,8 +11,8 @@
 // share one grid compete for light: a bud under another's crown reads less.
 //
 // Opaque boxes (walls) are 0 inside, and each of their voxels shadows the
-// pyramid below it as a bud of strength 1 would (1 * b^-q), so a wall
-// darkens the side of a tree that faces it.
+// pyramid below it as a bud does (a * b^-q; a box may set its own a), so a
+// wall darkens the side of a tree that faces it, the more the nearer.
 //
 // The grid is dense and rebuilt on every Update(): it spans the buds' box
 // widened by `depth` voxels sideways and downward, on voxel boundaries at
@@ -20,7 +20,7 @@
 // other buds are), at most kMaxLightCells voxels. Cost: each bud touches
 // sum (2q+1)^2 voxels, 165 for depth 4 (bench/bench_environment.cpp).
 //
-//   environment: light cell=0.5 depth=5 shadow=0.2 falloff=2 box(x0,y0,z0, x1,y1,z1) ...
+//   environment: light cell=0.5 depth=5 shadow=0.2 falloff=2 box(x0,y0,z0, x1,y1,z1[, a]) ...
 #pragma once
 
 #include <cstdint>
@@ -37,7 +37,8 @@ namespace sylva::plant {
 inline constexpr uint64_t kMaxLightCells = uint64_t(1) << 25;
 
 struct LightBox {
-  Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+  Vec3 lo{0, 0, 0}, hi{0, 0, 0};  // corners, any order
+  double shadow = -1;             // what each voxel casts into its own; < 0: LightDef::shadow
 };
 
 struct LightDef {

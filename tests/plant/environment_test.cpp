@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -111,7 +113,7 @@ TEST(LightGrid, AWallIsDarkInsideAndShadesItsSide) {
   def.depth = 5;
   def.shadow = 0.2;
   def.falloff = 2;
-  def.walls.push_back(LightBox{Vec3(2, 0, -10), Vec3(2.9, 20, 10)});  // voxels x = 2
+  def.walls.push_back(LightBox{Vec3(2, 0, -10), Vec3(2.9, 20, 10), 1.0});  // voxels x = 2
   LightGrid grid(def);
   const std::vector<Vec3> buds = {Vec3(-2.5, 5.5, 0.5), Vec3(-20.5, 5.5, 0.5)};
   ASSERT_TRUE(grid.Update(buds).ok());
@@ -126,6 +128,12 @@ TEST(LightGrid, AWallIsDarkInsideAndShadesItsSide) {
   ASSERT_TRUE(grid.Update({&nearer, 1}).ok());
   EXPECT_NEAR(grid.Exposure(nearer), std::max(0.0, 1.0 - 9.0 / 16 - 11.0 / 32), 1e-6)
       << "measured " << grid.Exposure(nearer);
+  // Without its own shadow a box casts the buds' (0.2 a voxel).
+  def.walls[0].shadow = -1;
+  LightGrid weaker(def);
+  ASSERT_TRUE(weaker.Update({&nearer, 1}).ok());
+  EXPECT_NEAR(weaker.Exposure(nearer), 1.0 - 0.2 * (9.0 / 16 + 11.0 / 32), 1e-6)
+      << "measured " << weaker.Exposure(nearer);
 }
 
 TEST(LightGrid, TooManyVoxelsIsAnErrorNotAnAllocation) {
@@ -196,6 +204,67 @@ TEST(Environment, LightGrammarDerivesWithItsAnswers) {
       0, Stage::kWord);
   ASSERT_TRUE(p);
   EXPECT_EQ(lsys::FormatWord(p->word, p->grammar.symbols), "[f(5.5)?E(1)][f(4.5)?E(0.9)]");
+}
+
+// Mean x of the segments' ends, and the reach of the drawing on each side
+// of the trunk at x0.
+struct Spread {
+  double meanX = 0, left = 0, right = 0;
+};
+Spread SpreadOf(const Plant& p, double x0, double lo, double hi) {
+  Spread s;
+  size_t n = 0;
+  for (const mesh::Segment& seg : p.geometry.segments) {
+    const double x = seg.end.x();
+    if (x < lo || x > hi) continue;
+    s.meanX += x;
+    ++n;
+    s.left = std::max(s.left, x0 - x);
+    s.right = std::max(s.right, x - x0);
+  }
+  if (n) s.meanX /= double(n);
+  return s;
+}
+
+std::optional<Plant> Example(const std::string& name, std::map<std::string, double> defines = {}) {
+  PlantSpec spec;
+  spec.path = std::string(SYLVA_SOURCE_DIR) + "/grammars/environment/" + name;
+  spec.until = Stage::kGeometry;
+  spec.defines = std::move(defines);
+  return testing::BuildOrFail(spec);
+}
+
+TEST(Environment, TreeByTheWallGrowsAwayFromIt) {
+  // The wall is at x = 2.4; moved 100 away, the same tree is about
+  // symmetric.
+  auto by = Example("tree_by_wall.lsys");
+  auto free = Example("tree_by_wall.lsys", {{"WX", 100}});
+  ASSERT_TRUE(by && free);
+  const Spread b = SpreadOf(*by, 0, -50, 50), f = SpreadOf(*free, 0, -50, 50);
+  RecordProperty("mean_x_by_wall", std::to_string(b.meanX));
+  RecordProperty("mean_x_free", std::to_string(f.meanX));
+  RecordProperty("reach_away", std::to_string(b.left));
+  RecordProperty("reach_toward", std::to_string(b.right));
+  EXPECT_LT(b.meanX, f.meanX - 0.3) << "mean x by the wall " << b.meanX << ", free " << f.meanX;
+  EXPECT_LT(b.right, 2.4) << "reach toward the wall " << b.right;
+  EXPECT_GT(b.left, b.right + 1.0) << "reach away " << b.left << ", toward " << b.right;
+}
+
+TEST(Environment, TwoTreesSharingLightGrowApart) {
+  // Trunks at x = -2 and 2: each reaches farther away from the other than
+  // toward it; 100 apart they are about symmetric.
+  auto near = Example("two_trees_light.lsys");
+  ASSERT_TRUE(near);
+  const Spread l = SpreadOf(*near, -2, -50, -0.0001), r = SpreadOf(*near, 2, 0.0001, 50);
+  RecordProperty("left_mean_x", std::to_string(l.meanX));
+  RecordProperty("right_mean_x", std::to_string(r.meanX));
+  EXPECT_LT(l.meanX, -2.2) << "left tree's mean x " << l.meanX;
+  EXPECT_GT(r.meanX, 2.2) << "right tree's mean x " << r.meanX;
+  auto apart = Example("two_trees_light.lsys", {{"D", 50}});
+  ASSERT_TRUE(apart);
+  const Spread la = SpreadOf(*apart, -50, -100, -0.0001);
+  RecordProperty("lone_mean_x", std::to_string(la.meanX));
+  EXPECT_NEAR(la.meanX, -50, 0.3) << "a lone tree's mean x " << la.meanX;
 }
 
 }  // namespace
