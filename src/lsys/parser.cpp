@@ -1476,7 +1476,7 @@ void GrammarParser::Finish() {
   WarnUnmatchable();
   // ?E is answered by the environment that `environment:` names; without
   // one its parameters keep the values written in the grammar.
-  if (!g_.environment) {
+  if (!g_.environment && !opt_.environmentGiven) {
     for (size_t s = 0; s < g_.symbols.size(); ++s) {
       if (g_.symbols.name(SymbolId(s)) != "?E") continue;
       auto it = g_.symbolLoc.find("?E");

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "plant/ground_environment.h"
 #include "plant/light_grid.h"
 #include "plant/shape_environment.h"
 
@@ -123,10 +124,20 @@ Expected<std::unique_ptr<Environment>> MakeLight(const lsys::EnvironmentStatemen
 }  // namespace
 
 Expected<std::unique_ptr<Environment>> MakeEnvironment(const lsys::EnvironmentStatement& st,
-                                                       const lsys::Grammar& g) {
+                                                       const lsys::Grammar& g,
+                                                       const Ground* ground) {
   if (st.kind == "shape") return MakeShape(st, g);
   if (st.kind == "light") return MakeLight(st, g);
-  return ErrorAt(g, st.loc, "unknown environment '" + st.kind + "': Sylva has 'shape' and 'light'",
+  if (st.kind == "terrain") {
+    if (!st.items.empty()) {
+      return ErrorAt(g, st.items[0].loc, "'environment: terrain' takes nothing after it",
+                     int(st.items[0].name.size()));
+    }
+    return std::unique_ptr<Environment>(
+        new GroundEnvironment(ground && ground->height && ground->normal ? *ground : FlatGround()));
+  }
+  return ErrorAt(g, st.loc,
+                 "unknown environment '" + st.kind + "': Sylva has 'shape', 'light' and 'terrain'",
                  int(st.kind.size()));
 }
 

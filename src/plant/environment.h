@@ -16,6 +16,8 @@
 //          ellipsoid, 0 outside: topiary pruning.
 //   light  (plant/light_grid.h): the light a bud receives in a voxel
 //          shadow-propagation grid (Palubicki et al. 2009), 0..1.
+//   terrain (plant/ground_environment.h): the ground's height and normal
+//          under the query (a scene's terrain, or the plane y = 0).
 // GL-free; units are the grammar's.
 #pragma once
 
@@ -47,10 +49,14 @@ class Environment {
   virtual Status Answer(std::span<EnvQuery> queries) = 0;
 };
 
+struct Ground;
+
 // The environment a grammar's `environment:` statement names, or an error
 // at the statement (an unknown kind, key or shape, a bad value), with the
-// line quoted from `g`.
+// line quoted from `g`. `ground` is what `environment: terrain` answers
+// from (null: the plane y = 0).
 Expected<std::unique_ptr<Environment>> MakeEnvironment(const lsys::EnvironmentStatement& statement,
-                                                       const lsys::Grammar& g);
+                                                       const lsys::Grammar& g,
+                                                       const Ground* ground = nullptr);
 
 }  // namespace sylva::plant

@@ -176,6 +176,7 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
   lsys::ParseOptions popt;
   popt.overrides = spec.defines;
   popt.readFile = spec.readFile;
+  popt.environmentGiven = spec.environment != nullptr;
   // `~lF`: cpfg's one-letter surface `l` then `F` when l.obj exists and lF.obj does not.
   const SurfaceLibrary surfaces(spec.path, spec.surfacePath, spec.readFile);
   popt.isSurface = [&surfaces](const std::string& name) { return surfaces.Has(name); };
@@ -199,7 +200,8 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
     }
   }
   if (grammar.environment) {
-    auto env = MakeEnvironment(*grammar.environment, grammar);
+    auto env =
+        MakeEnvironment(*grammar.environment, grammar, spec.ground ? &*spec.ground : nullptr);
     if (!env) {
       diagnostics.Add(env.error());
       return std::nullopt;

@@ -38,6 +38,7 @@
 #include "mesh/tessellator.h"
 #include "mesh/triangle_mesh.h"
 #include "plant/environment.h"
+#include "plant/ground_environment.h"
 #include "plant/queries.h"
 #include "turtle/interpreter.h"
 
@@ -92,6 +93,9 @@ struct PlantSpec {
   // Answers ?E instead of the environment the grammar's `environment:`
   // names (not owned; outlives the growth). Null: the grammar's, if any.
   Environment* environment = nullptr;
+  // The ground `environment: terrain` answers from, in the plant's own
+  // coordinates (a scene's terrain under the plant). Unset: the plane y = 0.
+  std::optional<Ground> ground;
   // Called after each derivation step, from the calling thread.
   std::function<void(int step, int steps, uint64_t modules)> progress;
 };

@@ -164,8 +164,8 @@ TEST(LightEnvironment, TheUpperOfTwoPlantsTakesTheLight) {
 
 TEST(Environment, GrammarChoosesItAndErrorsHaveAPosition) {
   EXPECT_NE(Errors("environment: water level=3\naxiom: A ?E(1)\n")
-                .find("t.lsys:1:14: error: unknown environment 'water': Sylva has 'shape' and "
-                      "'light'"),
+                .find("t.lsys:1:14: error: unknown environment 'water': Sylva has 'shape', 'light' "
+                      "and 'terrain'"),
             std::string::npos);
   EXPECT_NE(Errors("environment: shape cube(0,0,0,1)\naxiom: A\n")
                 .find("t.lsys:1:20: error: unknown shape 'cube'"),
@@ -194,6 +194,9 @@ TEST(Environment, GrammarChoosesItAndErrorsHaveAPosition) {
             std::string::npos);
   EXPECT_NE(Errors("environment: light sunny\naxiom: A\n").find("unknown word 'sunny'"),
             std::string::npos);
+  EXPECT_NE(Errors("environment: terrain slope=2\naxiom: A\n")
+                .find("t.lsys:1:22: error: 'environment: terrain' takes nothing after it"),
+            std::string::npos);
 }
 
 TEST(Environment, LightGrammarDerivesWithItsAnswers) {
@@ -204,6 +207,32 @@ TEST(Environment, LightGrammarDerivesWithItsAnswers) {
       0, Stage::kWord);
   ASSERT_TRUE(p);
   EXPECT_EQ(lsys::FormatWord(p->word, p->grammar.symbols), "[f(5.5)?E(1)][f(4.5)?E(0.9)]");
+}
+
+TEST(GroundEnvironment, AnswersHeightAndNormalUnderTheQuery) {
+  // The ground y = 0.5 x, tilted: normal (-0.5, 1, 0) / |..|.
+  PlantSpec spec;
+  spec.path = "t.lsys";
+  spec.text =
+      "environment: terrain\n"
+      "axiom: [ +(90) f(2) ?E(9,9,9,9) ] [ -(90) f(4) ?E(9) ] ?E(9,9)\n";
+  spec.until = Stage::kWord;
+  spec.steps = 0;
+  const double k = 1 / std::sqrt(1.25);
+  spec.ground = Ground{[](double x, double) { return 0.5 * x; },
+                       [k](double, double) { return Vec3(-0.5 * k, k, 0); }};
+  auto p = testing::BuildOrFail(spec);
+  ASSERT_TRUE(p);
+  // +(90) goes to x = -2: h = -1; -(90) to x = 4: h = 2; at the origin 0,
+  // and with 2 parameters the second keeps its value.
+  EXPECT_EQ(lsys::FormatWord(p->word, p->grammar.symbols),
+            "[+(90)f(2)?E(-1,-0.447214,0.894427,0)][-(90)f(4)?E(2)]?E(0,9)");
+  // Without a ground given: the plane y = 0.
+  spec.ground.reset();
+  auto flat = testing::BuildOrFail(spec);
+  ASSERT_TRUE(flat);
+  EXPECT_EQ(lsys::FormatWord(flat->word, flat->grammar.symbols),
+            "[+(90)f(2)?E(0,0,1,0)][-(90)f(4)?E(0)]?E(0,9)");
 }
 
 // Mean x of the segments' ends, and the reach of the drawing on each side

@@ -131,8 +131,11 @@ TEST(Queries, EnvironmentIsAskedOnTheAxiomAndAfterEveryStep) {
   spec.steps = 3;
   spec.until = Stage::kWord;
   spec.environment = &env;
-  auto p = testing::BuildOrFail(spec);
-  ASSERT_TRUE(p);
+  PlantResult r = BuildPlant(spec);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
+  // The program answers ?E: no warning that the grammar has no environment.
+  EXPECT_TRUE(r.diagnostics.items.empty()) << r.diagnostics.FormatAll();
+  auto& p = r.plant;
   EXPECT_EQ(env.calls, 4) << "the axiom and 3 steps";
   EXPECT_EQ(env.lastQueries, 1u);
   EXPECT_EQ(Text(*p), "FFFA?E(34)");  // y = 3 at the 4th call
