@@ -3,8 +3,7 @@
 namespace sylva::plant {
 
 Ground FlatGround() {
-  return Ground{[](double, double) { return 0.0; },
-                [](double, double) { return Vec3(0, 1, 0); }};
+  return Ground{[](double, double) { return 0.0; }, [](double, double) { return Vec3(0, 1, 0); }};
 }
 
 Status GroundEnvironment::Answer(std::span<EnvQuery> queries) {

@@ -35,6 +35,35 @@ std::optional<plant::Plant> Grow(plant::PlantSpec spec, const BuildOptions& opti
   return std::move(r.plant);
 }
 
+// The ground under a plant at `at`, turned by `yawDegrees` about Y and
+// scaled by `scale` (draw::Transform), in the plant's own coordinates.
+// Points into `built`: use it while the plants grow.
+plant::Ground GroundUnder(const BuiltScene& built, const Vec3& at, double yawDegrees,
+                          double scale) {
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(yawDegrees * 3.14159265358979323846 / 180, Vec3::UnitY())
+          .toRotationMatrix();
+  auto world = [r, at, scale](double x, double z) {
+    return Vec3(at + r * (scale * Vec3(x, 0, z)));
+  };
+  plant::Ground g;
+  g.height = [&built, world, at, scale](double x, double z) {
+    const Vec3 w = world(x, z);
+    return (built.GroundHeight(w.x(), w.z()) - at.y()) / scale;
+  };
+  g.normal = [&built, world, r](double x, double z) {
+    const Vec3 w = world(x, z);
+    for (const terrain::HeightField& t : built.terrains)
+      if (t.Contains(w.x(), w.z())) return Vec3(r.transpose() * t.Normal(w.x(), w.z()));
+    return Vec3(0, 1, 0);
+  };
+  return g;
+}
+
+bool UsesTerrain(const lsys::Grammar& g) {
+  return g.environment && g.environment->kind == "terrain";
+}
+
 // Box of a mesh through a transform.
 void GrowBounds(const mesh::TriangleMesh& m, const draw::Mat4f& t, Vec3& lo, Vec3& hi, bool& any) {
   for (const mesh::Vec3f& p : m.positions) {
@@ -221,15 +250,26 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
   if (diags.HasErrors()) return result;
 
   for (const PlantDef& p : scene.plants) {
-    const plant::PlantSpec spec = SpecFor(p);
+    plant::PlantSpec spec = SpecFor(p);
+    Vec3 at = p.position;
+    if (!p.positionHasY) at.y() = built.GroundHeight(at.x(), at.z());
+    // `environment: terrain` reads the terrain under the plant, in the
+    // plant's coordinates (at its `scale`: `height` rescales after growth).
+    spec.ground = GroundUnder(built, at, p.rotateDegrees, p.scale);
     std::optional<plant::Plant> grown = Grow(spec, options, p.grammarLoc, "plant", diags);
     if (!grown) continue;
+    spec.ground.reset();  // it points into `built`; the kept spec is for tessellation
+    if (p.height && UsesTerrain(grown->grammar)) {
+      diags.Add(AtElement(p.loc,
+                          "'height' rescales this plant after it grew: its grammar's "
+                          "'environment: terrain' read the terrain at scale " +
+                              std::to_string(p.scale) + ", not at the height's",
+                          Severity::kWarning));
+    }
     BuiltMesh m;
     m.mesh = std::make_shared<mesh::TriangleMesh>(std::move(grown->mesh));
     m.palette = grown->palette;
     m.spec = spec;
-    Vec3 at = p.position;
-    if (!p.positionHasY) at.y() = built.GroundHeight(at.x(), at.z());
     const double unit = p.height ? HeightScale(*m.mesh, *p.height, p.loc, diags) : 1;
     m.instances.push_back({draw::Transform(at, p.rotateDegrees, p.scale * unit), {1, 1, 1}});
     m.loc = p.loc;
@@ -268,6 +308,13 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       const plant::PlantSpec spec = SpecFor(f, forestSeed, v);
       std::optional<plant::Plant> grown = Grow(spec, options, f.grammarLoc, "forest", diags);
       if (!grown) break;
+      if (v == 0 && UsesTerrain(grown->grammar)) {
+        diags.Add(AtElement(f.loc,
+                            "a forest grows each variant once and places it many times: its "
+                            "grammar's 'environment: terrain' read flat ground at y = 0, not the "
+                            "terrain under each tree",
+                            Severity::kWarning));
+      }
       BuiltMesh m;
       m.mesh = std::make_shared<mesh::TriangleMesh>(std::move(grown->mesh));
       m.palette = grown->palette;
