@@ -89,25 +89,50 @@ Status LightGrid::Update(std::span<const Vec3> buds) {
   opaque_.assign(size_t(cells), 0);
 
   // Walls: every voxel of a wall that can reach the grid casts like a bud;
-  // those inside the grid are opaque.
+  // those inside the grid are opaque. First their extent, clipped to the
+  // reach of the grid, so that the work is known before it is done.
+  struct WallSpan {
+    int64_t lo[3], hi[3];
+    double strength;
+  };
+  std::vector<WallSpan> spans;
+  double work = 0;
   for (const LightBox& w : def_.walls) {
-    int64_t wlo[3], whi[3];
+    WallSpan span;
     bool empty = false;
+    double voxels = 1;
     for (int a = 0; a < 3; ++a) {
       const double reachLo = double(origin_[a]) - (a == 1 ? 0 : def_.depth);
       const double reachHi = double(origin_[a] + size_[a] - 1) + def_.depth;
       const double l = std::max(std::floor(std::min(w.lo[a], w.hi[a]) / cell), reachLo);
       const double h = std::min(std::floor(std::max(w.lo[a], w.hi[a]) / cell), reachHi);
       if (!(l <= h)) empty = true;
-      wlo[a] = int64_t(l) - origin_[a];
-      whi[a] = int64_t(h) - origin_[a];
+      span.lo[a] = empty ? 0 : int64_t(l) - origin_[a];
+      span.hi[a] = empty ? 0 : int64_t(h) - origin_[a];
+      voxels *= empty ? 0 : h - l + 1;
     }
     if (empty) continue;
-    const double strength = w.shadow >= 0 ? w.shadow : def_.shadow;
-    for (int64_t y = wlo[1]; y <= whi[1]; ++y) {
-      for (int64_t z = wlo[2]; z <= whi[2]; ++z) {
-        for (int64_t x = wlo[0]; x <= whi[0]; ++x) {
-          Cast(x, y, z, strength);
+    span.strength = w.shadow >= 0 ? w.shadow : def_.shadow;
+    spans.push_back(span);
+    work += voxels;
+  }
+  double pyramid = 0;
+  for (int q = 0; q <= def_.depth; ++q) pyramid += double(2 * q + 1) * double(2 * q + 1);
+  work = (work + double(buds.size())) * pyramid;
+  if (work > double(kMaxLightWork)) {
+    shadow_.clear();
+    opaque_.clear();
+    size_[0] = size_[1] = size_[2] = 0;
+    return GridError("the light grid would take " + std::to_string(uint64_t(work)) +
+                     " voxel updates a step, more than the limit of " +
+                     std::to_string(kMaxLightWork) +
+                     " (raise 'cell=' or lower 'depth=' in 'environment: light')");
+  }
+  for (const WallSpan& w : spans) {
+    for (int64_t y = w.lo[1]; y <= w.hi[1]; ++y) {
+      for (int64_t z = w.lo[2]; z <= w.hi[2]; ++z) {
+        for (int64_t x = w.lo[0]; x <= w.hi[0]; ++x) {
+          Cast(x, y, z, w.strength);
           if (x >= 0 && x < size_[0] && y >= 0 && y < size_[1] && z >= 0 && z < size_[2])
             opaque_[size_t((y * size_[2] + z) * size_[0] + x)] = 1;
         }

@@ -35,6 +35,9 @@ namespace sylva::plant {
 
 // 2^25 voxels: 128 MiB of shadow.
 inline constexpr uint64_t kMaxLightCells = uint64_t(1) << 25;
+// Voxel updates of one Update() (buds and wall voxels times the pyramid's
+// sum (2q+1)^2 voxels): 2^32, about 1.3 s at the measured 3.4 G/s.
+inline constexpr uint64_t kMaxLightWork = uint64_t(1) << 32;
 
 struct LightBox {
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};  // corners, any order
@@ -54,7 +57,8 @@ class LightGrid {
   explicit LightGrid(const LightDef& def) : def_(def) {}
 
   // Rebuilds the shadow from these buds and the walls. An error when the
-  // grid would pass kMaxLightCells voxels (or a position is not finite).
+  // grid would pass kMaxLightCells voxels or the work kMaxLightWork (or a
+  // position is not finite).
   Status Update(std::span<const Vec3> buds);
   // The light at p, 0..1: 0 inside a wall, 1 outside the grid. For a bud
   // that Update() counted, its own shadow is taken back out.

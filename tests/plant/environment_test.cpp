@@ -147,6 +147,19 @@ TEST(LightGrid, TooManyVoxelsIsAnErrorNotAnAllocation) {
   EXPECT_EQ(grid.cellCount(), 0u);
   const std::vector<Vec3> bad = {Vec3(0, kNaN, 0)};
   EXPECT_FALSE(grid.Update(bad).ok());
+  // A thin grid (one bud) beside a wall 10^6 voxels tall, at depth 64: its
+  // voxels times the pyramid's 366,145 is far past the work limit, said
+  // before any of it is done.
+  LightDef deep;
+  deep.cell = 1;
+  deep.depth = 64;
+  deep.walls.push_back(LightBox{Vec3(-50, -1e6, -50), Vec3(50, 1e6, 50)});
+  LightGrid wall(deep);
+  const Vec3 bud(0, 0, 0);
+  Status w = wall.Update({&bud, 1});
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.error().message.find("voxel updates a step, more than the limit"), std::string::npos)
+      << w.error().message;
 }
 
 TEST(LightEnvironment, TheUpperOfTwoPlantsTakesTheLight) {
