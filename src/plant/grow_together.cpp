@@ -23,8 +23,7 @@ class Collector final : public Environment {
 }  // namespace
 
 std::vector<PlantResult> GrowTogether(std::span<const PlantSpec> specs,
-                                      std::span<const Placement> placements,
-                                      Environment& shared) {
+                                      std::span<const Placement> placements, Environment& shared) {
   SYLVA_ASSERT(specs.size() == placements.size());
   const size_t n = specs.size();
   std::vector<PlantResult> results(n);
@@ -40,9 +39,9 @@ std::vector<PlantResult> GrowTogether(std::span<const PlantSpec> specs,
     PlantSpec s = specs[i];
     s.environment = &collectors[i];
     growers[i] = Grower::Start(s, results[i].diagnostics);
-    turn[i] = Eigen::AngleAxisd(placements[i].yawDegrees * 3.14159265358979323846 / 180,
-                                Vec3::UnitY())
-                  .toRotationMatrix();
+    turn[i] =
+        Eigen::AngleAxisd(placements[i].yawDegrees * 3.14159265358979323846 / 180, Vec3::UnitY())
+            .toRotationMatrix();
   }
   // Every living plant's queries, in world coordinates, in one call.
   auto round = [&]() {

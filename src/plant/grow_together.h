@@ -31,7 +31,6 @@ struct Placement {
 // own `environment` is replaced by `shared` (and its grammar's
 // `environment:` is not used). An error of `shared` fails every plant.
 std::vector<PlantResult> GrowTogether(std::span<const PlantSpec> specs,
-                                      std::span<const Placement> placements,
-                                      Environment& shared);
+                                      std::span<const Placement> placements, Environment& shared);
 
 }  // namespace sylva::plant
