@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <ostream>
 #include <unordered_map>
@@ -358,6 +359,15 @@ std::shared_ptr<mesh::TriangleMesh> DartMesh() {
 
 }  // namespace
 
+// An attractor's centre at another element (`of`): fixed for a plant,
+// forest or emitter; the centroid of a flock or cloth at each step.
+struct Centre {
+  std::shared_ptr<Vec3> at;  // read by the attractor's force
+  std::string of;
+  SourceLoc loc;
+  std::function<Vec3()> follow;  // set for what moves
+};
+
 struct Simulation::Impl {
   const Scene* scene = nullptr;
   const BuiltScene* built = nullptr;
@@ -369,6 +379,8 @@ struct Simulation::Impl {
   std::vector<std::unique_ptr<ParticleSystem>> systems;
   std::vector<ClothSheet> cloths;
   std::vector<Flock> flocks;
+  std::vector<Centre> centres;
+  Status PlaceCentres();
   std::map<std::string, std::shared_ptr<const particles::TriangleBvh>> bvhs, leafBvhs;
   std::map<std::string, std::shared_ptr<const particles::CapsuleBvh>> capsuleBvhs;
   std::shared_ptr<const particles::CapsuleBvh> CapsulesOf(const std::string& id) {
@@ -507,7 +519,49 @@ Status Simulation::Impl::Emit(ParticleSystem& ps, double step) {
   return {};
 }
 
+Status Simulation::Impl::PlaceCentres() {
+  auto mean = [](const std::vector<Vec3>& points) {
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& p : points) c += p;
+    return points.empty() ? c : Vec3(c / double(points.size()));
+  };
+  for (Centre& c : centres) {
+    const auto points = built->points.find(c.of);
+    if (points != built->points.end()) {  // a plant or forest
+      *c.at = mean(points->second.segmentPoints);
+      continue;
+    }
+    bool found = false;
+    for (size_t k = 0; k < cloths.size() && !found; ++k) {
+      if (cloths[k].def->id != c.of) continue;
+      const particles::Cloth* cloth = cloths[k].cloth.get();
+      c.follow = [cloth, mean] { return mean(cloth->positions()); };
+      found = true;
+    }
+    for (size_t k = 0; k < flocks.size() && !found; ++k) {
+      if (flocks[k].def->id != c.of) continue;
+      const ParticleState* boids = &flocks[k].system->state;
+      c.follow = [boids, mean] { return mean(boids->position); };
+      found = true;
+    }
+    for (const ParticlesDef& p : scene->particles) {
+      for (const EmitterDef& e : p.emitters) {
+        if (found || e.id != c.of) continue;
+        found = true;
+        const auto target = built->points.find(e.of);  // an emitter on a plant's parts
+        *c.at = target != built->points.end() ? mean(target->second.segmentPoints) : e.at;
+      }
+    }
+    if (!found)  // the reader checks the kind of every `of`: this is a bug
+      return Fail(c.loc, "'of=\"" + c.of + "\"' names nothing an attractor can follow");
+    if (c.follow) *c.at = c.follow();
+  }
+  return {};
+}
+
 Status Simulation::Impl::Step() {
+  for (Centre& c : centres)
+    if (c.follow) *c.at = c.follow();
   for (auto& ps : systems) {
     const int sub = ps->def->substeps;
     for (int k = 0; k < sub; ++k) {
@@ -670,23 +724,14 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
                                                      windOn && wind ? windGrid : nullptr));
           break;
         case ForceKind::kAttractor: {
-          Vec3 c = f.position.value_or(Vec3::Zero());
-          if (!f.of.empty()) {
-            const auto it = built.points.find(f.of);
-            if (it != built.points.end() && !it->second.segmentPoints.empty()) {
-              c = Vec3::Zero();
-              for (const Vec3& p : it->second.segmentPoints) c += p;
-              c /= double(it->second.segmentPoints.size());
-            } else {
-              diags.Add(Warn(f.loc, "'of=\"" + f.of +
-                                        "\"': only a plant or forest gives an "
-                                        "attractor its position yet; the origin is used"));
-            }
-          }
+          // The centre: its position, or the element `of` names (a flock or
+          // cloth moves: its centroid is taken at the start of every step).
+          auto centre = std::make_shared<Vec3>(f.position.value_or(Vec3::Zero()));
+          if (!f.of.empty()) m.centres.push_back({centre, f.of, f.loc});
           const double strength = f.strength, soft = std::max(f.radius, 1e-3);
           const bool inverseSquare = f.falloff == Falloff::kInverseSquare;
           system.AddForce(std::make_shared<AccelerationField>([=](const Vec3& x, double) {
-            const Vec3 d = c - x;
+            const Vec3 d = *centre - x;
             const double r = std::max(d.norm(), soft);
             return Vec3(d / r * strength / (inverseSquare ? r * r : r));
           }));
@@ -958,6 +1003,7 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
     }
     m.flocks.push_back(std::move(flock));
   }
+  if (Status s = m.PlaceCentres(); !s.ok()) return s.error();
   return sim;
 }
 
