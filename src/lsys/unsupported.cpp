@@ -60,8 +60,23 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
     return "'" + std::string(name) + "' is not a command Sylva knows: it does nothing";
   }
   if (name[0] == '?') {
+    // ?P ?H ?L ?U are answered after each step (plant::Grower): 2 parameters
+    // take x, y and 3 take x, y, z. ?E is answered by the grammar's
+    // `environment:` (the parser warns when there is none).
+    if (name == "?P" || name == "?H" || name == "?L" || name == "?U") {
+      if (arity == 2 || arity == 3) return std::nullopt;
+      return "query module '" + std::string(name) +
+             "' takes 2 parameters (x, y) or 3 (x, y, z); with " + Params(arity) +
+             " it is not answered: its parameters keep the values written in the grammar";
+    }
+    if (name == "?E") {
+      if (arity >= 1) return std::nullopt;
+      return "query module '?E' needs at least 1 parameter for the environment to fill; with "
+             "none it is not answered";
+    }
     return "query module '" + std::string(name) +
-           "' is not answered yet: its parameters keep the values written in the grammar";
+           "' is not answered (Sylva answers ?P ?H ?L ?U and ?E): its parameters keep the "
+           "values written in the grammar";
   }
   if (name[0] == '~') {
     if (arity <= 1 || arity == 3) return std::nullopt;
