@@ -11,6 +11,9 @@
 namespace sylva::turtle {
 namespace {
 
+constexpr int kDiscSides = 24;     // polygon vertices of a @o or @c disc
+constexpr int kCylinderRings = 8;  // segments per @Gc/@Ge piece without a parameter
+
 enum class Op : uint8_t {
   kNone,
   kForwardDraw,
@@ -37,6 +40,15 @@ enum class Op : uint8_t {
   kSurface,
   kSphere,
   kMoveTo,
+  kDisc,         // @o
+  kCircle,       // @c
+  kGcStart,      // @Gs
+  kGcPoint,      // @Gc
+  kGcEnd,        // @Ge
+  kTropismSet,   // @Ts
+  kTropismUp,    // @Ti
+  kTropismDown,  // @Td
+  kTwistForce,   // @Tf
 };
 
 Op OpFor(const std::string& name) {
@@ -92,6 +104,16 @@ Op OpFor(const std::string& name) {
   if (name[0] == '~') return Op::kSurface;
   if (name == "@O") return Op::kSphere;
   if (name == "@M") return Op::kMoveTo;
+  if (name == "@v") return Op::kLevel;  // cpfg's roll to vertical is `$`
+  if (name == "@o") return Op::kDisc;
+  if (name == "@c") return Op::kCircle;
+  if (name == "@Gs") return Op::kGcStart;
+  if (name == "@Gc") return Op::kGcPoint;
+  if (name == "@Ge") return Op::kGcEnd;
+  if (name == "@Ts") return Op::kTropismSet;
+  if (name == "@Ti") return Op::kTropismUp;
+  if (name == "@Td") return Op::kTropismDown;
+  if (name == "@Tf") return Op::kTwistForce;
   return Op::kNone;
 }
 
@@ -99,9 +121,26 @@ struct State {
   Vec3 pos{0, 0, 0};
   Frame frame;
   double width = 1;
+  double elasticity = 0;  // tropism susceptibility (cpfg: elasticity), @Ts @Ti @Td change it
   uint32_t branch = 0;
   uint16_t depth = 0;
   uint16_t color = 0;
+  int32_t cylinder = -1;  // the open generalized cylinder (@Gs), or -1
+};
+
+// A control point of a generalized cylinder: where the turtle was at @Gs,
+// @Gc or @Ge.
+struct ControlPoint {
+  Vec3 pos, heading, left;
+  double width = 0;
+  uint16_t color = 0;
+};
+
+// An open generalized cylinder: its last control point and the branch id
+// its tube segments carry.
+struct Cylinder {
+  ControlPoint last;
+  uint32_t branch = 0;
 };
 
 // X' = X cos a + Y sin a, Y' = Y cos a - X sin a: X turns toward Y.
@@ -200,6 +239,9 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
     d.tropism = Vec3(g.tropism->x, g.tropism->y, g.tropism->z);
     d.susceptibility = g.tropism->susceptibility;
   }
+  d.initialColor = g.initialColor;
+  d.colorIncrement = g.colorIncrement;
+  d.elasticityIncrement = g.elasticityIncrement;
   return d;
 }
 
@@ -217,10 +259,91 @@ static std::string ModuleText(const lsys::Word& word, const lsys::SymbolTable& s
   for (size_t k = 0; k < params.size(); ++k) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g", params[k]);
-    text += (k ? "," : "(") + std::string(buf);
+    text += k ? ',' : '(';
+    text += buf;
   }
   if (!params.empty()) text += ")";
   return text;
+}
+
+// ABOP eq. 2.3: after a move, the frame turns about H x T by e |H x T|
+// (Rodrigues' rotation). True when it turned.
+static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
+  if (e == 0) return false;
+  const Vec3 axis = f.heading.cross(tropismVector);
+  const double norm = axis.norm();
+  if (!(norm > 1e-12)) return false;
+  // v' = v cos a + (k x v) sin a + k (k.v)(1 - cos a).
+  const double a = e * norm;
+  const Vec3 k = axis / norm;
+  double sa, ca;
+  SinCosSmall(a, &sa, &ca);
+  auto turn = [&](Vec3& v) { v = v * ca + k.cross(v) * sa + k * (k.dot(v) * (1 - ca)); };
+  turn(f.heading);
+  turn(f.left);
+  turn(f.up);
+  return true;
+}
+
+// @o and @c: a disc of diameter `diameter` centred at `centre` in the plane
+// of the unit vectors a and b, as a polygon of kDiscSides vertices running
+// from a toward b (its normal is a x b).
+static void AddDisc(const Vec3& centre, const Vec3& a, const Vec3& b, double diameter,
+                    uint16_t color, uint32_t module, PlantGeometry& g) {
+  Polygon poly;
+  poly.vertices.reserve(kDiscSides);
+  const double r = diameter * 0.5;
+  for (int k = 0; k < kDiscSides; ++k) {
+    double s, c;
+    SinCosRadians(2 * kPi * k / kDiscSides, &s, &c);
+    poly.vertices.push_back(centre + (a * c + b * s) * r);
+  }
+  poly.color = color;
+  poly.module = module;
+  g.polygons.push_back(std::move(poly));
+}
+
+// One piece of a generalized cylinder (@Gc, @Ge): the cubic Hermite curve
+// from control point a to b with tangents H_a |b - a| and H_b |b - a|,
+// cut into `rings` segments of one branch whose width runs linearly from
+// a's to b's.
+static void AddCylinderPiece(const ControlPoint& a, const ControlPoint& b, int rings,
+                             double widthScale, uint32_t branch, uint32_t parent, uint16_t depth,
+                             uint32_t module, PlantGeometry& g) {
+  const double chord = (b.pos - a.pos).norm();
+  const Vec3 m0 = a.heading * chord, m1 = b.heading * chord;
+  Vec3 prev = a.pos;
+  double prevWidth = a.width;
+  for (int k = 1; k <= rings; ++k) {
+    const double t = double(k) / rings, t2 = t * t, t3 = t2 * t;
+    const Vec3 p = k == rings ? b.pos
+                              : a.pos * (2 * t3 - 3 * t2 + 1) + m0 * (t3 - 2 * t2 + t) +
+                                    b.pos * (3 * t2 - 2 * t3) + m1 * (t3 - t2);
+    const double w = a.width + (b.width - a.width) * t;
+    Segment sg;
+    sg.start = prev;
+    sg.end = p;
+    sg.left = a.left;
+    sg.radiusStart = float(prevWidth * widthScale * 0.5);
+    sg.radiusEnd = float(w * widthScale * 0.5);
+    sg.branch = branch;
+    sg.parent = parent;
+    sg.depth = depth;
+    sg.color = a.color;
+    sg.module = module;
+    g.segments.push_back(sg);
+    prev = p;
+    prevWidth = w;
+  }
+}
+
+// The rings of a @Gc(n) or @Ge(n) piece: n (at least 1), kCylinderRings
+// without a parameter. A double: the caller compares it with its limit
+// before converting.
+static double CylinderRings(const double* p, uint32_t np) {
+  if (!np) return kCylinderRings;
+  if (!(p[0] >= 1)) return 1;  // NaN and below 1 (cpfg: at least 1)
+  return std::floor(p[0]);
 }
 
 // Every number the tessellator and the exporters will see must be finite
@@ -271,12 +394,23 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   g.modulePosition.clear();
   g.moduleFrame.clear();
   size_t draws = 0, spheres = 0, surfaces = 0;
+  double cylinderRings = 0;  // a double: a @Gc(1e300) must not overflow the count
+  const bool hasParams = word.HasParams();
   for (size_t i = 0; i < word.size(); ++i) {
     const Op op = ops[word.symbols[i]];
     draws += op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex;
     spheres += op == Op::kSphere;
     surfaces += op == Op::kSurface;
+    if (op == Op::kDisc || op == Op::kCircle) draws += kDiscSides;
+    if (op == Op::kGcPoint || op == Op::kGcEnd) {
+      const uint32_t np = hasParams ? word.paramStart[i + 1] - word.paramStart[i] : 0;
+      cylinderRings +=
+          CylinderRings(hasParams ? word.params.data() + word.paramStart[i] : nullptr, np);
+    }
   }
+  if (cylinderRings > double(options.maxPrimitives))
+    cylinderRings = double(options.maxPrimitives) + 1;
+  draws += size_t(cylinderRings);
   if (draws + spheres + surfaces > options.maxPrimitives) {
     Diagnostic d;
     d.kind = ErrorKind::kRuntime;
@@ -295,24 +429,6 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   g.spheres.reserve(spheres);
   g.surfaces.reserve(surfaces);
   return {};
-}
-
-// ABOP eq. 2.3: after a move, the frame turns about H x T by e |H x T|
-// (Rodrigues' rotation). True when it turned.
-static inline bool ApplyTropism(const TurtleDef& def, Frame& f) {
-  const Vec3 axis = f.heading.cross(def.tropism);
-  const double norm = axis.norm();
-  if (!(norm > 1e-12)) return false;
-  // v' = v cos a + (k x v) sin a + k (k.v)(1 - cos a).
-  const double a = def.susceptibility * norm;
-  const Vec3 k = axis / norm;
-  double sa, ca;
-  SinCosSmall(a, &sa, &ca);
-  auto turn = [&](Vec3& v) { v = v * ca + k.cross(v) * sa + k * (k.dot(v) * (1 - ca)); };
-  turn(f.heading);
-  turn(f.left);
-  turn(f.up);
-  return true;
 }
 
 // `}`: closes the innermost open polygon into g.polygons, dropping a closing
@@ -344,12 +460,19 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   std::vector<uint32_t> branchParent{0};
   std::vector<State> stack;
   std::vector<Polygon> openPolygons;
+  std::vector<Cylinder> cylinders;
   State t;
   t.width = def.width;
+  t.elasticity = def.susceptibility;
+  t.color = uint16_t(std::clamp(def.initialColor, 0, 65535));
+  const int colorStep = def.colorIncrement;
   SinCos sincos;
   double defSin, defCos;
   sincos.Get(def.angle, &defSin, &defCos);
-  const bool tropism = def.susceptibility != 0;
+  bool changesTropism = false;
+  for (Op op : ops)
+    changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp || op == Op::kTropismDown;
+  const bool tropism = def.susceptibility != 0 || changesTropism;
   Vec3 lo = t.pos, hi = t.pos;
   bool planar = true;
   const size_t n = word.size();
@@ -399,6 +522,9 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         if (inPolygon) {
           if (op == Op::kForwardDraw || op == Op::kForwardMove)
             openPolygons.back().vertices.push_back(t.pos);
+        } else if (t.cylinder >= 0) {
+          // Inside a generalized cylinder F draws nothing: the tube through
+          // the control points is the drawing (cpfg).
         } else if (op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex) {
           Segment sg;
           sg.start = start;
@@ -412,7 +538,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           sg.module = uint32_t(i);
           g.segments.push_back(sg);
         }
-        if (tropism && ApplyTropism(def, t.frame)) ++turnsSinceOrtho;
+        if (tropism && ApplyTropism(def.tropism, t.elasticity, t.frame)) ++turnsSinceOrtho;
         break;
       }
       case Op::kTurnLeft:
@@ -457,6 +583,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         branchParent.push_back(t.branch);
         t.branch = uint32_t(branchParent.size() - 1);
         t.depth = uint16_t(std::min<int>(t.depth + 1, 65535));
+        t.cylinder = -1;  // a branch draws its own segments; `]` resumes the cylinder
         break;
       case Op::kPop:
         if (stack.empty()) {
@@ -485,10 +612,12 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         }
         break;
       case Op::kColor:
-        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : std::min(t.color + 1, 65535));
+        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0)
+                              : std::clamp(t.color + colorStep, 0, 65535));
         break;
       case Op::kColorDown:
-        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : std::max(t.color - 1, 0));
+        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0)
+                              : std::clamp(t.color - colorStep, 0, 65535));
         break;
       case Op::kPolygonBegin: {
         Polygon poly;
@@ -536,6 +665,63 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           visit(t.pos);
         }
         break;
+      case Op::kDisc:
+      case Op::kCircle: {
+        // @o(d): in the plane of H and L, facing -U (the viewer of a 2D
+        // figure, which cpfg draws facing the screen); @c(d): across the
+        // heading, facing H. d defaults to the width.
+        const double d = (np ? p[0] : t.width) * def.widthScale;
+        if (op == Op::kDisc) {
+          AddDisc(t.pos, t.frame.heading, t.frame.left, d, t.color, uint32_t(i), g);
+        } else {
+          AddDisc(t.pos, t.frame.up, t.frame.left, d, t.color, uint32_t(i), g);
+        }
+        break;
+      }
+      case Op::kGcStart:
+      case Op::kGcPoint:
+      case Op::kGcEnd: {
+        const ControlPoint here{t.pos, t.frame.heading, t.frame.left, t.width, t.color};
+        if (t.cylinder < 0) {
+          if (op == Op::kGcEnd) break;  // nothing open: nothing to end
+          branchParent.push_back(t.branch);
+          t.cylinder = int32_t(cylinders.size());
+          cylinders.push_back({here, uint32_t(branchParent.size() - 1)});
+          if (op == Op::kGcStart) break;
+        }
+        Cylinder& cyl = cylinders[size_t(t.cylinder)];
+        if (op == Op::kGcStart) {  // @Gs inside an open cylinder restarts it here
+          cyl.last = here;
+          break;
+        }
+        AddCylinderPiece(cyl.last, here, int(CylinderRings(p, np)), def.widthScale, cyl.branch,
+                         t.branch, t.depth, uint32_t(i), g);
+        cyl.last = here;
+        if (op == Op::kGcEnd) t.cylinder = -1;
+        break;
+      }
+      case Op::kTropismSet:
+      case Op::kTropismUp:
+      case Op::kTropismDown: {
+        // @Ts(i, e) sets the elasticity of tropism i to e (0 without e);
+        // @Ti(i, d) and @Td(i, d) add and subtract d (default: the
+        // elasticity increment). Sylva has one tropism, i = 1.
+        if (np >= 1 && p[0] != 1) {
+          g.warnings.push_back("module " + std::to_string(i + 1) + " (" +
+                               ModuleText(word, symbols, i) +
+                               ") names a tropism other than 1; Sylva has one tropism: ignored");
+          break;
+        }
+        const double v = np >= 2 ? p[1] : (op == Op::kTropismSet ? 0 : def.elasticityIncrement);
+        if (op == Op::kTropismSet) t.elasticity = v;
+        if (op == Op::kTropismUp) t.elasticity += v;
+        if (op == Op::kTropismDown) t.elasticity -= v;
+        break;
+      }
+      case Op::kTwistForce:
+        // @Tf: cpfg records the frame so its next cylinder does not twist;
+        // Sylva's tubes follow rotation-minimizing frames and never twist.
+        break;
       case Op::kNone:
         break;
     }
@@ -547,6 +733,11 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
       g.modulePosition[i] = t.pos;
       g.moduleFrame[i] = t.frame;
     }
+  }
+  if (t.cylinder >= 0) {
+    g.warnings.push_back(
+        "generalized cylinder (@Gs) is never ended with @Ge; drawn up to its last "
+        "control point");
   }
   for (const Polygon& poly : openPolygons) {
     g.warnings.push_back("polygon opened at module " + std::to_string(poly.module + 1) +
