@@ -73,6 +73,9 @@ static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
                   "stop with an error when the word would grow past this many modules "
                   "(default 268435456)")
       ->check(CLI::Range(uint64_t(1), lsys::kMaxModulesCap));
+  cmd->add_option("--view", f.view,
+                  "cpfg view file (.v): angle, widths, colours, tropism, view direction "
+                  "(default: NAME.v beside the grammar, if any)");
   AddMaxErrorsFlag(cmd, f);
   AddStrictFlag(cmd, f.strict);
 }

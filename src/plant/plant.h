@@ -87,6 +87,10 @@ struct PlantSpec {
   bool cull = true;  // with a view: drop what lies outside its frustum
   Stage until = Stage::kMesh;
   FileReader readFile;  // empty: the file system
+  // Called once the grammar is parsed, before derivation: a front end's
+  // settings from outside the grammar (a cpfg view file, app/view_file.h)
+  // go in here. Its diagnostics join the plant's; an error stops the build.
+  std::function<void(lsys::Grammar& grammar, DiagnosticList& diagnostics)> amendGrammar;
   // Called after each derivation step, from the calling thread.
   std::function<void(int step, int steps, uint64_t modules)> progress;
 };
