@@ -257,8 +257,8 @@ void Reader::Read(const app::Line& line) {
   } else if (L == "initial color:" || L == "color increment:") {
     if (auto x = Number(0, "a colour index")) {
       if (*x < 0 || *x > 65535 || *x != std::floor(*x)) {
-        Error(tokens_[0].column, "expected a whole number from 0 to 65535, not '" +
-                                     tokens_[0].text + "'");
+        Error(tokens_[0].column,
+              "expected a whole number from 0 to 65535, not '" + tokens_[0].text + "'");
       } else {
         (L == "initial color:" ? v_.initialColor : v_.colorIncrement) = int(*x);
       }
@@ -274,9 +274,8 @@ void Reader::Read(const app::Line& line) {
     }
     // `pixels`, `polygons`, `cylinder`: how cpfg draws lines; Sylva draws
     // tubes (lines for 2D figures) of this width in world units.
-    ExtraValues(tokens_.size() > 1 && std::isalpha(static_cast<unsigned char>(tokens_[1].text[0]))
-                    ? 2
-                    : 1);
+    ExtraValues(
+        tokens_.size() > 1 && std::isalpha(static_cast<unsigned char>(tokens_[1].text[0])) ? 2 : 1);
   } else if (L == "line width increment:") {
     if (auto x = Number(0, "a width")) v_.widthIncrement = *x;
     ExtraValues(1);
@@ -363,8 +362,9 @@ void Reader::Tropism() {
     auto x = Number(k + 1, "a number");
     if (!x) return;
     if (c == 'A' && *x != 0)
-      Warn(tokens_[k + 1].column,
-           "a tropism at an angle A to its vector (plagiotropism) is not implemented: drawn as A 0");
+      Warn(
+          tokens_[k + 1].column,
+          "a tropism at an angle A to its vector (plagiotropism) is not implemented: drawn as A 0");
     if (c == 'E') elasticity = *x;
     if (c == 'S') v_.elasticityIncrement = *x;
     if (c == 'I') intensity = std::clamp(*x, -1.0, 1.0);
@@ -418,9 +418,10 @@ Expected<std::vector<std::array<float, 3>>> ParseColormap(const std::string& byt
                                                           const std::string& path,
                                                           DiagnosticList& warnings) {
   if (bytes.size() < kMapBytes) {
-    return FileError(path, "a colour map (.map) has 256 colours of 3 bytes (768 bytes); this one "
-                           "has " +
-                               std::to_string(bytes.size()) + " bytes (truncated?)");
+    return FileError(path,
+                     "a colour map (.map) has 256 colours of 3 bytes (768 bytes); this one "
+                     "has " +
+                         std::to_string(bytes.size()) + " bytes (truncated?)");
   }
   if (bytes.size() > kMapBytes) {
     Diagnostic d = FileError(path, "a colour map (.map) has 768 bytes; the " +
@@ -438,10 +439,11 @@ Expected<std::vector<std::array<float, 3>>> ParseColormap(const std::string& byt
 Expected<std::vector<std::array<float, 3>>> ParseMaterials(const std::string& bytes,
                                                            const std::string& path) {
   if (bytes.empty() || bytes.size() % kMaterialBytes != 0) {
-    return FileError(path, "a material file (.mat) is a list of 15-byte records (an index, then "
-                           "transparency, ambient, diffuse, emissive, specular, shininess); this "
-                           "one has " +
-                               std::to_string(bytes.size()) + " bytes (truncated?)");
+    return FileError(path,
+                     "a material file (.mat) is a list of 15-byte records (an index, then "
+                     "transparency, ambient, diffuse, emissive, specular, shininess); this "
+                     "one has " +
+                         std::to_string(bytes.size()) + " bytes (truncated?)");
   }
   // cpfg's default material is white; its default colour-map entry grey.
   std::vector<std::array<float, 3>> colors(256, {200 / 255.0f, 200 / 255.0f, 200 / 255.0f});
@@ -544,7 +546,8 @@ std::optional<std::array<double, 2>> ViewDirection(const ViewFile& v) {
   const double n = d.norm();
   if (!(n > 0) || !std::isfinite(n)) return std::nullopt;
   const Vec3 u = d / n;
-  const double elevation = std::clamp(std::asin(std::clamp(u.y(), -1.0, 1.0)) * kRadToDeg, -89.0, 89.0);
+  const double elevation =
+      std::clamp(std::asin(std::clamp(u.y(), -1.0, 1.0)) * kRadToDeg, -89.0, 89.0);
   const double azimuth = std::atan2(u.x(), u.z()) * kRadToDeg;
   return std::array<double, 2>{azimuth, elevation};
 }
