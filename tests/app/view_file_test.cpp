@@ -44,7 +44,7 @@ TEST(ViewFile, ReadsWhatTheTurtleUses) {
   EXPECT_EQ(v.scale.value_or(-1), 0.8);
   ASSERT_TRUE(v.tropism.has_value());
   EXPECT_LT((*v.tropism - Vec3(0, -1, 0)).norm(), 1e-15);  // unit, as cpfg
-  EXPECT_EQ(v.elasticity.value_or(-1), 0.15);             // E times I
+  EXPECT_EQ(v.elasticity.value_or(-1), 0.15);              // E times I
   EXPECT_EQ(v.elasticityIncrement.value_or(-1), 0.01);
   auto dir = ViewDirection(v);
   ASSERT_TRUE(dir.has_value());
@@ -67,11 +67,9 @@ TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
   ASSERT_EQ(v.diagnostics.items.size(), 5u) << all;
   EXPECT_EQ(v.diagnostics.HasErrors(), false) << all;
   EXPECT_EQ(v.diagnostics.items[0].loc.line, 4) << all;
-  EXPECT_NE(all.find("4:1 warning: 'light direction:' is read but not acted on"),
-            std::string::npos)
+  EXPECT_NE(all.find("4:1 warning: 'light direction:' is read but not acted on"), std::string::npos)
       << all;
-  EXPECT_NE(all.find("5:3 warning: 'surface:' is read but not acted on"), std::string::npos)
-      << all;
+  EXPECT_NE(all.find("5:3 warning: 'surface:' is read but not acted on"), std::string::npos) << all;
   EXPECT_EQ(all.find("6:1"), std::string::npos) << all;  // once per label
   EXPECT_NE(all.find("7:1 warning: preprocessor lines"), std::string::npos) << all;
   EXPECT_NE(all.find("8:1 warning: 'blorp:' is not a cpfg view file setting"), std::string::npos)
@@ -85,7 +83,8 @@ TEST(ViewFile, BadValuesAreErrorsAtTheirColumn) {
     ViewFile v = ParseViewFile(text, "p.v");
     return v.diagnostics.items.empty() ? std::string("none") : Messages(v.diagnostics);
   };
-  EXPECT_EQ(first("angle increment: nan\n"), "1:18 error: expected an angle in degrees, not 'nan'\n");
+  EXPECT_EQ(first("angle increment: nan\n"),
+            "1:18 error: expected an angle in degrees, not 'nan'\n");
   EXPECT_EQ(first("angle increment: 1e999\n").rfind("1:18 error", 0), 0u);
   EXPECT_EQ(first("viewpoint: 1,2\n").rfind("1:15 error: expected x,y,z after 'viewpoint:'", 0),
             0u);
@@ -182,7 +181,7 @@ TEST(ViewFile, TheTurtleDrawsWithTheViewFilesSettings) {
   EXPECT_NEAR(s[1].end.x(), -0.5, 1e-12);
   EXPECT_NEAR(s[1].end.y(), 1 + std::sqrt(3.0) / 2, 1e-12);
   EXPECT_EQ(s[0].color, 3);
-  EXPECT_EQ(s[2].color, 5);  // ; adds the colour increment
+  EXPECT_EQ(s[2].color, 5);                  // ; adds the colour increment
   EXPECT_FLOAT_EQ(s[3].radiusStart, 0.25f);  // ! with an increment of 0: unchanged
   std::filesystem::remove(Scratch() / "vt.v");
 }
