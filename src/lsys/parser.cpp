@@ -787,9 +787,10 @@ void GrammarParser::ParseContextNames(const Line& l, size_t after, size_t end, b
     std::string name;
     if (!LexName(l, p, end, &name)) return;
     if (name == "[" || name == "]") {
-      Error(l, c,
-            "brackets cannot be " + std::string(ignore ? "ignored" : "considered") +
-                ": they give the branching structure");
+      // cpfg files list the brackets in `consider:` so that context
+      // matching sees the branching; Sylva's matcher always does.
+      if (!ignore) continue;
+      Error(l, c, "brackets cannot be ignored: they give the branching structure");
       return;
     }
     (ignore ? ignoreNames_ : considerNames_).insert(name);

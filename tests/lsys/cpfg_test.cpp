@@ -58,6 +58,18 @@ TEST(Cpfg, ImplementedCommandsWarnAboutParametersTheyDoNotUse) {
   EXPECT_EQ(w[3].rfind("1:45 '@Ts'", 0), 0u) << all;
 }
 
+TEST(Cpfg, BracketsInConsiderAreAcceptedAndKeepTheBranching) {
+  // B and the branch [C] are skipped: A sees A as its left context.
+  EXPECT_EQ(DeriveText("consider: [ ] A\naxiom: A B [C] A\nA < A --> D\n", 1), "AB[C]D");
+  // Without the consider: list B stands between them.
+  EXPECT_EQ(DeriveText("axiom: A B [C] A\nA < A --> D\n", 1), "AB[C]A");
+  ParseResult r = ParseGrammarText("ignore: [ +\naxiom: A\n", "c.l", {});
+  EXPECT_FALSE(r.grammar);
+  EXPECT_NE(r.diagnostics.FormatAll().find("c.l:1:9: error: brackets cannot be ignored"),
+            std::string::npos)
+      << r.diagnostics.FormatAll();
+}
+
 TEST(Cpfg, QueryModulesWarnThatTheyAreNotAnswered) {
   auto w = Warnings("axiom: A ?P(0,0,0)\nA --> F ?H(0,0,0) ?P(1,1,1)\n");
   ASSERT_EQ(w.size(), 2u) << Joined(w);
