@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 #include "core/assert.h"
 #include "core/memory.h"
@@ -117,14 +118,21 @@ Op OpFor(const std::string& name) {
   return Op::kNone;
 }
 
+// What `[` saves and `]` restores. 112 bytes: copied at every bracket.
 struct State {
   Vec3 pos{0, 0, 0};
   Frame frame;
   double width = 1;
-  double elasticity = 0;  // tropism susceptibility (cpfg: elasticity), @Ts @Ti @Td change it
   uint32_t branch = 0;
   uint16_t depth = 0;
   uint16_t color = 0;
+};
+
+// The part of the state only cpfg's @T and @G commands change, saved on its
+// own stack only when the word's symbols include them, so that State stays
+// small for every other word.
+struct CpfgState {
+  double elasticity = 0;  // tropism susceptibility (cpfg: elasticity), @Ts @Ti @Td change it
   int32_t cylinder = -1;  // the open generalized cylinder (@Gs), or -1
 };
 
@@ -253,7 +261,8 @@ Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTabl
 }
 
 // Module i as written: its name and parameters (%g), for error messages.
-static std::string ModuleText(const lsys::Word& word, const lsys::SymbolTable& symbols, size_t i) {
+[[gnu::noinline]] static std::string ModuleText(const lsys::Word& word,
+                                                const lsys::SymbolTable& symbols, size_t i) {
   std::string text = symbols.name(word.symbols[i]);
   const auto params = word.ParamsOf(i);
   for (size_t k = 0; k < params.size(); ++k) {
@@ -288,8 +297,9 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
 // @o and @c: a disc of diameter `diameter` centred at `centre` in the plane
 // of the unit vectors a and b, as a polygon of kDiscSides vertices running
 // from a toward b (its normal is a x b).
-static void AddDisc(const Vec3& centre, const Vec3& a, const Vec3& b, double diameter,
-                    uint16_t color, uint32_t module, PlantGeometry& g) {
+[[gnu::noinline]] static void AddDisc(const Vec3& centre, const Vec3& a, const Vec3& b,
+                                      double diameter, uint16_t color, uint32_t module,
+                                      PlantGeometry& g) {
   Polygon poly;
   poly.vertices.reserve(kDiscSides);
   const double r = diameter * 0.5;
@@ -307,9 +317,10 @@ static void AddDisc(const Vec3& centre, const Vec3& a, const Vec3& b, double dia
 // from control point a to b with tangents H_a |b - a| and H_b |b - a|,
 // cut into `rings` segments of one branch whose width runs linearly from
 // a's to b's.
-static void AddCylinderPiece(const ControlPoint& a, const ControlPoint& b, int rings,
-                             double widthScale, uint32_t branch, uint32_t parent, uint16_t depth,
-                             uint32_t module, PlantGeometry& g) {
+[[gnu::noinline]] static void AddCylinderPiece(const ControlPoint& a, const ControlPoint& b,
+                                               int rings, double widthScale, uint32_t branch,
+                                               uint32_t parent, uint16_t depth, uint32_t module,
+                                               PlantGeometry& g) {
   const double chord = (b.pos - a.pos).norm();
   const Vec3 m0 = a.heading * chord, m1 = b.heading * chord;
   Vec3 prev = a.pos;
@@ -393,16 +404,41 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   g.warnings.clear();
   g.modulePosition.clear();
   g.moduleFrame.clear();
+  // How often each symbol occurs (one increment a module), then what each draws.
+  std::vector<size_t> count(ops.size(), 0);
+  for (size_t i = 0; i < word.size(); ++i) ++count[word.symbols[i]];
   size_t draws = 0, spheres = 0, surfaces = 0;
+  bool cylinders = false;
+  for (size_t sym = 0; sym < ops.size(); ++sym) {
+    switch (ops[sym]) {
+      case Op::kForwardDraw:
+      case Op::kForwardDrawNoVertex:
+        draws += count[sym];
+        break;
+      case Op::kSphere:
+        spheres += count[sym];
+        break;
+      case Op::kSurface:
+        surfaces += count[sym];
+        break;
+      case Op::kDisc:
+      case Op::kCircle:
+        draws += count[sym] * kDiscSides;
+        break;
+      case Op::kGcPoint:
+      case Op::kGcEnd:
+        cylinders |= count[sym] > 0;
+        break;
+      default:
+        break;
+    }
+  }
   double cylinderRings = 0;  // a double: a @Gc(1e300) must not overflow the count
-  const bool hasParams = word.HasParams();
-  for (size_t i = 0; i < word.size(); ++i) {
-    const Op op = ops[word.symbols[i]];
-    draws += op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex;
-    spheres += op == Op::kSphere;
-    surfaces += op == Op::kSurface;
-    if (op == Op::kDisc || op == Op::kCircle) draws += kDiscSides;
-    if (op == Op::kGcPoint || op == Op::kGcEnd) {
+  if (cylinders) {
+    const bool hasParams = word.HasParams();
+    for (size_t i = 0; i < word.size(); ++i) {
+      const Op op = ops[word.symbols[i]];
+      if (op != Op::kGcPoint && op != Op::kGcEnd) continue;
       const uint32_t np = hasParams ? word.paramStart[i + 1] - word.paramStart[i] : 0;
       cylinderRings +=
           CylinderRings(hasParams ? word.params.data() + word.paramStart[i] : nullptr, np);
@@ -463,15 +499,20 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   std::vector<Cylinder> cylinders;
   State t;
   t.width = def.width;
-  t.elasticity = def.susceptibility;
+  CpfgState x;
+  x.elasticity = def.susceptibility;
+  std::vector<CpfgState> xstack;
   t.color = uint16_t(std::clamp(def.initialColor, 0, 65535));
   const int colorStep = def.colorIncrement;
   SinCos sincos;
   double defSin, defCos;
   sincos.Get(def.angle, &defSin, &defCos);
-  bool changesTropism = false;
-  for (Op op : ops)
+  bool changesTropism = false, drawsCylinders = false;
+  for (Op op : ops) {
     changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp || op == Op::kTropismDown;
+    drawsCylinders |= op == Op::kGcStart || op == Op::kGcPoint || op == Op::kGcEnd;
+  }
+  const bool cpfgState = changesTropism || drawsCylinders;
   const bool tropism = def.susceptibility != 0 || changesTropism;
   Vec3 lo = t.pos, hi = t.pos;
   bool planar = true;
@@ -488,253 +529,268 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   };
   uint32_t turnsSinceOrtho = 0;
 
-  for (size_t i = 0; i < n; ++i) {
-    const lsys::SymbolId sym = word.symbols[i];
-    const Op op = ops[sym];
-    if (op == Op::kNone) {
+  // The loop, compiled twice: words with cpfg's @T and @G commands keep a
+  // second stack of state (CpfgState); every other word runs without it.
+  auto run = [&](auto cpfgTag) -> Status {
+    constexpr bool kCpfg = decltype(cpfgTag)::value;
+    for (size_t i = 0; i < n; ++i) {
+      const lsys::SymbolId sym = word.symbols[i];
+      const Op op = ops[sym];
+      if (op == Op::kNone) {
+        if (options.recordModules) {
+          g.modulePosition[i] = t.pos;
+          g.moduleFrame[i] = t.frame;
+        }
+        continue;
+      }
+      const double* p = nullptr;
+      uint32_t np = 0;
+      if (hasParams) {
+        p = word.params.data() + word.paramStart[i];
+        np = word.paramStart[i + 1] - word.paramStart[i];
+      }
+      double s = defSin, c = defCos;
+      auto angle = [&] {
+        if (np) sincos.Get(p[0], &s, &c);
+        ++turnsSinceOrtho;
+      };
+      switch (op) {
+        case Op::kForwardDraw:
+        case Op::kForwardMove:
+        case Op::kForwardDrawNoVertex:
+        case Op::kForwardMoveNoVertex: {
+          const double len = np ? p[0] : def.step;
+          const Vec3 start = t.pos;
+          t.pos += t.frame.heading * len;
+          visit(t.pos);
+          const bool inPolygon = !openPolygons.empty();
+          if (inPolygon) {
+            if (op == Op::kForwardDraw || op == Op::kForwardMove)
+              openPolygons.back().vertices.push_back(t.pos);
+          } else if (kCpfg && x.cylinder >= 0) {
+            // Inside a generalized cylinder F draws nothing: the tube through
+            // the control points is the drawing (cpfg).
+          } else if (op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex) {
+            Segment sg;
+            sg.start = start;
+            sg.end = t.pos;
+            sg.left = t.frame.left;
+            sg.radiusStart = sg.radiusEnd = float(t.width * def.widthScale * 0.5);
+            sg.branch = t.branch;
+            sg.parent = branchParent[t.branch];
+            sg.depth = t.depth;
+            sg.color = t.color;
+            sg.module = uint32_t(i);
+            g.segments.push_back(sg);
+          }
+          if (tropism && ApplyTropism(def.tropism, x.elasticity, t.frame)) ++turnsSinceOrtho;
+          break;
+        }
+        case Op::kTurnLeft:
+          angle();
+          Rotate(t.frame.heading, t.frame.left, c, s);
+          break;
+        case Op::kTurnRight:
+          angle();
+          Rotate(t.frame.heading, t.frame.left, c, -s);
+          break;
+        case Op::kPitchDown:
+          angle();
+          Rotate(t.frame.heading, t.frame.up, c, s);
+          break;
+        case Op::kPitchUp:
+          angle();
+          Rotate(t.frame.heading, t.frame.up, c, -s);
+          break;
+        case Op::kRollRight:
+          angle();
+          Rotate(t.frame.left, t.frame.up, c, s);
+          break;
+        case Op::kRollLeft:
+          angle();
+          Rotate(t.frame.left, t.frame.up, c, -s);
+          break;
+        case Op::kTurnAround:
+          t.frame.heading = -t.frame.heading;
+          t.frame.left = -t.frame.left;
+          break;
+        case Op::kLevel: {
+          const Vec3 v = Vec3::UnitY().cross(t.frame.heading);
+          const double norm = v.norm();
+          if (norm > 1e-9) {
+            t.frame.left = v / norm;
+            t.frame.up = t.frame.left.cross(t.frame.heading);
+          }
+          break;
+        }
+        case Op::kPush:
+          stack.push_back(t);
+          branchParent.push_back(t.branch);
+          t.branch = uint32_t(branchParent.size() - 1);
+          t.depth = uint16_t(std::min<int>(t.depth + 1, 65535));
+          if constexpr (kCpfg) {
+            xstack.push_back(x);
+            x.cylinder = -1;  // a branch draws its own segments; `]` resumes the cylinder
+          }
+          break;
+        case Op::kPop:
+          if (stack.empty()) {
+            g = PlantGeometry();
+            return MakeError({},
+                             "unmatched ']' at module " + std::to_string(i + 1) + " of the word");
+          }
+          t = stack.back();
+          stack.pop_back();
+          if constexpr (kCpfg) {
+            x = xstack.back();
+            xstack.pop_back();
+          }
+          break;
+        case Op::kWidth:
+          if (np) {
+            t.width = p[0];
+          } else if (def.widthIncrement > 0) {
+            t.width = std::max(t.width - def.widthIncrement, 0.0);
+          } else {
+            t.width *= def.widthFactor;
+          }
+          break;
+        case Op::kWidthUp:
+          if (np) {
+            t.width = p[0];
+          } else if (def.widthIncrement > 0) {
+            t.width += def.widthIncrement;
+          } else if (def.widthFactor != 0) {
+            t.width /= def.widthFactor;
+          }
+          break;
+        case Op::kColor:
+          t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0)
+                                : std::clamp(t.color + colorStep, 0, 65535));
+          break;
+        case Op::kColorDown:
+          t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0)
+                                : std::clamp(t.color - colorStep, 0, 65535));
+          break;
+        case Op::kPolygonBegin: {
+          Polygon poly;
+          poly.color = t.color;
+          poly.module = uint32_t(i);
+          openPolygons.push_back(std::move(poly));
+          break;
+        }
+        case Op::kVertex:
+          if (!openPolygons.empty()) openPolygons.back().vertices.push_back(t.pos);
+          break;
+        case Op::kPolygonEnd:
+          ClosePolygon(openPolygons, i, g);
+          break;
+        case Op::kSurface: {
+          SurfaceInstance si;
+          si.name = symbols.name(sym).substr(1);
+          si.position = t.pos;
+          si.frame = t.frame;
+          // ~name(s): uniform; ~name(sx, sy, sz): along L, H, U (cpfg).
+          if (np >= 3) {
+            si.scale = Vec3(p[0], p[1], p[2]);
+          } else if (np) {
+            si.scale = Vec3(p[0], p[0], p[0]);
+          }
+          si.color = t.color;
+          si.module = uint32_t(i);
+          g.surfaces.push_back(std::move(si));
+          break;
+        }
+        case Op::kSphere: {
+          Sphere sp;
+          sp.center = t.pos;
+          sp.radius = (np ? p[0] : t.width * def.widthScale) * 0.5;
+          sp.color = t.color;
+          sp.module = uint32_t(i);
+          g.spheres.push_back(sp);
+          break;
+        }
+        case Op::kMoveTo:
+          // @M(x,y,z): cpfg's move-to, drawing nothing. Other arities are
+          // warned about by the parser and do nothing.
+          if (np >= 3) {
+            t.pos = Vec3(p[0], p[1], p[2]);
+            visit(t.pos);
+          }
+          break;
+        case Op::kDisc:
+        case Op::kCircle: {
+          // @o(d): in the plane of H and L, facing -U (the viewer of a 2D
+          // figure, which cpfg draws facing the screen); @c(d): across the
+          // heading, facing H. d defaults to the width.
+          const double d = (np ? p[0] : t.width) * def.widthScale;
+          if (op == Op::kDisc) {
+            AddDisc(t.pos, t.frame.heading, t.frame.left, d, t.color, uint32_t(i), g);
+          } else {
+            AddDisc(t.pos, t.frame.up, t.frame.left, d, t.color, uint32_t(i), g);
+          }
+          break;
+        }
+        case Op::kGcStart:
+        case Op::kGcPoint:
+        case Op::kGcEnd: {
+          const ControlPoint here{t.pos, t.frame.heading, t.frame.left, t.width, t.color};
+          if (x.cylinder < 0) {
+            if (op == Op::kGcEnd) break;  // nothing open: nothing to end
+            branchParent.push_back(t.branch);
+            x.cylinder = int32_t(cylinders.size());
+            cylinders.push_back({here, uint32_t(branchParent.size() - 1)});
+            if (op == Op::kGcStart) break;
+          }
+          Cylinder& cyl = cylinders[size_t(x.cylinder)];
+          if (op == Op::kGcStart) {  // @Gs inside an open cylinder restarts it here
+            cyl.last = here;
+            break;
+          }
+          AddCylinderPiece(cyl.last, here, int(CylinderRings(p, np)), def.widthScale, cyl.branch,
+                           t.branch, t.depth, uint32_t(i), g);
+          cyl.last = here;
+          if (op == Op::kGcEnd) x.cylinder = -1;
+          break;
+        }
+        case Op::kTropismSet:
+        case Op::kTropismUp:
+        case Op::kTropismDown: {
+          // @Ts(i, e) sets the elasticity of tropism i to e (0 without e);
+          // @Ti(i, d) and @Td(i, d) add and subtract d (default: the
+          // elasticity increment). Sylva has one tropism, i = 1.
+          if (np >= 1 && p[0] != 1) {
+            g.warnings.push_back("module " + std::to_string(i + 1) + " (" +
+                                 ModuleText(word, symbols, i) +
+                                 ") names a tropism other than 1; Sylva has one tropism: ignored");
+            break;
+          }
+          const double v = np >= 2 ? p[1] : (op == Op::kTropismSet ? 0 : def.elasticityIncrement);
+          if (op == Op::kTropismSet) x.elasticity = v;
+          if (op == Op::kTropismUp) x.elasticity += v;
+          if (op == Op::kTropismDown) x.elasticity -= v;
+          break;
+        }
+        case Op::kTwistForce:
+          // @Tf: cpfg records the frame so its next cylinder does not twist;
+          // Sylva's tubes follow rotation-minimizing frames and never twist.
+          break;
+        case Op::kNone:
+          break;
+      }
+      if (turnsSinceOrtho >= 64) {
+        Orthonormalise(t.frame);
+        turnsSinceOrtho = 0;
+      }
       if (options.recordModules) {
         g.modulePosition[i] = t.pos;
         g.moduleFrame[i] = t.frame;
       }
-      continue;
     }
-    const double* p = nullptr;
-    uint32_t np = 0;
-    if (hasParams) {
-      p = word.params.data() + word.paramStart[i];
-      np = word.paramStart[i + 1] - word.paramStart[i];
-    }
-    double s = defSin, c = defCos;
-    auto angle = [&] {
-      if (np) sincos.Get(p[0], &s, &c);
-      ++turnsSinceOrtho;
-    };
-    switch (op) {
-      case Op::kForwardDraw:
-      case Op::kForwardMove:
-      case Op::kForwardDrawNoVertex:
-      case Op::kForwardMoveNoVertex: {
-        const double len = np ? p[0] : def.step;
-        const Vec3 start = t.pos;
-        t.pos += t.frame.heading * len;
-        visit(t.pos);
-        const bool inPolygon = !openPolygons.empty();
-        if (inPolygon) {
-          if (op == Op::kForwardDraw || op == Op::kForwardMove)
-            openPolygons.back().vertices.push_back(t.pos);
-        } else if (t.cylinder >= 0) {
-          // Inside a generalized cylinder F draws nothing: the tube through
-          // the control points is the drawing (cpfg).
-        } else if (op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex) {
-          Segment sg;
-          sg.start = start;
-          sg.end = t.pos;
-          sg.left = t.frame.left;
-          sg.radiusStart = sg.radiusEnd = float(t.width * def.widthScale * 0.5);
-          sg.branch = t.branch;
-          sg.parent = branchParent[t.branch];
-          sg.depth = t.depth;
-          sg.color = t.color;
-          sg.module = uint32_t(i);
-          g.segments.push_back(sg);
-        }
-        if (tropism && ApplyTropism(def.tropism, t.elasticity, t.frame)) ++turnsSinceOrtho;
-        break;
-      }
-      case Op::kTurnLeft:
-        angle();
-        Rotate(t.frame.heading, t.frame.left, c, s);
-        break;
-      case Op::kTurnRight:
-        angle();
-        Rotate(t.frame.heading, t.frame.left, c, -s);
-        break;
-      case Op::kPitchDown:
-        angle();
-        Rotate(t.frame.heading, t.frame.up, c, s);
-        break;
-      case Op::kPitchUp:
-        angle();
-        Rotate(t.frame.heading, t.frame.up, c, -s);
-        break;
-      case Op::kRollRight:
-        angle();
-        Rotate(t.frame.left, t.frame.up, c, s);
-        break;
-      case Op::kRollLeft:
-        angle();
-        Rotate(t.frame.left, t.frame.up, c, -s);
-        break;
-      case Op::kTurnAround:
-        t.frame.heading = -t.frame.heading;
-        t.frame.left = -t.frame.left;
-        break;
-      case Op::kLevel: {
-        const Vec3 v = Vec3::UnitY().cross(t.frame.heading);
-        const double norm = v.norm();
-        if (norm > 1e-9) {
-          t.frame.left = v / norm;
-          t.frame.up = t.frame.left.cross(t.frame.heading);
-        }
-        break;
-      }
-      case Op::kPush:
-        stack.push_back(t);
-        branchParent.push_back(t.branch);
-        t.branch = uint32_t(branchParent.size() - 1);
-        t.depth = uint16_t(std::min<int>(t.depth + 1, 65535));
-        t.cylinder = -1;  // a branch draws its own segments; `]` resumes the cylinder
-        break;
-      case Op::kPop:
-        if (stack.empty()) {
-          g = PlantGeometry();
-          return MakeError({}, "unmatched ']' at module " + std::to_string(i + 1) + " of the word");
-        }
-        t = stack.back();
-        stack.pop_back();
-        break;
-      case Op::kWidth:
-        if (np) {
-          t.width = p[0];
-        } else if (def.widthIncrement > 0) {
-          t.width = std::max(t.width - def.widthIncrement, 0.0);
-        } else {
-          t.width *= def.widthFactor;
-        }
-        break;
-      case Op::kWidthUp:
-        if (np) {
-          t.width = p[0];
-        } else if (def.widthIncrement > 0) {
-          t.width += def.widthIncrement;
-        } else if (def.widthFactor != 0) {
-          t.width /= def.widthFactor;
-        }
-        break;
-      case Op::kColor:
-        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0)
-                              : std::clamp(t.color + colorStep, 0, 65535));
-        break;
-      case Op::kColorDown:
-        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0)
-                              : std::clamp(t.color - colorStep, 0, 65535));
-        break;
-      case Op::kPolygonBegin: {
-        Polygon poly;
-        poly.color = t.color;
-        poly.module = uint32_t(i);
-        openPolygons.push_back(std::move(poly));
-        break;
-      }
-      case Op::kVertex:
-        if (!openPolygons.empty()) openPolygons.back().vertices.push_back(t.pos);
-        break;
-      case Op::kPolygonEnd:
-        ClosePolygon(openPolygons, i, g);
-        break;
-      case Op::kSurface: {
-        SurfaceInstance si;
-        si.name = symbols.name(sym).substr(1);
-        si.position = t.pos;
-        si.frame = t.frame;
-        // ~name(s): uniform; ~name(sx, sy, sz): along L, H, U (cpfg).
-        if (np >= 3) {
-          si.scale = Vec3(p[0], p[1], p[2]);
-        } else if (np) {
-          si.scale = Vec3(p[0], p[0], p[0]);
-        }
-        si.color = t.color;
-        si.module = uint32_t(i);
-        g.surfaces.push_back(std::move(si));
-        break;
-      }
-      case Op::kSphere: {
-        Sphere sp;
-        sp.center = t.pos;
-        sp.radius = (np ? p[0] : t.width * def.widthScale) * 0.5;
-        sp.color = t.color;
-        sp.module = uint32_t(i);
-        g.spheres.push_back(sp);
-        break;
-      }
-      case Op::kMoveTo:
-        // @M(x,y,z): cpfg's move-to, drawing nothing. Other arities are
-        // warned about by the parser and do nothing.
-        if (np >= 3) {
-          t.pos = Vec3(p[0], p[1], p[2]);
-          visit(t.pos);
-        }
-        break;
-      case Op::kDisc:
-      case Op::kCircle: {
-        // @o(d): in the plane of H and L, facing -U (the viewer of a 2D
-        // figure, which cpfg draws facing the screen); @c(d): across the
-        // heading, facing H. d defaults to the width.
-        const double d = (np ? p[0] : t.width) * def.widthScale;
-        if (op == Op::kDisc) {
-          AddDisc(t.pos, t.frame.heading, t.frame.left, d, t.color, uint32_t(i), g);
-        } else {
-          AddDisc(t.pos, t.frame.up, t.frame.left, d, t.color, uint32_t(i), g);
-        }
-        break;
-      }
-      case Op::kGcStart:
-      case Op::kGcPoint:
-      case Op::kGcEnd: {
-        const ControlPoint here{t.pos, t.frame.heading, t.frame.left, t.width, t.color};
-        if (t.cylinder < 0) {
-          if (op == Op::kGcEnd) break;  // nothing open: nothing to end
-          branchParent.push_back(t.branch);
-          t.cylinder = int32_t(cylinders.size());
-          cylinders.push_back({here, uint32_t(branchParent.size() - 1)});
-          if (op == Op::kGcStart) break;
-        }
-        Cylinder& cyl = cylinders[size_t(t.cylinder)];
-        if (op == Op::kGcStart) {  // @Gs inside an open cylinder restarts it here
-          cyl.last = here;
-          break;
-        }
-        AddCylinderPiece(cyl.last, here, int(CylinderRings(p, np)), def.widthScale, cyl.branch,
-                         t.branch, t.depth, uint32_t(i), g);
-        cyl.last = here;
-        if (op == Op::kGcEnd) t.cylinder = -1;
-        break;
-      }
-      case Op::kTropismSet:
-      case Op::kTropismUp:
-      case Op::kTropismDown: {
-        // @Ts(i, e) sets the elasticity of tropism i to e (0 without e);
-        // @Ti(i, d) and @Td(i, d) add and subtract d (default: the
-        // elasticity increment). Sylva has one tropism, i = 1.
-        if (np >= 1 && p[0] != 1) {
-          g.warnings.push_back("module " + std::to_string(i + 1) + " (" +
-                               ModuleText(word, symbols, i) +
-                               ") names a tropism other than 1; Sylva has one tropism: ignored");
-          break;
-        }
-        const double v = np >= 2 ? p[1] : (op == Op::kTropismSet ? 0 : def.elasticityIncrement);
-        if (op == Op::kTropismSet) t.elasticity = v;
-        if (op == Op::kTropismUp) t.elasticity += v;
-        if (op == Op::kTropismDown) t.elasticity -= v;
-        break;
-      }
-      case Op::kTwistForce:
-        // @Tf: cpfg records the frame so its next cylinder does not twist;
-        // Sylva's tubes follow rotation-minimizing frames and never twist.
-        break;
-      case Op::kNone:
-        break;
-    }
-    if (turnsSinceOrtho >= 64) {
-      Orthonormalise(t.frame);
-      turnsSinceOrtho = 0;
-    }
-    if (options.recordModules) {
-      g.modulePosition[i] = t.pos;
-      g.moduleFrame[i] = t.frame;
-    }
-  }
-  if (t.cylinder >= 0) {
+    return {};
+  };
+  if (Status st = cpfgState ? run(std::true_type{}) : run(std::false_type{}); !st.ok()) return st;
+  if (x.cylinder >= 0) {
     g.warnings.push_back(
         "generalized cylinder (@Gs) is never ended with @Ge; drawn up to its last "
         "control point");
