@@ -22,6 +22,9 @@ constexpr size_t kMaxViewBytes = size_t(1) << 20;
 constexpr size_t kMaxColorBytes = size_t(64) << 10;
 constexpr size_t kMapBytes = 768;
 constexpr size_t kMaterialBytes = 15;
+// A file that is not a view file (a binary one) stops here, not after a
+// diagnostic for each of its million lines.
+constexpr size_t kMaxViewErrors = 50;
 
 // What Sylva says about a label it reads but does not act on.
 struct Ignored {
@@ -410,7 +413,18 @@ ViewFile ParseViewFile(const std::string& text, const std::string& path) {
   ViewFile v;
   v.path = path;
   Reader r(v, path);
-  for (const Line& line : Lines(text)) r.Read(line);
+  for (const Line& line : Lines(text)) {
+    r.Read(line);
+    if (v.diagnostics.ErrorCount() >= kMaxViewErrors ||
+        v.diagnostics.items.size() >= 4 * kMaxViewErrors) {
+      Diagnostic d;
+      d.loc.file = path;
+      d.loc.line = line.number;
+      d.message = "too many errors or warnings in the view file (is it one?); the rest is not read";
+      v.diagnostics.Add(std::move(d));
+      break;
+    }
+  }
   return v;
 }
 

@@ -147,6 +147,24 @@ TEST(ViewFile, HostileFilesAreClearErrors) {
             std::string::npos);
   const std::string huge = WriteFile("huge.v", std::string(size_t(2) << 20, ' '));
   EXPECT_NE(errorOf(huge).find("larger than the limit"), std::string::npos);
+  // Binary garbage: a bounded number of errors, then a stop.
+  std::string garbage;
+  uint32_t state = 12345;
+  for (int i = 0; i < 500000; ++i) {
+    state = state * 1664525u + 1013904223u;
+    garbage += char(state >> 24);
+  }
+  auto noise = LoadViewFiles(grammar, WriteFile("noise.v", garbage));
+  ASSERT_TRUE(noise != nullptr);
+  EXPECT_LE(noise->diagnostics.items.size(), 200u);
+  EXPECT_NE(noise->diagnostics.items.back().message.find("too many errors"), std::string::npos)
+      << noise->diagnostics.items.back().message;
+  std::string labels;
+  for (int i = 0; i < 100000; ++i) labels += "x" + std::to_string(i) + ": 1\n";
+  auto many = LoadViewFiles(grammar, WriteFile("labels.v", labels));
+  ASSERT_TRUE(many != nullptr);
+  EXPECT_LE(many->diagnostics.items.size(), 201u);
+  EXPECT_TRUE(many->diagnostics.HasErrors());  // the stop is an error
   // A truncated colour map beside the grammar.
   WriteFile("hostile.map", std::string(100, '\1'));
   auto v = LoadViewFiles(grammar, "");
