@@ -199,9 +199,23 @@ TEST(ViewFile, TheTurtleDrawsWithTheViewFilesSettings) {
   EXPECT_NEAR(s[1].end.x(), -0.5, 1e-12);
   EXPECT_NEAR(s[1].end.y(), 1 + std::sqrt(3.0) / 2, 1e-12);
   EXPECT_EQ(s[0].color, 3);
-  EXPECT_EQ(s[2].color, 5);                  // ; adds the colour increment
-  EXPECT_FLOAT_EQ(s[3].radiusStart, 0.25f);  // ! with an increment of 0: unchanged
+  EXPECT_EQ(s[2].color, 5);                       // ; adds the colour increment
+  EXPECT_FLOAT_EQ(s[3].radiusStart, 0.25f);       // ! with an increment of 0: unchanged
+  EXPECT_TRUE(r.plant->grammar.palette.empty());  // no colour file yet
+  // A colour map beside the grammar becomes the palette (sRGB 255 -> linear 1).
+  std::string map(768, '\0');
+  map[3 * 5] = char(255);
+  WriteFile("vt.map", map);
+  spec.amendGrammar = nullptr;
+  AttachViewFile(LoadViewFiles(grammar, ""), spec);
+  plant::PlantResult colored = plant::BuildPlant(spec);
+  ASSERT_TRUE(colored.plant.has_value()) << colored.diagnostics.FormatAll();
+  ASSERT_EQ(colored.plant->palette.size(), 256u);
+  EXPECT_FLOAT_EQ(colored.plant->palette[5].x(), 1.0f);
+  EXPECT_FLOAT_EQ(colored.plant->palette[5].y(), 0.0f);
+  EXPECT_FLOAT_EQ(colored.plant->palette[4].x(), 0.0f);
   std::filesystem::remove(Scratch() / "vt.v");
+  std::filesystem::remove(Scratch() / "vt.map");
 }
 
 TEST(ViewFile, StrictMakesItsWarningsErrorsAndViewNamesTheFile) {
