@@ -200,6 +200,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   c->add_option("file", check.file, "grammar file (.lsys) or scene file (.xml)")->required();
   c->add_option("-D,--define", check.defines,
                 "override a grammar's #define or a scene's <default>: NAME=VALUE (repeatable)");
+  c->add_option("--view", check.view,
+                "grammars: cpfg view file (.v) to check with it (default: NAME.v beside it)");
   AddMaxErrorsFlag(c, check);
   AddStrictFlag(c, check.strict);
 

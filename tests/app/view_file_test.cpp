@@ -228,6 +228,9 @@ TEST(ViewFile, StrictMakesItsWarningsErrorsAndViewNamesTheFile) {
       << plain.err;
   auto strict = RunSylva({"derive", "--strict", grammar, "--view", view});
   EXPECT_EQ(strict.code, 2) << strict.err;
+  auto check = RunSylva({"check", "--strict", grammar, "--view", view});
+  EXPECT_EQ(check.code, 2) << check.err;
+  EXPECT_NE(check.err.find("other.v:2:1: warning: 'shade mode:'"), std::string::npos) << check.err;
   auto bad = RunSylva({"derive", grammar, "--view", "/dev/null"});
   EXPECT_EQ(bad.code, 2) << bad.err;
   EXPECT_NE(bad.err.find("/dev/null: error: view file: is not a regular file"), std::string::npos)
