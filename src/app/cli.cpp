@@ -73,6 +73,9 @@ static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
                   "stop with an error when the word would grow past this many modules "
                   "(default 268435456)")
       ->check(CLI::Range(uint64_t(1), lsys::kMaxModulesCap));
+  cmd->add_option("--view", f.view,
+                  "cpfg view file (.v): angle, widths, colours, tropism, view direction "
+                  "(default: NAME.v beside the grammar, if any)");
   AddMaxErrorsFlag(cmd, f);
   AddStrictFlag(cmd, f.strict);
 }
@@ -200,6 +203,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   c->add_option("file", check.file, "grammar file (.lsys) or scene file (.xml)")->required();
   c->add_option("-D,--define", check.defines,
                 "override a grammar's #define or a scene's <default>: NAME=VALUE (repeatable)");
+  c->add_option("--view", check.view,
+                "grammars: cpfg view file (.v) to check with it (default: NAME.v beside it)");
   AddMaxErrorsFlag(c, check);
   AddStrictFlag(c, check.strict);
 

@@ -61,6 +61,24 @@ int ParseView(const std::string& size, const std::string& camera, ViewFlags& v, 
   return kExitOk;
 }
 
+// A cpfg view file's view direction, unless --camera gives one.
+void UseViewFileDirection(const ViewFile* view, ViewFlags& v) {
+  if (!view || v.explicitCamera) return;
+  if (auto dir = ViewDirection(*view)) {
+    v.explicitCamera = true;
+    v.cam[0] = (*dir)[0];
+    v.cam[1] = (*dir)[1];
+    v.cam[2] = 0;  // framed
+  }
+}
+
+// cpfg's `scale factor:` zooms the framed view.
+void UseViewFileScale(const ViewFile* view, render::Camera& camera) {
+  if (!view || !view->scale) return;
+  camera.distance /= *view->scale;
+  camera.orthoHeight /= *view->scale;
+}
+
 // The camera that frames the plant, or the one --camera gives. The box
 // comes from the geometry, before tessellation, so every detail (uniform
 // or screen-space) sees one view.
@@ -168,8 +186,10 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   int exit = kExitOk;
-  auto spec = SpecFrom(cmd.derive, err, &exit);
+  std::shared_ptr<const ViewFile> viewFile;
+  auto spec = SpecFrom(cmd.derive, err, &exit, &viewFile);
   if (!spec) return exit;
+  UseViewFileDirection(viewFile.get(), v);
   if (cmd.sides) spec->detail.sides = *cmd.sides;
   spec->until = plant::Stage::kGeometry;
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
@@ -183,6 +203,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   mesh::Box bounds;
   auto camera = FrameCamera(*plant, *spec, v, lines, &bounds);
   if (!camera) return Report(camera.error(), err);
+  if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
   const int W = v.width * K, H = v.height * K;
   if (lines) {
     draw::Lines figure = LinesOf(*plant);
@@ -285,14 +306,17 @@ int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err)
     return kExitBadInput;
   }
   int exit = kExitOk;
-  auto spec = SpecFrom(cmd.derive, err, &exit);
+  std::shared_ptr<const ViewFile> viewFile;
+  auto spec = SpecFrom(cmd.derive, err, &exit, &viewFile);
   if (!spec) return exit;
+  UseViewFileDirection(viewFile.get(), v);
   spec->until = plant::Stage::kGeometry;
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   // Framed as `sylva render` frames a mesh (never as a line figure).
   auto camera = FrameCamera(*plant, *spec, v, false);
   if (!camera) return Report(camera.error(), err);
+  if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
   spec->view = ViewOf(*camera, v.width, v.height, eps);
   DiagnosticList warnings;
   Status s = plant::Tessellate(*plant, *spec, warnings);

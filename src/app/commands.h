@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "app/view_file.h"
 #include "core/diagnostic.h"
 #include "core/parallel.h"
 #include "draw/draw_list.h"
@@ -32,6 +33,7 @@ struct DeriveFlags {
   uint64_t maxTriangles = 0;  // mesh and render only; 0: the library default
   int maxErrors = 20;         // errors (and warnings) printed; 0: all
   bool strict = false;        // --strict: any warning is an error (exit 2)
+  std::string view;           // --view: cpfg view file (default: FILE's NAME.v beside it)
 };
 
 struct DeriveCommand {
@@ -84,7 +86,11 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 
 // The plant spec the flags describe (steps, seed, -D, threads, limits);
 // nullopt with *exit set when a flag is malformed (printed to `err`).
-std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit);
+// The cpfg view file (and .map/.mat) of the grammar is read here and
+// attached to the spec (app/view_file.h); `view`, when given, receives it
+// (nullptr when there is none).
+std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit,
+                                         std::shared_ptr<const ViewFile>* view = nullptr);
 // -D NAME=VALUE arguments into `overrides`; false (the error printed) on a
 // bad name or number.
 bool ParseDefines(const std::vector<std::string>& defs, std::map<std::string, double>* overrides,

@@ -23,6 +23,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/view_file.h"
 #include "app/viewer_window.h"
 #include "plant/plant.h"
 #include "plant/surface_library.h"
@@ -74,6 +75,8 @@ Result RunJob(const Job& job) {
   if (job.steps >= 0) spec.steps = job.steps;
   spec.detail.sides = job.sides;
   spec.threads = job.threads;
+  // cpfg's NAME.v (and .map, .mat) beside the grammar, read again on each reload.
+  AttachViewFile(LoadViewFiles(job.path, ""), spec);
   plant::PlantResult built = plant::BuildPlant(spec);
   r.diagnostics = built.diagnostics.FormatAll();
   if (!built.plant) return r;

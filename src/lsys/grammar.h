@@ -106,6 +106,11 @@ struct Grammar {
   double widthScale = 1;      // drawing: diameter = width x widthScale (cpfg's pixel widths)
   std::optional<Tropism> tropism;
   std::optional<EnvironmentStatement> environment;  // `environment:`
+  // From a cpfg view file (app/view_file.h): the colour index the turtle
+  // starts with, the step of `;` and `,`, and of @Ti/@Td.
+  int initialColor = 0;
+  int colorIncrement = 1;
+  double elasticityIncrement = 0;
   uint64_t seed = 1;
   // `palette: #rrggbb ...`: material colour of each colour index (sRGB as
   // written, 0..1); empty: the exporters' default palette.

@@ -69,8 +69,8 @@ bool IsIdentChar(char c) {
 constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_;,#";
 
 // cpfg's @ commands, longest first where they share a prefix.
-constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS",
-                                            "@PD", "@Ts", "@Sx", "@O",  "@o",  "@c",  "@v",
+constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS", "@PD",
+                                            "@Ts", "@Ti", "@Td", "@Sx", "@O",  "@o",  "@c",  "@v",
                                             "@M",  "@m",  "@R",  "@D",  "@i",  "@L",  "@b"};
 
 std::string Lower(std::string_view s) {
@@ -789,9 +789,10 @@ void GrammarParser::ParseContextNames(const Line& l, size_t after, size_t end, b
     std::string name;
     if (!LexName(l, p, end, &name)) return;
     if (name == "[" || name == "]") {
-      Error(l, c,
-            "brackets cannot be " + std::string(ignore ? "ignored" : "considered") +
-                ": they give the branching structure");
+      // cpfg files list the brackets in `consider:` so that context
+      // matching sees the branching; Sylva's matcher always does.
+      if (!ignore) continue;
+      Error(l, c, "brackets cannot be ignored: they give the branching structure");
       return;
     }
     (ignore ? ignoreNames_ : considerNames_).insert(name);

@@ -11,19 +11,11 @@ struct Command {
 
 // cpfg's @ commands that Sylva lexes but does not draw.
 constexpr Command kUndrawn[] = {
-    {"@Gs", "start of a generalized cylinder"},
-    {"@Ge", "end of a generalized cylinder"},
-    {"@Gc", "generalized cylinder control point"},
     {"@Gr", "generalized cylinder radius"},
     {"@Gt", "generalized cylinder tangent"},
-    {"@Tf", "tropism change"},
-    {"@Ts", "tropism strength"},
     {"@PS", "bicubic patch"},
     {"@PD", "bicubic patch"},
     {"@Sx", "surface command"},
-    {"@o", "disc"},
-    {"@c", "circle"},
-    {"@v", "roll to vertical"},
     {"@m", "move-to with drawing"},
     {"@R", "set heading and up"},
     {"@D", "scale factor"},
@@ -45,6 +37,30 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
       if (arity <= 1) return std::nullopt;
       return "'@O' (sphere) uses 1 parameter, the diameter; the other " +
              std::to_string(arity - 1) + " are ignored";
+    }
+    // Implemented, with the parameters they use (docs/turtle.md).
+    struct Used {
+      std::string_view name, what, params;
+      int most;
+    };
+    static constexpr Used kUsed[] = {
+        {"@o", "disc", "the diameter", 1},
+        {"@c", "circle", "the diameter", 1},
+        {"@v", "roll to vertical", "none", 0},
+        {"@Gs", "start of a generalized cylinder", "none", 0},
+        {"@Gc", "generalized cylinder point", "the number of segments", 1},
+        {"@Ge", "end of a generalized cylinder", "the number of segments", 1},
+        {"@Ts", "set tropism elasticity", "the tropism and the elasticity", 2},
+        {"@Ti", "raise tropism elasticity", "the tropism and the step", 2},
+        {"@Td", "lower tropism elasticity", "the tropism and the step", 2},
+        {"@Tf", "keep the twist", "none", 0},
+    };
+    for (const Used& u : kUsed) {
+      if (name != u.name) continue;
+      if (arity <= u.most) return std::nullopt;
+      return "'" + std::string(name) + "' (" + std::string(u.what) + ") uses " +
+             (u.most == 0 ? std::string("no parameters") : std::string(u.params)) + "; the other " +
+             std::to_string(arity - u.most) + " are ignored";
     }
     if (name == "@M") {
       if (arity == 3) return std::nullopt;

@@ -189,6 +189,15 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
   g.spec_ = spec;
   g.grammar_ = std::make_unique<lsys::Grammar>(std::move(*parsed.grammar));
   g.diagnostics_ = std::move(parsed.diagnostics);
+  if (spec.amendGrammar) {
+    DiagnosticList amended;
+    spec.amendGrammar(*g.grammar_, amended);
+    for (const Diagnostic& d : amended.items) {
+      diagnostics.Add(d);
+      g.diagnostics_.Add(d);
+    }
+    if (amended.HasErrors()) return std::nullopt;
+  }
   g.time_.parse = MsSince(t0);
   g.steps_ = spec.steps.value_or(g.grammar_->derivationLength);
   const lsys::Grammar& grammar = *g.grammar_;

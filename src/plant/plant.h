@@ -96,6 +96,10 @@ struct PlantSpec {
   // The ground `environment: terrain` answers from, in the plant's own
   // coordinates (a scene's terrain under the plant). Unset: the plane y = 0.
   std::optional<Ground> ground;
+  // Called once the grammar is parsed, before derivation: a front end's
+  // settings from outside the grammar (a cpfg view file, app/view_file.h)
+  // go in here. Its diagnostics join the plant's; an error stops the build.
+  std::function<void(lsys::Grammar& grammar, DiagnosticList& diagnostics)> amendGrammar;
   // Called after each derivation step, from the calling thread.
   std::function<void(int step, int steps, uint64_t modules)> progress;
 };

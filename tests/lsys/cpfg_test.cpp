@@ -36,21 +36,38 @@ std::string Joined(const std::vector<std::string>& v) {
 TEST(Cpfg, UnimplementedCommandsWarnOncePerSymbolAtTheirFirstUse) {
   auto w = Warnings(
       "axiom: A\n"
-      "A --> F@Gs F@Gc(1)@Gc(2)@Ge A\n"
-      "F --> @Gs F @Tf(1) @Ts(2) @o(1) @c(1) @v @M(1,2) @O(2)\n");
+      "A --> F@Gr(1) F@Gt(1)@Gt(2)@PS(1) A\n"
+      "F --> @Gs F @Tf @Ts(1,2) @o(1) @c(1) @v @M(1,2) @O(2) @Ge\n");
   const std::string all = Joined(w);
-  ASSERT_EQ(w.size(), 9u) << all;
-  EXPECT_EQ(w[0].rfind("2:8 '@Gs' (cpfg: start of a generalized cylinder) is not implemented", 0),
-            0u)
+  ASSERT_EQ(w.size(), 4u) << all;
+  EXPECT_EQ(w[0].rfind("2:8 '@Gr' (cpfg: generalized cylinder radius) is not implemented", 0), 0u)
       << all;
-  EXPECT_EQ(w[1].rfind("2:13 '@Gc'", 0), 0u) << all;  // once for @Gc(1) and @Gc(2)
-  EXPECT_EQ(w[2].rfind("2:25 '@Ge'", 0), 0u) << all;
-  EXPECT_EQ(w[3].rfind("3:13 '@Tf'", 0), 0u) << all;
-  EXPECT_EQ(w[4].rfind("3:20 '@Ts'", 0), 0u) << all;
-  EXPECT_EQ(w[5].rfind("3:27 '@o'", 0), 0u) << all;
-  EXPECT_EQ(w[6].rfind("3:33 '@c'", 0), 0u) << all;
-  EXPECT_EQ(w[7].rfind("3:39 '@v'", 0), 0u) << all;
-  EXPECT_EQ(w[8].rfind("3:42 '@M' (move to) needs 3 parameters", 0), 0u) << all;
+  EXPECT_EQ(w[1].rfind("2:16 '@Gt'", 0), 0u) << all;  // once for @Gt(1) and @Gt(2)
+  EXPECT_EQ(w[2].rfind("2:28 '@PS'", 0), 0u) << all;
+  EXPECT_EQ(w[3].rfind("3:41 '@M' (move to) needs 3 parameters", 0), 0u) << all;
+}
+
+TEST(Cpfg, ImplementedCommandsWarnAboutParametersTheyDoNotUse) {
+  auto w = Warnings("axiom: @o(1,2) @c(1) @Gs(3) @Gc(2) @Ge(1,1) @Ts(1,2,3) @Ti(1) @Td @v\n");
+  const std::string all = Joined(w);
+  ASSERT_EQ(w.size(), 4u) << all;
+  EXPECT_EQ(w[0].rfind("1:8 '@o' (disc) uses the diameter; the other 1 are ignored", 0), 0u) << all;
+  EXPECT_EQ(w[1].rfind("1:22 '@Gs' (start of a generalized cylinder) uses no parameters", 0), 0u)
+      << all;
+  EXPECT_EQ(w[2].rfind("1:36 '@Ge'", 0), 0u) << all;
+  EXPECT_EQ(w[3].rfind("1:45 '@Ts'", 0), 0u) << all;
+}
+
+TEST(Cpfg, BracketsInConsiderAreAcceptedAndKeepTheBranching) {
+  // B and the branch [C] are skipped: A sees A as its left context.
+  EXPECT_EQ(DeriveText("consider: [ ] A\naxiom: A B [C] A\nA < A --> D\n", 1), "AB[C]D");
+  // Without the consider: list B stands between them.
+  EXPECT_EQ(DeriveText("axiom: A B [C] A\nA < A --> D\n", 1), "AB[C]A");
+  ParseResult r = ParseGrammarText("ignore: [ +\naxiom: A\n", "c.l", {});
+  EXPECT_FALSE(r.grammar);
+  EXPECT_NE(r.diagnostics.FormatAll().find("c.l:1:9: error: brackets cannot be ignored"),
+            std::string::npos)
+      << r.diagnostics.FormatAll();
 }
 
 TEST(Cpfg, QueryModulesWarnOnlyWhereTheyAreNotAnswered) {
