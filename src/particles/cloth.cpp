@@ -4,7 +4,9 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
+#include "particles/cloth_collision.h"
 #include "particles/def_check.h"
 
 namespace sylva::particles {
@@ -54,6 +56,8 @@ Status Validate(const ClothDef& d) {
   for (size_t k = 0; k < d.pinned.size(); ++k) {
     SYLVA_CHECK_OK(Range("ClothDef.pinned[" + std::to_string(k) + "]", d.pinned[k], 0, n - 1));
   }
+  SYLVA_CHECK_OK(Range("ClothDef.thickness", d.thickness, 0, 1e12, "m"));
+  SYLVA_CHECK_OK(Range("ClothDef.selfFriction", d.selfFriction, 0, 1e3));
   SYLVA_CHECK_OK(Range("ClothDef.threads", d.threads, 0, 256));
   SYLVA_CHECK_OK(Range("ClothDef.implicitStiffness", d.implicitStiffness, 1e-12, 1e12, "N/m"));
   SYLVA_CHECK_OK(Range("ClothDef.implicitDamping", d.implicitDamping, 0, 1e12, "N s/m"));
@@ -145,6 +149,8 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
       }
     }
   }
+  if (def_.thickness > 0)
+    self_ = std::make_unique<clothcontact::SelfCollision>(x_, def_.thickness, def_.selfFriction);
   if (def_.pool && def_.solver == ClothSolver::kXPBD) {
     pool_ = def_.pool->threads() > 1 ? def_.pool : nullptr;
   } else if (def_.threads != 1 && def_.solver == ClothSolver::kXPBD) {  // implicit: its own
@@ -173,9 +179,30 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
   }
 }
 
+Cloth::~Cloth() = default;
+
+Status Cloth::AddCollider(Collider c) {
+  SYLVA_CHECK_OK(Validate(c));
+  if (c.response == Response::kKill)
+    return check::Error(
+        "Cloth.AddCollider: a kKill collider cannot take cloth (a cloth particle "
+        "cannot die); use kBounce or kStick");
+  if (implicit_) SYLVA_CHECK_OK(implicit_->AddCollider(c));
+  colliders_.push_back(std::move(c));
+  return {};
+}
+
 void Cloth::AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f) {
+  if (externalForce_) {
+    const size_t n = x_.size();
+    ForRanges(pool, n, BalancedGrain(pool, n, 512, 4096), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        if (w_[i] > 0) f[i] += externalForce_(i, x[i], v[i]);
+    });
+  }
   const double cd = def_.windDrag, cl = def_.windLift, cf = def_.windFriction;
   if (cd == 0 && cl == 0 && cf == 0) return;
+  const WindField* field = windField_;
   // Each triangle's force, then each particle gathers from the (up to six)
   // triangles around it in a fixed order: parallel, and the same sums for
   // any thread count.
@@ -186,8 +213,13 @@ void Cloth::AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& 
       const auto& t = tris_[k];
       const Vec3 cr = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
       const double area2 = cr.norm();
-      const Vec3 u = wind - (v[t[0]] + v[t[1]] + v[t[2]]) / 3;
+      const Vec3 air = field ? (*field)((x[t[0]] + x[t[1]] + x[t[2]]) / 3) : wind;
+      const Vec3 u = air - (v[t[0]] + v[t[1]] + v[t[2]]) / 3;
       const double uu = u.squaredNorm();
+      if (!std::isfinite(uu)) {  // a non-finite wind: the corners report it as theirs
+        triForce_[k] = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
       if (!(area2 > 0) || !(uu > 0)) {
         triForce_[k] = Vec3::Zero();
         continue;
@@ -258,12 +290,24 @@ Status Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
   implicit_->state.velocity = v_;
   const int subs = def_.implicitSubsteps;
   for (int s = 0; s < subs; ++s) {
+    if (self_) selfPrev_ = implicit_->state.position;
     if (Status st = implicit_->Step(dt / subs, Integrator::kImplicitEuler); !st.ok()) {
       Diagnostic d = st.error();
       d.message = "cloth: frame " + std::to_string(frames_) + ", implicit substep " +
                   std::to_string(s) + ": " + d.message;
       fault_ = d;
       return d;
+    }
+    if (self_) {  // after the step: the correction's velocity is dx / h
+      ParticleState& ps = implicit_->state;
+      const size_t moved =
+          self_->Pass(def_.pool, selfPrev_.data(), ps.position.data(), w_.data(), selfDx_);
+      lastContacts_ += moved;
+      const double invH = subs / dt;
+      for (size_t i = 0; i < ps.size(); ++i) {
+        ps.position[i] += selfDx_[i];
+        ps.velocity[i] += invH * selfDx_[i];
+      }
     }
   }
   x_ = implicit_->state.position;
@@ -272,12 +316,24 @@ Status Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
 }
 
 Status Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
+  return StepAny(dt, gravity, wind, nullptr);
+}
+
+Status Cloth::StepInWindField(double dt, const Vec3& gravity, const WindField& wind) {
+  if (!wind) return Step(dt, gravity, Vec3::Zero());
+  return StepAny(dt, gravity, Vec3::Zero(), &wind);
+}
+
+Status Cloth::StepAny(double dt, const Vec3& gravity, const Vec3& wind, const WindField* field) {
   if (fault_) return *fault_;
   if (!(dt > 0 && dt <= 1e6))
     return check::Error("Cloth.Step dt " + check::Num(dt) + " is outside (0, 1e+06] s");
   SYLVA_CHECK_OK(check::Finite("Cloth.Step gravity", gravity, 1e12, "m/s^2"));
   SYLVA_CHECK_OK(check::Finite("Cloth.Step wind", wind, 1e12, "m/s"));
+  windField_ = field;
+  lastContacts_ = 0;
   Status st = implicit_ ? StepImplicit(dt, gravity, wind) : StepXpbd(dt, gravity, wind);
+  windField_ = nullptr;
   ++frames_;
   return st;
 }
@@ -355,6 +411,7 @@ Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
         });
       }
     }
+    if (self_ || !colliders_.empty()) ContactsXpbd(pool);
     // This substep's attachments and velocities, fused with the next one's
     // prediction (or the store back).
     const bool last = s + 1 == subs;
@@ -371,6 +428,48 @@ Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
     });
   }
   return bad.load() ? FindNonFinite("after") : Status{};
+}
+
+void Cloth::ContactsXpbd(ThreadPool* pool) {
+  const size_t n = x_.size();
+  const size_t grain = BalancedGrain(pool, n, 512, 4096);
+  auto get = [](const xpbd::Point4& p) { return Vec3(p.p[0], p.p[1], p.p[2]); };
+  auto put = [](xpbd::Point4& p, const Vec3& v) {
+    p.p[0] = v.x();
+    p.p[1] = v.y();
+    p.p[2] = v.z();
+  };
+  if (self_) {
+    selfX_.resize(n);
+    selfPrev_.resize(n);
+    ForRanges(pool, n, grain, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        selfX_[i] = get(x4_[i]);
+        selfPrev_[i] = get(prev4_[i]);
+      }
+    });
+    lastContacts_ += self_->Pass(pool, selfPrev_.data(), selfX_.data(), w_.data(), selfDx_);
+    ForRanges(pool, n, grain, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        if (selfDx_[i] != Vec3::Zero()) put(x4_[i], selfX_[i] + selfDx_[i]);
+    });
+  }
+  if (colliders_.empty()) return;
+  std::atomic<size_t> touched{0};
+  ForRanges(pool, n, grain, [&](size_t b, size_t e) {
+    size_t count = 0;
+    for (size_t i = b; i < e; ++i) {
+      if (w_[i] == 0) continue;
+      Vec3 x = get(x4_[i]);
+      bool any = false;
+      for (const Collider& c : colliders_) any = any || c.MayHit(get(prev4_[i]), x);
+      if (!any || !clothcontact::Collide(colliders_, get(prev4_[i]), x)) continue;
+      put(x4_[i], x);
+      ++count;
+    }
+    touched.fetch_add(count, std::memory_order_relaxed);
+  });
+  lastContacts_ += touched.load();
 }
 
 }  // namespace sylva::particles

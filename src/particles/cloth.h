@@ -26,6 +26,17 @@
 // All three are linear in |u|. With c_d = c_l drag and lift add up to
 // A (n.u) n, the pressure on a flat plate, which is the default.
 //
+// The wind may vary over the cloth (StepInWindField): each triangle
+// feels the air at its centroid, so gusts smaller than the sheet bend it
+// and a flag waves instead of swinging as a board.
+//
+// Contacts (cloth_collision.h): colliders of collider.h (plane, sphere,
+// box, polygon, mesh, capsules) with Coulomb friction, and the cloth with
+// itself when ClothDef::thickness > 0. XPBD resolves them on positions
+// after the constraints of every substep; the implicit solver passes the
+// colliders to its particle System (its contact response, restitution
+// included) and runs the self-collision pass after each implicit step.
+//
 // The implicit solver (ClothDef::solver = kImplicit) turns every constraint
 // into a damped spring of stiffness 1/compliance, at most `implicitStiffness` and takes
 // backward-Euler steps (Baraff & Witkin 1998) with `cgIterations` of matrix-free conjugate
@@ -34,16 +45,21 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
 
 #include "core/math.h"
 #include "core/parallel.h"
+#include "particles/collider.h"
 #include "particles/system.h"
 #include "particles/xpbd.h"
 
 namespace sylva::particles {
+namespace clothcontact {
+class SelfCollision;
+}
 
 enum class ClothSolver { kXPBD, kImplicit };
 
@@ -71,7 +87,14 @@ struct ClothDef {
   // Long-range attachments: tethers from every particle to its two nearest
   // pins, at their rest distance (XPBD only).
   bool longRangeAttachments = true;
-  int threads = 1;  // 0..256, 0 = every hardware thread
+  // Self-collision: two particles that were farther apart than `thickness`
+  // at rest are kept at least that far apart, m, 0..1e12 (0: off). A sheet
+  // cannot slip through itself between particles when thickness is at
+  // least the diagonal gap of a cell, spacing / sqrt(2), and no particle
+  // moves more than `thickness` in a substep.
+  double thickness = 0;
+  double selfFriction = 0.3;  // Coulomb mu between layers that touch, 0..1e3
+  int threads = 1;            // 0..256, 0 = every hardware thread
   // When set, the cloth runs on this pool (shared with the process, not
   // owned, outliving the cloth) and `threads` is not used.
   ThreadPool* pool = nullptr;
@@ -91,6 +114,7 @@ class Cloth {
   // A cloth of a valid definition, or the Diagnostic of Validate. The cloth
   // stays where it was made (its forces point back at it), hence the pointer.
   static Expected<std::unique_ptr<Cloth>> Create(const ClothDef& def);
+  ~Cloth();
   Cloth(const Cloth&) = delete;
   Cloth& operator=(const Cloth&) = delete;
   // One frame of dt seconds. dt in (0, 1e6] s, gravity (m/s^2) and wind
@@ -101,6 +125,30 @@ class Cloth {
   // implicit solver's failures (a non-positive-definite system) come back
   // the same way.
   [[nodiscard]] Status Step(double dt, const Vec3& gravity, const Vec3& wind = Vec3::Zero());
+  // The air's velocity (m/s) at a point: evaluated at each triangle's
+  // centroid once a frame (XPBD) or at each force evaluation (implicit), on
+  // the cloth's threads, so it must be safe to call concurrently. A
+  // non-finite value is reported like a non-finite particle.
+  using WindField = std::function<Vec3(const Vec3& x)>;
+  [[nodiscard]] Status StepInWindField(double dt, const Vec3& gravity, const WindField& wind);
+  // A collider (Validate'd: a Diagnostic and nothing added if it is bad).
+  // The cloth keeps its contacts inelastic (XPBD: restitution is not used),
+  // with the collider's friction; kStick holds the particles that touch it
+  // (infinite friction); kKill is an error (a cloth particle cannot die).
+  Status AddCollider(Collider c);
+  const std::vector<Collider>& colliders() const { return colliders_; }
+  // An extra force on each free particle, N: f(i, x, v) for particle i at
+  // x with velocity v (drag, attractors, noise). Evaluated with the wind
+  // (once a frame for XPBD), on the cloth's threads: it must be safe to call
+  // concurrently. Empty: none.
+  using ForceField = std::function<Vec3(size_t i, const Vec3& x, const Vec3& v)>;
+  void SetExternalForce(ForceField f) { externalForce_ = std::move(f); }
+  // Mass of one particle, kg (ClothDef::mass / particles).
+  double particleMass() const { return def_.mass / double(x_.size()); }
+  // Particles that a collider or the self-collision moved in the last
+  // frame, summed over the substeps (implicit: the self-collision's only;
+  // its particle System handles the colliders).
+  size_t lastContacts() const { return lastContacts_; }
   // Frames stepped so far.
   uint64_t frames() const { return frames_; }
 
@@ -122,8 +170,11 @@ class Cloth {
 
  private:
   explicit Cloth(const ClothDef& def);
+  Status StepAny(double dt, const Vec3& gravity, const Vec3& wind, const WindField* field);
   Status StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
   Status StepXpbd(double dt, const Vec3& gravity, const Vec3& wind);
+  // Colliders and self-collision on the XPBD substep's positions.
+  void ContactsXpbd(ThreadPool* pool);
   // The fault of the first particle whose position or velocity is not
   // finite (`when`: before or after the frame), or ok if there is none.
   Status FindNonFinite(const char* when);
@@ -131,7 +182,14 @@ class Cloth {
   std::vector<size_t> colorStart_;     // constraints_ sorted by colour
   std::unique_ptr<ThreadPool> ownPool_;
   ThreadPool* pool_ = nullptr;  // own or def.pool; null: serial
+  // Wind and the external force field on positions x, velocities v, into f.
   void AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f);
+  const WindField* windField_ = nullptr;  // during a Step with a field
+  ForceField externalForce_;
+  std::vector<Collider> colliders_;
+  std::unique_ptr<clothcontact::SelfCollision> self_;
+  std::vector<Vec3> selfX_, selfPrev_, selfDx_;
+  size_t lastContacts_ = 0;
   class ExternalForce;          // gravity, damping and wind for the implicit solver
   std::vector<Vec3> triForce_;  // AddWind's per-triangle forces
   ClothDef def_;
