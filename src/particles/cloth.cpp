@@ -63,6 +63,8 @@ Status Validate(const ClothDef& d) {
   SYLVA_CHECK_OK(Range("ClothDef.implicitDamping", d.implicitDamping, 0, 1e12, "N s/m"));
   SYLVA_CHECK_OK(Range("ClothDef.implicitSubsteps", d.implicitSubsteps, 1, 10000));
   SYLVA_CHECK_OK(Range("ClothDef.cgIterations", d.cgIterations, 1, 100000));
+  SYLVA_CHECK_OK(Range("ClothDef.implicitStrainLimit", d.implicitStrainLimit, 0, 1e6));
+  SYLVA_CHECK_OK(Range("ClothDef.implicitStrainIterations", d.implicitStrainIterations, 1, 100000));
   return {};
 }
 
@@ -309,6 +311,8 @@ Status Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
         ps.velocity[i] += invH * selfDx_[i];
       }
     }
+    if (def_.implicitStrainLimit > 0)
+      LimitStrain(implicit_->state.position, implicit_->state.velocity, dt / subs);
   }
   x_ = implicit_->state.position;
   v_ = implicit_->state.velocity;
@@ -470,6 +474,50 @@ void Cloth::ContactsXpbd(ThreadPool* pool) {
     touched.fetch_add(count, std::memory_order_relaxed);
   });
   lastContacts_ += touched.load();
+}
+
+void Cloth::LimitStrain(std::vector<Vec3>& x, std::vector<Vec3>& v, double h) {
+  // A stretched constraint goes back to 98 % of the limit: a neighbour's
+  // later correction then rarely pushes it over again (Gauss-Seidel passes
+  // approach the limit from above only geometrically otherwise).
+  const double limit = 1 + def_.implicitStrainLimit;
+  const double target = 1 + 0.98 * def_.implicitStrainLimit;
+  strainX0_ = x;
+  const size_t n = x.size();
+  for (int it = 0; it < def_.implicitStrainIterations; ++it) {
+    bool any = false;
+    // Structural constraints (those MaxStretch measures), in colour order.
+    for (const Constraint& c : constraints_) {
+      if (c.compliance != def_.stretchCompliance) continue;
+      const double wa = w_[c.a], wb = w_[c.b];
+      if (wa + wb == 0) continue;
+      const Vec3 d = x[c.b] - x[c.a];
+      const double len = d.norm();
+      if (!(len > limit * c.rest)) continue;
+      const Vec3 corr = d * ((len - target * c.rest) / (len * (wa + wb)));
+      x[c.a] += wa * corr;
+      x[c.b] -= wb * corr;
+      any = true;
+    }
+    // Tethers: no farther from a pin than the limit allows.
+    if (!tethers_.empty()) {
+      for (size_t i = 0; i < n; ++i) {
+        if (w_[i] == 0) continue;
+        for (int k = 0; k < xpbd::kTethers; ++k) {
+          const xpbd::Tether& t = tethers_[i * xpbd::kTethers + size_t(k)];
+          if (t.pin == UINT32_MAX) continue;
+          const Vec3 d = x[i] - x[t.pin];
+          const double len = d.norm();
+          if (!(len > limit * t.rest)) continue;
+          x[i] = x[t.pin] + d * (target * t.rest / len);
+          any = true;
+        }
+      }
+    }
+    if (!any) break;
+  }
+  const double invH = 1 / h;
+  for (size_t i = 0; i < n; ++i) v[i] += invH * (x[i] - strainX0_[i]);
 }
 
 }  // namespace sylva::particles
