@@ -482,21 +482,27 @@ void Cloth::LimitStrain(std::vector<Vec3>& x, std::vector<Vec3>& v, double h) {
   // approach the limit from above only geometrically otherwise).
   const double limit = 1 + def_.implicitStrainLimit;
   const double target = 1 + 0.98 * def_.implicitStrainLimit;
+  if (strainLinks_.empty()) {  // the structural constraints (MaxStretch's), in colour order
+    for (const Constraint& c : constraints_) {
+      const double wa = w_[c.a], wb = w_[c.b];
+      if (c.compliance != def_.stretchCompliance || wa + wb == 0) continue;
+      const double max = limit * c.rest;
+      strainLinks_.push_back(
+          {c.a, c.b, max * max, target * c.rest, wa / (wa + wb), wb / (wa + wb)});
+    }
+  }
   strainX0_ = x;
   const size_t n = x.size();
   for (int it = 0; it < def_.implicitStrainIterations; ++it) {
     bool any = false;
-    // Structural constraints (those MaxStretch measures), in colour order.
-    for (const Constraint& c : constraints_) {
-      if (c.compliance != def_.stretchCompliance) continue;
-      const double wa = w_[c.a], wb = w_[c.b];
-      if (wa + wb == 0) continue;
-      const Vec3 d = x[c.b] - x[c.a];
-      const double len = d.norm();
-      if (!(len > limit * c.rest)) continue;
-      const Vec3 corr = d * ((len - target * c.rest) / (len * (wa + wb)));
-      x[c.a] += wa * corr;
-      x[c.b] -= wb * corr;
+    for (const StrainLink& l : strainLinks_) {
+      const Vec3 d = x[l.b] - x[l.a];
+      const double len2 = d.squaredNorm();
+      if (!(len2 > l.max2)) continue;
+      const double len = std::sqrt(len2);
+      const Vec3 corr = d * ((len - l.target) / len);
+      x[l.a] += l.shareA * corr;
+      x[l.b] -= l.shareB * corr;
       any = true;
     }
     // Tethers: no farther from a pin than the limit allows.
@@ -507,9 +513,9 @@ void Cloth::LimitStrain(std::vector<Vec3>& x, std::vector<Vec3>& v, double h) {
           const xpbd::Tether& t = tethers_[i * xpbd::kTethers + size_t(k)];
           if (t.pin == UINT32_MAX) continue;
           const Vec3 d = x[i] - x[t.pin];
-          const double len = d.norm();
-          if (!(len > limit * t.rest)) continue;
-          x[i] = x[t.pin] + d * (target * t.rest / len);
+          const double len2 = d.squaredNorm(), max = limit * t.rest;
+          if (!(len2 > max * max)) continue;
+          x[i] = x[t.pin] + d * (target * t.rest / std::sqrt(len2));
           any = true;
         }
       }

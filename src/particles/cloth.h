@@ -188,6 +188,12 @@ class Cloth {
   Status StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
   // Strain limiting of the implicit state after a step of h seconds.
   void LimitStrain(std::vector<Vec3>& x, std::vector<Vec3>& v, double h);
+  struct StrainLink {  // 40 bytes
+    uint32_t a, b;
+    double max2, target;    // (limit rest)^2, the length a stretched link goes back to
+    double shareA, shareB;  // w_a / (w_a + w_b), w_b / (w_a + w_b)
+  };
+  std::vector<StrainLink> strainLinks_;
   std::vector<Vec3> strainX0_;
   Status StepXpbd(double dt, const Vec3& gravity, const Vec3& wind);
   // Colliders and self-collision on the XPBD substep's positions.
