@@ -74,6 +74,22 @@ struct WindGrid {
       lo = lo.cwiseMin(s.position[i]);
       hi = hi.cwiseMax(s.position[i]);
     }
+    PrepareBox(lo, hi, t, eddy);
+  }
+
+  // Over points x (a cloth's vertices).
+  void Prepare(const std::vector<Vec3>& x, double t, double eddy) {
+    valid = false;
+    if (!wind || !wind->gusts || x.empty()) return;
+    Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+    for (const Vec3& p : x) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    PrepareBox(lo, hi, t, eddy);
+  }
+
+  void PrepareBox(Vec3 lo, Vec3 hi, double t, double eddy) {
     if (!lo.allFinite() || !hi.allFinite() || !(lo.array() <= hi.array()).all()) return;
     spacing = eddy / 4;
     lo.array() -= 2 * spacing;  // room for a step's motion
@@ -328,6 +344,7 @@ void ParticleSystem::TurnLeaves(double h, const Wind* wind, double time) {
 struct ClothSheet {
   const ClothDef* def = nullptr;
   std::unique_ptr<particles::Cloth> cloth;
+  std::unique_ptr<WindGrid> windGrid = std::make_unique<WindGrid>();  // the gusts over it
   Vec3 gravity = Vec3::Zero();
 };
 
@@ -564,10 +581,13 @@ Status Simulation::Impl::Step() {
     particles::RemoveDead(st);
   }
   for (ClothSheet& c : cloths) {
-    // The wind at each triangle (gusts smaller than the sheet bend it).
+    // The wind at each triangle (gusts smaller than the sheet bend it),
+    // from the gusts sampled on a grid over the sheet.
     const double t = time;
-    const Wind* air = &wind;
-    Status s = hasWind && c.def->wind && wind.gusts
+    const bool gusts = hasWind && c.def->wind && wind.gusts;
+    if (gusts) c.windGrid->Prepare(c.cloth->positions(), t, scene->wind->scale);
+    const WindGrid* air = c.windGrid.get();
+    Status s = gusts
                    ? c.cloth->StepInWindField(h, c.gravity,
                                               [air, t](const Vec3& x) { return air->At(x, t); })
                    : c.cloth->Step(h, c.gravity, hasWind && c.def->wind ? wind.mean : Vec3::Zero());
@@ -903,6 +923,7 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
     ClothSheet sheet;
     sheet.def = &c;
     sheet.cloth = std::move(*cloth);
+    sheet.windGrid->wind = wind;
     for (particles::Collider& col : colliders) {
       const Status s = sheet.cloth->AddCollider(std::move(col));
       SYLVA_ASSERT(s.ok());  // validated, and never kKill
