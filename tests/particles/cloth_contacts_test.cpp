@@ -125,52 +125,58 @@ TEST(ClothContacts, FoldedSheetDroppedOnABallDoesNotPassThroughItself) {
   const double s = 1.0 / (C - 1);
   const double R = 0.25, thickness = 0.8 * s;
   const Vec3 centre(0.5, -R - 0.05, 0.5 * (K - 1) * s);
-  size_t crossings[2];
-  for (int self = 0; self < 2; ++self) {
-    ClothDef def;
-    def.columns = C;
-    def.rows = 2 * K;
-    def.u = Vec3(1, 0, 0);
-    def.v = Vec3(0, 0, (2 * K - 1) * s);  // square cells of side s
-    def.bendCompliance = 1;
-    def.windDrag = def.windLift = 0;
-    def.thickness = self ? thickness : 0;
-    auto cloth = testing::Made(Cloth::Create(def));
-    std::vector<Vec3>& x = cloth->mutablePositions();
-    for (int r = 0; r < 2 * K; ++r) {
-      for (int c = 0; c < C; ++c) {
-        const bool upper = r >= K;
-        x[size_t(cloth->Index(c, r))] = Vec3(c * s, upper ? s : 0, (upper ? 2 * K - 1 - r : r) * s);
+  for (ClothSolver solver : {ClothSolver::kXPBD, ClothSolver::kImplicit}) {
+    const char* name = solver == ClothSolver::kXPBD ? "XPBD" : "implicit";
+    size_t crossings[2];
+    for (int self = 0; self < 2; ++self) {
+      ClothDef def;
+      def.solver = solver;
+      def.columns = C;
+      def.rows = 2 * K;
+      def.u = Vec3(1, 0, 0);
+      def.v = Vec3(0, 0, (2 * K - 1) * s);  // square cells of side s
+      def.bendCompliance = 1;
+      def.windDrag = def.windLift = 0;
+      def.thickness = self ? thickness : 0;
+      auto cloth = testing::Made(Cloth::Create(def));
+      std::vector<Vec3>& x = cloth->mutablePositions();
+      for (int r = 0; r < 2 * K; ++r) {
+        for (int c = 0; c < C; ++c) {
+          const bool upper = r >= K;
+          x[size_t(cloth->Index(c, r))] =
+              Vec3(c * s, upper ? s : 0, (upper ? 2 * K - 1 - r : r) * s);
+        }
       }
-    }
-    ASSERT_OK(cloth->AddCollider(Collider::Sphere(centre, R).Friction(0.5)));
-    for (int i = 0; i < 90; ++i) ASSERT_OK(cloth->Step(1.0 / 60, kG));
-    size_t crossed = 0, counted = 0;
-    for (int r = K; r < 2 * K; ++r) {
-      for (int c = 0; c < C; ++c) {
-        const Vec3 dt = x[size_t(cloth->Index(c, r))] - centre;
-        if (dt.normalized().y() < 0.7) continue;  // over the top of the ball only
-        double best = -2, rb = 0;
-        for (int rr = 0; rr < K; ++rr) {
-          for (int cc = 0; cc < C; ++cc) {
-            const Vec3 db = x[size_t(cloth->Index(cc, rr))] - centre;
-            const double cosine = db.normalized().dot(dt.normalized());
-            if (cosine > best) {
-              best = cosine;
-              rb = db.norm();
+      ASSERT_OK(cloth->AddCollider(Collider::Sphere(centre, R).Friction(0.5)));
+      for (int i = 0; i < 90; ++i) ASSERT_OK(cloth->Step(1.0 / 60, kG));
+      size_t crossed = 0, counted = 0;
+      for (int r = K; r < 2 * K; ++r) {
+        for (int c = 0; c < C; ++c) {
+          const Vec3 dt = x[size_t(cloth->Index(c, r))] - centre;
+          if (dt.normalized().y() < 0.7) continue;  // over the top of the ball only
+          double best = -2, rb = 0;
+          for (int rr = 0; rr < K; ++rr) {
+            for (int cc = 0; cc < C; ++cc) {
+              const Vec3 db = x[size_t(cloth->Index(cc, rr))] - centre;
+              const double cosine = db.normalized().dot(dt.normalized());
+              if (cosine > best) {
+                best = cosine;
+                rb = db.norm();
+              }
             }
           }
+          ++counted;
+          crossed += dt.norm() < rb + 1e-3;
         }
-        ++counted;
-        crossed += dt.norm() < rb + 1e-3;
       }
+      ASSERT_GT(counted, 20u) << name << ": too few upper particles over the ball to count";
+      crossings[self] = crossed;
+      if (self) EXPECT_GT(cloth->lastContacts(), 0u);
     }
-    ASSERT_GT(counted, 20u) << "too few upper particles over the ball to count";
-    crossings[self] = crossed;
-    if (self) EXPECT_GT(cloth->lastContacts(), 0u);
+    EXPECT_GT(crossings[0], 10u) << name << ": without self-collision the layers should merge";
+    EXPECT_EQ(crossings[1], 0u) << name << ": with self-collision (thickness " << thickness
+                                << " m)";
   }
-  EXPECT_GT(crossings[0], 10u) << "without self-collision the layers should merge";
-  EXPECT_EQ(crossings[1], 0u) << "with self-collision (thickness " << thickness << " m)";
 }
 
 // The free edge of a flag in a steady, uniform wind: with the per-triangle
