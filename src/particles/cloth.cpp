@@ -300,6 +300,14 @@ Status Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
       fault_ = d;
       return d;
     }
+    // A kStick collider makes the particles it holds immovable in the
+    // particle system: so in the cloth too (self-collision, strain limits).
+    for (size_t i = 0; i < w_.size(); ++i) {
+      if (w_[i] > 0 && implicit_->state.invMass[i] == 0) {
+        w_[i] = 0;
+        strainLinks_.clear();  // rebuilt with the new shares
+      }
+    }
     if (self_) {  // after the step: the correction's velocity is dx / h
       ParticleState& ps = implicit_->state;
       const size_t moved =
@@ -350,17 +358,8 @@ Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
   // Wind once a frame (it changes slowly next to the substeps).
   fext_.assign(n, Vec3::Zero());
   AddWind(pool, x_.data(), v_.data(), wind, fext_.data());
-  const size_t m = constraints_.size();
-  const bool reuse = projH_ == h && proj_.size() == m;  // the masses never change; the substep may
-  projH_ = h;
-  proj_.resize(m);
-  for (size_t k = 0; k < m && !reuse; ++k) {
-    const Constraint& c = constraints_[k];
-    const double alphaT = c.compliance / (h * h);
-    const double denom = w_[c.a] + w_[c.b] + alphaT;
-    const double scale = denom > 0 ? 1 / denom : 0;  // 0: both ends pinned, nothing moves
-    proj_[k] = {c.a, c.b, c.rest, scale, w_[c.a] * scale, w_[c.b] * scale, alphaT};
-  }
+  // The masses change only when a particle sticks (which resets projH_).
+  if (!(projH_ == h && proj_.size() == constraints_.size())) BuildProjections(h);
   const double invH = 1 / h;
   const bool keepLambda = def_.iterations > 1;
   // The substeps run on padded positions, velocities and forces (see
@@ -415,7 +414,10 @@ Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
         });
       }
     }
-    if (self_ || !colliders_.empty()) ContactsXpbd(pool);
+    if (self_ || !colliders_.empty()) {
+      ContactsXpbd(pool);
+      if (projH_ == 0) BuildProjections(h);  // a particle stuck: it is a pin now
+    }
     // This substep's attachments and velocities, fused with the next one's
     // prediction (or the store back).
     const bool last = s + 1 == subs;
@@ -432,6 +434,19 @@ Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
     });
   }
   return bad.load() ? FindNonFinite("after") : Status{};
+}
+
+void Cloth::BuildProjections(double h) {
+  const size_t m = constraints_.size();
+  projH_ = h;
+  proj_.resize(m);
+  for (size_t k = 0; k < m; ++k) {
+    const Constraint& c = constraints_[k];
+    const double alphaT = c.compliance / (h * h);
+    const double denom = w_[c.a] + w_[c.b] + alphaT;
+    const double scale = denom > 0 ? 1 / denom : 0;  // 0: both ends pinned, nothing moves
+    proj_[k] = {c.a, c.b, c.rest, scale, w_[c.a] * scale, w_[c.b] * scale, alphaT};
+  }
 }
 
 void Cloth::ContactsXpbd(ThreadPool* pool) {
@@ -460,6 +475,7 @@ void Cloth::ContactsXpbd(ThreadPool* pool) {
   }
   if (colliders_.empty()) return;
   std::atomic<size_t> touched{0};
+  std::atomic<bool> stuck{false};
   ForRanges(pool, n, grain, [&](size_t b, size_t e) {
     size_t count = 0;
     for (size_t i = b; i < e; ++i) {
@@ -467,13 +483,22 @@ void Cloth::ContactsXpbd(ThreadPool* pool) {
       Vec3 x = get(x4_[i]);
       bool any = false;
       for (const Collider& c : colliders_) any = any || c.MayHit(get(prev4_[i]), x);
-      if (!any || !clothcontact::Collide(colliders_, get(prev4_[i]), x)) continue;
+      if (!any) continue;
+      const Collider* hit = clothcontact::Collide(colliders_, get(prev4_[i]), x);
+      if (!hit) continue;
       put(x4_[i], x);
       ++count;
+      if (hit->response == Response::kStick) {  // immovable from now on, as a pin
+        w_[i] = 0;
+        v4_[i] = xpbd::Point4{{0, 0, 0, 0}};
+        prev4_[i] = x4_[i];
+        stuck.store(true, std::memory_order_relaxed);
+      }
     }
     touched.fetch_add(count, std::memory_order_relaxed);
   });
   lastContacts_ += touched.load();
+  if (stuck.load()) projH_ = 0;  // the projections' shares change: rebuilt below
 }
 
 void Cloth::LimitStrain(std::vector<Vec3>& x, std::vector<Vec3>& v, double h) {

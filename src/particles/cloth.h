@@ -147,8 +147,9 @@ class Cloth {
   [[nodiscard]] Status StepInWindField(double dt, const Vec3& gravity, const WindField& wind);
   // A collider (Validate'd: a Diagnostic and nothing added if it is bad).
   // The cloth keeps its contacts inelastic (XPBD: restitution is not used),
-  // with the collider's friction; kStick holds the particles that touch it
-  // (infinite friction); kKill is an error (a cloth particle cannot die).
+  // with the collider's friction; a particle that touches a kStick collider
+  // becomes immovable, as a pin; kKill is an error (a cloth particle cannot
+  // die).
   Status AddCollider(Collider c);
   const std::vector<Collider>& colliders() const { return colliders_; }
   // An extra force on each free particle, N: f(i, x, v) for particle i at
@@ -198,6 +199,8 @@ class Cloth {
   Status StepXpbd(double dt, const Vec3& gravity, const Vec3& wind);
   // Colliders and self-collision on the XPBD substep's positions.
   void ContactsXpbd(ThreadPool* pool);
+  // proj_ for substeps of h seconds from the current inverse masses.
+  void BuildProjections(double h);
   // The fault of the first particle whose position or velocity is not
   // finite (`when`: before or after the frame), or ok if there is none.
   Status FindNonFinite(const char* when);

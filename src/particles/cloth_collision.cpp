@@ -18,8 +18,8 @@ Vec3 FrictionTaken(const Vec3& t, double mu, double depth) {
 
 }  // namespace
 
-bool Collide(const std::vector<Collider>& colliders, const Vec3& p, Vec3& x) {
-  bool touched = false;
+const Collider* Collide(const std::vector<Collider>& colliders, const Vec3& p, Vec3& x) {
+  const Collider* touched = nullptr;
   Vec3 a = p;
   for (int k = 0; k < 4; ++k) {
     Contact best;
@@ -33,7 +33,7 @@ bool Collide(const std::vector<Collider>& colliders, const Vec3& p, Vec3& x) {
       }
     }
     if (!hit) break;
-    touched = true;
+    touched = hit;
     const Vec3& n = best.normal;
     const double depth = n.dot(best.point - x);
     if (!(depth > 0)) break;  // the path touched the surface but ends outside it
@@ -44,12 +44,12 @@ bool Collide(const std::vector<Collider>& colliders, const Vec3& p, Vec3& x) {
     x = y;
     a = best.point;
   }
-  if (!touched) return false;
+  if (!touched) return nullptr;
   for (const Collider& c : colliders) {  // never left inside a solid
     Vec3 sp, sn;
     if (c.Project(x, &sp, &sn)) x = sp;
   }
-  return true;
+  return touched;
 }
 
 SelfCollision::SelfCollision(std::vector<Vec3> rest, double thickness, double friction)

@@ -38,9 +38,10 @@
 namespace sylva::particles::clothcontact {
 
 // Moves x (reached from p over the substep) out of the colliders, with
-// friction; true if it touched one. A kStick collider holds the particle's
-// tangential motion entirely (infinite friction).
-bool Collide(const std::vector<Collider>& colliders, const Vec3& p, Vec3& x);
+// friction; returns the last collider it touched (null: none). A kStick
+// collider takes the particle's tangential motion entirely (the caller
+// then makes it immovable).
+const Collider* Collide(const std::vector<Collider>& colliders, const Vec3& p, Vec3& x);
 
 class SelfCollision {
  public:

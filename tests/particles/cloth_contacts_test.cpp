@@ -48,7 +48,9 @@ TEST(ClothContacts, SheetDropsOntoASphereAndDrapesOverIt) {
       if (collide) {
         EXPECT_LT(inside, 1e-6) << name << ": a particle is " << inside << " m inside the ball";
         EXPECT_NEAR(middle.y(), R, 0.02) << name << ": the middle of the sheet rests on top";
-        if (solver == ClothSolver::kXPBD) EXPECT_GT(cloth->lastContacts(), 0u) << name;
+        if (solver == ClothSolver::kXPBD) {
+          EXPECT_GT(cloth->lastContacts(), 0u) << name;
+        }
       } else {
         EXPECT_LT(middle.y(), -3) << name << ": without the collider the sheet falls through";
       }
@@ -171,7 +173,9 @@ TEST(ClothContacts, FoldedSheetDroppedOnABallDoesNotPassThroughItself) {
       }
       ASSERT_GT(counted, 20u) << name << ": too few upper particles over the ball to count";
       crossings[self] = crossed;
-      if (self) EXPECT_GT(cloth->lastContacts(), 0u);
+      if (self) {
+        EXPECT_GT(cloth->lastContacts(), 0u) << name;
+      }
     }
     EXPECT_GT(crossings[0], 10u) << name << ": without self-collision the layers should merge";
     EXPECT_EQ(crossings[1], 0u) << name << ": with self-collision (thickness " << thickness
@@ -266,6 +270,30 @@ TEST(ClothWind, WindFieldActsOnEachTriangleWhereItIs) {
   const Status st = cloth->StepInWindField(dt, Vec3::Zero(),
                                            [](const Vec3&) { return Vec3(0, 0, std::nan("")); });
   EXPECT_FALSE(st.ok());
+}
+
+// A kStick collider holds what touches it: the particles on a ball stay
+// where they landed while the rest of the sheet hangs around it.
+TEST(ClothContacts, StickyColliderHoldsTheParticlesThatTouchIt) {
+  const double R = 0.3;
+  for (ClothSolver solver : {ClothSolver::kXPBD, ClothSolver::kImplicit}) {
+    const char* name = solver == ClothSolver::kXPBD ? "XPBD" : "implicit";
+    ClothDef def = FlatSheet(20, R + 0.05);
+    def.solver = solver;
+    def.implicitStiffness = 5e4;
+    auto cloth = testing::Made(Cloth::Create(def));
+    ASSERT_OK(cloth->AddCollider(Collider::Sphere(Vec3::Zero(), R).Respond(Response::kStick)));
+    for (int i = 0; i < 30; ++i) ASSERT_OK(cloth->Step(1.0 / 60, kG));
+    std::vector<size_t> held;
+    for (size_t i = 0; i < cloth->positions().size(); ++i)
+      if (cloth->positions()[i].norm() < R + 1e-6) held.push_back(i);
+    ASSERT_GT(held.size(), 3u) << name << ": particles on the ball";
+    const std::vector<Vec3> before = cloth->positions();
+    for (int i = 0; i < 60; ++i) ASSERT_OK(cloth->Step(1.0 / 60, kG));
+    double moved = 0;
+    for (size_t i : held) moved = std::max(moved, (cloth->positions()[i] - before[i]).norm());
+    EXPECT_LT(moved, 1e-3) << name << ": the farthest a held particle moved in 1 s (m)";
+  }
 }
 
 TEST(ClothContacts, BadCollidersAndThicknessAreDiagnostics) {
