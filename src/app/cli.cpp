@@ -260,8 +260,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
         code = g.simulate ? g.simulate(simulate, out, err) : NotBuilt("simulate -o", err);
     }
   } catch (const std::bad_alloc&) {
-    err << "sylva: error: out of memory; lower the derivation length (-n), the detail or the "
-           "limits\n";
+    err << "sylva: error: out of memory; for a grammar, lower the derivation length (-n), the "
+           "detail or the limits; for a scene, lower its counts, resolutions and steps\n";
     code = kExitRuntime;
   } catch (const std::exception& e) {
     err << "sylva: error: " << e.what() << "\n";

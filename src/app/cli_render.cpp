@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <ostream>
 
 #include "app/cli.h"
@@ -11,6 +12,7 @@
 #include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
+#include "scene/default_scene.h"
 
 namespace sylva::app {
 
@@ -59,9 +61,9 @@ int ParseView(const std::string& size, const std::string& camera, ViewFlags& v, 
   return kExitOk;
 }
 
-// The camera that frames the plant (and the ground disc under a mesh), or
-// the one --camera gives. The box comes from the geometry, before
-// tessellation, so every detail (uniform or screen-space) sees one view.
+// The camera that frames the plant, or the one --camera gives. The box
+// comes from the geometry, before tessellation, so every detail (uniform
+// or screen-space) sees one view.
 Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSpec& spec,
                                      const ViewFlags& v, bool lines, mesh::Box* meshBox = nullptr) {
   Vec3 lo = p.geometry.boundsMin, hi = p.geometry.boundsMax;
@@ -72,11 +74,6 @@ Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSp
     if ((box->lo.array() <= box->hi.array()).all()) {
       lo = box->lo;
       hi = box->hi;
-      // Frame the ground disc the renderer puts under the plant too.
-      const double r = 0.55 * (hi - lo).norm();
-      const Vec3 c((lo.x() + hi.x()) / 2, lo.y(), (lo.z() + hi.z()) / 2);
-      lo = lo.cwiseMin(c - Vec3(r, 0, r));
-      hi = hi.cwiseMax(c + Vec3(r, 0, r));
     }
   }
   const double aspect = double(v.width) / v.height;
@@ -165,7 +162,6 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   // 2D figures (all in the z = 0 plane, nothing but segments) draw as lines
   // in an orthographic view from +Z; everything else as a lit mesh.
   const bool lines = plant::IsLineFigure(*geometry);
-  const mesh::TriangleMesh& m = plant->mesh;
   render::LineBatch batch;
   mesh::Box bounds;
   auto camera = FrameCamera(*plant, *spec, v, lines, &bounds);
@@ -199,6 +195,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     if (!s.ok()) return Report(s.error(), err);
     if (exit != kExitOk) return exit;
   }
+  const auto m = std::make_shared<const mesh::TriangleMesh>(std::move(plant->mesh));
 
   auto t0 = Clock::now();
   auto context = render::HeadlessContext::Create();
@@ -208,18 +205,23 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (Status s = (*renderer)->Resize(W, H); !s.ok()) return Report(s.error(), err);
   const double contextMs = MsSince(t0);
   t0 = Clock::now();
+  draw::DrawList list;
   if (lines) {
     (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
     if (Status s = (*renderer)->SetLines(batch); !s.ok()) return Report(s.error(), err);
   } else {
-    (*renderer)->SetGround(true);
-    (*renderer)->SetWireframe(cmd.wireframe);
-    // Ground and shadow map fitted to the whole plant, whatever was culled.
-    (*renderer)->SetMesh(m, palette, &bounds);
+    // The default scene: the plant on a ground plane, lit by the default
+    // rig; the shadow map fitted to the whole plant, whatever was culled.
+    list = scene::DefaultScene(m, palette, bounds.lo, bounds.hi);
+    list.wireframe = cmd.wireframe;
   }
   const double uploadMs = MsSince(t0);
   t0 = Clock::now();
-  (*renderer)->Draw(*camera);
+  if (lines) {
+    (*renderer)->Draw(*camera);
+  } else if (Status s = (*renderer)->Draw(list, *camera); !s.ok()) {
+    return Report(s.error(), err);
+  }
   render::Image image = (*renderer)->ReadPixels();
   const double drawMs = MsSince(t0);
   t0 = Clock::now();
@@ -231,7 +233,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   char line[256];
   std::snprintf(line, sizeof line, "%s: %dx%d, %s, %zu triangles, %zu lines (%s)\n",
                 cmd.output.c_str(), v.width, v.height,
-                lines ? "lines, orthographic" : "mesh, perspective", m.triangleCount(),
+                lines ? "lines, orthographic" : "mesh, perspective", m->triangleCount(),
                 batch.points.size() / 2, (*context)->Renderer().c_str());
   err << line;
   if (cmd.stats) {
@@ -246,7 +248,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
                   "parse: %.1f ms\nderive: %.1f ms\ninterpret: %.1f ms\nturtle: %.1f ms\n"
                   "tessellate: %.1f ms\ncontext: %.1f ms\nupload: %.1f ms\ndraw: %.1f ms\n"
                   "downsample: %.1f ms\nwrite: %.1f ms\ntotal: %.1f ms\n",
-                  m.triangleCount(), detail.c_str(), t.parse, t.derive, t.interpret, t.turtle,
+                  m->triangleCount(), detail.c_str(), t.parse, t.derive, t.interpret, t.turtle,
                   t.tessellate, contextMs, uploadMs, drawMs, downsampleMs, writeMs,
                   MsSince(tStart));
     out << buf;

@@ -5,11 +5,13 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/diagnostic.h"
+#include "core/parallel.h"
 #include "plant/plant.h"
 #include "scene/build.h"
 #include "scene/scene.h"
@@ -129,6 +131,29 @@ std::optional<scene::Scene> LoadScene(const std::string& path,
                                       const std::vector<std::string>& defines, int maxErrors,
                                       std::ostream& err, int* exit, bool strict = false);
 int RunCheckScene(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
+
+// A scene read, built and its simulation created at t = 0: the sequence
+// that render, mesh and simulate share. It lives on the heap and never
+// moves (the simulation keeps references to the scene, the built scene and
+// the pool).
+struct SceneRun {
+  explicit SceneRun(int threads) : pool(threads) {}
+  ThreadPool pool;  // one pool for the command: derivation, tessellation, simulation
+  scene::Scene scene;
+  scene::BuiltScene built;
+  std::unique_ptr<scene::Simulation> simulation;
+};
+struct SceneRunOptions {
+  std::string path;
+  std::vector<std::string> defines;
+  int maxErrors = 0;
+  bool strict = false;  // a warning of the scene, a grammar, the build or the simulation fails
+  int threads = 0;
+  int sides = 8;  // uniform tube sides of the built plants
+};
+// Reports every diagnostic to `err`; null with *exit set on an error (or a
+// warning under `strict`).
+std::unique_ptr<SceneRun> StartScene(const SceneRunOptions& options, std::ostream& err, int* exit);
 
 // Prints diagnostics; returns the exit status they call for (0 when there
 // are only warnings, 2 when there are warnings and `strict`, saying so).

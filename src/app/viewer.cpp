@@ -26,6 +26,7 @@
 #include "plant/plant.h"
 #include "plant/surface_library.h"
 #include "render/renderer.h"
+#include "scene/default_scene.h"
 
 namespace sylva::app {
 namespace {
@@ -47,7 +48,8 @@ struct Result {
   uint64_t id = 0;
   bool ok = false;
   std::string diagnostics;  // errors and warnings, formatted
-  mesh::TriangleMesh mesh;
+  mesh::TriangleMesh mesh;  // moved into the drawn scene when shown
+  size_t triangles = 0;
   mesh::Palette palette;
   Vec3 lo{0, 0, 0}, hi{1, 1, 1};
   uint64_t modules = 0;
@@ -79,6 +81,7 @@ Result RunJob(const Job& job) {
   r.mesh = std::move(p.mesh);
   r.palette = p.palette;
   r.modules = p.DrawnWord().size();
+  r.triangles = r.mesh.triangleCount();
   if (r.mesh.vertexCount()) {
     r.lo = r.hi = r.mesh.positions[0].cast<double>();
     for (const auto& q : r.mesh.positions) {
@@ -167,8 +170,7 @@ bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double fr
   ImGui::Separator();
   if (shown.plant) {
     ImGui::Text("modules %llu, triangles %zu",
-                static_cast<unsigned long long>(shown.plant->modules),
-                shown.plant->mesh.triangleCount());
+                static_cast<unsigned long long>(shown.plant->modules), shown.plant->triangles);
     ImGui::Text("derive %.1f ms, turtle %.1f ms, mesh %.1f ms", shown.plant->deriveMs,
                 shown.plant->turtleMs, shown.plant->tessellateMs);
   }
@@ -223,7 +225,8 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   // Declared after the window: its GL objects are destroyed before the context.
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer) return Report(renderer.error(), err);
-  (*renderer)->SetGround(true);
+  // The default scene of the plant shown (a ground plane, the default lights).
+  draw::DrawList drawn;
 
   int exitCode = kExitOk;
   Worker<Job, Result> worker(RunJobSafely);
@@ -263,7 +266,8 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       if (r->ok) {
         shown.constants = r->constants;
         shown.derivationLength = r->derivationLength;
-        (*renderer)->SetMesh(r->mesh, r->palette);
+        drawn = scene::DefaultScene(std::make_shared<const mesh::TriangleMesh>(std::move(r->mesh)),
+                                    r->palette, r->lo, r->hi);
         if (!framed) {
           camera = render::Camera::Frame(r->lo, r->hi, double(width) / height, 30, 12, false);
           framed = true;
@@ -295,7 +299,10 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     if (DrawPanel(path, shown, worker.Busy(), frameMs, job)) post();
     ImGui::Render();
 
-    (*renderer)->Draw(camera);
+    if (Status s = (*renderer)->Draw(drawn, camera); !s.ok()) {
+      exitCode = Report(s.error(), err);
+      break;
+    }
     (*renderer)->PresentToWindow(fbw, fbh);
     glViewport(0, 0, fbw, fbh);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());

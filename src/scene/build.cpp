@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "core/rng.h"
+#include "plant/surface_library.h"
 #include "scene/plants.h"
 
 namespace sylva::scene {
@@ -78,8 +79,21 @@ double HeightScale(const mesh::TriangleMesh& m, double height, const SourceLoc& 
   return height / double(hi - lo);
 }
 
-// Tips, segment points and leaves of `g` through the transform `t`.
-void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t, PlantPoints& out) {
+// The surface meshes `g` places (`~leaf`), found as the plant's
+// tessellation found them; empty when it places none.
+std::unordered_map<std::string, mesh::TriangleMesh> SurfacesOf(const plant::Plant& p,
+                                                               const plant::PlantSpec& spec) {
+  if (p.geometry.surfaces.empty()) return {};
+  plant::SurfaceLibrary library(p.grammar.path, spec.surfacePath, spec.readFile);
+  if (!library.LoadFor(p.geometry, p.grammar).ok()) return {};  // the mesh was built: never
+  return library.meshes();
+}
+
+// Tips, segment points and leaves of `g` through the transform `t`; the
+// surfaces it places (`surfaces`, by name) collide as their triangles.
+void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t,
+               const std::unordered_map<std::string, mesh::TriangleMesh>& surfaces,
+               PlantPoints& out) {
   const Eigen::Matrix4d m = t.cast<double>();
   auto world = [&](const Vec3& p) { return Vec3((m * p.homogeneous()).head<3>()); };
   struct Hash {
@@ -107,7 +121,23 @@ void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t, PlantPoints& 
       out.leafTriangles.push_back(
           {world(p.vertices[0]), world(p.vertices[k]), world(p.vertices[k + 1])});
   }
-  for (const mesh::SurfaceInstance& s : g.surfaces) out.leaves.push_back(world(s.position));
+  for (const mesh::SurfaceInstance& s : g.surfaces) {
+    out.leaves.push_back(world(s.position));
+    const auto found = surfaces.find(s.name);
+    if (found == surfaces.end()) continue;
+    // Placed as the tessellator places it: scaled along its own axes, then
+    // in the turtle's frame (left, heading, up) at its position.
+    const mesh::TriangleMesh& sm = found->second;
+    auto place = [&](const mesh::Vec3f& p) {
+      const Vec3 q = p.cast<double>().cwiseProduct(s.scale);
+      return world(s.position + q.x() * s.frame.left + q.y() * s.frame.heading +
+                   q.z() * s.frame.up);
+    };
+    for (size_t k = 0; k + 2 < sm.indices.size(); k += 3)
+      out.leafTriangles.push_back({place(sm.positions[sm.indices[k]]),
+                                   place(sm.positions[sm.indices[k + 1]]),
+                                   place(sm.positions[sm.indices[k + 2]])});
+  }
 }
 
 }  // namespace
@@ -240,7 +270,8 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
     built.trianglesDrawn += m.mesh->triangleCount();
     if (!p.id.empty()) {
-      AddPoints(grown->geometry, m.instances[0].transform, built.points[p.id]);
+      AddPoints(grown->geometry, m.instances[0].transform, SurfacesOf(*grown, spec),
+                built.points[p.id]);
       built.meshesOf[p.id].push_back(built.meshes.size());
     }
     m.plant = std::make_shared<plant::Plant>(std::move(*grown));
@@ -264,6 +295,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     const size_t first = built.meshes.size();
     std::vector<double> unit;
     std::vector<mesh::PlantGeometry> geometry;
+    std::vector<std::unordered_map<std::string, mesh::TriangleMesh>> surfaces;
     for (int v = 0; v < variants; ++v) {
       const plant::PlantSpec spec = SpecFor(f, forestSeed, v);
       std::optional<plant::Plant> grown = Grow(spec, options, f.grammarLoc, "forest", diags);
@@ -276,6 +308,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       unit.push_back(f.height ? HeightScale(*m.mesh, *f.height, f.loc, diags) : 1);
       if (!f.id.empty()) {
         geometry.push_back(grown->geometry);
+        surfaces.push_back(SurfacesOf(*grown, spec));
         built.meshesOf[f.id].push_back(built.meshes.size());
       }
       m.plant = std::make_shared<plant::Plant>(std::move(*grown));
@@ -300,7 +333,8 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       GrowBounds(*m.mesh, m.instances.back().transform, built.lo, built.hi, any);
       built.trianglesDrawn += m.mesh->triangleCount();
       if (!f.id.empty())
-        AddPoints(geometry[size_t(v)], m.instances.back().transform, built.points[f.id]);
+        AddPoints(geometry[size_t(v)], m.instances.back().transform, surfaces[size_t(v)],
+                  built.points[f.id]);
     }
   }
 
