@@ -17,6 +17,7 @@
 #include <ostream>
 #include <unordered_map>
 
+#include "core/assert.h"
 #include "core/rng.h"
 #include "mesh/obj_reader.h"
 #include "particles/cloth.h"
@@ -75,6 +76,22 @@ struct WindGrid {
       lo = lo.cwiseMin(s.position[i]);
       hi = hi.cwiseMax(s.position[i]);
     }
+    PrepareBox(lo, hi, t, eddy);
+  }
+
+  // Over points x (a cloth's vertices).
+  void Prepare(const std::vector<Vec3>& x, double t, double eddy) {
+    valid = false;
+    if (!wind || !wind->gusts || x.empty()) return;
+    Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+    for (const Vec3& p : x) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    PrepareBox(lo, hi, t, eddy);
+  }
+
+  void PrepareBox(Vec3 lo, Vec3 hi, double t, double eddy) {
     if (!lo.allFinite() || !hi.allFinite() || !(lo.array() <= hi.array()).all()) return;
     spacing = eddy / 4;
     lo.array() -= 2 * spacing;  // room for a step's motion
@@ -397,6 +414,7 @@ void ParticleSystem::TurnLeaves(double h, const Wind* wind, double time) {
 struct ClothSheet {
   const ClothDef* def = nullptr;
   std::unique_ptr<particles::Cloth> cloth;
+  std::unique_ptr<WindGrid> windGrid = std::make_unique<WindGrid>();  // the gusts over it
   Vec3 gravity = Vec3::Zero();
 };
 
@@ -471,6 +489,11 @@ struct Simulation::Impl {
     return slot;
   }
 
+  // The colliders of `collides`, validated; a cloth named in `with` is
+  // skipped silently when it is `selfId` (the cloth's own self-collision)
+  // and with a warning otherwise.
+  Status CollidersOf(const std::vector<CollideDef>& collides, const std::string& selfId,
+                     DiagnosticList& diags, std::vector<particles::Collider>& out);
   Status AddColliders(particles::System& system, const std::vector<CollideDef>& collides,
                       DiagnosticList& diags);
   std::shared_ptr<const particles::TriangleBvh> BvhOf(const std::string& id);
@@ -504,51 +527,58 @@ std::shared_ptr<const particles::TriangleBvh> Simulation::Impl::BvhOf(const std:
   return bvh;
 }
 
-Status Simulation::Impl::AddColliders(particles::System& system,
-                                      const std::vector<CollideDef>& collides,
-                                      DiagnosticList& diags) {
+Status Simulation::Impl::CollidersOf(const std::vector<CollideDef>& collides,
+                                     const std::string& selfId, DiagnosticList& diags,
+                                     std::vector<particles::Collider>& out) {
   for (const CollideDef& c : collides) {
     const particles::Response response =
         c.stick ? particles::Response::kStick : particles::Response::kBounce;
     for (const std::string& id : c.with) {
-      particles::Collider collider;
+      std::vector<particles::Collider> parts;
       if (id == "ground") {
-        collider = particles::Collider::Plane(Vec3::Zero(), Vec3::UnitY());
+        parts.push_back(particles::Collider::Plane(Vec3::Zero(), Vec3::UnitY()));
       } else {
         bool isCloth = false;
         for (const ClothDef& cl : scene->cloths) isCloth = isCloth || cl.id == id;
         if (isCloth) {
-          diags.Add(
-              Warn(c.withLoc, "collisions with a cloth ('" + id + "') are not simulated yet"));
+          if (id != selfId)  // a cloth with itself: its self-collision (the caller)
+            diags.Add(
+                Warn(c.withLoc, "collisions with a cloth ('" + id + "') are not simulated yet"));
           continue;
         }
         const auto pts = built->points.find(id);
         if (pts != built->points.end()) {
           // A plant or forest: capsules for the branches, triangles for the
           // leaves.
-          std::vector<particles::Collider> parts;
           parts.push_back(particles::Collider::Capsules(CapsulesOf(id)));
           if (!pts->second.leafTriangles.empty())
             parts.push_back(particles::Collider::Mesh(LeavesOf(id)));
-          for (particles::Collider& part : parts) {
-            part.Restitution(c.restitution).Friction(std::min(c.friction, 1e3)).Respond(response);
-            if (Status s = system.AddCollider(part); !s.ok()) {
-              Diagnostic d = s.error();
-              d.loc = c.loc;
-              return d;
-            }
-          }
-          continue;
+        } else {
+          parts.push_back(particles::Collider::Mesh(BvhOf(id)));
         }
-        collider = particles::Collider::Mesh(BvhOf(id));
       }
-      collider.Restitution(c.restitution).Friction(std::min(c.friction, 1e3)).Respond(response);
-      if (Status s = system.AddCollider(collider); !s.ok()) {
-        Diagnostic d = s.error();
-        d.loc = c.loc;
-        return d;
+      for (particles::Collider& part : parts) {
+        part.Restitution(c.restitution).Friction(std::min(c.friction, 1e3)).Respond(response);
+        if (Status s = particles::Validate(part); !s.ok()) {
+          Diagnostic d = s.error();
+          d.loc = c.loc;
+          return d;
+        }
+        out.push_back(std::move(part));
       }
     }
+  }
+  return {};
+}
+
+Status Simulation::Impl::AddColliders(particles::System& system,
+                                      const std::vector<CollideDef>& collides,
+                                      DiagnosticList& diags) {
+  std::vector<particles::Collider> colliders;
+  if (Status s = CollidersOf(collides, "", diags, colliders); !s.ok()) return s;
+  for (particles::Collider& c : colliders) {
+    const Status s = system.AddCollider(std::move(c));
+    SYLVA_ASSERT(s.ok());  // validated above
   }
   return {};
 }
@@ -689,13 +719,17 @@ Status Simulation::Impl::Step() {
     }
   }
   for (ClothSheet& c : cloths) {
-    Vec3 w = Vec3::Zero();
-    if (hasWind && c.def->wind) {
-      Vec3 centre = Vec3::Zero();
-      for (const Vec3& p : c.cloth->positions()) centre += p;
-      w = wind.At(centre / double(c.cloth->positions().size()), time);
-    }
-    if (Status s = c.cloth->Step(h, c.gravity, w); !s.ok()) {
+    // The wind at each triangle (gusts smaller than the sheet bend it),
+    // from the gusts sampled on a grid over the sheet.
+    const double t = time;
+    const bool gusts = hasWind && c.def->wind && wind.gusts;
+    if (gusts) c.windGrid->Prepare(c.cloth->positions(), t, scene->wind->scale);
+    const WindGrid* air = c.windGrid.get();
+    Status s = gusts
+                   ? c.cloth->StepInWindField(h, c.gravity,
+                                              [air, t](const Vec3& x) { return air->At(x, t); })
+                   : c.cloth->Step(h, c.gravity, hasWind && c.def->wind ? wind.mean : Vec3::Zero());
+    if (!s.ok()) {
       Diagnostic d = s.error();
       d.loc = c.def->loc;
       d.message = "<cloth> at t = " + std::to_string(time) + " s: " + d.message;
@@ -794,6 +828,54 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
         std::make_shared<mesh::TriangleMesh>(std::move(*obj)));
   };
 
+  // The acceleration field (m/s^2 at x, t) of an attractor, vortex or noise
+  // force.
+  auto accelerationOf = [&](const ForceDef& f) -> Expected<AccelerationField::Fn> {
+    switch (f.kind) {
+      case ForceKind::kAttractor: {
+        // The centre: its position, or the element `of` names (a flock or
+        // cloth moves: its centroid is taken at the start of every step).
+        auto centre = std::make_shared<Vec3>(f.position.value_or(Vec3::Zero()));
+        if (!f.of.empty()) m.centres.push_back({centre, f.of, f.loc, {}});
+        const double strength = f.strength, soft = std::max(f.radius, 1e-3);
+        const bool inverseSquare = f.falloff == Falloff::kInverseSquare;
+        return AccelerationField::Fn([=](const Vec3& x, double) {
+          const Vec3 d = *centre - x;
+          const double r = std::max(d.norm(), soft);
+          return Vec3(d / r * strength / (inverseSquare ? r * r : r));
+        });
+      }
+      case ForceKind::kVortex: {
+        const Vec3 c = f.position.value_or(Vec3::Zero()), a = f.axis.normalized();
+        const double strength = f.strength;
+        return AccelerationField::Fn([=](const Vec3& x, double) {
+          const Vec3 r = x - c;
+          const Vec3 radial = r - a * a.dot(r);
+          const double n = radial.norm();
+          return n < 1e-9 ? Vec3(Vec3::Zero()) : Vec3(strength * a.cross(radial) / n);
+        });
+      }
+      case ForceKind::kNoise: {
+        particles::NoiseWindDef w;
+        w.speed = 1;
+        w.scale = f.scale;
+        w.frequency = 2 * kPi * f.frequency;
+        w.seed = ElementSeed(scene.seed, f.id, "noise-force", size_t(f.loc.line));
+        auto field = particles::NoiseWind::Create(w);
+        if (!field) return Fail(f.loc, field.error().message, ErrorKind::kInput);
+        std::shared_ptr<particles::NoiseWind> n = *field;
+        const double strength = f.strength;
+        return AccelerationField::Fn(
+            [=](const Vec3& x, double t) { return Vec3(strength * n->Velocity(x, t)); });
+      }
+      case ForceKind::kGravity:
+      case ForceKind::kDrag:
+        break;
+    }
+    SYLVA_ASSERT(false);  // gravity and drag are not fields
+    return AccelerationField::Fn();
+  };
+
   auto addForces = [&](particles::System& system, const std::vector<ForceDef>& forces, bool windOn,
                        const SourceLoc& loc, const WindGrid* windGrid) -> Status {
     bool drag = false;
@@ -807,43 +889,12 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
           system.AddForce(std::make_shared<WindDrag>(f.quadratic ? 0 : f.k, f.quadratic ? f.k : 0,
                                                      windOn && wind ? windGrid : nullptr));
           break;
-        case ForceKind::kAttractor: {
-          // The centre: its position, or the element `of` names (a flock or
-          // cloth moves: its centroid is taken at the start of every step).
-          auto centre = std::make_shared<Vec3>(f.position.value_or(Vec3::Zero()));
-          if (!f.of.empty()) m.centres.push_back({centre, f.of, f.loc});
-          const double strength = f.strength, soft = std::max(f.radius, 1e-3);
-          const bool inverseSquare = f.falloff == Falloff::kInverseSquare;
-          system.AddForce(std::make_shared<AccelerationField>([=](const Vec3& x, double) {
-            const Vec3 d = *centre - x;
-            const double r = std::max(d.norm(), soft);
-            return Vec3(d / r * strength / (inverseSquare ? r * r : r));
-          }));
-          break;
-        }
-        case ForceKind::kVortex: {
-          const Vec3 c = f.position.value_or(Vec3::Zero()), a = f.axis.normalized();
-          const double strength = f.strength;
-          system.AddForce(std::make_shared<AccelerationField>([=](const Vec3& x, double) {
-            const Vec3 r = x - c;
-            const Vec3 radial = r - a * a.dot(r);
-            const double n = radial.norm();
-            return n < 1e-9 ? Vec3(Vec3::Zero()) : Vec3(strength * a.cross(radial) / n);
-          }));
-          break;
-        }
+        case ForceKind::kAttractor:
+        case ForceKind::kVortex:
         case ForceKind::kNoise: {
-          particles::NoiseWindDef w;
-          w.speed = 1;
-          w.scale = f.scale;
-          w.frequency = 2 * kPi * f.frequency;
-          w.seed = ElementSeed(scene.seed, f.id, "noise-force", size_t(f.loc.line));
-          auto field = particles::NoiseWind::Create(w);
-          if (!field) return Fail(f.loc, field.error().message, ErrorKind::kInput);
-          std::shared_ptr<particles::NoiseWind> n = *field;
-          const double strength = f.strength;
-          system.AddForce(std::make_shared<AccelerationField>(
-              [=](const Vec3& x, double t) { return Vec3(strength * n->Velocity(x, t)); }));
+          auto field = accelerationOf(f);
+          if (!field) return field.error();
+          system.AddForce(std::make_shared<AccelerationField>(std::move(*field)));
           break;
         }
       }
@@ -997,21 +1048,58 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
         break;
     }
     if (!c.wind || !scene.wind) d.windDrag = d.windLift = 0;
+    // Colliders; `with` naming the cloth itself turns on its self-collision,
+    // at a thickness of 0.75 of its larger cell side (at least the cell's
+    // half diagonal, so a layer cannot slip between two particles of
+    // another), with that <collide>'s friction.
+    std::vector<particles::Collider> colliders;
+    if (Status s = m.CollidersOf(c.collides, c.id, diags, colliders); !s.ok()) return s.error();
+    for (const CollideDef& col : c.collides) {
+      if (c.id.empty() || std::find(col.with.begin(), col.with.end(), c.id) == col.with.end())
+        continue;
+      d.thickness = 0.75 * std::max(c.size.x() / (c.columns - 1), c.size.y() / (c.rows - 1));
+      d.selfFriction = std::min(col.friction, 1e3);
+    }
     auto cloth = particles::Cloth::Create(d);
     if (!cloth) return Fail(c.loc, cloth.error().message, ErrorKind::kInput);
     ClothSheet sheet;
     sheet.def = &c;
     sheet.cloth = std::move(*cloth);
-    for (const ForceDef& f : c.forces) {
-      if (f.kind == ForceKind::kGravity)
-        sheet.gravity += f.g;
-      else
-        diags.Add(Warn(f.loc,
-                       "cloth feels gravity and the wind; this force is not simulated on "
-                       "cloth yet"));
+    sheet.windGrid->wind = wind;
+    for (particles::Collider& col : colliders) {
+      const Status s = sheet.cloth->AddCollider(std::move(col));
+      SYLVA_ASSERT(s.ok());  // validated, and never kKill
     }
-    for (const CollideDef& col : c.collides)
-      diags.Add(Warn(col.loc, "cloth collisions are not simulated yet (the cloth passes through)"));
+    // Forces: gravity as the cloth's own, the others through one field of
+    // forces on each vertex (drag -k (v - wind) per vertex, as on particles;
+    // attractor, vortex and noise as accelerations of the vertex's mass).
+    std::vector<AccelerationField::Fn> fields;
+    std::vector<std::pair<double, bool>> drags;  // k, quadratic
+    for (const ForceDef& f : c.forces) {
+      if (f.kind == ForceKind::kGravity) {
+        sheet.gravity += f.g;
+      } else if (f.kind == ForceKind::kDrag) {
+        drags.emplace_back(f.k, f.quadratic);
+      } else {
+        auto field = accelerationOf(f);
+        if (!field) return field.error();
+        fields.push_back(std::move(*field));
+      }
+    }
+    if (!fields.empty() || !drags.empty()) {
+      const double mass = sheet.cloth->particleMass();
+      const double* time = &m.time;
+      const Wind* air = c.wind ? wind : nullptr;
+      sheet.cloth->SetExternalForce([=](size_t, const Vec3& x, const Vec3& v) {
+        Vec3 f = Vec3::Zero();
+        for (const AccelerationField::Fn& a : fields) f += mass * a(x, *time);
+        if (!drags.empty()) {
+          const Vec3 u = air ? Vec3(v - air->At(x, *time)) : v;
+          for (const auto& [k, quadratic] : drags) f -= (quadratic ? k * u.norm() : k) * u;
+        }
+        return f;
+      });
+    }
     m.cloths.push_back(std::move(sheet));
   }
 
