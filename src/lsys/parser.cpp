@@ -100,7 +100,13 @@ constexpr const char* kKeywords[] = {
     "derivation length", "width factor",   "width increment", "width scale", "maximum depth",
     "lsystem",           "axiom",          "angle",           "step",        "width",
     "tropism",           "seed",           "ignore",          "consider",    "module",
-    "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette"};
+    "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette",
+    "starteach",         "endeach",        "start",           "end",         "define"};
+
+// cpfg's blocks of statements run around the derivation (global variables).
+bool IsGlobalBlockKeyword(std::string_view k) {
+  return k == "start" || k == "end" || k == "starteach" || k == "endeach";
+}
 
 // The keyword that starts `t` at `pos` ("keyword:", or a bare section
 // keyword alone on its line), case-insensitive; *after is just past it.
@@ -174,6 +180,10 @@ class GrammarParser {
   void ParseTropism(const Line& l, size_t after, size_t end);
   void ParseNumberStatement(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseDefine(const Line& l, size_t pos);
+  void ParseGlobalBlock(const Line& l, const std::string& k, size_t after, size_t end);
+  void CollectGlobals();
+  bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
+                      size_t lhsEnd);
   void ParseMacro(const Line& l, const std::string& name, int col, size_t pos);
   void ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen);
   bool LexName(const Line& l, size_t& pos, size_t end, std::string* name);
@@ -520,6 +530,22 @@ bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const
     while (pos < end && IsSpace(t[pos])) ++pos;
     if (pos >= end) break;
     int col = int(pos) + 1;
+    if (t[pos] == '{' && IsStatementBlock(view, pos)) {
+      if (!scope.locals) {
+        Error(l, col, "a statement block belongs in a production, not here");
+        return false;
+      }
+      Successor::Block b;
+      b.before = uint32_t(out->symbols.size());
+      ExprParseError err;
+      if (!ParseBlock(view, &pos, scope, &b.code, &err)) {
+        Error(l, err.column, err.message, err.length);
+        return false;
+      }
+      out->blocks.push_back(std::move(b));
+      out->allConstant = false;
+      continue;
+    }
     std::string name;
     if (!LexName(l, pos, end, &name)) return false;
     size_t q = pos;
@@ -762,6 +788,7 @@ void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end)
     return;
   }
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+  scope.globals = &g_.globals;
   Successor s;
   if (!ParseActualWord(l, after, end, scope, &s)) return;
   if (s.symbols.empty()) {
@@ -897,6 +924,75 @@ void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, si
   }
 }
 
+// `Start: { ... }` and the like: statements over the global variables.
+void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t after,
+                                     size_t end) {
+  const std::string& t = l.text;
+  std::optional<Expr>* slot = k == "start"       ? &g_.startBlock
+                              : k == "end"       ? &g_.endBlock
+                              : k == "starteach" ? &g_.startEachBlock
+                                                 : &g_.endEachBlock;
+  const char* shown = k == "start"       ? "Start"
+                      : k == "end"       ? "End"
+                      : k == "starteach" ? "StartEach"
+                                         : "EndEach";
+  if (*slot) {
+    Error(l, int(after), std::string("a second '") + shown + ":' block");
+    return;
+  }
+  if (after >= end || t[after] != '{') {
+    Error(l, int(after) + 1, std::string("expected '{' after '") + shown + ":'");
+    return;
+  }
+  ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+  scope.globals = &g_.globals;
+  std::string_view view(t.data(), end);
+  size_t pos = after;
+  Expr block;
+  ExprParseError err;
+  if (!ParseBlock(view, &pos, scope, &block, &err)) {
+    Error(l, err.column, err.message, err.length);
+    return;
+  }
+  while (pos < end && (IsSpace(t[pos]) || t[pos] == ';')) ++pos;
+  if (pos < end) {
+    Error(l, int(pos) + 1, std::string("unexpected text after the '") + shown + ":' block");
+    return;
+  }
+  *slot = std::move(block);
+}
+
+// The global variables: every name assigned in a Start:, StartEach:,
+// EndEach: or End: block (found in the text before any line is parsed, so
+// a production anywhere in the file sees them).
+void GrammarParser::CollectGlobals() {
+  for (const Line& l : lines_) {
+    const std::string& t = l.text;
+    size_t p = 0;
+    while (p < t.size() && IsSpace(t[p])) ++p;
+    size_t after = 0;
+    const char* kw = MatchKeyword(t, p, &after);
+    if (!kw || !IsGlobalBlockKeyword(kw)) continue;
+    for (size_t i = after; i < t.size(); ++i) {
+      if (t[i] != '=') continue;
+      if (i + 1 < t.size() && t[i + 1] == '=') {
+        ++i;
+        continue;
+      }
+      size_t e = i;
+      if (e > after && std::strchr("<>!=", t[e - 1])) continue;
+      if (e > after && std::strchr("+-*/", t[e - 1])) --e;
+      while (e > after && IsSpace(t[e - 1])) --e;
+      size_t b = e;
+      while (b > after && IsIdentChar(t[b - 1])) --b;
+      if (b == e || !IsIdentStart(t[b])) continue;
+      std::string name = t.substr(b, e - b);
+      if (std::find(g_.globals.begin(), g_.globals.end(), name) == g_.globals.end())
+        g_.globals.push_back(std::move(name));
+    }
+  }
+}
+
 bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
   const std::string& t = l.text;
   size_t after = 0;
@@ -954,6 +1050,16 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
     return true;
   }
   if (!mainOnly()) return true;
+  if (IsGlobalBlockKeyword(k)) {
+    ParseGlobalBlock(l, k, after, end);
+    return true;
+  }
+  if (k == "define") {
+    Error(l, col,
+          "'define:' (cpfg arrays) is not supported by Sylva: arrays cannot be declared or used",
+          6);
+    return true;
+  }
   if (k == "axiom") {
     ParseAxiom(l, col, after, end);
     return true;
@@ -987,6 +1093,51 @@ static size_t FindTopLevel(const std::string& t, size_t from, size_t to, std::st
       return i;
   }
   return std::string::npos;
+}
+
+// The ':' before a probability weight in a successor: the first outside
+// parentheses and outside cpfg statement blocks (which may hold `?:`).
+static size_t FindWeightColon(const std::string& t, size_t from, size_t to) {
+  int depth = 0;
+  std::string_view view(t.data(), to);
+  for (size_t i = from; i < to; ++i) {
+    char c = t[i];
+    if (c == '(') {
+      ++depth;
+    } else if (c == ')') {
+      --depth;
+    } else if (c == '{' && IsStatementBlock(view, i)) {
+      int braces = 0;
+      for (; i < to; ++i) {
+        if (t[i] == '{') ++braces;
+        if (t[i] == '}' && --braces == 0) break;
+      }
+    } else if (depth == 0 && c == ':') {
+      return i;
+    }
+  }
+  return std::string::npos;
+}
+
+// The depth of statement-block braces at the end of `t`, from `depth` at
+// its start: a `{` opens a block when it follows a ':' and ends its line
+// (a pre-condition, `Start: {`) or starts a statement (IsStatementBlock; `next` is the text
+// of the following line, for a `{` that ends its line); inside a block
+// every brace counts.
+static int BlockDepth(const std::string& t, int depth, std::string_view next) {
+  char prev = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    const char c = t[i];
+    if (depth > 0) {
+      depth += c == '{' ? 1 : (c == '}' ? -1 : 0);
+    } else if (c == '{' &&
+               ((prev == ':' && t.find_first_not_of(" \t\r", i + 1) == std::string::npos) ||
+                IsStatementBlock(t, i, next))) {
+      depth = 1;
+    }
+    if (!IsSpace(c)) prev = c;
+  }
+  return depth;
 }
 
 // A line continued on the next: by a `\` at its end (the `\` reads as a
@@ -1032,11 +1183,24 @@ void GrammarParser::JoinContinuations() {
   out.reserve(lines_.size());
   bool continued = false;  // out.back() ended with a backslash
   bool curArrow = false;   // out.back() has a `->` (kept, not rescanned: linear time)
+  int blocks = 0;          // statement blocks open at the end of out.back()
   for (size_t i = 0; i < lines_.size(); ++i) {
     Line& l = lines_[i];
     const Line* next = i + 1 < lines_.size() ? &lines_[i + 1] : nullptr;
+    const std::string_view nextText = next ? std::string_view(next->text) : std::string_view();
     const size_t p = firstText(l.text);
     const bool blank = p >= l.text.size();
+    if (blocks > 0 && out.back().file == l.file) {
+      // Inside a statement block: joined with a space between the lines.
+      Line& cur = out.back();
+      cur.more.push_back(Line::Piece{int(cur.text.size()) + 1, l.number, 1, l.original});
+      cur.text += ' ';
+      cur.text += l.text;
+      blocks = BlockDepth(l.text, blocks, nextText);
+      curArrow = curArrow || hasArrow(l.text);
+      continued = blocks == 0 && takeBackslash(cur, next);
+      continue;
+    }
     bool join = continued;
     if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
         isProduction(out.back())) {
@@ -1045,14 +1209,16 @@ void GrammarParser::JoinContinuations() {
     if (!join) {
       out.push_back(std::move(l));
       curArrow = hasArrow(out.back().text);
-      continued = takeBackslash(out.back(), next);
+      blocks = BlockDepth(out.back().text, 0, nextText);
+      continued = blocks == 0 && takeBackslash(out.back(), next);
       continue;
     }
     curArrow = curArrow || hasArrow(l.text);
     Line& cur = out.back();
     cur.more.push_back(Line::Piece{int(cur.text.size()), l.number, 1, l.original});
     cur.text += l.text;
-    continued = takeBackslash(cur, next);
+    blocks = BlockDepth(l.text, 0, nextText);
+    continued = blocks == 0 && takeBackslash(cur, next);
   }
   lines_ = std::move(out);
 }
@@ -1164,42 +1330,18 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   p.formalCount = uint16_t(formals.size());
   ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
 
-  // Condition.
-  if (condAt != std::string::npos) {
-    size_t c = condAt + 1;
-    while (c < lhsEnd && IsSpace(t[c])) ++c;
-    size_t e = lhsEnd;
-    while (e > c && IsSpace(t[e - 1])) --e;
-    if (c >= e) {
-      Error(l, int(condAt) + 1, "empty condition after ':' (write '*' for always)");
-      return;
-    }
-    if (!(e == c + 1 && t[c] == '*')) {
-      std::string_view view(t.data(), e);
-      Expr cond;
-      ExprParseError err;
-      size_t cp = c;
-      if (!ParseExpr(view, &cp, scope, &cond, &err)) {
-        Error(l, err.column, err.message, err.length);
-        return;
-      }
-      if (cp < e) {
-        Error(l, int(cp) + 1, "unexpected text after the condition");
-        return;
-      }
-      p.conditionColumn = int(c) + 1;
-      if (cond.IsConstant() && cond.constant() == 0) {
-        Warn(Loc(l, int(c) + 1), OriginalAt(l, int(c) + 1),
-             "condition is always false: production never applies", int(e - c));
-      }
-      if (!(cond.IsConstant() && cond.constant() != 0)) p.condition = std::move(cond);
-    }
-  }
+  // Condition, with cpfg's statement blocks around it.
+  std::vector<std::string> locals;
+  bool writesGlobal = false;
+  scope.locals = &locals;
+  scope.globals = &g_.globals;
+  scope.writesGlobal = &writesGlobal;
+  if (condAt != std::string::npos && !ParseCondition(l, p, scope, condAt, lhsEnd)) return;
 
   // RHS: SUCCESSOR [: WEIGHT]
   size_t rs = arrow + arrowLen;
   size_t rend = t.size();
-  size_t weightAt = FindTopLevel(t, rs, rend, ":");
+  size_t weightAt = FindWeightColon(t, rs, rend);
   size_t succEnd = weightAt == std::string::npos ? rend : weightAt;
   size_t s0 = rs;
   while (s0 < succEnd && IsSpace(t[s0])) ++s0;
@@ -1239,6 +1381,12 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     p.weightColumn = int(w) + 1;
     p.weight = std::move(weight);
   }
+  if (locals.size() + formals.size() > 60000) {
+    Error(l, pf.column, "too many local variables in one production");
+    return;
+  }
+  p.localCount = uint16_t(locals.size());
+  if (writesGlobal) g_.productionsWriteGlobals = true;
   p.loc = Loc(l, pf.column);
   if (!l.more.empty()) {
     p.pieces.push_back(Production::LinePiece{0, l.number, 1});
@@ -1251,6 +1399,63 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     return;
   }
   section_->productions.push_back(std::move(p));
+}
+
+// `: [{pre}] [COND] [{post}]` between condAt (the ':') and lhsEnd (the
+// arrow). A condition left out, or `*`, is always true.
+bool GrammarParser::ParseCondition(const Line& l, Production& p, const ExprScope& scope,
+                                   size_t condAt, size_t lhsEnd) {
+  const std::string& t = l.text;
+  std::string_view view(t.data(), lhsEnd);
+  size_t c = condAt + 1;
+  auto skip = [&]() {
+    while (c < lhsEnd && IsSpace(t[c])) ++c;
+  };
+  auto block = [&](std::optional<Expr>* out) {
+    Expr b;
+    ExprParseError err;
+    if (!ParseBlock(view, &c, scope, &b, &err)) {
+      Error(l, err.column, err.message, err.length);
+      return false;
+    }
+    *out = std::move(b);
+    skip();
+    return true;
+  };
+  skip();
+  if (c < lhsEnd && t[c] == '{' && !block(&p.preBlock)) return false;
+  if (c >= lhsEnd) {
+    if (p.preBlock) return true;
+    Error(l, int(condAt) + 1, "empty condition after ':' (write '*' for always)");
+    return false;
+  }
+  if (t[c] == '*') {
+    ++c;
+    skip();
+  } else if (t[c] != '{') {
+    const size_t c0 = c;
+    Expr cond;
+    ExprParseError err;
+    if (!ParseExpr(view, &c, scope, &cond, &err)) {
+      Error(l, err.column, err.message, err.length);
+      return false;
+    }
+    size_t e = c;
+    while (e > c0 && IsSpace(t[e - 1])) --e;
+    p.conditionColumn = int(c0) + 1;
+    if (cond.IsConstant() && cond.constant() == 0) {
+      Warn(Loc(l, int(c0) + 1), OriginalAt(l, int(c0) + 1),
+           "condition is always false: production never applies", int(e - c0));
+    }
+    if (!(cond.IsConstant() && cond.constant() != 0)) p.condition = std::move(cond);
+    skip();
+  }
+  if (c < lhsEnd && t[c] == '{' && !block(&p.postBlock)) return false;
+  if (c < lhsEnd) {
+    Error(l, int(c) + 1, "unexpected text after the condition");
+    return false;
+  }
+  return true;
 }
 
 void GrammarParser::ParseLine(const Line& l) {
@@ -1280,6 +1485,19 @@ void GrammarParser::ParseLine(const Line& l) {
     return;
   }
   // Name the problem as precisely as we can.
+  if (BlockDepth(t, 0, {}) > 0) {
+    // A statement block that runs to the end of the file (or of its
+    // #include): point at its '{'.
+    size_t open = t.size();
+    int depth = 0;
+    for (size_t i = t.size(); i-- > 0;) {
+      if (t[i] == '}') ++depth;
+      if (t[i] == '{' && depth-- == 0) open = i;
+      if (open != t.size()) break;
+    }
+    Error(l, int(open) + 1, "unclosed '{': the statement block has no '}'");
+    return;
+  }
   size_t e = pos;
   while (e < t.size() && (IsIdentChar(t[e]) || t[e] == ' ')) ++e;
   if (e < t.size() && t[e] == ':' && e > pos) {
@@ -1398,8 +1616,13 @@ void GrammarParser::Finish() {
       if (p.weight) g_.usesRandom = true;
       if (p.condition && p.condition->UsesRandom()) g_.usesRandom = true;
       for (const auto& e : p.successor.params) g_.usesRandom |= e.UsesRandom();
+      for (const auto& b : p.successor.blocks) g_.usesRandom |= b.code.UsesRandom();
+      if (p.preBlock) g_.usesRandom |= p.preBlock->UsesRandom();
+      if (p.postBlock) g_.usesRandom |= p.postBlock->UsesRandom();
     }
   }
+  for (const auto* b : {&g_.startBlock, &g_.startEachBlock, &g_.endEachBlock, &g_.endBlock})
+    if (*b) g_.usesRandom |= (*b)->UsesRandom();
   g_.contextSkip.assign(nsym, 0);
   for (size_t s = 2; s < nsym; ++s) {
     const std::string& name = g_.symbols.name(SymbolId(s));
@@ -1423,6 +1646,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   std::vector<std::string> stack{std::filesystem::path(path).lexically_normal().string()};
   Preprocess(std::make_shared<const std::string>(text), path, 0, stack);
   JoinContinuations();
+  CollectGlobals();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
   // module: declarations apply to the whole file, wherever they stand.
