@@ -185,6 +185,51 @@ static int OpArity(OpCode op) {
   }
 }
 
+// Gamma(shape, 1) by Marsaglia & Tsang, "A simple method for generating
+// gamma variables" (ACM TOMS 26(3), 2000); shape < 1 by the boost
+// Gamma(shape + 1) * U^(1/shape).
+static double Gamma(double shape, RandomStream& rng) {
+  double boost = 1;
+  if (shape < 1) {
+    double u = rng.Uniform();
+    if (u < 0x1.0p-60) u = 0x1.0p-60;
+    boost = std::pow(u, 1 / shape);
+    shape += 1;
+  }
+  const double d = shape - 1.0 / 3, c = 1 / std::sqrt(9 * d);
+  for (;;) {
+    double x, v;
+    do {
+      x = rng.Normal();
+      v = 1 + c * x;
+    } while (v <= 0);
+    v = v * v * v;
+    double u = rng.Uniform();
+    if (u < 0x1.0p-60) u = 0x1.0p-60;
+    if (std::log(u) < 0.5 * x * x + d - d * v + d * std::log(v)) return d * v * boost;
+  }
+}
+
+// cpfg's bran(a, b): a number in [0, 1] from the beta distribution with
+// shapes a, b > 0 (mean a / (a + b)). Null, or why not.
+static const char* Beta(double a, double b, RandomStream& rng, double* out) {
+  if (!(a > 0 && b > 0)) return "bran(a, b) needs a > 0 and b > 0";
+  const double x = Gamma(a, rng), y = Gamma(b, rng);
+  *out = x + y > 0 ? x / (x + y) : 0.5;
+  return nullptr;
+}
+
+// cpfg's biran(n, p): the number of successes in n trials of probability p.
+static const char* Binomial(double n, double p, RandomStream& rng, double* out) {
+  if (!(n >= 0 && n == std::floor(n) && n <= 1e6))
+    return "biran(n, p) needs a whole number of trials n from 0 to 1000000";
+  if (!(p >= 0 && p <= 1)) return "biran(n, p) needs a probability p from 0 to 1";
+  double k = 0;
+  for (int i = 0; i < int(n); ++i) k += rng.Uniform() < p ? 1 : 0;
+  *out = k;
+  return nullptr;
+}
+
 bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
                EvalError* err) const {
   double stack[kMaxStack];
@@ -272,6 +317,15 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
         --sp;
         stack[sp - 1] = stack[sp - 1] + stack[sp] * rng.Normal();
         break;
+      case OpCode::kBran:
+      case OpCode::kBiran: {
+        --sp;
+        const char* why = in.op == OpCode::kBran
+                              ? Beta(stack[sp - 1], stack[sp], rng, &stack[sp - 1])
+                              : Binomial(stack[sp - 1], stack[sp], rng, &stack[sp - 1]);
+        if (why) return Fail(err, int(columns_[pc]), why);
+        break;
+      }
       default: {
         int k = OpArity(in.op);
         sp -= k;
@@ -342,14 +396,15 @@ constexpr FunctionInfo kFunctions[] = {
     {"max", OpCode::kMax, 2},       {"clamp", OpCode::kClamp, 3}, {"sign", OpCode::kSign, 1},
     {"trunc", OpCode::kTrunc, 1},   {"ran", OpCode::kRan, 1},     {"uniform", OpCode::kUniform, 2},
     {"normal", OpCode::kNormal, 2}, {"nran", OpCode::kNormal, 2},  // nran: cpfg's name
+    {"bran", OpCode::kBran, 2},     {"biran", OpCode::kBiran, 2},
 };
 
 // cpfg's functions that Sylva does not have: named as such when called.
-constexpr std::string_view kCpfgFunctions[] = {"bran", "biran",  "tran", "srand",
-                                               "func", "inblob", "stop"};
+constexpr std::string_view kCpfgFunctions[] = {"tran", "srand", "func", "inblob", "stop"};
 
 bool IsRandom(OpCode op) {
-  return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal;
+  return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal ||
+         op == OpCode::kBran || op == OpCode::kBiran;
 }
 
 // Nesting (parentheses, unary operators, '^', '?:', function arguments)

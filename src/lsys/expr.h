@@ -67,6 +67,8 @@ enum class OpCode : uint8_t {
   kRan,
   kUniform,
   kNormal,
+  kBran,         // cpfg bran(a, b): beta distribution
+  kBiran,        // cpfg biran(n, p): binomial distribution
   kGlobal,       // push globals[arg]
   kStore,        // pop into vars[arg] (a formal slot or a local)
   kStoreGlobal,  // pop into globals[arg]

@@ -180,6 +180,7 @@ class GrammarParser {
   void ParseTropism(const Line& l, size_t after, size_t end);
   void ParseNumberStatement(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseDefine(const Line& l, size_t pos);
+  void Conditionals();
   void ParseGlobalBlock(const Line& l, const std::string& k, size_t after, size_t end);
   void CollectGlobals();
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
@@ -696,7 +697,8 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
   }
   while (pos < t.size() && IsSpace(t[pos])) ++pos;
   if (pos >= t.size()) {
-    Error(l, col, "#define '" + name + "' has no value", int(name.size()));
+    // `#define NAME` alone: defined for #ifdef, with no value.
+    defines_[name] = Define{Loc(l, col), int(name.size())};
     return;
   }
   double v;
@@ -922,6 +924,140 @@ void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, si
     }
     g_.seed = uint64_t(v);
   }
+}
+
+// The preprocessor's conditionals, in file order: `#if EXPR` (constants
+// and `defined(NAME)`), `#ifdef NAME`, `#ifndef NAME`, `#elif EXPR`,
+// `#else`, `#endif`. Lines of a branch not taken are dropped; #define lines
+// of the branches taken are read here, in order, so a condition sees the
+// #defines above it. (#include is spliced before: a file included in a
+// branch not taken is still read, and must exist.)
+void GrammarParser::Conditionals() {
+  struct Open {
+    bool active;  // this branch is taken (and every enclosing one)
+    bool taken;   // some branch of this #if was taken
+    bool sawElse;
+    bool parentActive;
+    Line line;  // of the #if, for the error when it is not closed
+    int column;
+  };
+  std::vector<Open> stack;
+  std::vector<Line> kept;
+  kept.reserve(lines_.size());
+  auto active = [&]() { return stack.empty() || stack.back().active; };
+  // The directive word at the start of a line ("if", "ifdef", ...), or "".
+  auto directive = [](const std::string& t, size_t* pos, size_t* after) {
+    size_t p = 0;
+    while (p < t.size() && IsSpace(t[p])) ++p;
+    *pos = p;
+    if (p >= t.size() || t[p] != '#') return std::string();
+    size_t q = p + 1;
+    while (q < t.size() && IsSpace(t[q])) ++q;
+    size_t e = q;
+    while (e < t.size() && IsIdentChar(t[e])) ++e;
+    *after = e;
+    return t.substr(q, e - q);
+  };
+  // The value of `#if`/`#elif` text from `after` on.
+  auto condition = [&](Line& l, size_t after) -> bool {
+    // defined(NAME) and defined NAME become 1 or 0, padded to keep columns.
+    std::string& t = l.text;
+    for (size_t i = after; (i = t.find("defined", i)) != std::string::npos;) {
+      if ((i > 0 && IsIdentChar(t[i - 1])) || (i + 7 < t.size() && IsIdentChar(t[i + 7]))) {
+        i += 7;
+        continue;
+      }
+      size_t q = i + 7;
+      while (q < t.size() && IsSpace(t[q])) ++q;
+      const bool paren = q < t.size() && t[q] == '(';
+      if (paren) ++q;
+      while (q < t.size() && IsSpace(t[q])) ++q;
+      size_t e = q;
+      while (e < t.size() && IsIdentChar(t[e])) ++e;
+      std::string name = t.substr(q, e - q);
+      if (name.empty()) {
+        Error(l, int(q) + 1, "expected a name after 'defined'");
+        return false;
+      }
+      if (paren) {
+        while (e < t.size() && IsSpace(t[e])) ++e;
+        if (e >= t.size() || t[e] != ')') {
+          Error(l, int(e) + 1, "expected ')' after 'defined(" + name + "'");
+          return false;
+        }
+        ++e;
+      }
+      usedConstants_.insert(name);
+      const bool is = defines_.count(name) > 0;
+      t.replace(i, e - i, std::string(1, is ? '1' : '0') + std::string(e - i - 1, ' '));
+      i = e;
+    }
+    double v = 0;
+    if (!ParseConstExpr(l, after, t.size(), &v)) return false;
+    return v != 0;
+  };
+  for (Line& l : lines_) {
+    size_t pos = 0, after = 0;
+    const std::string d = directive(l.text, &pos, &after);
+    const int col = int(pos) + 1;
+    if (d == "if" || d == "ifdef" || d == "ifndef") {
+      Open o{false, false, false, active(), l, col};
+      if (o.parentActive) {
+        bool v = false;
+        if (d == "if") {
+          v = condition(l, after);
+        } else {
+          size_t q = after;
+          while (q < l.text.size() && IsSpace(l.text[q])) ++q;
+          size_t e = q;
+          while (e < l.text.size() && IsIdentChar(l.text[e])) ++e;
+          if (e == q) {
+            Error(l, int(q) + 1, "expected a name after #" + d);
+          } else {
+            const std::string name = l.text.substr(q, e - q);
+            usedConstants_.insert(name);
+            v = (defines_.count(name) > 0) == (d == "ifdef");
+          }
+        }
+        o.active = o.taken = v;
+      }
+      o.line.text.clear();
+      stack.push_back(std::move(o));
+      continue;
+    }
+    if (d == "elif" || d == "else" || d == "endif") {
+      if (stack.empty()) {
+        Error(l, col, "#" + d + " without #if", int(after - pos));
+        continue;
+      }
+      Open& o = stack.back();
+      if (d == "endif") {
+        stack.pop_back();
+        continue;
+      }
+      if (o.sawElse) {
+        Error(l, col, "#" + d + " after #else", int(after - pos));
+        continue;
+      }
+      if (d == "else") {
+        o.sawElse = true;
+        o.active = o.parentActive && !o.taken;
+        o.taken = true;
+        continue;
+      }
+      o.active = false;
+      if (o.parentActive && !o.taken) o.active = o.taken = condition(l, after);
+      continue;
+    }
+    if (!active()) continue;
+    if (d == "define") {
+      ParseDefine(l, pos);
+      continue;
+    }
+    kept.push_back(std::move(l));
+  }
+  for (const Open& o : stack) Error(o.line, o.column, "#if without #endif", 3);
+  lines_ = std::move(kept);
 }
 
 // `Start: { ... }` and the like: statements over the global variables.
@@ -1464,8 +1600,7 @@ void GrammarParser::ParseLine(const Line& l) {
   while (pos < t.size() && IsSpace(t[pos])) ++pos;
   if (pos >= t.size()) return;
   if (t.compare(pos, 7, "#define") == 0 && (pos + 7 >= t.size() || IsSpace(t[pos + 7]))) {
-    ParseDefine(l, pos);
-    return;
+    return;  // read by Conditionals()
   }
   if (t[pos] == '#') {
     size_t e = pos + 1;
@@ -1646,6 +1781,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   std::vector<std::string> stack{std::filesystem::path(path).lexically_normal().string()};
   Preprocess(std::make_shared<const std::string>(text), path, 0, stack);
   JoinContinuations();
+  Conditionals();
   CollectGlobals();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
