@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "core/math.h"
+#include "lsys/cpfg_function.h"
 #include "lsys/expr_parser.h"
 
 namespace sylva::lsys {
@@ -177,6 +178,7 @@ static int OpArity(OpCode op) {
     case OpCode::kSign:
     case OpCode::kTrunc:
     case OpCode::kRan:
+    case OpCode::kFunc:
       return 1;
     case OpCode::kClamp:
       return 3;
@@ -221,8 +223,8 @@ static const char* Beta(double a, double b, RandomStream& rng, double* out) {
 
 // cpfg's biran(n, p): the number of successes in n trials of probability p.
 static const char* Binomial(double n, double p, RandomStream& rng, double* out) {
-  if (!(n >= 0 && n == std::floor(n) && n <= 1e6))
-    return "biran(n, p) needs a whole number of trials n from 0 to 1000000";
+  n = std::trunc(n);  // cpfg: (int) n
+  if (!(n >= 0 && n <= 1e6)) return "biran(n, p) needs a number of trials n from 0 to 1000000";
   if (!(p >= 0 && p <= 1)) return "biran(n, p) needs a probability p from 0 to 1";
   double k = 0;
   for (int i = 0; i < int(n); ++i) k += rng.Uniform() < p ? 1 : 0;
@@ -317,6 +319,9 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
         --sp;
         stack[sp - 1] = stack[sp - 1] + stack[sp] * rng.Normal();
         break;
+      case OpCode::kFunc:
+        stack[sp - 1] = funcs_[in.arg]->Value(stack[sp - 1]);
+        break;
       case OpCode::kBran:
       case OpCode::kBiran: {
         --sp;
@@ -400,7 +405,10 @@ constexpr FunctionInfo kFunctions[] = {
 };
 
 // cpfg's functions that Sylva does not have: named as such when called.
-constexpr std::string_view kCpfgFunctions[] = {"tran", "srand", "func", "inblob", "stop"};
+constexpr std::string_view kCpfgFunctions[] = {
+    "srand",  "inblob",   "stop",           "printf",         "fprintf", "fopen",
+    "fclose", "fflush",   "fscanf",         "play",           "curveX",  "curveY",
+    "curveZ", "curveGAL", "setDerivLength", "getDerivLength", "display"};
 
 bool IsRandom(OpCode op) {
   return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal ||
@@ -719,7 +727,36 @@ class Parser {
   }
 
  private:
+  // cpfg's func(id, x): id a constant naming one of the grammar's function
+  // files (1 is the first).
+  NodePtr Func(int col, int len, int depth) {
+    ++p_;  // '('
+    NodePtr id = Ternary(depth + 1);
+    if (!id) return nullptr;
+    if (!Accept(",")) return Error(Col(), "func takes 2 arguments: func(id, x)");
+    NodePtr x = Ternary(depth + 1);
+    if (!x) return nullptr;
+    if (!Accept(")")) return Error(Col(), "func takes 2 arguments: func(id, x)");
+    const size_t count = scope_.functions ? scope_.functions->size() : 0;
+    if (count == 0)
+      return Error(col,
+                   "func(id, x) needs cpfg function files: name them with "
+                   "'functions: FILE.func ...' before the productions",
+                   len);
+    if (id->op != OpCode::kConst || id->value != std::floor(id->value) || id->value < 1 ||
+        id->value > double(count)) {
+      return Error(col,
+                   "func(id, x): id must be a whole number from 1 to " + std::to_string(count) +
+                       " (the files of 'functions:')",
+                   len);
+    }
+    auto n = Make(OpCode::kFunc, col, std::move(x));
+    n->slot = uint32_t(id->value) - 1;
+    return n;
+  }
+
   NodePtr Call(const std::string& name, int col, int len, int depth) {
+    if (name == "func") return Func(col, len, depth);
     if (scope_.macros) {
       auto it = scope_.macros->find(name);
       if (it != scope_.macros->end()) return Macro(name, it->second, col, len, depth);
@@ -872,7 +909,7 @@ class ExprCompiler {
   // Folds one node whose children are folded.
   bool FoldNode(Node& n) {
     if (n.op == OpCode::kConst || n.op == OpCode::kFormal || n.op == OpCode::kGlobal ||
-        IsRandom(n.op))
+        n.op == OpCode::kFunc || IsRandom(n.op))
       return true;
     for (auto& k : n.kids) {
       if (k->op != OpCode::kConst) {
@@ -985,7 +1022,7 @@ class ExprCompiler {
         push(OpCode::kToBool);
         code[f.jump1].arg = uint32_t(code.size());
       } else {
-        push(n.op);
+        push(n.op, n.slot);
       }
       stack.pop_back();
     }
@@ -1026,10 +1063,22 @@ class ExprCompiler {
         return false;
       }
       for (const Instr& in : e.code_) e.usesRandom_ |= IsRandom(in.op);
+      TakeFunctions(e);
     }
     *out = std::move(e);
     return true;
   }
+
+  // The grammar's function files, when the code calls func().
+  void TakeFunctions(Expr& e) const {
+    for (const Instr& in : e.code_) {
+      if (in.op == OpCode::kFunc && scope_ && scope_->functions) {
+        e.funcs_ = *scope_->functions;
+        return;
+      }
+    }
+  }
+  const ExprScope* scope_ = nullptr;
 
   void TakeBlock(Expr* out) {
     Expr e;
@@ -1039,6 +1088,7 @@ class ExprCompiler {
       e.code_ = std::move(blockCode);
       e.columns_ = std::move(blockColumns);
       for (const Instr& in : e.code_) e.usesRandom_ |= IsRandom(in.op);
+      TakeFunctions(e);
     }
     *out = std::move(e);
   }
@@ -1232,6 +1282,7 @@ class ExprCompiler {
 bool ParseBlock(std::string_view text, size_t* pos, const ExprScope& scope, Expr* out,
                 ExprParseError* err) {
   ExprCompiler c(err);
+  c.scope_ = &scope;
   if (!c.Block(text, pos, scope, 0)) return false;
   if (c.blockDepth + 1 >= Expr::kMaxStack) {
     err->column = int(*pos);
@@ -1278,6 +1329,7 @@ bool ParseExpr(std::string_view text, size_t* pos, const ExprScope& scope, Expr*
   if (!root) return false;
   *pos = p.pos();
   ExprCompiler c(err);
+  c.scope_ = &scope;
   if (!c.Fold(*root)) return false;
   return c.Finish(*root, out);
 }

@@ -16,12 +16,15 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/rng.h"
 
 namespace sylva::lsys {
+
+class CpfgFunction;
 
 enum class OpCode : uint8_t {
   kConst,
@@ -69,6 +72,7 @@ enum class OpCode : uint8_t {
   kNormal,
   kBran,         // cpfg bran(a, b): beta distribution
   kBiran,        // cpfg biran(n, p): binomial distribution
+  kFunc,         // cpfg func(id, x): top = funcs_[arg]->Value(top)
   kGlobal,       // push globals[arg]
   kStore,        // pop into vars[arg] (a formal slot or a local)
   kStoreGlobal,  // pop into globals[arg]
@@ -138,6 +142,7 @@ class Expr {
   double constant_ = 0;
   std::vector<Instr> code_;
   std::vector<uint32_t> columns_;  // per instruction: column of the operation, for errors
+  std::vector<std::shared_ptr<const CpfgFunction>> funcs_;  // of kFunc: the grammar's functions
 };
 
 }  // namespace sylva::lsys

@@ -11,6 +11,7 @@
 //   primary := number | name | name '(' args ')' | '(' ternary ')'
 #pragma once
 
+#include <memory>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -52,6 +53,8 @@ struct ExprScope {
   const std::vector<std::string>* globals = nullptr;
   // Set when a block assigns a global variable.
   bool* writesGlobal = nullptr;
+  // cpfg function files, for `func(id, x)`: id 1 is the first.
+  const std::vector<std::shared_ptr<const CpfgFunction>>* functions = nullptr;
 };
 
 // Parses one expression starting at text[pos]; stops before the first

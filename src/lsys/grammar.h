@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/diagnostic.h"
+#include "lsys/cpfg_function.h"
 #include "lsys/expr.h"
 #include "lsys/symbols.h"
 #include "lsys/word.h"
@@ -125,6 +126,8 @@ struct Grammar {
   // axiom is built, StartEach before each derivation step, EndEach after it
   // (after decomposition and cut), End after the last step.
   std::vector<std::string> globals;
+  // cpfg function files (`functions: a.func b.func`), for func(id, x).
+  std::vector<std::shared_ptr<const CpfgFunction>> functions;
   std::optional<Expr> startBlock, startEachBlock, endEachBlock, endBlock;
   // Some production assigns a global variable: its steps are then rewritten
   // left to right on one thread, as cpfg does, so the assignments happen in

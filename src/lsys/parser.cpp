@@ -101,7 +101,8 @@ constexpr const char* kKeywords[] = {
     "lsystem",           "axiom",          "angle",           "step",        "width",
     "tropism",           "seed",           "ignore",          "consider",    "module",
     "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette",
-    "starteach",         "endeach",        "start",           "end",         "define"};
+    "starteach",         "endeach",        "start",           "end",         "define",
+    "functions"};
 
 // cpfg's blocks of statements run around the derivation (global variables).
 bool IsGlobalBlockKeyword(std::string_view k) {
@@ -182,6 +183,7 @@ class GrammarParser {
   void ParseDefine(const Line& l, size_t pos);
   void Conditionals();
   void ParseGlobalBlock(const Line& l, const std::string& k, size_t after, size_t end);
+  void ParseFunctions(const Line& l, size_t after, size_t end);
   void CollectGlobals();
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
                       size_t lhsEnd);
@@ -641,6 +643,7 @@ bool GrammarParser::ParseFormalWord(const Line& l, size_t& pos, size_t end,
 bool GrammarParser::ParseConstExpr(const Line& l, size_t pos, size_t end, double* out,
                                    Expr* exprOut) {
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+  scope.functions = &g_.functions;
   std::string_view view(l.text.data(), end);
   Expr e;
   ExprParseError err;
@@ -765,6 +768,7 @@ void GrammarParser::ParseMacro(const Line& l, const std::string& name, int col, 
   }
   // Check the body where it is written, its parameters standing as formals.
   ExprScope scope{&g_.constants, &usedConstants_, &m.params, &macros_};
+  scope.functions = &g_.functions;
   std::string_view view(t.data(), end);
   Expr body;
   ExprParseError err;
@@ -790,6 +794,7 @@ void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end)
     return;
   }
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+  scope.functions = &g_.functions;
   scope.globals = &g_.globals;
   Successor s;
   if (!ParseActualWord(l, after, end, scope, &s)) return;
@@ -1060,6 +1065,47 @@ void GrammarParser::Conditionals() {
   lines_ = std::move(kept);
 }
 
+// `functions: a.func b.func`: cpfg function files, func(1, x) is the first.
+// Names are relative to the grammar file.
+void GrammarParser::ParseFunctions(const Line& l, size_t after, size_t end) {
+  const std::string& t = l.text;
+  size_t p = after;
+  while (p < end) {
+    while (p < end && IsSpace(t[p])) ++p;
+    if (p >= end) break;
+    const bool quoted = t[p] == '"';
+    size_t s = quoted ? p + 1 : p;
+    size_t e = s;
+    while (e < end && (quoted ? t[e] != '"' : !IsSpace(t[e]))) ++e;
+    const std::string name = t.substr(s, e - s);
+    const int col = int(p) + 1, len = int(e - p) + (quoted ? 1 : 0);
+    p = quoted ? e + 1 : e;
+    if (name.empty()) {
+      Error(l, col, "empty function file name");
+      return;
+    }
+    std::filesystem::path target(name);
+    if (target.is_relative())
+      target = std::filesystem::path(files_[size_t(l.file)]).parent_path() / target;
+    const std::string resolved = target.lexically_normal().string();
+    std::string why;
+    auto text = Read(resolved, &why);
+    if (!text) {
+      Error(l, col, "cannot read function file '" + resolved + "': " + why, len);
+      return;
+    }
+    auto f = CpfgFunction::Parse(*text, resolved);
+    if (!f) {
+      Error(l, col,
+            "in function file " + resolved + ":" + std::to_string(f.error().loc.line) + ": " +
+                f.error().message,
+            len);
+      return;
+    }
+    g_.functions.push_back(std::make_shared<const CpfgFunction>(std::move(f).value()));
+  }
+}
+
 // `Start: { ... }` and the like: statements over the global variables.
 void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t after,
                                      size_t end) {
@@ -1081,6 +1127,7 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
     return;
   }
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+  scope.functions = &g_.functions;
   scope.globals = &g_.globals;
   std::string_view view(t.data(), end);
   size_t pos = after;
@@ -1206,6 +1253,10 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
   }
   if (k == "palette") {
     ParsePalette(l, col, after, end);
+    return true;
+  }
+  if (k == "functions") {
+    ParseFunctions(l, after, end);
     return true;
   }
   if (k == "tropism") {
@@ -1465,6 +1516,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   }
   p.formalCount = uint16_t(formals.size());
   ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
+  scope.functions = &g_.functions;
 
   // Condition, with cpfg's statement blocks around it.
   std::vector<std::string> locals;
