@@ -85,7 +85,8 @@ struct ProdInfo {
   uint8_t rightKind;     // same for the right context
   uint8_t hasCondition;  // a condition or statement blocks
   uint8_t hasWeight;
-  uint32_t pad = 0;
+  uint8_t hasBlocks;  // statement blocks (cpfg): the slow path of Matches
+  uint8_t pad[3] = {};
 };
 static_assert(sizeof(ProdInfo) == 16);
 
@@ -145,6 +146,7 @@ class Pass {
       needsMatch_ |= p.HasContext();
       succModules_.push_back(uint32_t(p.successor.symbols.size()));
       succParams_.push_back(uint32_t(p.successor.params.size()));
+      anyBlocks_ |= p.HasBlocks();
     }
     // Per symbol: no production (identity), a production that always
     // applies first (its index), or a choice to make per module.
@@ -166,6 +168,7 @@ class Pass {
         pi.left0 = p.left.empty() ? 0 : p.left.back().symbol;
         pi.right0 = p.right.empty() ? 0 : p.right.front().symbol;
         pi.hasCondition = p.condition.has_value() || p.HasBlocks();
+        pi.hasBlocks = p.HasBlocks();
         pi.hasWeight = p.weight.has_value();
         infos_.push_back(pi);
       }
@@ -204,6 +207,9 @@ class Pass {
                                   uint32_t* choice);
   int Matches(const ProdInfo& pi, const WordView& w, size_t i, const double* pp, int arity,
               double* formals, size_t& prev, size_t& next, RandomStream& rng, Chunk& c);
+  // The blocks and condition of a production with statement blocks.
+  [[gnu::noinline]] int MatchBlocks(const Production& q, size_t i, double* formals,
+                                    RandomStream& rng, Chunk& c);
   void Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams);
   // Runs the successor of a production with statement blocks (vars bound)
   // and appends its parameters to c.stash; false on an error (in c).
@@ -222,6 +228,7 @@ class Pass {
   uint64_t maxModules_;
   size_t maxFormals_ = 0;
   bool needsMatch_ = false;
+  bool anyBlocks_ = false;                             // some production has statement blocks
   std::vector<uint32_t> symChoice_;                    // per symbol
   std::vector<ProdInfo> infos_;                        // per symbol, in file order
   std::vector<uint32_t> infoStart_;                    // symbol -> first info
@@ -393,27 +400,38 @@ int Pass::Matches(const ProdInfo& pi, const WordView& w, size_t i, const double*
     if (!MatchRight(q, w, i, next, formals)) return 0;
   }
   if (pi.hasCondition) {
+    if (pi.hasBlocks) [[unlikely]]
+      return MatchBlocks(q, i, formals, rng, c);
+    double v;
     EvalError e;
-    if (q.localCount) {
-      double* locals = formals + q.formalCount;
-      for (int k = 0; k < q.localCount; ++k) locals[k] = 0;
-    }
-    if (q.preBlock && !q.preBlock->Exec(formals, globals_, rng, &e)) {
+    if (!q.condition->Eval(formals, rng, &v, &e, globals_)) {
       Fail(c, q, e, q.conditionColumn, i);
       return -1;
     }
-    if (q.condition) {
-      double v;
-      if (!q.condition->Eval(formals, rng, &v, &e, globals_)) {
-        Fail(c, q, e, q.conditionColumn, i);
-        return -1;
-      }
-      if (v == 0) return 0;
-    }
-    if (q.postBlock && !q.postBlock->Exec(formals, globals_, rng, &e)) {
+    if (v == 0) return 0;
+  }
+  return 1;
+}
+
+int Pass::MatchBlocks(const Production& q, size_t i, double* formals, RandomStream& rng, Chunk& c) {
+  EvalError e;
+  double* locals = formals + q.formalCount;
+  for (int k = 0; k < q.localCount; ++k) locals[k] = 0;
+  if (q.preBlock && !q.preBlock->Exec(formals, globals_, rng, &e)) {
+    Fail(c, q, e, q.conditionColumn, i);
+    return -1;
+  }
+  if (q.condition) {
+    double v;
+    if (!q.condition->Eval(formals, rng, &v, &e, globals_)) {
       Fail(c, q, e, q.conditionColumn, i);
       return -1;
     }
+    if (v == 0) return 0;
+  }
+  if (q.postBlock && !q.postBlock->Exec(formals, globals_, rng, &e)) {
+    Fail(c, q, e, q.conditionColumn, i);
+    return -1;
   }
   return 1;
 }
@@ -530,8 +548,7 @@ bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice
     if (m == 0) continue;
     if (!pi->hasWeight) {
       *choice = pi->index;
-      const Production& q = sec_.productions[pi->index];
-      return !q.HasBlocks() || Stash(q, i, formals, c);
+      return !pi->hasBlocks || Stash(sec_.productions[pi->index], i, formals, c);
     }
     // Stochastic: draw among every matching production that carries a
     // weight, however many: up to kInline here; past that, DrawMany draws
@@ -585,17 +602,6 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
     }
     const Production& p = sec_.productions[ch16];
     const Successor& s = p.successor;
-    if (p.HasBlocks()) {  // parameters computed when it was chosen
-      for (SymbolId x : s.symbols) {
-        osym[o] = x;
-        if (ostart) {
-          ostart[o] = uint32_t(po);
-          for (int k = 0; k < arities[x]; ++k) opar[po++] = c.stash[c.stashAt++];
-        }
-        ++o;
-      }
-      continue;
-    }
     if (!ostart) {  // no parameters anywhere in the output: copy the symbols
       const size_t len = s.symbols.size();
       const SymbolId* src = s.symbols.data();
@@ -605,6 +611,15 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
         std::memcpy(osym + o, src, len * sizeof(SymbolId));
       }
       o += len;
+      continue;
+    }
+    if (anyBlocks_ && p.HasBlocks()) [[unlikely]] {  // parameters computed when chosen
+      for (SymbolId x : s.symbols) {
+        osym[o] = x;
+        ostart[o] = uint32_t(po);
+        for (int k = 0; k < arities[x]; ++k) opar[po++] = c.stash[c.stashAt++];
+        ++o;
+      }
       continue;
     }
     if (!s.allConstant) {

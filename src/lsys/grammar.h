@@ -56,9 +56,6 @@ struct Production {
   // Local variables of the statement blocks: slots after the formals, set
   // to 0 each time the production is tried.
   uint16_t localCount = 0;
-  // cpfg's `PRED : {pre} COND {post} --> ...`: pre runs before the
-  // condition is evaluated (whether or not it holds), post when it holds.
-  std::optional<Expr> preBlock, postBlock;
   std::optional<Expr> condition;  // none = always true
   std::optional<Expr> weight;     // none = not stochastic
   Successor successor;
@@ -73,6 +70,10 @@ struct Production {
     int at = 0, line = 0, column = 1;
   };
   std::vector<LinePiece> pieces;
+  // cpfg's `PRED : {pre} COND {post} --> ...`: pre runs before the
+  // condition is evaluated (whether or not it holds), post when it holds.
+  // (Cold: after the fields the derivation reads for every module.)
+  std::optional<Expr> preBlock, postBlock;
   // The file position of a column of the production as read.
   SourceLoc LocOf(int column) const;
 

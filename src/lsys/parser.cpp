@@ -948,6 +948,7 @@ void GrammarParser::Conditionals() {
   };
   std::vector<Open> stack;
   std::vector<Line> kept;
+  bool ended = false;
   kept.reserve(lines_.size());
   auto active = [&]() { return stack.empty() || stack.back().active; };
   // The directive word at the start of a line ("if", "ifdef", ...), or "".
@@ -1055,9 +1056,16 @@ void GrammarParser::Conditionals() {
       continue;
     }
     if (!active()) continue;
-    if (d == "define") {
+    if (d == "define" && !ended) {
       ParseDefine(l, pos);
       continue;
+    }
+    // After `endlsystem` nothing is read (it is warned about): a second
+    // L-system's #defines are not this one's.
+    size_t kwAfter = 0;
+    if (d.empty() && !ended) {
+      const char* kw = MatchKeyword(l.text, pos, &kwAfter);
+      ended = kw && std::string_view(kw) == "endlsystem";
     }
     kept.push_back(std::move(l));
   }

@@ -59,6 +59,18 @@ TEST(CpfgPreprocessor, ConditionsSeeCommandLineOverrides) {
   EXPECT_EQ(FormatWord(w->word, r.grammar->symbols), "Y(2)");
 }
 
+TEST(CpfgPreprocessor, DefinesAfterEndlsystemAreNotRead) {
+  // A second L-system's #defines (ignored with a warning) do not clash.
+  ParseResult r = ParseGrammarText(
+      "#define N 1\naxiom: A(N)\nendlsystem\nlsystem: 2\n#define N 2\naxiom: B\n", "c.l");
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  DeriveOptions d;
+  d.steps = 0;
+  auto w = Derive(*r.grammar, d);
+  ASSERT_TRUE(w);
+  EXPECT_EQ(FormatWord(w->word, r.grammar->symbols), "A(1)");
+}
+
 TEST(CpfgPreprocessor, UnbalancedDirectivesAreErrorsWithLocations) {
   EXPECT_EQ(FirstError("#if 1\naxiom: A\n"), "1:1 #if without #endif");
   EXPECT_EQ(FirstError("axiom: A\n#endif\n"), "2:1 #endif without #if");
