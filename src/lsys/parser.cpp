@@ -1399,7 +1399,10 @@ void GrammarParser::JoinContinuations() {
     bool join = continued;
     if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
         isProduction(out.back())) {
-      join = curArrow ? !hasArrow(l.text) : startsWithArrow(l.text);
+      // Without its arrow yet, the production goes on with a line that
+      // starts with the arrow or with a statement block (cpfg's
+      // `A(t) : t < 5` / `  {nt = t + 1;}` / `  --> ...`).
+      join = curArrow ? !hasArrow(l.text) : (startsWithArrow(l.text) || l.text[p] == '{');
     }
     if (!join) {
       out.push_back(std::move(l));

@@ -132,6 +132,28 @@ TEST(CpfgBlocks, BlocksOverSeveralLinesKeepTheirLineNumbers) {
             "4:10 unexpected character ';' in expression");
 }
 
+TEST(CpfgBlocks, IndentedBlocksAndArrowContinueTheProduction) {
+  const std::string g =
+      "Start: {time = 0;}\n"
+      "StartEach: {time = time + 1;}\n"
+      "derivation length: 3\n"
+      "Axiom: A(0)\n"
+      "A(t) : t < 5\n"
+      "\t{\n"
+      "\t\tnt = t + time;\n"
+      "\t}\n"
+      "\t--> [B(nt)]A(nt)\n"
+      "A(t) :\n"
+      "\t{ q = 2; } *\n"
+      "\t--> C(q)\n";
+  // time 1: A(0) -> [B(1)]A(1); time 2: -> [B(3)]A(3); time 3: -> [B(6)]A(6).
+  EXPECT_EQ(DeriveText(g), "[B(1)][B(3)][B(6)]A(6)");
+  EXPECT_EQ(
+      DeriveText(
+          "axiom: A(9)\nA(t) : t < 5\n  {nt = 1;}\n  --> B\nA(t) :\n  {q = 2;} *\n  --> C(q)\n", 1),
+      "C(2)");
+}
+
 TEST(CpfgBlocks, AWeightAfterABlockWithAConditionalExpression) {
   EXPECT_EQ(DeriveText("axiom: A(1)\nA(x) --> B(x) {z = x > 0 ? 7 : 2;} C(z) : 1\n", 1),
             "B(1)C(7)");
