@@ -116,6 +116,26 @@ TEST(CpfgBlocks, ProductionsAssigningGlobalsRunInWordOrderOnAnyThreadCount) {
   }
 }
 
+TEST(CpfgBlocks, LocalsOnlyDeriveInParallelToTheSameWord) {
+  // Blocks with local variables (and random draws) keep the parallel
+  // derivation: the word is the same on 1 and 4 threads.
+  Grammar gr = MustParse(
+      "seed: 5\nderivation length: 16\naxiom: A(1)\n"
+      "A(x) : {y = x + ran(1); z = y * 0.5;} y > 0 --> A(y) [B(z)] A(z)\n"
+      "B(x) : {w = x * 2; if (w > 100) w = 0;} * --> B(w * 0.5)\n");
+  EXPECT_FALSE(gr.productionsWriteGlobals);
+  std::string first;
+  for (int threads : {1, 4}) {
+    DeriveOptions opt;
+    opt.threads = threads;
+    DeriveResult r = MustDerive(gr, opt);
+    ASSERT_GT(r.word.size(), 100000u);
+    const std::string text = FormatWord(r.word, gr.symbols);
+    if (first.empty()) first = text;
+    EXPECT_EQ(text, first) << "threads " << threads;
+  }
+}
+
 TEST(CpfgBlocks, BlocksOverSeveralLinesKeepTheirLineNumbers) {
   const std::string g =
       "Start: {\n"
