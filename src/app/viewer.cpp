@@ -17,15 +17,18 @@
 #include <map>
 #include <mutex>
 #include <ostream>
+#include <set>
 #include <sstream>
 #include <thread>
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/view_file.h"
 #include "app/viewer_window.h"
 #include "plant/plant.h"
 #include "plant/surface_library.h"
 #include "render/renderer.h"
+#include "scene/default_scene.h"
 
 namespace sylva::app {
 namespace {
@@ -40,6 +43,7 @@ struct Job {
   std::optional<uint64_t> seed;
   int steps = -1;
   int sides = 8;
+  int threads = 0;
   bool strict = false;  // warnings are errors
 };
 
@@ -47,12 +51,17 @@ struct Result {
   uint64_t id = 0;
   bool ok = false;
   std::string diagnostics;  // errors and warnings, formatted
-  mesh::TriangleMesh mesh;
+  mesh::TriangleMesh mesh;  // moved into the drawn scene when shown
+  size_t triangles = 0;
   mesh::Palette palette;
   Vec3 lo{0, 0, 0}, hi{1, 1, 1};
   uint64_t modules = 0;
   int derivationLength = 0;
   std::vector<std::pair<std::string, double>> constants;  // file order not kept: sorted
+  std::set<std::string> overridden;  // the constants the job set (the others are the file's)
+  // A 2D figure (plant::IsLineFigure): drawn as these lines, orthographic,
+  // with no ground and no shadow.
+  std::optional<draw::Lines> lines;
   double deriveMs = 0, turtleMs = 0, tessellateMs = 0;
 };
 
@@ -65,6 +74,9 @@ Result RunJob(const Job& job) {
   spec.seed = job.seed;
   if (job.steps >= 0) spec.steps = job.steps;
   spec.detail.sides = job.sides;
+  spec.threads = job.threads;
+  // cpfg's NAME.v (and .map, .mat) beside the grammar, read again on each reload.
+  AttachViewFile(LoadViewFiles(job.path, ""), spec);
   plant::PlantResult built = plant::BuildPlant(spec);
   r.diagnostics = built.diagnostics.FormatAll();
   if (!built.plant) return r;
@@ -76,10 +88,17 @@ Result RunJob(const Job& job) {
   r.derivationLength = p.grammar.derivationLength;
   for (const auto& [k, v] : p.grammar.constants) r.constants.emplace_back(k, v);
   std::sort(r.constants.begin(), r.constants.end());
+  for (const auto& [k, v] : job.overrides) r.overridden.insert(k);
+  if (plant::IsLineFigure(p.geometry)) {
+    r.lines = LinesOf(p);
+    r.lo = p.geometry.boundsMin;
+    r.hi = p.geometry.boundsMax;
+  }
   r.mesh = std::move(p.mesh);
   r.palette = p.palette;
   r.modules = p.DrawnWord().size();
-  if (r.mesh.vertexCount()) {
+  r.triangles = r.mesh.triangleCount();
+  if (!r.lines && r.mesh.vertexCount()) {
     r.lo = r.hi = r.mesh.positions[0].cast<double>();
     for (const auto& q : r.mesh.positions) {
       r.lo = r.lo.cwiseMin(q.cast<double>());
@@ -126,25 +145,68 @@ std::string DefaultGrammar() {
 // What the panel shows of the newest results.
 struct Shown {
   std::optional<Result> plant;  // the last good plant
+  uint64_t id = 0;              // the job it came from
   std::string diagnostics;
   bool lastFailed = false;
   std::vector<std::pair<std::string, double>> constants;
+  // Each #define's slider range, fixed: set from the file's value (not from
+  // a value the slider set, or the range would follow the slider away).
+  std::map<std::string, std::pair<float, float>> ranges;
   int derivationLength = 0;
+  bool playing = false;  // stepping the derivation 0, 1, 2 ... by itself
+  Clock::time_point lastPlayed;
 };
 
-// The control panel: step, seed, sides and a slider per #define; true when
-// the job changed.
-bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double frameMs, Job& job) {
+// The slider range of a #define whose file value is v.
+std::pair<float, float> RangeFor(double v) {
+  if (v > 0) return {0.0f, float(2 * v)};
+  if (v < 0) return {float(2 * v), 0.0f};
+  return {-1.0f, 1.0f};
+}
+
+// What the panel asked for beyond a new job.
+struct PanelActions {
+  bool changed = false;   // post the job
+  bool frameAll = false;  // frame the plant again
+};
+
+// The control panel: step (with play, step and reset), seed, sides, frame
+// all, and a slider per #define.
+PanelActions DrawPanel(const std::string& path, Shown& shown, bool busy, double frameMs, Job& job) {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("Sylva", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
   ImGui::TextWrapped("%s", fs::path(path).filename().string().c_str());
-  bool changed = false;
+  PanelActions act;
+  bool& changed = act.changed;
   int steps = job.steps < 0 ? shown.derivationLength : job.steps;
   if (ImGui::SliderInt("step", &steps, 0, std::max(shown.derivationLength, 1))) {
     job.steps = steps;
+    shown.playing = false;
     changed = true;
   }
+  if (ImGui::Button(shown.playing ? "pause" : "play")) {
+    shown.playing = !shown.playing;
+    if (shown.playing && steps >= shown.derivationLength) {  // play from the axiom
+      job.steps = 0;
+      changed = true;
+    }
+    shown.lastPlayed = Clock::now();
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("step") && steps < shown.derivationLength) {
+    job.steps = steps + 1;
+    shown.playing = false;
+    changed = true;
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("reset")) {
+    job.steps = 0;
+    shown.playing = false;
+    changed = true;
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("frame all")) act.frameAll = true;
   int seed = int(job.seed.value_or(1));
   if (ImGui::InputInt("seed", &seed)) {
     job.seed = uint64_t(std::max(seed, 0));
@@ -155,20 +217,22 @@ bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double fr
       ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
     for (const auto& [name, value] : shown.constants) {
       float v = float(job.overrides.count(name) ? job.overrides[name] : value);
-      const float lo = value > 0 ? 0.0f : float(value) - 10.0f;
-      const float hi = value > 0 ? float(value) * 2.0f : float(value) + 10.0f;
-      if (ImGui::SliderFloat(name.c_str(), &v, lo, hi)) {
+      const auto range = shown.ranges.count(name) ? shown.ranges[name] : RangeFor(value);
+      if (ImGui::SliderFloat(name.c_str(), &v, range.first, range.second)) {
         job.overrides[name] = v;
         changed = true;
       }
+    }
+    if (!job.overrides.empty() && ImGui::Button("file values")) {
+      job.overrides.clear();
+      changed = true;
     }
   }
   if (busy) ImGui::ProgressBar(-1.0f * float(ImGui::GetTime()), ImVec2(-1, 0), "deriving...");
   ImGui::Separator();
   if (shown.plant) {
     ImGui::Text("modules %llu, triangles %zu",
-                static_cast<unsigned long long>(shown.plant->modules),
-                shown.plant->mesh.triangleCount());
+                static_cast<unsigned long long>(shown.plant->modules), shown.plant->triangles);
     ImGui::Text("derive %.1f ms, turtle %.1f ms, mesh %.1f ms", shown.plant->deriveMs,
                 shown.plant->turtleMs, shown.plant->tessellateMs);
   }
@@ -180,7 +244,29 @@ bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double fr
     ImGui::TextWrapped("%s", shown.diagnostics.c_str());
   }
   ImGui::End();
-  return changed;
+  return act;
+}
+
+// The drawn scene of a result: a 2D figure's lines on white, or the
+// plant's default scene.
+draw::DrawList SceneOf(Result& r) {
+  if (r.lines) {
+    draw::DrawList list;
+    list.background = mesh::Vec3f(1, 1, 1);
+    list.lines.push_back(std::move(*r.lines));
+    r.lines.reset();
+    return list;
+  }
+  return scene::DefaultScene(std::make_shared<const mesh::TriangleMesh>(std::move(r.mesh)),
+                             r.palette, r.lo, r.hi);
+}
+
+// A camera that frames the result: the 2D figure from +Z, orthographic;
+// a plant from `azimuth`, `elevation`.
+render::Camera FrameOf(const Result& r, double aspect, bool lines, double azimuth,
+                       double elevation) {
+  return lines ? render::Camera::Frame(r.lo, r.hi, aspect, 0, 0, true)
+               : render::Camera::Frame(r.lo, r.hi, aspect, azimuth, elevation, false);
 }
 
 }  // namespace
@@ -208,26 +294,36 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   if (IsSceneFile(path)) {
+    if (cmd.steps || cmd.seed) {
+      err << "sylva: error: -n and --seed are for grammars; a scene sets them on <plant> and "
+             "<forest>\n";
+      return kExitBadInput;
+    }
     ViewCommand scene = cmd;
     scene.file = path;  // the bundled scene when no file was given
     return RunViewScene(scene, width, height, out, err);
   }
-  if (cmd.time || !cmd.defines.empty() || cmd.threads) {
-    err << "sylva: error: --time, -D and --threads are for scenes (.xml); a grammar's #defines "
-           "have sliders in the viewer\n";
+  if (cmd.time) {
+    err << "sylva: error: --time is for scenes (.xml); a grammar has its derivation step (-n)\n";
     return kExitBadInput;
   }
+  Job job;
+  if (!ParseDefines(cmd.defines, &job.overrides, err)) return kExitBadInput;
+  if (cmd.steps) job.steps = *cmd.steps;
+  job.seed = cmd.seed;
+  job.threads = cmd.threads;
   Window window;
   if (int code = OpenWindow(width, height, "Sylva - " + path, cmd.frames == 0, window, err))
     return code;
   // Declared after the window: its GL objects are destroyed before the context.
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer) return Report(renderer.error(), err);
-  (*renderer)->SetGround(true);
+  (*renderer)->SetShadowMapSize(2048);  // interactive: cheaper shadow samples
+  // The default scene of the plant shown (a ground plane, the default lights).
+  draw::DrawList drawn;
 
   int exitCode = kExitOk;
   Worker<Job, Result> worker(RunJobSafely);
-  Job job;
   job.path = path;
   job.strict = cmd.strict;
   uint64_t nextId = 1;
@@ -244,6 +340,8 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   double frameMs = 0;
   int frame = 0;
   int shots = 0;
+  bool screenshotKeyDown = false;  // one picture per press of P, however long it is held
+  bool lines = false;              // the plant shown is a 2D figure
   MouseCamera mouse;
 
   while (!glfwWindowShouldClose(window.handle)) {
@@ -262,10 +360,16 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       shown.diagnostics = r->diagnostics;
       if (r->ok) {
         shown.constants = r->constants;
+        for (const auto& [name, value] : r->constants)
+          if (!r->overridden.count(name) || !shown.ranges.count(name))
+            shown.ranges[name] = RangeFor(value);
         shown.derivationLength = r->derivationLength;
-        (*renderer)->SetMesh(r->mesh, r->palette);
-        if (!framed) {
-          camera = render::Camera::Frame(r->lo, r->hi, double(width) / height, 30, 12, false);
+        shown.id = r->id;
+        const bool wasLines = lines;
+        lines = r->lines.has_value();
+        drawn = SceneOf(*r);
+        if (!framed || lines != wasLines) {
+          camera = FrameOf(*r, double(width) / height, lines, 30, 12);
           framed = true;
         }
         shown.plant = std::move(r);
@@ -287,22 +391,45 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     if (fbw > 0 && fbh > 0 && (fbw != (*renderer)->width() || fbh != (*renderer)->height())) {
       (void)(*renderer)->Resize(fbw, fbh);
     }
-    mouse.Update(window.handle, camera);
-
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
-    if (DrawPanel(path, shown, worker.Busy(), frameMs, job)) post();
+    // After NewFrame: ImGui knows whether this frame's click is on the panel.
+    mouse.Update(window.handle, camera);
+    const PanelActions act = DrawPanel(path, shown, worker.Busy(), frameMs, job);
+    // Playing: the next step once the last one is shown (at most 4 a second).
+    if (shown.playing && !worker.Busy() && shown.id + 1 == nextId &&
+        Clock::now() - shown.lastPlayed > std::chrono::milliseconds(250)) {
+      const int at = job.steps < 0 ? shown.derivationLength : job.steps;
+      if (at < shown.derivationLength) {
+        job.steps = at + 1;
+        shown.lastPlayed = Clock::now();
+        post();
+      } else {
+        shown.playing = false;
+      }
+    }
+    if (act.changed) post();
+    const bool frameKey =
+        glfwGetKey(window.handle, GLFW_KEY_F) == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard;
+    if ((act.frameAll || frameKey) && shown.plant)
+      camera = FrameOf(*shown.plant, double(fbw) / std::max(fbh, 1), lines, camera.azimuth,
+                       camera.elevation);
     ImGui::Render();
 
-    (*renderer)->Draw(camera);
+    if (Status s = (*renderer)->Draw(drawn, camera); !s.ok()) {
+      exitCode = Report(s.error(), err);
+      break;
+    }
     (*renderer)->PresentToWindow(fbw, fbh);
     glViewport(0, 0, fbw, fbh);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
     ++frame;
-    const bool key =
+    const bool keyDown =
         glfwGetKey(window.handle, GLFW_KEY_P) == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard;
+    const bool key = keyDown && !screenshotKeyDown;
+    screenshotKeyDown = keyDown;
     const bool done = cmd.frames > 0 && frame >= cmd.frames && shown.plant.has_value();
     if (key || done) {
       std::string file =

@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <unordered_map>
 
@@ -286,10 +288,78 @@ struct ParticleSystem {
   std::unique_ptr<LeafStates> leaves;
   double plateK = 0;  // drag along the normal, N s/m
   uint64_t leafSeed = 0;
+  // <springs>: joined by particle id, so a spring survives the renumbering
+  // of RemoveDead; `springs` holds them at the current indices.
+  struct Joint {
+    uint32_t a, b;
+    double rest;
+  };
+  const SpringsDef* springsDef = nullptr;
+  std::shared_ptr<particles::Springs> springs;
+  std::vector<Joint> joints;
+  std::optional<uint32_t> lastBorn;  // chain: the id of the latest birth
+  // Joins particle i, just born, as `between` says.
+  Status Join(size_t i);
+  // After RemoveDead: the springs of living particles at their new indices.
+  Status Renumber();
   // Turns each leaf by the flow's torque and its spin; new ones get a
   // random orientation and spin, dead ones are forgotten.
   void TurnLeaves(double h, const Wind* wind, double time);
 };
+
+Status ParticleSystem::Join(size_t i) {
+  const ParticleState& st = system->state;
+  const SpringsDef& d = *springsDef;
+  auto join = [&](size_t j) -> Status {
+    const double rest = d.rest.value_or((st.position[i] - st.position[j]).norm());
+    joints.push_back({st.id[j], st.id[i], rest});
+    return springs->Add(uint32_t(j), uint32_t(i), rest, d.k, d.damping);
+  };
+  if (d.between == SpringTopology::kChain) {
+    // The latest birth is the last particle before i, if it still lives
+    // (births are appended; RemoveDead keeps the order).
+    const bool chained = lastBorn && i > 0 && st.id[i - 1] == *lastBorn;
+    lastBorn = st.id[i];
+    return chained ? join(i - 1) : Status{};
+  }
+  // Nearest (and for `grid` every particle within 1.5 times the nearest
+  // distance, at most 6): a linear scan, bounded by `max` (Create).
+  double best = HUGE_VAL;
+  size_t nearest = i;
+  for (size_t j = 0; j < i; ++j) {
+    const double d2 = (st.position[j] - st.position[i]).squaredNorm();
+    if (d2 < best) best = d2, nearest = j;
+  }
+  if (nearest == i) return {};
+  if (d.between == SpringTopology::kNearest) return join(nearest);
+  const double reach = 2.25 * best;  // (1.5 x)^2
+  int joined = 0;
+  for (size_t j = 0; j < i && joined < 6; ++j) {
+    if ((st.position[j] - st.position[i]).squaredNorm() > reach) continue;
+    if (Status s = join(j); !s.ok()) return s;
+    ++joined;
+  }
+  return {};
+}
+
+Status ParticleSystem::Renumber() {
+  const ParticleState& st = system->state;
+  std::unordered_map<uint32_t, uint32_t> index;
+  index.reserve(st.size());
+  for (size_t i = 0; i < st.size(); ++i) index.emplace(st.id[i], uint32_t(i));
+  springs->Clear();
+  size_t kept = 0;
+  for (const Joint& j : joints) {
+    const auto a = index.find(j.a), b = index.find(j.b);
+    if (a == index.end() || b == index.end()) continue;  // an end died: the spring goes
+    joints[kept++] = j;
+    if (Status s = springs->Add(a->second, b->second, j.rest, springsDef->k, springsDef->damping);
+        !s.ok())
+      return s;
+  }
+  joints.resize(kept);
+  return {};
+}
 
 void ParticleSystem::TurnLeaves(double h, const Wind* wind, double time) {
   const ParticleState& st = system->state;
@@ -358,6 +428,15 @@ std::shared_ptr<mesh::TriangleMesh> DartMesh() {
 
 }  // namespace
 
+// An attractor's centre at another element (`of`): fixed for a plant,
+// forest or emitter; the centroid of a flock or cloth at each step.
+struct Centre {
+  std::shared_ptr<Vec3> at;  // read by the attractor's force
+  std::string of;
+  SourceLoc loc;
+  std::function<Vec3()> follow;  // set for what moves
+};
+
 struct Simulation::Impl {
   const Scene* scene = nullptr;
   const BuiltScene* built = nullptr;
@@ -369,6 +448,8 @@ struct Simulation::Impl {
   std::vector<std::unique_ptr<ParticleSystem>> systems;
   std::vector<ClothSheet> cloths;
   std::vector<Flock> flocks;
+  std::vector<Centre> centres;
+  Status PlaceCentres();
   std::map<std::string, std::shared_ptr<const particles::TriangleBvh>> bvhs, leafBvhs;
   std::map<std::string, std::shared_ptr<const particles::CapsuleBvh>> capsuleBvhs;
   std::shared_ptr<const particles::CapsuleBvh> CapsulesOf(const std::string& id) {
@@ -502,12 +583,61 @@ Status Simulation::Impl::Emit(ParticleSystem& ps, double step) {
         if (at != b.x && c.Intersect(b.x, at, &contact)) at = b.x;
       st.Add(at, b.v, b.mass, b.lifetime);
       st.age.back() = remaining;
+      if (ps.springs) {
+        if (Status s = ps.Join(st.size() - 1); !s.ok()) {
+          Diagnostic d = s.error();
+          d.loc = ps.springsDef->loc;
+          return d;
+        }
+      }
     }
   }
   return {};
 }
 
+Status Simulation::Impl::PlaceCentres() {
+  auto mean = [](const std::vector<Vec3>& points) {
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& p : points) c += p;
+    return points.empty() ? c : Vec3(c / double(points.size()));
+  };
+  for (Centre& c : centres) {
+    const auto points = built->points.find(c.of);
+    if (points != built->points.end()) {  // a plant or forest
+      *c.at = mean(points->second.segmentPoints);
+      continue;
+    }
+    bool found = false;
+    for (size_t k = 0; k < cloths.size() && !found; ++k) {
+      if (cloths[k].def->id != c.of) continue;
+      const particles::Cloth* cloth = cloths[k].cloth.get();
+      c.follow = [cloth, mean] { return mean(cloth->positions()); };
+      found = true;
+    }
+    for (size_t k = 0; k < flocks.size() && !found; ++k) {
+      if (flocks[k].def->id != c.of) continue;
+      const ParticleState* boids = &flocks[k].system->state;
+      c.follow = [boids, mean] { return mean(boids->position); };
+      found = true;
+    }
+    for (const ParticlesDef& p : scene->particles) {
+      for (const EmitterDef& e : p.emitters) {
+        if (found || e.id != c.of) continue;
+        found = true;
+        const auto target = built->points.find(e.of);  // an emitter on a plant's parts
+        *c.at = target != built->points.end() ? mean(target->second.segmentPoints) : e.at;
+      }
+    }
+    if (!found)  // the reader checks the kind of every `of`: this is a bug
+      return Fail(c.loc, "'of=\"" + c.of + "\"' names nothing an attractor can follow");
+    if (c.follow) *c.at = c.follow();
+  }
+  return {};
+}
+
 Status Simulation::Impl::Step() {
+  for (Centre& c : centres)
+    if (c.follow) *c.at = c.follow();
   for (auto& ps : systems) {
     const int sub = ps->def->substeps;
     for (int k = 0; k < sub; ++k) {
@@ -548,7 +678,15 @@ Status Simulation::Impl::Step() {
         }
       }
     }
+    const size_t before = st.size();
     particles::RemoveDead(st);
+    if (ps->springs && st.size() != before) {
+      if (Status s = ps->Renumber(); !s.ok()) {
+        Diagnostic d = s.error();
+        d.loc = ps->springsDef->loc;
+        return d;
+      }
+    }
   }
   for (ClothSheet& c : cloths) {
     Vec3 w = Vec3::Zero();
@@ -670,23 +808,14 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
                                                      windOn && wind ? windGrid : nullptr));
           break;
         case ForceKind::kAttractor: {
-          Vec3 c = f.position.value_or(Vec3::Zero());
-          if (!f.of.empty()) {
-            const auto it = built.points.find(f.of);
-            if (it != built.points.end() && !it->second.segmentPoints.empty()) {
-              c = Vec3::Zero();
-              for (const Vec3& p : it->second.segmentPoints) c += p;
-              c /= double(it->second.segmentPoints.size());
-            } else {
-              diags.Add(Warn(f.loc, "'of=\"" + f.of +
-                                        "\"': only a plant or forest gives an "
-                                        "attractor its position yet; the origin is used"));
-            }
-          }
+          // The centre: its position, or the element `of` names (a flock or
+          // cloth moves: its centroid is taken at the start of every step).
+          auto centre = std::make_shared<Vec3>(f.position.value_or(Vec3::Zero()));
+          if (!f.of.empty()) m.centres.push_back({centre, f.of, f.loc});
           const double strength = f.strength, soft = std::max(f.radius, 1e-3);
           const bool inverseSquare = f.falloff == Falloff::kInverseSquare;
           system.AddForce(std::make_shared<AccelerationField>([=](const Vec3& x, double) {
-            const Vec3 d = c - x;
+            const Vec3 d = *centre - x;
             const double r = std::max(d.norm(), soft);
             return Vec3(d / r * strength / (inverseSquare ? r * r : r));
           }));
@@ -763,8 +892,21 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
           !s.ok())
         return Fail(p.loc, s.error().message, ErrorKind::kInput);
     }
-    for (const SpringsDef& sp : p.springs)
-      diags.Add(Warn(sp.loc, "<springs> in a scene are not simulated yet"));
+    if (p.springs.size() > 1)
+      return Fail(p.springs[1].loc, "one <springs> per <particles>", ErrorKind::kInput);
+    if (!p.springs.empty()) {
+      const SpringsDef& sp = p.springs[0];
+      // Nearest and grid scan every living particle at each birth.
+      if (sp.between != SpringTopology::kChain && p.max > 20000)
+        return Fail(sp.loc,
+                    "springs between nearest particles scan them all at each birth: at most "
+                    "20000 particles (the <particles> max is " +
+                        std::to_string(p.max) + ")",
+                    ErrorKind::kInput);
+      ps->springsDef = &sp;
+      ps->springs = std::make_shared<particles::Springs>();
+      ps->system->AddForce(ps->springs);
+    }
     for (size_t k = 0; k < p.emitters.size(); ++k) {
       const EmitterDef& e = p.emitters[k];
       Source src;
@@ -958,6 +1100,7 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
     }
     m.flocks.push_back(std::move(flock));
   }
+  if (Status s = m.PlaceCentres(); !s.ok()) return s.error();
   return sim;
 }
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <string>
 
@@ -15,6 +16,7 @@
 #include "render/camera.h"
 #include "render/render_fixture.h"
 #include "render/renderer.h"
+#include "scene/default_scene.h"
 
 namespace sylva::render {
 namespace {
@@ -22,8 +24,9 @@ namespace {
 class ScreenDetailRender : public testing::RenderFixture {};
 
 // A close-up inside the crown (most of the tree is outside the frustum),
-// without and with the ground and its shadows (a branch outside the view
-// may cast a shadow into it, so culling keeps it then).
+// without and with the default scene's ground and shadows (a branch
+// outside the view may cast a shadow into it, so culling keeps it then),
+// drawn as `sylva render` draws a grammar: through the DrawList.
 TEST_F(ScreenDetailRender, CullingNeverRemovesAVisiblePixel) {
   auto p =
       sylva::testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 11, plant::Stage::kGeometry);
@@ -55,10 +58,13 @@ TEST_F(ScreenDetailRender, CullingNeverRemovesAVisiblePixel) {
         items = stats.chains;
         triangles[cull] = m.triangleCount();
         ASSERT_TRUE(renderer_->Resize(W, H).ok());
-        renderer_->SetGround(shadows);
-        renderer_->SetShadows(shadows);
-        renderer_->SetMesh(m, mesh::DefaultPalette(), &box);
-        renderer_->Draw(cam);
+        auto shared = std::make_shared<const mesh::TriangleMesh>(std::move(m));
+        draw::DrawList list = scene::DefaultScene(shared, mesh::DefaultPalette(), box.lo, box.hi);
+        if (!shadows) {  // the plant alone, lit by an ambient light: no shadow map
+          list.meshes.resize(1);
+          list.lights = {draw::Light::Ambient({1, 1, 1}, 0.8f)};
+        }
+        ASSERT_TRUE(renderer_->Draw(list, cam).ok());
         images[cull] = renderer_->ReadPixels();
       }
       // Without shadows most of the tree is culled; with them, what shades the view stays.
@@ -130,7 +136,6 @@ TEST_F(ScreenDetailRender, SubPixelTwigsKeepTheirCoverage) {
     mesh::TriangleMesh m;
     EXPECT_TRUE(mesh::Tessellate(g, opt, m).ok());
     EXPECT_TRUE(renderer_->Resize(W * scale, H * scale).ok());
-    renderer_->SetGround(false);
     renderer_->SetShadows(false);
     renderer_->SetMesh(m, mesh::DefaultPalette());
     renderer_->Draw(cam);
