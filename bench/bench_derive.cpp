@@ -9,6 +9,8 @@
 //   2 threads >= 1.7x one thread on the large cases
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "core/atomic_file.h"
@@ -68,6 +70,48 @@ SYLVA_DERIVE_BENCH(ternary_2_8a_n13, "fig2_08a_ternary", 13);
 SYLVA_DERIVE_BENCH(hogeweg_1_31a_n62, "fig1_31a_hogeweg_hesper", 62);
 SYLVA_DERIVE_BENCH(hogeweg_1_31e_n58, "fig1_31e_hogeweg_hesper", 58);
 SYLVA_DERIVE_BENCH(stochastic_1_27_n10, "fig1_27_stochastic_plant", 10);
+
+// cpfg statement blocks: a doubling grammar whose every production runs a
+// block, with local variables only (parallel) or assigning a global
+// variable (one thread, word order, as cpfg). 2^18 A's, ~1.3 M modules.
+void BM_DeriveBlocks(benchmark::State& state, const char* text) {
+  ParseResult r = ParseGrammarText(text, "blocks.l");
+  if (!r.grammar) {
+    std::fprintf(stderr, "%s", r.diagnostics.FormatAll().c_str());
+    std::abort();
+  }
+  DeriveOptions opt;
+  opt.threads = int(state.range(0));
+  uint64_t produced = 0;
+  for (auto _ : state) {
+    auto w = Derive(*r.grammar, opt);
+    if (!w) {
+      state.SkipWithError(w.error().message.c_str());
+      return;
+    }
+    produced = 0;
+    for (size_t k = 1; k < w->steps.size(); ++k) produced += w->steps[k].modules;
+    benchmark::DoNotOptimize(w->word.symbols.data());
+  }
+  state.counters["Mmodules/s"] =
+      benchmark::Counter(double(produced) / 1e6, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK_CAPTURE(BM_DeriveBlocks, locals,
+                  "derivation length: 18\naxiom: A(1)\n"
+                  "A(x) : {y = x + 1; z = y * 0.5;} y > 0 --> A(y) [B(z)] A(y)\n"
+                  "B(x) : {w = x * 2; if (w > 1e6) w = 0;} * --> B(w * 0.5)\n")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DeriveBlocks, globals,
+                  "Start: {k = 0;}\nderivation length: 18\naxiom: A(1)\n"
+                  "A(x) : {k = k + 1;} * --> A(k) [B(k)] A(x)\n"
+                  "B(x) : {w = x * 2; if (w > 1e6) w = 0;} * --> B(w * 0.5)\n")
+    ->Arg(1)
+    ->Arg(2)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
 
 // Parsing and checking one grammar file (the monopodial tree).
 void BM_Parse(benchmark::State& state) {

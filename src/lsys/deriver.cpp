@@ -17,7 +17,13 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Purposes of random draws; combined with the pass depth into the stream key.
-enum : uint64_t { kAxiomDraws = 0, kMainDraws = 1, kDecompositionDraws = 2, kInterpretDraws = 3 };
+enum : uint64_t {
+  kAxiomDraws = 0,
+  kMainDraws = 1,
+  kDecompositionDraws = 2,
+  kInterpretDraws = 3,
+  kGlobalBlockDraws = 4,  // Start:, StartEach:, EndEach:, End:
+};
 
 constexpr uint32_t kIdentity = 0xFFFFFFFFu;
 constexpr uint32_t kDynamic = 0xFFFFFFFEu;
@@ -58,7 +64,7 @@ StaticTable BuildStaticTable(const Grammar& g, const Section& sec) {
       continue;
     }
     const Production& p = sec.productions[list[0]];
-    if (p.HasContext() || p.condition || p.weight || !p.successor.params.empty() ||
+    if (p.HasContext() || p.condition || p.weight || p.HasBlocks() || !p.successor.params.empty() ||
         g.symbols.arity(SymbolId(s)) != 0)
       return t;  // not usable
     for (SymbolId x : p.successor.symbols) t.flat.push_back(x);
@@ -72,14 +78,15 @@ StaticTable BuildStaticTable(const Grammar& g, const Section& sec) {
 // What Choose needs of a production, packed (16 bytes) and stored per symbol
 // in file order, so trying the productions of a module touches one cache line.
 struct ProdInfo {
-  uint32_t index;     // into Section::productions
-  SymbolId left0;     // the left-context module nearest the predecessor
-  SymbolId right0;    // the first right-context module
-  uint8_t leftKind;   // 0 none; 1 one module, no parameters; 2 anything else
-  uint8_t rightKind;  // same for the right context
-  uint8_t hasCondition;
+  uint32_t index;        // into Section::productions
+  SymbolId left0;        // the left-context module nearest the predecessor
+  SymbolId right0;       // the first right-context module
+  uint8_t leftKind;      // 0 none; 1 one module, no parameters; 2 anything else
+  uint8_t rightKind;     // same for the right context
+  uint8_t hasCondition;  // a condition or statement blocks
   uint8_t hasWeight;
-  uint32_t pad = 0;
+  uint8_t hasBlocks;  // statement blocks (cpfg): the slow path of Matches
+  uint8_t pad[3] = {};
 };
 static_assert(sizeof(ProdInfo) == 16);
 
@@ -101,6 +108,11 @@ struct Chunk {
   uint64_t outModules = 0, outParams = 0;
   uint64_t outModuleAt = 0, outParamAt = 0;
   bool changed = false;
+  // Successor parameters of the productions with statement blocks, computed
+  // when the production is chosen (so the blocks run once, in word order),
+  // in module order; Write takes them from stashAt on.
+  std::vector<double> stash;
+  size_t stashAt = 0;
   std::optional<Diagnostic> error;
 };
 
@@ -116,7 +128,7 @@ class Pass {
  public:
   Pass(const Grammar& g, const Section& sec, const StaticTable& table, ThreadPool& pool,
        Scratch& scratch, uint64_t seed, uint64_t purpose, uint64_t step, int stepForMessages,
-       uint64_t maxModules)
+       uint64_t maxModules, double* globals)
       : g_(g),
         sec_(sec),
         table_(table),
@@ -127,12 +139,14 @@ class Pass {
         stepForMessages_(stepForMessages),
         maxModules_(maxModules),
         choice_(scratch.choice),
-        match_(scratch.match) {
+        match_(scratch.match),
+        globals_(globals) {
     for (const auto& p : sec.productions) {
-      maxFormals_ = std::max<size_t>(maxFormals_, p.formalCount);
+      maxFormals_ = std::max<size_t>(maxFormals_, size_t(p.formalCount) + p.localCount);
       needsMatch_ |= p.HasContext();
       succModules_.push_back(uint32_t(p.successor.symbols.size()));
       succParams_.push_back(uint32_t(p.successor.params.size()));
+      anyBlocks_ |= p.HasBlocks();
     }
     // Per symbol: no production (identity), a production that always
     // applies first (its index), or a choice to make per module.
@@ -153,7 +167,8 @@ class Pass {
         pi.rightKind = kind(p.right);
         pi.left0 = p.left.empty() ? 0 : p.left.back().symbol;
         pi.right0 = p.right.empty() ? 0 : p.right.front().symbol;
-        pi.hasCondition = p.condition.has_value();
+        pi.hasCondition = p.condition.has_value() || p.HasBlocks();
+        pi.hasBlocks = p.HasBlocks();
         pi.hasWeight = p.weight.has_value();
         infos_.push_back(pi);
       }
@@ -169,7 +184,8 @@ class Pass {
         continue;
       }
       const Production& p = sec.productions[list[0]];
-      symChoice_[s] = (p.HasContext() || p.condition || p.weight) ? kDynamic : list[0];
+      symChoice_[s] =
+          (p.HasContext() || p.condition || p.weight || p.HasBlocks()) ? kDynamic : list[0];
     }
   }
 
@@ -191,7 +207,16 @@ class Pass {
                                   uint32_t* choice);
   int Matches(const ProdInfo& pi, const WordView& w, size_t i, const double* pp, int arity,
               double* formals, size_t& prev, size_t& next, RandomStream& rng, Chunk& c);
+  // The blocks and condition of a production with statement blocks.
+  [[gnu::noinline]] int MatchBlocks(const Production& q, size_t i, double* formals,
+                                    RandomStream& rng, Chunk& c);
   void Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams);
+  // Runs the successor of a production with statement blocks (vars bound)
+  // and appends its parameters to c.stash; false on an error (in c).
+  bool Stash(const Production& p, size_t i, double* vars, Chunk& c);
+  // Binds the formals and context of production `index` for module i and
+  // runs its blocks and condition again (a weighted production drawn).
+  bool Rebind(uint32_t index, const WordView& w, size_t i, double* vars, Chunk& c);
   void Fail(Chunk& c, const Production& p, const EvalError& e, int column, size_t i);
 
   const Grammar& g_;
@@ -203,6 +228,7 @@ class Pass {
   uint64_t maxModules_;
   size_t maxFormals_ = 0;
   bool needsMatch_ = false;
+  bool anyBlocks_ = false;                             // some production has statement blocks
   std::vector<uint32_t> symChoice_;                    // per symbol
   std::vector<ProdInfo> infos_;                        // per symbol, in file order
   std::vector<uint32_t> infoStart_;                    // symbol -> first info
@@ -249,6 +275,7 @@ class Pass {
   std::vector<Chunk> chunks_;
   PodBuffer<uint16_t>& choice_;
   PodBuffer<uint32_t>& match_;
+  double* globals_;  // the grammar's global variables (null: none)
 };
 
 // Bracket partners in parallel: each chunk matches its own brackets and
@@ -301,7 +328,8 @@ void Pass::MatchBrackets(const Word& in) {
 void Pass::SplitChunks(const Word& in) {
   const size_t n = in.size();
   size_t count = 1;
-  if (n >= 2 * kMinChunk && pool_.threads() > 1)
+  // Productions that assign global variables run in word order, as in cpfg.
+  if (n >= 2 * kMinChunk && pool_.threads() > 1 && !g_.productionsWriteGlobals)
     count = std::min<size_t>(size_t(pool_.threads()) * 8, n / kMinChunk);
   chunks_.assign(count, Chunk{});
   for (size_t k = 0; k < count; ++k) {
@@ -372,15 +400,76 @@ int Pass::Matches(const ProdInfo& pi, const WordView& w, size_t i, const double*
     if (!MatchRight(q, w, i, next, formals)) return 0;
   }
   if (pi.hasCondition) {
+    if (pi.hasBlocks) [[unlikely]]
+      return MatchBlocks(q, i, formals, rng, c);
     double v;
     EvalError e;
-    if (!q.condition->Eval(formals, rng, &v, &e)) {
+    if (!q.condition->Eval(formals, rng, &v, &e, globals_)) {
       Fail(c, q, e, q.conditionColumn, i);
       return -1;
     }
     if (v == 0) return 0;
   }
   return 1;
+}
+
+int Pass::MatchBlocks(const Production& q, size_t i, double* formals, RandomStream& rng, Chunk& c) {
+  EvalError e;
+  double* locals = formals + q.formalCount;
+  for (int k = 0; k < q.localCount; ++k) locals[k] = 0;
+  if (q.preBlock && !q.preBlock->Exec(formals, globals_, rng, &e)) {
+    Fail(c, q, e, q.conditionColumn, i);
+    return -1;
+  }
+  if (q.condition) {
+    double v;
+    if (!q.condition->Eval(formals, rng, &v, &e, globals_)) {
+      Fail(c, q, e, q.conditionColumn, i);
+      return -1;
+    }
+    if (v == 0) return 0;
+  }
+  if (q.postBlock && !q.postBlock->Exec(formals, globals_, rng, &e)) {
+    Fail(c, q, e, q.conditionColumn, i);
+    return -1;
+  }
+  return 1;
+}
+
+bool Pass::Stash(const Production& p, size_t i, double* vars, Chunk& c) {
+  const Successor& s = p.successor;
+  RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2 + 1, 0};
+  const auto& arities = g_.symbols.arities();
+  size_t e = 0, b = 0;
+  EvalError err;
+  for (size_t m = 0; m <= s.symbols.size(); ++m) {
+    for (; b < s.blocks.size() && s.blocks[b].before == m; ++b) {
+      if (!s.blocks[b].code.Exec(vars, globals_, rng, &err)) {
+        Fail(c, p, err, 0, i);
+        return false;
+      }
+    }
+    if (m == s.symbols.size()) break;
+    for (int k = 0; k < arities[s.symbols[m]]; ++k, ++e) {
+      double v;
+      if (!s.params[e].Eval(vars, rng, &v, &err, globals_)) {
+        Fail(c, p, err, 0, i);
+        return false;
+      }
+      c.stash.push_back(v);
+    }
+  }
+  return true;
+}
+
+bool Pass::Rebind(uint32_t index, const WordView& w, size_t i, double* vars, Chunk& c) {
+  const SymbolId sym = w.symbols[i];
+  const ProdInfo* pi = infos_.data() + infoStart_[sym];
+  while (pi->index != index) ++pi;
+  RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2, 1};
+  const double* pp = w.paramStart ? w.params + w.paramStart[i] : nullptr;
+  size_t prev = kNotLooked, next = kNotLooked;
+  return Matches(*pi, w, i, pp, g_.symbols.arity(sym), vars, prev, next, rng, c) >= 0;
 }
 
 // Draws one of the matching weighted productions from pi on, by weight
@@ -404,7 +493,7 @@ inline int Pass::Draw(const ProdInfo* pi, const ProdInfo* last, const WordView& 
     const Production& q = sec_.productions[qi->index];
     double wv;
     EvalError e;
-    if (!q.weight->Eval(formals, rng, &wv, &e)) {
+    if (!q.weight->Eval(formals, rng, &wv, &e, globals_)) {
       Fail(c, q, e, q.weightColumn, i);
       return -1;
     }
@@ -459,7 +548,7 @@ bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice
     if (m == 0) continue;
     if (!pi->hasWeight) {
       *choice = pi->index;
-      return true;
+      return !pi->hasBlocks || Stash(sec_.productions[pi->index], i, formals, c);
     }
     // Stochastic: draw among every matching production that carries a
     // weight, however many: up to kInline here; past that, DrawMany draws
@@ -471,9 +560,16 @@ bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice
     int got = Draw(pi, last, w, i, pp, arity, formals, prev, next, rng, c, weights, cands, kInline,
                    choice);
     if (got == 0) [[unlikely]] {
-      return DrawMany(pi, last, w, i, pp, arity, formals, prev, next, rngAtWeights, c, choice);
+      if (!DrawMany(pi, last, w, i, pp, arity, formals, prev, next, rngAtWeights, c, choice))
+        return false;
+      got = 1;
     }
-    return got > 0;
+    if (got < 0) return false;
+    if (*choice != kIdentity && sec_.productions[*choice].HasBlocks()) {
+      const Production& q = sec_.productions[*choice];
+      return Rebind(*choice, w, i, formals, c) && Stash(q, i, formals, c);
+    }
+    return true;
   }
   *choice = kIdentity;
   return true;
@@ -517,6 +613,15 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
       o += len;
       continue;
     }
+    if (anyBlocks_ && p.HasBlocks()) [[unlikely]] {  // parameters computed when chosen
+      for (SymbolId x : s.symbols) {
+        osym[o] = x;
+        ostart[o] = uint32_t(po);
+        for (int k = 0; k < arities[x]; ++k) opar[po++] = c.stash[c.stashAt++];
+        ++o;
+      }
+      continue;
+    }
     if (!s.allConstant) {
       // Bind formals for the chosen production.
       const int a = arities[sym];
@@ -537,7 +642,7 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
         for (int k = 0; k < a; ++k, ++e) {
           double v;
           EvalError err;
-          if (!s.params[e].Eval(formals.data(), rng, &v, &err)) {
+          if (!s.params[e].Eval(formals.data(), rng, &v, &err, globals_)) {
             Fail(c, p, err, 0, i);
             return;
           }
@@ -707,7 +812,28 @@ bool ContainsSymbol(const Word& w, SymbolId s) {
   return std::find(w.symbols.begin(), w.symbols.end(), s) != w.symbols.end();
 }
 
-Expected<Word> BuildAxiom(const Grammar& g, uint64_t seed) {
+// Runs one of the grammar's global blocks (Start:, StartEach:, ...).
+Status RunGlobalBlock(const Grammar& g, const std::optional<Expr>& block, const char* name,
+                      uint64_t seed, uint64_t step, std::vector<double>& globals) {
+  if (!block) return {};
+  RandomStream rng{seed, kGlobalBlockDraws, step, 0, 0};
+  EvalError err;
+  if (block->Exec(nullptr, globals.data(), rng, &err)) return {};
+  Diagnostic d;
+  d.message = err.message + " in the '" + name + ":' block (step " + std::to_string(step) + ")";
+  d.kind = ErrorKind::kRuntime;
+  return d;
+}
+
+// The global variables as the Start: block leaves them.
+Expected<std::vector<double>> StartGlobals(const Grammar& g, uint64_t seed) {
+  std::vector<double> globals(g.globals.size(), 0.0);
+  if (Status s = RunGlobalBlock(g, g.startBlock, "Start", seed, 0, globals); !s.ok())
+    return s.error();
+  return globals;
+}
+
+Expected<Word> BuildAxiom(const Grammar& g, uint64_t seed, const double* globals) {
   Word w;
   const Successor& a = g.axiom;
   RandomStream rng{seed, kAxiomDraws, 0, 0, 0};
@@ -718,7 +844,7 @@ Expected<Word> BuildAxiom(const Grammar& g, uint64_t seed) {
     for (int k = 0; k < g.symbols.arity(s); ++k, ++e) {
       double v;
       EvalError err;
-      if (!a.params[e].Eval(nullptr, rng, &v, &err)) {
+      if (!a.params[e].Eval(nullptr, rng, &v, &err, globals)) {
         return MakeError(g.axiomLoc, err.message + " in the axiom");
       }
       values.push_back(v);
@@ -732,13 +858,13 @@ Expected<Word> BuildAxiom(const Grammar& g, uint64_t seed) {
 // changes or the maximum depth is reached.
 Status RunSection(const Grammar& g, const Section& sec, ThreadPool& pool, Scratch& scratch,
                   uint64_t seed, uint64_t purpose, uint64_t step, int stepForMessages,
-                  uint64_t maxModules, Word& word) {
+                  uint64_t maxModules, double* globals, Word& word) {
   if (sec.empty()) return {};
   StaticTable table = BuildStaticTable(g, sec);
   Word next;
   for (int depth = 0; depth < sec.maxDepth; ++depth) {
     Pass pass(g, sec, table, pool, scratch, seed, purpose | (uint64_t(depth) << 8), step,
-              stepForMessages, maxModules);
+              stepForMessages, maxModules, globals);
     bool changed = false;
     if (Status s = pass.Run(word, next, &changed); !s.ok()) return s;
     if (!changed) break;
@@ -769,6 +895,7 @@ struct Derivation::State {
   const StaticTable table;
   Scratch scratch;
   Word word, next;
+  std::vector<double> globals;  // the grammar's global variables
   int step = 0;
   bool fixedPoint = false;
   std::vector<StepStats> stats;
@@ -782,7 +909,10 @@ Derivation::~Derivation() = default;
 Expected<Derivation> Derivation::Start(const Grammar& g, const DeriveOptions& options) {
   SYLVA_ASSERT(g.main.bySymbol.size() == g.symbols.size());  // a Grammar from the parser
   auto state = std::make_unique<State>(g, options);
-  auto axiom = BuildAxiom(g, state->seed);
+  auto globals = StartGlobals(g, state->seed);
+  if (!globals) return globals.error();
+  state->globals = std::move(globals).value();
+  auto axiom = BuildAxiom(g, state->seed, state->globals.data());
   if (!axiom) return axiom.error();
   state->word = std::move(axiom).value();
   if (state->word.size() > state->maxModules) {
@@ -804,22 +934,33 @@ Status Derivation::Step() {
   const int step = s.step + 1;
   if (!s.fixedPoint) {
     bool changed = false;
+    double* globals = s.globals.data();
+    if (Status st =
+            RunGlobalBlock(s.g, s.g.startEachBlock, "StartEach", s.seed, uint64_t(step), s.globals);
+        !st.ok())
+      return st;
     Pass pass(s.g, s.g.main, s.table, s.pool, s.scratch, s.seed, kMainDraws, uint64_t(step), step,
-              s.maxModules);
+              s.maxModules, globals);
     if (Status st = pass.Run(s.word, s.next, &changed); !st.ok()) return st;
     std::swap(s.word, s.next);
-    if (Status st = RunSection(s.g, s.g.decomposition, s.pool, s.scratch, s.seed,
-                               kDecompositionDraws, uint64_t(step), step, s.maxModules, s.word);
+    if (Status st =
+            RunSection(s.g, s.g.decomposition, s.pool, s.scratch, s.seed, kDecompositionDraws,
+                       uint64_t(step), step, s.maxModules, globals, s.word);
         !st.ok())
       return st;
     if (s.g.cutSymbol && ContainsSymbol(s.word, *s.g.cutSymbol)) {
       ApplyCut(s.word, *s.g.cutSymbol);
       changed = true;
     }
-    // With no production applied and no randomness, every later step gives
-    // this same word. (A caller that edits the word between steps breaks
-    // this: MutableWord() clears it.)
-    if (!changed && s.g.decomposition.empty() && !s.g.usesRandom) s.fixedPoint = true;
+    if (Status st =
+            RunGlobalBlock(s.g, s.g.endEachBlock, "EndEach", s.seed, uint64_t(step), s.globals);
+        !st.ok())
+      return st;
+    // With no production applied, no randomness and no global variables,
+    // every later step gives this same word. (A caller that edits the word
+    // between steps breaks this: MutableWord() clears it.)
+    if (!changed && s.g.decomposition.empty() && !s.g.usesRandom && s.g.globals.empty())
+      s.fixedPoint = true;
   }
   s.step = step;
   s.stats.push_back(
@@ -846,11 +987,21 @@ Expected<Word> Derivation::Interpreted() const {
   Word w = s.word;
   if (s.g.interpretation.empty()) return w;
   Scratch scratch;
+  std::vector<double> globals = s.globals;  // interpretation may assign them: a copy
   if (Status st = RunSection(s.g, s.g.interpretation, s.pool, scratch, s.seed, kInterpretDraws, 0,
-                             0, s.maxModules, w);
+                             0, s.maxModules, globals.data(), w);
       !st.ok())
     return st.error();
   return w;
+}
+
+Status Derivation::RunEnd() {
+  State& s = *state_;
+  return RunGlobalBlock(s.g, s.g.endBlock, "End", s.seed, uint64_t(s.step), s.globals);
+}
+
+const std::vector<double>& Derivation::globals() const {
+  return state_->globals;
 }
 
 DeriveResult Derivation::Finish() && {
@@ -876,6 +1027,7 @@ Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
     if (Status s = derivation->Step(); !s.ok()) return s.error();
     if (options.progress) options.progress(derivation->step(), steps, derivation->word().size());
   }
+  if (Status s = derivation->RunEnd(); !s.ok()) return s.error();
   DeriveResult result = std::move(*derivation).Finish();
   result.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return result;
@@ -889,8 +1041,12 @@ Expected<Word> Interpret(const Grammar& g, const Word& word, const DeriveOptions
   const uint64_t seed = options.seed.value_or(g.seed);
   const uint64_t maxModules = std::min(options.maxModules, kMaxModulesCap);
   Scratch scratch;
+  // The global variables as Start: leaves them (the derivation's own are
+  // in Derivation::Interpreted).
+  auto globals = StartGlobals(g, seed);
+  if (!globals) return globals.error();
   if (Status s = RunSection(g, g.interpretation, pool, scratch, seed, kInterpretDraws, 0, 0,
-                            maxModules, w);
+                            maxModules, globals->data(), w);
       !s.ok())
     return s.error();
   return w;

@@ -93,6 +93,11 @@ class Derivation {
   // The current word through the interpretation section (what the turtle
   // reads); a copy of word() when the section is empty.
   Expected<Word> Interpreted() const;
+  // Runs the grammar's End: block (Derive() does, after the last step).
+  Status RunEnd();
+  // The grammar's global variables (Grammar::globals order), as the last
+  // step left them.
+  const std::vector<double>& globals() const;
   // Ends the derivation, handing over the word and the statistics.
   DeriveResult Finish() &&;
 

@@ -1,6 +1,7 @@
 // Expression parser, constant folder, code generator and stack machine.
 #include "lsys/expr.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -8,6 +9,7 @@
 #include <memory>
 
 #include "core/math.h"
+#include "lsys/cpfg_function.h"
 #include "lsys/expr_parser.h"
 
 namespace sylva::lsys {
@@ -176,6 +178,7 @@ static int OpArity(OpCode op) {
     case OpCode::kSign:
     case OpCode::kTrunc:
     case OpCode::kRan:
+    case OpCode::kFunc:
       return 1;
     case OpCode::kClamp:
       return 3;
@@ -184,9 +187,56 @@ static int OpArity(OpCode op) {
   }
 }
 
-bool Expr::Run(const double* formals, RandomStream& rng, double* out, EvalError* err) const {
+// Gamma(shape, 1) by Marsaglia & Tsang, "A simple method for generating
+// gamma variables" (ACM TOMS 26(3), 2000); shape < 1 by the boost
+// Gamma(shape + 1) * U^(1/shape).
+static double Gamma(double shape, RandomStream& rng) {
+  double boost = 1;
+  if (shape < 1) {
+    double u = rng.Uniform();
+    if (u < 0x1.0p-60) u = 0x1.0p-60;
+    boost = std::pow(u, 1 / shape);
+    shape += 1;
+  }
+  const double d = shape - 1.0 / 3, c = 1 / std::sqrt(9 * d);
+  for (;;) {
+    double x, v;
+    do {
+      x = rng.Normal();
+      v = 1 + c * x;
+    } while (v <= 0);
+    v = v * v * v;
+    double u = rng.Uniform();
+    if (u < 0x1.0p-60) u = 0x1.0p-60;
+    if (std::log(u) < 0.5 * x * x + d - d * v + d * std::log(v)) return d * v * boost;
+  }
+}
+
+// cpfg's bran(a, b): a number in [0, 1] from the beta distribution with
+// shapes a, b > 0 (mean a / (a + b)). Null, or why not.
+static const char* Beta(double a, double b, RandomStream& rng, double* out) {
+  if (!(a > 0 && b > 0)) return "bran(a, b) needs a > 0 and b > 0";
+  const double x = Gamma(a, rng), y = Gamma(b, rng);
+  *out = x + y > 0 ? x / (x + y) : 0.5;
+  return nullptr;
+}
+
+// cpfg's biran(n, p): the number of successes in n trials of probability p.
+static const char* Binomial(double n, double p, RandomStream& rng, double* out) {
+  n = std::trunc(n);  // cpfg: (int) n
+  if (!(n >= 0 && n <= 1e6)) return "biran(n, p) needs a number of trials n from 0 to 1000000";
+  if (!(p >= 0 && p <= 1)) return "biran(n, p) needs a probability p from 0 to 1";
+  double k = 0;
+  for (int i = 0; i < int(n); ++i) k += rng.Uniform() < p ? 1 : 0;
+  *out = k;
+  return nullptr;
+}
+
+bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
+               EvalError* err) const {
   double stack[kMaxStack];
   int sp = 0;
+  uint32_t loops = 0;
   const Instr* code = code_.data();
   const size_t n = code_.size();
   for (size_t pc = 0; pc < n; ++pc) {
@@ -196,7 +246,24 @@ bool Expr::Run(const double* formals, RandomStream& rng, double* out, EvalError*
         stack[sp++] = in.value;
         break;
       case OpCode::kFormal:
-        stack[sp++] = formals[in.arg];
+        stack[sp++] = vars[in.arg];
+        break;
+      case OpCode::kGlobal:
+        stack[sp++] = globals[in.arg];
+        break;
+      case OpCode::kStore:
+      case OpCode::kStoreGlobal: {
+        const double v = stack[--sp];
+        if (!std::isfinite(v))
+          return Fail(err, int(columns_[pc]), "assigned value is not a finite number (overflow)");
+        (in.op == OpCode::kStore ? vars : globals)[in.arg] = v;
+        break;
+      }
+      case OpCode::kLoop:
+        if (++loops > kMaxLoopIterations)
+          return Fail(err, int(columns_[pc]),
+                      "loop ran more than 1000000 times (a loop that never ends?)");
+        pc = in.arg - 1;
         break;
       case OpCode::kAdd:
         --sp;
@@ -252,6 +319,18 @@ bool Expr::Run(const double* formals, RandomStream& rng, double* out, EvalError*
         --sp;
         stack[sp - 1] = stack[sp - 1] + stack[sp] * rng.Normal();
         break;
+      case OpCode::kFunc:
+        stack[sp - 1] = funcs_[in.arg]->Value(stack[sp - 1]);
+        break;
+      case OpCode::kBran:
+      case OpCode::kBiran: {
+        --sp;
+        const char* why = in.op == OpCode::kBran
+                              ? Beta(stack[sp - 1], stack[sp], rng, &stack[sp - 1])
+                              : Binomial(stack[sp - 1], stack[sp], rng, &stack[sp - 1]);
+        if (why) return Fail(err, int(columns_[pc]), why);
+        break;
+      }
       default: {
         int k = OpArity(in.op);
         sp -= k;
@@ -264,6 +343,7 @@ bool Expr::Run(const double* formals, RandomStream& rng, double* out, EvalError*
       }
     }
   }
+  if (!out) return true;  // a statement block
   *out = stack[0];
   // Adds and multiplies skip their own checks in the loop above.
   if (!std::isfinite(*out))
@@ -321,14 +401,18 @@ constexpr FunctionInfo kFunctions[] = {
     {"max", OpCode::kMax, 2},       {"clamp", OpCode::kClamp, 3}, {"sign", OpCode::kSign, 1},
     {"trunc", OpCode::kTrunc, 1},   {"ran", OpCode::kRan, 1},     {"uniform", OpCode::kUniform, 2},
     {"normal", OpCode::kNormal, 2}, {"nran", OpCode::kNormal, 2},  // nran: cpfg's name
+    {"bran", OpCode::kBran, 2},     {"biran", OpCode::kBiran, 2},
 };
 
 // cpfg's functions that Sylva does not have: named as such when called.
-constexpr std::string_view kCpfgFunctions[] = {"bran", "biran",  "tran", "srand",
-                                               "func", "inblob", "stop"};
+constexpr std::string_view kCpfgFunctions[] = {
+    "srand",  "inblob",   "stop",           "printf",         "fprintf", "fopen",
+    "fclose", "fflush",   "fscanf",         "play",           "curveX",  "curveY",
+    "curveZ", "curveGAL", "setDerivLength", "getDerivLength", "display"};
 
 bool IsRandom(OpCode op) {
-  return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal;
+  return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal ||
+         op == OpCode::kBran || op == OpCode::kBiran;
 }
 
 // Nesting (parentheses, unary operators, '^', '?:', function arguments)
@@ -571,15 +655,7 @@ class Parser {
           if (bound_->names[i] == name) return Clone(*bound_->args[i]);
         }
       }
-      if (scope_.formals) {
-        for (size_t i = 0; i < scope_.formals->size(); ++i) {
-          if ((*scope_.formals)[i] == name) {
-            auto n = Make(OpCode::kFormal, col);
-            n->slot = uint32_t(i);
-            return n;
-          }
-        }
-      }
+      if (auto n = Variable(name, col)) return n;
       if (scope_.constants) {
         auto it = scope_.constants->find(name);
         if (it != scope_.constants->end()) {
@@ -609,7 +685,78 @@ class Parser {
     return Error(col, "unexpected character '" + shown + "' in expression");
   }
 
+  // A formal parameter, local or global variable of this name, or null.
+  NodePtr Variable(const std::string& name, int col) {
+    uint32_t slot;
+    if (FindVar(scope_, name, &slot)) {
+      auto n = Make(OpCode::kFormal, col);
+      n->slot = slot;
+      return n;
+    }
+    if (scope_.globals) {
+      for (size_t i = 0; i < scope_.globals->size(); ++i) {
+        if ((*scope_.globals)[i] == name) {
+          auto n = Make(OpCode::kGlobal, col);
+          n->slot = uint32_t(i);
+          return n;
+        }
+      }
+    }
+    return nullptr;
+  }
+
+ public:
+  // The slot of a formal parameter or local variable.
+  static bool FindVar(const ExprScope& scope, const std::string& name, uint32_t* slot) {
+    const size_t nf = scope.formals ? scope.formals->size() : 0;
+    for (size_t i = 0; i < nf; ++i) {
+      if ((*scope.formals)[i] == name) {
+        *slot = uint32_t(i);
+        return true;
+      }
+    }
+    if (scope.locals) {
+      for (size_t i = 0; i < scope.locals->size(); ++i) {
+        if ((*scope.locals)[i] == name) {
+          *slot = uint32_t(nf + i);
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+
+ private:
+  // cpfg's func(id, x): id a constant naming one of the grammar's function
+  // files (1 is the first).
+  NodePtr Func(int col, int len, int depth) {
+    ++p_;  // '('
+    NodePtr id = Ternary(depth + 1);
+    if (!id) return nullptr;
+    if (!Accept(",")) return Error(Col(), "func takes 2 arguments: func(id, x)");
+    NodePtr x = Ternary(depth + 1);
+    if (!x) return nullptr;
+    if (!Accept(")")) return Error(Col(), "func takes 2 arguments: func(id, x)");
+    const size_t count = scope_.functions ? scope_.functions->size() : 0;
+    if (count == 0)
+      return Error(col,
+                   "func(id, x) needs cpfg function files: name them with "
+                   "'functions: FILE.func ...' before the productions",
+                   len);
+    if (id->op != OpCode::kConst || id->value != std::floor(id->value) || id->value < 1 ||
+        id->value > double(count)) {
+      return Error(col,
+                   "func(id, x): id must be a whole number from 1 to " + std::to_string(count) +
+                       " (the files of 'functions:')",
+                   len);
+    }
+    auto n = Make(OpCode::kFunc, col, std::move(x));
+    n->slot = uint32_t(id->value) - 1;
+    return n;
+  }
+
   NodePtr Call(const std::string& name, int col, int len, int depth) {
+    if (name == "func") return Func(col, len, depth);
     if (scope_.macros) {
       auto it = scope_.macros->find(name);
       if (it != scope_.macros->end()) return Macro(name, it->second, col, len, depth);
@@ -761,7 +908,9 @@ class ExprCompiler {
 
   // Folds one node whose children are folded.
   bool FoldNode(Node& n) {
-    if (n.op == OpCode::kConst || n.op == OpCode::kFormal || IsRandom(n.op)) return true;
+    if (n.op == OpCode::kConst || n.op == OpCode::kFormal || n.op == OpCode::kGlobal ||
+        n.op == OpCode::kFunc || IsRandom(n.op))
+      return true;
     for (auto& k : n.kids) {
       if (k->op != OpCode::kConst) {
         // Short-circuit forms fold when their deciding operand is constant.
@@ -835,11 +984,11 @@ class ExprCompiler {
         columns.push_back(uint32_t(n.column));
       };
       if (f.depth > *maxDepth) *maxDepth = f.depth;
-      if (n.op == OpCode::kConst || n.op == OpCode::kFormal) {
+      if (n.op == OpCode::kConst || n.op == OpCode::kFormal || n.op == OpCode::kGlobal) {
         if (n.op == OpCode::kConst)
           push(OpCode::kConst, 0, n.value);
         else
-          push(OpCode::kFormal, n.slot);
+          push(n.op, n.slot);
         stack.pop_back();
         continue;
       }
@@ -873,9 +1022,28 @@ class ExprCompiler {
         push(OpCode::kToBool);
         code[f.jump1].arg = uint32_t(code.size());
       } else {
-        push(n.op);
+        push(n.op, n.slot);
       }
       stack.pop_back();
+    }
+  }
+
+  // --- statement blocks ---
+  // Compiles the block at text[*pos] == '{' into `blockCode`, the statements in
+  // order; false with err_ filled on a syntax error.
+  bool Block(std::string_view text, size_t* pos, const ExprScope& scope, int depth) {
+    if (depth > kMaxExprNesting) return Err(int(*pos) + 1, "statements nested deeper than 48");
+    const size_t open = *pos;
+    ++*pos;  // '{'
+    for (;;) {
+      SkipSpace(text, pos);
+      if (*pos >= text.size())
+        return Err(int(open) + 1, "unclosed '{': the statement block has no '}'");
+      if (text[*pos] == '}') {
+        ++*pos;
+        return true;
+      }
+      if (!Statement(text, pos, scope, depth + 1)) return false;
     }
   }
 
@@ -895,14 +1063,264 @@ class ExprCompiler {
         return false;
       }
       for (const Instr& in : e.code_) e.usesRandom_ |= IsRandom(in.op);
+      TakeFunctions(e);
     }
     *out = std::move(e);
     return true;
   }
 
+  // The grammar's function files, when the code calls func().
+  void TakeFunctions(Expr& e) const {
+    for (const Instr& in : e.code_) {
+      if (in.op == OpCode::kFunc && scope_ && scope_->functions) {
+        e.funcs_ = *scope_->functions;
+        return;
+      }
+    }
+  }
+  const ExprScope* scope_ = nullptr;
+
+  void TakeBlock(Expr* out) {
+    Expr e;
+    e.isBlock_ = true;
+    if (!blockCode.empty()) {
+      e.kind_ = Expr::Kind::kCode;
+      e.code_ = std::move(blockCode);
+      e.columns_ = std::move(blockColumns);
+      for (const Instr& in : e.code_) e.usesRandom_ |= IsRandom(in.op);
+      TakeFunctions(e);
+    }
+    *out = std::move(e);
+  }
+
+  std::vector<Instr> blockCode;
+  std::vector<uint32_t> blockColumns;
+  int blockDepth = 0;
+
  private:
+  static void SkipSpace(std::string_view t, size_t* p) {
+    while (*p < t.size() && (t[*p] == ' ' || t[*p] == '\t' || t[*p] == '\r')) ++*p;
+  }
+  static bool IsIdent(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+  // The keyword `kw` at *p, not followed by a name character.
+  static bool Keyword(std::string_view t, size_t p, std::string_view kw) {
+    return t.substr(p, kw.size()) == kw &&
+           (p + kw.size() >= t.size() || !IsIdent(t[p + kw.size()]));
+  }
+  bool Err(int column, std::string msg, int len = 1) {
+    if (err_->message.empty()) {
+      err_->column = column;
+      err_->length = len;
+      err_->message = std::move(msg);
+    }
+    return false;
+  }
+  void Push(OpCode op, uint32_t arg, int column) {
+    blockCode.push_back(Instr{op, arg, 0});
+    blockColumns.push_back(uint32_t(column));
+  }
+  // One expression at *pos, folded and emitted.
+  bool Expression(std::string_view text, size_t* pos, const ExprScope& scope) {
+    Parser p(text, *pos, scope, err_);
+    NodePtr root = p.Parse();
+    if (!root) return false;
+    *pos = p.pos();
+    if (!Fold(*root)) return false;
+    int depth = 0;
+    Emit(*root, blockCode, blockColumns, &depth);
+    blockDepth = std::max(blockDepth, depth);
+    return true;
+  }
+  // '(' expression ')'
+  bool Condition(std::string_view text, size_t* pos, const ExprScope& scope, const char* what) {
+    SkipSpace(text, pos);
+    if (*pos >= text.size() || text[*pos] != '(')
+      return Err(int(*pos) + 1, std::string("expected '(' after '") + what + "'");
+    ++*pos;
+    if (!Expression(text, pos, scope)) return false;
+    SkipSpace(text, pos);
+    if (*pos >= text.size() || text[*pos] != ')')
+      return Err(int(*pos) + 1, std::string("expected ')' after the condition of '") + what + "'");
+    ++*pos;
+    return true;
+  }
+  // An optional ';' (required unless a '}' follows).
+  bool EndOfStatement(std::string_view text, size_t* pos) {
+    SkipSpace(text, pos);
+    if (*pos < text.size() && text[*pos] == ';') {
+      ++*pos;
+      return true;
+    }
+    if (*pos < text.size() && text[*pos] == '}') return true;
+    return Err(int(*pos) + 1, "expected ';' after the statement");
+  }
+
+  bool Statement(std::string_view text, size_t* pos, const ExprScope& scope, int depth) {
+    if (depth > kMaxExprNesting) return Err(int(*pos) + 1, "statements nested deeper than 48");
+    SkipSpace(text, pos);
+    const size_t at = *pos;
+    const int col = int(at) + 1;
+    if (at >= text.size()) return Err(col, "expected a statement");
+    const char c = text[at];
+    if (c == ';') {
+      ++*pos;
+      return true;
+    }
+    if (c == '{') return Block(text, pos, scope, depth);
+    if (Keyword(text, at, "if")) {
+      *pos += 2;
+      if (!Condition(text, pos, scope, "if")) return false;
+      const size_t jumpElse = blockCode.size();
+      Push(OpCode::kJumpIfZero, 0, col);
+      if (!Statement(text, pos, scope, depth + 1)) return false;
+      size_t q = *pos;
+      SkipSpace(text, &q);
+      if (Keyword(text, q, "else")) {
+        *pos = q + 4;
+        const size_t jumpEnd = blockCode.size();
+        Push(OpCode::kJump, 0, col);
+        blockCode[jumpElse].arg = uint32_t(blockCode.size());
+        if (!Statement(text, pos, scope, depth + 1)) return false;
+        blockCode[jumpEnd].arg = uint32_t(blockCode.size());
+      } else {
+        blockCode[jumpElse].arg = uint32_t(blockCode.size());
+      }
+      return true;
+    }
+    if (Keyword(text, at, "while")) {
+      *pos += 5;
+      const size_t top = blockCode.size();
+      if (!Condition(text, pos, scope, "while")) return false;
+      const size_t jumpEnd = blockCode.size();
+      Push(OpCode::kJumpIfZero, 0, col);
+      if (!Statement(text, pos, scope, depth + 1)) return false;
+      Push(OpCode::kLoop, uint32_t(top), col);
+      blockCode[jumpEnd].arg = uint32_t(blockCode.size());
+      return true;
+    }
+    if (Keyword(text, at, "do")) {
+      *pos += 2;
+      const size_t top = blockCode.size();
+      if (!Statement(text, pos, scope, depth + 1)) return false;
+      SkipSpace(text, pos);
+      if (!Keyword(text, *pos, "while")) return Err(int(*pos) + 1, "expected 'while' after 'do'");
+      *pos += 5;
+      if (!Condition(text, pos, scope, "while")) return false;
+      // Loop while the condition holds: skip the loop-back when it is 0.
+      const size_t jumpEnd = blockCode.size();
+      Push(OpCode::kJumpIfZero, 0, col);
+      Push(OpCode::kLoop, uint32_t(top), col);
+      blockCode[jumpEnd].arg = uint32_t(blockCode.size());
+      return EndOfStatement(text, pos);
+    }
+    if (!(std::isalpha(static_cast<unsigned char>(c)) || c == '_'))
+      return Err(col, "expected a statement (an assignment 'name = expression;', if or while)");
+    size_t e = at;
+    while (e < text.size() && IsIdent(text[e])) ++e;
+    const std::string name(text.substr(at, e - at));
+    size_t q = e;
+    SkipSpace(text, &q);
+    if (q < text.size() && text[q] == '[')
+      return Err(int(q) + 1, "arrays are not supported by Sylva (cpfg 'define: { array ... }')");
+    if (q < text.size() && text[q] == '(')
+      return Err(col,
+                 "a call '" + name + "(...)' as a statement is not supported (cpfg's printf, ...)",
+                 int(name.size()));
+    OpCode compound = OpCode::kConst;  // kConst: plain '='
+    if (q + 1 < text.size() && text[q + 1] == '=' &&
+        (text[q] == '+' || text[q] == '-' || text[q] == '*' || text[q] == '/')) {
+      compound = text[q] == '+'   ? OpCode::kAdd
+                 : text[q] == '-' ? OpCode::kSub
+                 : text[q] == '*' ? OpCode::kMul
+                                  : OpCode::kDiv;
+      ++q;
+    }
+    if (q >= text.size() || text[q] != '=' || (q + 1 < text.size() && text[q + 1] == '='))
+      return Err(int(q) + 1, "expected '=' after '" + name + "' (an assignment)");
+    *pos = q + 1;
+    // The target: a formal or local, a global, or a new local.
+    uint32_t slot = 0;
+    OpCode store = OpCode::kStore;
+    bool found = Parser::FindVar(scope, name, &slot);
+    if (!found && scope.globals) {
+      for (size_t i = 0; i < scope.globals->size(); ++i) {
+        if ((*scope.globals)[i] == name) {
+          slot = uint32_t(i);
+          store = OpCode::kStoreGlobal;
+          found = true;
+        }
+      }
+    }
+    if (compound != OpCode::kConst && !found)
+      return Err(col, "'" + name + "' has no value before this assignment", int(name.size()));
+    if (compound != OpCode::kConst)
+      Push(store == OpCode::kStore ? OpCode::kFormal : OpCode::kGlobal, slot, col);
+    if (!Expression(text, pos, scope)) return false;
+    if (compound != OpCode::kConst) {
+      Push(compound, 0, col);
+      blockDepth = std::max(blockDepth, 2);
+    }
+    if (!found) {
+      if (!scope.locals)
+        return Err(col,
+                   "'" + name +
+                       "' is not a variable here (a global variable is one assigned in Start:, "
+                       "StartEach:, EndEach: or End:)",
+                   int(name.size()));
+      // Declared after its value is compiled: `y = y + 1` with no y is an error.
+      scope.locals->push_back(name);
+      Parser::FindVar(scope, name, &slot);
+    }
+    if (store == OpCode::kStoreGlobal && scope.writesGlobal) *scope.writesGlobal = true;
+    Push(store, slot, col);
+    return EndOfStatement(text, pos);
+  }
+
   ExprParseError* err_;
 };
+
+bool ParseBlock(std::string_view text, size_t* pos, const ExprScope& scope, Expr* out,
+                ExprParseError* err) {
+  ExprCompiler c(err);
+  c.scope_ = &scope;
+  if (!c.Block(text, pos, scope, 0)) return false;
+  if (c.blockDepth + 1 >= Expr::kMaxStack) {
+    err->column = int(*pos);
+    err->message = "statement too complex (evaluation stack deeper than 64)";
+    return false;
+  }
+  c.TakeBlock(out);
+  return true;
+}
+
+bool IsStatementBlock(std::string_view text, size_t pos, std::string_view next) {
+  auto isIdent = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+  auto startsStatement = [&](std::string_view t, size_t p) {
+    while (p < t.size() && (t[p] == ' ' || t[p] == '\t' || t[p] == '\r')) ++p;
+    if (p >= t.size() || !(std::isalpha(static_cast<unsigned char>(t[p])) || t[p] == '_'))
+      return false;
+    size_t e = p;
+    while (e < t.size() && isIdent(t[e])) ++e;
+    const std::string_view word = t.substr(p, e - p);
+    size_t q = e;
+    while (q < t.size() && (t[q] == ' ' || t[q] == '\t')) ++q;
+    if ((word == "if" || word == "while") && q < t.size() && t[q] == '(') return true;
+    if (word == "do" && (q >= t.size() || t[q] == '{' || q > e)) return true;
+    if (q < t.size() && t[q] == '[') {  // an array element: name[...] =
+      while (q < t.size() && t[q] != ']') ++q;
+      ++q;
+      while (q < t.size() && (t[q] == ' ' || t[q] == '\t')) ++q;
+    }
+    if (q + 1 < t.size() && t[q + 1] == '=' &&
+        std::string_view("+-*/").find(t[q]) != std::string_view::npos)
+      return true;
+    return q < t.size() && t[q] == '=' && (q + 1 >= t.size() || t[q + 1] != '=');
+  };
+  size_t p = pos + 1;
+  while (p < text.size() && (text[p] == ' ' || text[p] == '\t' || text[p] == '\r')) ++p;
+  if (p >= text.size()) return startsStatement(next, 0);
+  return startsStatement(text, p);
+}
 
 bool ParseExpr(std::string_view text, size_t* pos, const ExprScope& scope, Expr* out,
                ExprParseError* err) {
@@ -911,6 +1329,7 @@ bool ParseExpr(std::string_view text, size_t* pos, const ExprScope& scope, Expr*
   if (!root) return false;
   *pos = p.pos();
   ExprCompiler c(err);
+  c.scope_ = &scope;
   if (!c.Fold(*root)) return false;
   return c.Finish(*root, out);
 }

@@ -7,18 +7,24 @@
 //   a constant            (most successor parameters: `F(1)`, `+(a0)`)
 //   a formal parameter    (`F(l)`)
 //   code                  (up to kMaxStack deep)
+// A statement block (cpfg's `{ y = x*2; if (y > 1) z = 1; else z = 2; }`)
+// compiles to the same code with stores: Exec runs it for its effects on
+// the variables (locals after the formals, and the globals).
 // Run-time failures (division by zero, a result that is not finite, a
 // function outside its domain) are reported with the column of the
 // operation that failed, never turned into NaN.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/rng.h"
 
 namespace sylva::lsys {
+
+class CpfgFunction;
 
 enum class OpCode : uint8_t {
   kConst,
@@ -64,7 +70,18 @@ enum class OpCode : uint8_t {
   kRan,
   kUniform,
   kNormal,
+  kBran,         // cpfg bran(a, b): beta distribution
+  kBiran,        // cpfg biran(n, p): binomial distribution
+  kFunc,         // cpfg func(id, x): top = funcs_[arg]->Value(top)
+  kGlobal,       // push globals[arg]
+  kStore,        // pop into vars[arg] (a formal slot or a local)
+  kStoreGlobal,  // pop into globals[arg]
+  kLoop,         // jump back to arg; counts iterations (kMaxLoopIterations)
 };
+
+// A `while` loop in a statement block that runs more often than this in one
+// execution of the block is an error at the `while`, never a hang.
+inline constexpr uint32_t kMaxLoopIterations = 1000000;
 
 struct Instr {  // 16 bytes
   OpCode op;
@@ -91,7 +108,9 @@ class Expr {
 
   // Evaluates with the given formal values; random functions draw from rng.
   // Returns false and fills *err on a run-time failure.
-  bool Eval(const double* formals, RandomStream& rng, double* out, EvalError* err) const {
+  // globals: the grammar's global variables (null when it has none).
+  bool Eval(const double* formals, RandomStream& rng, double* out, EvalError* err,
+            const double* globals = nullptr) const {
     if (kind_ == Kind::kConstant) {
       *out = constant_;
       return true;
@@ -100,21 +119,30 @@ class Expr {
       *out = formals[slot_];
       return true;
     }
-    return Run(formals, rng, out, err);
+    return Run(const_cast<double*>(formals), const_cast<double*>(globals), rng, out, err);
   }
+  // Runs a statement block: assigns vars (formals, then locals) and globals.
+  bool Exec(double* vars, double* globals, RandomStream& rng, EvalError* err) const {
+    if (kind_ != Kind::kCode) return true;  // an empty block
+    return Run(vars, globals, rng, nullptr, err);
+  }
+  bool IsBlock() const { return isBlock_; }
 
   static constexpr int kMaxStack = 64;
 
  private:
   friend class ExprCompiler;
-  bool Run(const double* formals, RandomStream& rng, double* out, EvalError* err) const;
+  // out null: a statement block (nothing left on the stack).
+  bool Run(double* vars, double* globals, RandomStream& rng, double* out, EvalError* err) const;
 
   Kind kind_ = Kind::kConstant;
   bool usesRandom_ = false;
+  bool isBlock_ = false;
   uint32_t slot_ = 0;
   double constant_ = 0;
   std::vector<Instr> code_;
   std::vector<uint32_t> columns_;  // per instruction: column of the operation, for errors
+  std::vector<std::shared_ptr<const CpfgFunction>> funcs_;  // of kFunc: the grammar's functions
 };
 
 }  // namespace sylva::lsys

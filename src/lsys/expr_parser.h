@@ -11,6 +11,7 @@
 //   primary := number | name | name '(' args ')' | '(' ternary ')'
 #pragma once
 
+#include <memory>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -43,6 +44,17 @@ struct ExprScope {
   std::unordered_set<std::string>* usedConstants = nullptr;  // may be null; macros too
   const std::vector<std::string>* formals = nullptr;         // slot = index
   const std::unordered_map<std::string, ExprMacro>* macros = nullptr;
+  // Local variables of a production (cpfg statement blocks): slot =
+  // formals->size() + index. An assignment in a block to a name that is
+  // no formal, local or global adds it here (null: not allowed).
+  std::vector<std::string>* locals = nullptr;
+  // Global variables (assigned in Start:, StartEach:, EndEach:, End:):
+  // slot = index into the grammar's globals.
+  const std::vector<std::string>* globals = nullptr;
+  // Set when a block assigns a global variable.
+  bool* writesGlobal = nullptr;
+  // cpfg function files, for `func(id, x)`: id 1 is the first.
+  const std::vector<std::shared_ptr<const CpfgFunction>>* functions = nullptr;
 };
 
 // Parses one expression starting at text[pos]; stops before the first
@@ -56,5 +68,21 @@ struct ExprParseError {
 
 bool ParseExpr(std::string_view text, size_t* pos, const ExprScope& scope, Expr* out,
                ExprParseError* err);
+
+// A cpfg statement block starting at text[*pos] == '{', to its matching
+// '}' (*pos is set just past it):
+//   block := '{' {stmt} '}'
+//   stmt  := block | NAME ('=' | '+=' | '-=' | '*=' | '/=') expr ';'
+//          | 'if' '(' expr ')' stmt ['else' stmt]
+//          | 'while' '(' expr ')' stmt | 'do' stmt 'while' '(' expr ')' ';' | ';'
+// The `;` before a `}` may be left out. Out is a block Expr (Expr::Exec).
+bool ParseBlock(std::string_view text, size_t* pos, const ExprScope& scope, Expr* out,
+                ExprParseError* err);
+
+// Whether the '{' at text[pos] starts a statement block rather than a
+// polygon: the text after it (or, when nothing follows it on the line, the
+// text of `next`) starts with a statement: `NAME =`, `NAME op=`, `if (`,
+// `while (`, `do`, or it is `{ }` with only spaces or a `;` inside.
+bool IsStatementBlock(std::string_view text, size_t pos, std::string_view next = {});
 
 }  // namespace sylva::lsys

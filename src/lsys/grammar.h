@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/diagnostic.h"
+#include "lsys/cpfg_function.h"
 #include "lsys/expr.h"
 #include "lsys/symbols.h"
 #include "lsys/word.h"
@@ -33,6 +34,14 @@ struct Successor {
   std::vector<SymbolId> symbols;
   std::vector<Expr> params;
   bool allConstant = true;  // every parameter is a constant
+  // cpfg statement blocks written in the successor (`B(y) {z = y+1;} C(z)`):
+  // each runs before the module at `before` is written (symbols.size():
+  // after the last one).
+  struct Block {
+    uint32_t before = 0;
+    Expr code;
+  };
+  std::vector<Block> blocks;
 };
 
 // Brackets a right context may nest (`A > [[[B]]]` is 3); deeper is a parse
@@ -44,6 +53,9 @@ struct Production {
   FormalModule pred;
   std::vector<FormalModule> right;  // may contain brackets; empty = any
   uint16_t formalCount = 0;
+  // Local variables of the statement blocks: slots after the formals, set
+  // to 0 each time the production is tried.
+  uint16_t localCount = 0;
   std::optional<Expr> condition;  // none = always true
   std::optional<Expr> weight;     // none = not stochastic
   Successor successor;
@@ -58,10 +70,15 @@ struct Production {
     int at = 0, line = 0, column = 1;
   };
   std::vector<LinePiece> pieces;
+  // cpfg's `PRED : {pre} COND {post} --> ...`: pre runs before the
+  // condition is evaluated (whether or not it holds), post when it holds.
+  // (Cold: after the fields the derivation reads for every module.)
+  std::optional<Expr> preBlock, postBlock;
   // The file position of a column of the production as read.
   SourceLoc LocOf(int column) const;
 
   bool HasContext() const { return !left.empty() || !right.empty(); }
+  bool HasBlocks() const { return preBlock || postBlock || !successor.blocks.empty(); }
 };
 
 struct Section {
@@ -128,6 +145,19 @@ struct Grammar {
   bool usesRandom = false;            // weights or random functions anywhere
 
   std::unordered_map<std::string, double> constants;  // after -D overrides
+
+  // Global variables (cpfg): the names assigned in the Start:, StartEach:,
+  // EndEach: and End: blocks, 0 until assigned. Start runs before the
+  // axiom is built, StartEach before each derivation step, EndEach after it
+  // (after decomposition and cut), End after the last step.
+  std::vector<std::string> globals;
+  // cpfg function files (`functions: a.func b.func`), for func(id, x).
+  std::vector<std::shared_ptr<const CpfgFunction>> functions;
+  std::optional<Expr> startBlock, startEachBlock, endEachBlock, endBlock;
+  // Some production assigns a global variable: its steps are then rewritten
+  // left to right on one thread, as cpfg does, so the assignments happen in
+  // word order.
+  bool productionsWriteGlobals = false;
 
   // Where each module name is first written (axiom or successor), so later
   // stages can point into the grammar (an unknown surface `~name`).

@@ -101,7 +101,13 @@ constexpr const char* kKeywords[] = {
     "lsystem",           "axiom",          "angle",           "step",        "width",
     "tropism",           "seed",           "ignore",          "consider",    "module",
     "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette",
-    "environment"};
+    "starteach",         "endeach",        "start",           "end",         "define",
+    "functions",         "environment"};
+
+// cpfg's blocks of statements run around the derivation (global variables).
+bool IsGlobalBlockKeyword(std::string_view k) {
+  return k == "start" || k == "end" || k == "starteach" || k == "endeach";
+}
 
 // The keyword that starts `t` at `pos` ("keyword:", or a bare section
 // keyword alone on its line), case-insensitive; *after is just past it.
@@ -176,6 +182,12 @@ class GrammarParser {
   void ParseTropism(const Line& l, size_t after, size_t end);
   void ParseNumberStatement(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseDefine(const Line& l, size_t pos);
+  void Conditionals();
+  void ParseGlobalBlock(const Line& l, const std::string& k, size_t after, size_t end);
+  void ParseFunctions(const Line& l, size_t after, size_t end);
+  void CollectGlobals();
+  bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
+                      size_t lhsEnd);
   void ParseMacro(const Line& l, const std::string& name, int col, size_t pos);
   void ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen);
   bool LexName(const Line& l, size_t& pos, size_t end, std::string* name);
@@ -522,6 +534,22 @@ bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const
     while (pos < end && IsSpace(t[pos])) ++pos;
     if (pos >= end) break;
     int col = int(pos) + 1;
+    if (t[pos] == '{' && IsStatementBlock(view, pos)) {
+      if (!scope.locals) {
+        Error(l, col, "a statement block belongs in a production, not here");
+        return false;
+      }
+      Successor::Block b;
+      b.before = uint32_t(out->symbols.size());
+      ExprParseError err;
+      if (!ParseBlock(view, &pos, scope, &b.code, &err)) {
+        Error(l, err.column, err.message, err.length);
+        return false;
+      }
+      out->blocks.push_back(std::move(b));
+      out->allConstant = false;
+      continue;
+    }
     std::string name;
     if (!LexName(l, pos, end, &name)) return false;
     size_t q = pos;
@@ -616,6 +644,7 @@ bool GrammarParser::ParseFormalWord(const Line& l, size_t& pos, size_t end,
 bool GrammarParser::ParseConstExpr(const Line& l, size_t pos, size_t end, double* out,
                                    Expr* exprOut) {
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+  scope.functions = &g_.functions;
   std::string_view view(l.text.data(), end);
   Expr e;
   ExprParseError err;
@@ -672,7 +701,8 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
   }
   while (pos < t.size() && IsSpace(t[pos])) ++pos;
   if (pos >= t.size()) {
-    Error(l, col, "#define '" + name + "' has no value", int(name.size()));
+    // `#define NAME` alone: defined for #ifdef, with no value.
+    defines_[name] = Define{Loc(l, col), int(name.size())};
     return;
   }
   double v;
@@ -739,6 +769,7 @@ void GrammarParser::ParseMacro(const Line& l, const std::string& name, int col, 
   }
   // Check the body where it is written, its parameters standing as formals.
   ExprScope scope{&g_.constants, &usedConstants_, &m.params, &macros_};
+  scope.functions = &g_.functions;
   std::string_view view(t.data(), end);
   Expr body;
   ExprParseError err;
@@ -764,6 +795,8 @@ void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end)
     return;
   }
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+  scope.functions = &g_.functions;
+  scope.globals = &g_.globals;
   Successor s;
   if (!ParseActualWord(l, after, end, scope, &s)) return;
   if (s.symbols.empty()) {
@@ -981,6 +1014,259 @@ void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, si
   }
 }
 
+// The preprocessor's conditionals, in file order: `#if EXPR` (constants
+// and `defined(NAME)`), `#ifdef NAME`, `#ifndef NAME`, `#elif EXPR`,
+// `#else`, `#endif`. Lines of a branch not taken are dropped; #define lines
+// of the branches taken are read here, in order, so a condition sees the
+// #defines above it. (#include is spliced before: a file included in a
+// branch not taken is still read, and must exist.)
+void GrammarParser::Conditionals() {
+  struct Open {
+    bool active;  // this branch is taken (and every enclosing one)
+    bool taken;   // some branch of this #if was taken
+    bool sawElse;
+    bool parentActive;
+    Line line;  // of the #if, for the error when it is not closed
+    int column;
+  };
+  std::vector<Open> stack;
+  std::vector<Line> kept;
+  bool ended = false;
+  kept.reserve(lines_.size());
+  auto active = [&]() { return stack.empty() || stack.back().active; };
+  // The directive word at the start of a line ("if", "ifdef", ...), or "".
+  auto directive = [](const std::string& t, size_t* pos, size_t* after) {
+    size_t p = 0;
+    while (p < t.size() && IsSpace(t[p])) ++p;
+    *pos = p;
+    if (p >= t.size() || t[p] != '#') return std::string();
+    size_t q = p + 1;
+    while (q < t.size() && IsSpace(t[q])) ++q;
+    size_t e = q;
+    while (e < t.size() && IsIdentChar(t[e])) ++e;
+    *after = e;
+    return t.substr(q, e - q);
+  };
+  // The value of `#if`/`#elif` text from `after` on.
+  auto condition = [&](Line& l, size_t after) -> bool {
+    // defined(NAME) and defined NAME become 1 or 0, padded to keep columns.
+    std::string& t = l.text;
+    for (size_t i = after; (i = t.find("defined", i)) != std::string::npos;) {
+      if ((i > 0 && IsIdentChar(t[i - 1])) || (i + 7 < t.size() && IsIdentChar(t[i + 7]))) {
+        i += 7;
+        continue;
+      }
+      size_t q = i + 7;
+      while (q < t.size() && IsSpace(t[q])) ++q;
+      const bool paren = q < t.size() && t[q] == '(';
+      if (paren) ++q;
+      while (q < t.size() && IsSpace(t[q])) ++q;
+      size_t e = q;
+      while (e < t.size() && IsIdentChar(t[e])) ++e;
+      std::string name = t.substr(q, e - q);
+      if (name.empty()) {
+        Error(l, int(q) + 1, "expected a name after 'defined'");
+        return false;
+      }
+      if (paren) {
+        while (e < t.size() && IsSpace(t[e])) ++e;
+        if (e >= t.size() || t[e] != ')') {
+          Error(l, int(e) + 1, "expected ')' after 'defined(" + name + "'");
+          return false;
+        }
+        ++e;
+      }
+      usedConstants_.insert(name);
+      const bool is = defines_.count(name) > 0;
+      t.replace(i, e - i, std::string(1, is ? '1' : '0') + std::string(e - i - 1, ' '));
+      i = e;
+    }
+    double v = 0;
+    if (!ParseConstExpr(l, after, t.size(), &v)) return false;
+    return v != 0;
+  };
+  for (Line& l : lines_) {
+    size_t pos = 0, after = 0;
+    const std::string d = directive(l.text, &pos, &after);
+    const int col = int(pos) + 1;
+    if (d == "if" || d == "ifdef" || d == "ifndef") {
+      Open o{false, false, false, active(), l, col};
+      if (o.parentActive) {
+        bool v = false;
+        if (d == "if") {
+          v = condition(l, after);
+        } else {
+          size_t q = after;
+          while (q < l.text.size() && IsSpace(l.text[q])) ++q;
+          size_t e = q;
+          while (e < l.text.size() && IsIdentChar(l.text[e])) ++e;
+          if (e == q) {
+            Error(l, int(q) + 1, "expected a name after #" + d);
+          } else {
+            const std::string name = l.text.substr(q, e - q);
+            usedConstants_.insert(name);
+            v = (defines_.count(name) > 0) == (d == "ifdef");
+          }
+        }
+        o.active = o.taken = v;
+      }
+      o.line.text.clear();
+      stack.push_back(std::move(o));
+      continue;
+    }
+    if (d == "elif" || d == "else" || d == "endif") {
+      if (stack.empty()) {
+        Error(l, col, "#" + d + " without #if", int(after - pos));
+        continue;
+      }
+      Open& o = stack.back();
+      if (d == "endif") {
+        stack.pop_back();
+        continue;
+      }
+      if (o.sawElse) {
+        Error(l, col, "#" + d + " after #else", int(after - pos));
+        continue;
+      }
+      if (d == "else") {
+        o.sawElse = true;
+        o.active = o.parentActive && !o.taken;
+        o.taken = true;
+        continue;
+      }
+      o.active = false;
+      if (o.parentActive && !o.taken) o.active = o.taken = condition(l, after);
+      continue;
+    }
+    if (!active()) continue;
+    if (d == "define" && !ended) {
+      ParseDefine(l, pos);
+      continue;
+    }
+    // After `endlsystem` nothing is read (it is warned about): a second
+    // L-system's #defines are not this one's.
+    size_t kwAfter = 0;
+    if (d.empty() && !ended) {
+      const char* kw = MatchKeyword(l.text, pos, &kwAfter);
+      ended = kw && std::string_view(kw) == "endlsystem";
+    }
+    kept.push_back(std::move(l));
+  }
+  for (const Open& o : stack) Error(o.line, o.column, "#if without #endif", 3);
+  lines_ = std::move(kept);
+}
+
+// `functions: a.func b.func`: cpfg function files, func(1, x) is the first.
+// Names are relative to the grammar file.
+void GrammarParser::ParseFunctions(const Line& l, size_t after, size_t end) {
+  const std::string& t = l.text;
+  size_t p = after;
+  while (p < end) {
+    while (p < end && IsSpace(t[p])) ++p;
+    if (p >= end) break;
+    const bool quoted = t[p] == '"';
+    size_t s = quoted ? p + 1 : p;
+    size_t e = s;
+    while (e < end && (quoted ? t[e] != '"' : !IsSpace(t[e]))) ++e;
+    const std::string name = t.substr(s, e - s);
+    const int col = int(p) + 1, len = int(e - p) + (quoted ? 1 : 0);
+    p = quoted ? e + 1 : e;
+    if (name.empty()) {
+      Error(l, col, "empty function file name");
+      return;
+    }
+    std::filesystem::path target(name);
+    if (target.is_relative())
+      target = std::filesystem::path(files_[size_t(l.file)]).parent_path() / target;
+    const std::string resolved = target.lexically_normal().string();
+    std::string why;
+    auto text = Read(resolved, &why);
+    if (!text) {
+      Error(l, col, "cannot read function file '" + resolved + "': " + why, len);
+      return;
+    }
+    auto f = CpfgFunction::Parse(*text, resolved);
+    if (!f) {
+      Error(l, col,
+            "in function file " + resolved + ":" + std::to_string(f.error().loc.line) + ": " +
+                f.error().message,
+            len);
+      return;
+    }
+    g_.functions.push_back(std::make_shared<const CpfgFunction>(std::move(f).value()));
+  }
+}
+
+// `Start: { ... }` and the like: statements over the global variables.
+void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t after,
+                                     size_t end) {
+  const std::string& t = l.text;
+  std::optional<Expr>* slot = k == "start"       ? &g_.startBlock
+                              : k == "end"       ? &g_.endBlock
+                              : k == "starteach" ? &g_.startEachBlock
+                                                 : &g_.endEachBlock;
+  const char* shown = k == "start"       ? "Start"
+                      : k == "end"       ? "End"
+                      : k == "starteach" ? "StartEach"
+                                         : "EndEach";
+  if (*slot) {
+    Error(l, int(after), std::string("a second '") + shown + ":' block");
+    return;
+  }
+  if (after >= end || t[after] != '{') {
+    Error(l, int(after) + 1, std::string("expected '{' after '") + shown + ":'");
+    return;
+  }
+  ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+  scope.functions = &g_.functions;
+  scope.globals = &g_.globals;
+  std::string_view view(t.data(), end);
+  size_t pos = after;
+  Expr block;
+  ExprParseError err;
+  if (!ParseBlock(view, &pos, scope, &block, &err)) {
+    Error(l, err.column, err.message, err.length);
+    return;
+  }
+  while (pos < end && (IsSpace(t[pos]) || t[pos] == ';')) ++pos;
+  if (pos < end) {
+    Error(l, int(pos) + 1, std::string("unexpected text after the '") + shown + ":' block");
+    return;
+  }
+  *slot = std::move(block);
+}
+
+// The global variables: every name assigned in a Start:, StartEach:,
+// EndEach: or End: block (found in the text before any line is parsed, so
+// a production anywhere in the file sees them).
+void GrammarParser::CollectGlobals() {
+  for (const Line& l : lines_) {
+    const std::string& t = l.text;
+    size_t p = 0;
+    while (p < t.size() && IsSpace(t[p])) ++p;
+    size_t after = 0;
+    const char* kw = MatchKeyword(t, p, &after);
+    if (!kw || !IsGlobalBlockKeyword(kw)) continue;
+    for (size_t i = after; i < t.size(); ++i) {
+      if (t[i] != '=') continue;
+      if (i + 1 < t.size() && t[i + 1] == '=') {
+        ++i;
+        continue;
+      }
+      size_t e = i;
+      if (e > after && std::strchr("<>!=", t[e - 1])) continue;
+      if (e > after && std::strchr("+-*/", t[e - 1])) --e;
+      while (e > after && IsSpace(t[e - 1])) --e;
+      size_t b = e;
+      while (b > after && IsIdentChar(t[b - 1])) --b;
+      if (b == e || !IsIdentStart(t[b])) continue;
+      std::string name = t.substr(b, e - b);
+      if (std::find(g_.globals.begin(), g_.globals.end(), name) == g_.globals.end())
+        g_.globals.push_back(std::move(name));
+    }
+  }
+}
+
 bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
   const std::string& t = l.text;
   size_t after = 0;
@@ -1038,6 +1324,16 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
     return true;
   }
   if (!mainOnly()) return true;
+  if (IsGlobalBlockKeyword(k)) {
+    ParseGlobalBlock(l, k, after, end);
+    return true;
+  }
+  if (k == "define") {
+    Error(l, col,
+          "'define:' (cpfg arrays) is not supported by Sylva: arrays cannot be declared or used",
+          6);
+    return true;
+  }
   if (k == "axiom") {
     ParseAxiom(l, col, after, end);
     return true;
@@ -1048,6 +1344,10 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
   }
   if (k == "palette") {
     ParsePalette(l, col, after, end);
+    return true;
+  }
+  if (k == "functions") {
+    ParseFunctions(l, after, end);
     return true;
   }
   if (k == "tropism") {
@@ -1075,6 +1375,51 @@ static size_t FindTopLevel(const std::string& t, size_t from, size_t to, std::st
       return i;
   }
   return std::string::npos;
+}
+
+// The ':' before a probability weight in a successor: the first outside
+// parentheses and outside cpfg statement blocks (which may hold `?:`).
+static size_t FindWeightColon(const std::string& t, size_t from, size_t to) {
+  int depth = 0;
+  std::string_view view(t.data(), to);
+  for (size_t i = from; i < to; ++i) {
+    char c = t[i];
+    if (c == '(') {
+      ++depth;
+    } else if (c == ')') {
+      --depth;
+    } else if (c == '{' && IsStatementBlock(view, i)) {
+      int braces = 0;
+      for (; i < to; ++i) {
+        if (t[i] == '{') ++braces;
+        if (t[i] == '}' && --braces == 0) break;
+      }
+    } else if (depth == 0 && c == ':') {
+      return i;
+    }
+  }
+  return std::string::npos;
+}
+
+// The depth of statement-block braces at the end of `t`, from `depth` at
+// its start: a `{` opens a block when it follows a ':' and ends its line
+// (a pre-condition, `Start: {`) or starts a statement (IsStatementBlock; `next` is the text
+// of the following line, for a `{` that ends its line); inside a block
+// every brace counts.
+static int BlockDepth(const std::string& t, int depth, std::string_view next) {
+  char prev = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    const char c = t[i];
+    if (depth > 0) {
+      depth += c == '{' ? 1 : (c == '}' ? -1 : 0);
+    } else if (c == '{' &&
+               ((prev == ':' && t.find_first_not_of(" \t\r", i + 1) == std::string::npos) ||
+                IsStatementBlock(t, i, next))) {
+      depth = 1;
+    }
+    if (!IsSpace(c)) prev = c;
+  }
+  return depth;
 }
 
 // A line continued on the next: by a `\` at its end (the `\` reads as a
@@ -1120,27 +1465,45 @@ void GrammarParser::JoinContinuations() {
   out.reserve(lines_.size());
   bool continued = false;  // out.back() ended with a backslash
   bool curArrow = false;   // out.back() has a `->` (kept, not rescanned: linear time)
+  int blocks = 0;          // statement blocks open at the end of out.back()
   for (size_t i = 0; i < lines_.size(); ++i) {
     Line& l = lines_[i];
     const Line* next = i + 1 < lines_.size() ? &lines_[i + 1] : nullptr;
+    const std::string_view nextText = next ? std::string_view(next->text) : std::string_view();
     const size_t p = firstText(l.text);
     const bool blank = p >= l.text.size();
+    if (blocks > 0 && out.back().file == l.file) {
+      // Inside a statement block: joined with a space between the lines.
+      Line& cur = out.back();
+      cur.more.push_back(Line::Piece{int(cur.text.size()) + 1, l.number, 1, l.original});
+      cur.text += ' ';
+      cur.text += l.text;
+      blocks = BlockDepth(l.text, blocks, nextText);
+      curArrow = curArrow || hasArrow(l.text);
+      continued = blocks == 0 && takeBackslash(cur, next);
+      continue;
+    }
     bool join = continued;
     if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
         isProduction(out.back())) {
-      join = curArrow ? !hasArrow(l.text) : startsWithArrow(l.text);
+      // Without its arrow yet, the production goes on with a line that
+      // starts with the arrow or with a statement block (cpfg's
+      // `A(t) : t < 5` / `  {nt = t + 1;}` / `  --> ...`).
+      join = curArrow ? !hasArrow(l.text) : (startsWithArrow(l.text) || l.text[p] == '{');
     }
     if (!join) {
       out.push_back(std::move(l));
       curArrow = hasArrow(out.back().text);
-      continued = takeBackslash(out.back(), next);
+      blocks = BlockDepth(out.back().text, 0, nextText);
+      continued = blocks == 0 && takeBackslash(out.back(), next);
       continue;
     }
     curArrow = curArrow || hasArrow(l.text);
     Line& cur = out.back();
     cur.more.push_back(Line::Piece{int(cur.text.size()), l.number, 1, l.original});
     cur.text += l.text;
-    continued = takeBackslash(cur, next);
+    blocks = BlockDepth(l.text, 0, nextText);
+    continued = blocks == 0 && takeBackslash(cur, next);
   }
   lines_ = std::move(out);
 }
@@ -1251,43 +1614,20 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   }
   p.formalCount = uint16_t(formals.size());
   ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
+  scope.functions = &g_.functions;
 
-  // Condition.
-  if (condAt != std::string::npos) {
-    size_t c = condAt + 1;
-    while (c < lhsEnd && IsSpace(t[c])) ++c;
-    size_t e = lhsEnd;
-    while (e > c && IsSpace(t[e - 1])) --e;
-    if (c >= e) {
-      Error(l, int(condAt) + 1, "empty condition after ':' (write '*' for always)");
-      return;
-    }
-    if (!(e == c + 1 && t[c] == '*')) {
-      std::string_view view(t.data(), e);
-      Expr cond;
-      ExprParseError err;
-      size_t cp = c;
-      if (!ParseExpr(view, &cp, scope, &cond, &err)) {
-        Error(l, err.column, err.message, err.length);
-        return;
-      }
-      if (cp < e) {
-        Error(l, int(cp) + 1, "unexpected text after the condition");
-        return;
-      }
-      p.conditionColumn = int(c) + 1;
-      if (cond.IsConstant() && cond.constant() == 0) {
-        Warn(Loc(l, int(c) + 1), OriginalAt(l, int(c) + 1),
-             "condition is always false: production never applies", int(e - c));
-      }
-      if (!(cond.IsConstant() && cond.constant() != 0)) p.condition = std::move(cond);
-    }
-  }
+  // Condition, with cpfg's statement blocks around it.
+  std::vector<std::string> locals;
+  bool writesGlobal = false;
+  scope.locals = &locals;
+  scope.globals = &g_.globals;
+  scope.writesGlobal = &writesGlobal;
+  if (condAt != std::string::npos && !ParseCondition(l, p, scope, condAt, lhsEnd)) return;
 
   // RHS: SUCCESSOR [: WEIGHT]
   size_t rs = arrow + arrowLen;
   size_t rend = t.size();
-  size_t weightAt = FindTopLevel(t, rs, rend, ":");
+  size_t weightAt = FindWeightColon(t, rs, rend);
   size_t succEnd = weightAt == std::string::npos ? rend : weightAt;
   size_t s0 = rs;
   while (s0 < succEnd && IsSpace(t[s0])) ++s0;
@@ -1327,6 +1667,12 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     p.weightColumn = int(w) + 1;
     p.weight = std::move(weight);
   }
+  if (locals.size() + formals.size() > 60000) {
+    Error(l, pf.column, "too many local variables in one production");
+    return;
+  }
+  p.localCount = uint16_t(locals.size());
+  if (writesGlobal) g_.productionsWriteGlobals = true;
   p.loc = Loc(l, pf.column);
   if (!l.more.empty()) {
     p.pieces.push_back(Production::LinePiece{0, l.number, 1});
@@ -1341,14 +1687,70 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   section_->productions.push_back(std::move(p));
 }
 
+// `: [{pre}] [COND] [{post}]` between condAt (the ':') and lhsEnd (the
+// arrow). A condition left out, or `*`, is always true.
+bool GrammarParser::ParseCondition(const Line& l, Production& p, const ExprScope& scope,
+                                   size_t condAt, size_t lhsEnd) {
+  const std::string& t = l.text;
+  std::string_view view(t.data(), lhsEnd);
+  size_t c = condAt + 1;
+  auto skip = [&]() {
+    while (c < lhsEnd && IsSpace(t[c])) ++c;
+  };
+  auto block = [&](std::optional<Expr>* out) {
+    Expr b;
+    ExprParseError err;
+    if (!ParseBlock(view, &c, scope, &b, &err)) {
+      Error(l, err.column, err.message, err.length);
+      return false;
+    }
+    *out = std::move(b);
+    skip();
+    return true;
+  };
+  skip();
+  if (c < lhsEnd && t[c] == '{' && !block(&p.preBlock)) return false;
+  if (c >= lhsEnd) {
+    if (p.preBlock) return true;
+    Error(l, int(condAt) + 1, "empty condition after ':' (write '*' for always)");
+    return false;
+  }
+  if (t[c] == '*') {
+    ++c;
+    skip();
+  } else if (t[c] != '{') {
+    const size_t c0 = c;
+    Expr cond;
+    ExprParseError err;
+    if (!ParseExpr(view, &c, scope, &cond, &err)) {
+      Error(l, err.column, err.message, err.length);
+      return false;
+    }
+    size_t e = c;
+    while (e > c0 && IsSpace(t[e - 1])) --e;
+    p.conditionColumn = int(c0) + 1;
+    if (cond.IsConstant() && cond.constant() == 0) {
+      Warn(Loc(l, int(c0) + 1), OriginalAt(l, int(c0) + 1),
+           "condition is always false: production never applies", int(e - c0));
+    }
+    if (!(cond.IsConstant() && cond.constant() != 0)) p.condition = std::move(cond);
+    skip();
+  }
+  if (c < lhsEnd && t[c] == '{' && !block(&p.postBlock)) return false;
+  if (c < lhsEnd) {
+    Error(l, int(c) + 1, "unexpected text after the condition");
+    return false;
+  }
+  return true;
+}
+
 void GrammarParser::ParseLine(const Line& l) {
   const std::string& t = l.text;
   size_t pos = 0;
   while (pos < t.size() && IsSpace(t[pos])) ++pos;
   if (pos >= t.size()) return;
   if (t.compare(pos, 7, "#define") == 0 && (pos + 7 >= t.size() || IsSpace(t[pos + 7]))) {
-    ParseDefine(l, pos);
-    return;
+    return;  // read by Conditionals()
   }
   if (t[pos] == '#') {
     size_t e = pos + 1;
@@ -1368,6 +1770,19 @@ void GrammarParser::ParseLine(const Line& l) {
     return;
   }
   // Name the problem as precisely as we can.
+  if (BlockDepth(t, 0, {}) > 0) {
+    // A statement block that runs to the end of the file (or of its
+    // #include): point at its '{'.
+    size_t open = t.size();
+    int depth = 0;
+    for (size_t i = t.size(); i-- > 0;) {
+      if (t[i] == '}') ++depth;
+      if (t[i] == '{' && depth-- == 0) open = i;
+      if (open != t.size()) break;
+    }
+    Error(l, int(open) + 1, "unclosed '{': the statement block has no '}'");
+    return;
+  }
   size_t e = pos;
   while (e < t.size() && (IsIdentChar(t[e]) || t[e] == ' ')) ++e;
   if (e < t.size() && t[e] == ':' && e > pos) {
@@ -1500,8 +1915,13 @@ void GrammarParser::Finish() {
       if (p.weight) g_.usesRandom = true;
       if (p.condition && p.condition->UsesRandom()) g_.usesRandom = true;
       for (const auto& e : p.successor.params) g_.usesRandom |= e.UsesRandom();
+      for (const auto& b : p.successor.blocks) g_.usesRandom |= b.code.UsesRandom();
+      if (p.preBlock) g_.usesRandom |= p.preBlock->UsesRandom();
+      if (p.postBlock) g_.usesRandom |= p.postBlock->UsesRandom();
     }
   }
+  for (const auto* b : {&g_.startBlock, &g_.startEachBlock, &g_.endEachBlock, &g_.endBlock})
+    if (*b) g_.usesRandom |= (*b)->UsesRandom();
   g_.contextSkip.assign(nsym, 0);
   for (size_t s = 2; s < nsym; ++s) {
     const std::string& name = g_.symbols.name(SymbolId(s));
@@ -1525,6 +1945,8 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   std::vector<std::string> stack{std::filesystem::path(path).lexically_normal().string()};
   Preprocess(std::make_shared<const std::string>(text), path, 0, stack);
   JoinContinuations();
+  Conditionals();
+  CollectGlobals();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
   // module: declarations apply to the whole file, wherever they stand.

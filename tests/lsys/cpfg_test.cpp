@@ -240,10 +240,10 @@ TEST(Cpfg, NranIsTheNormalDistribution) {
 }
 
 TEST(Cpfg, UnsupportedCpfgFunctionsAreNamedAsSuch) {
-  ParseResult r = ParseGrammarText("axiom: A\nA --> B(bran(1, 2))\n", "c.l");
+  ParseResult r = ParseGrammarText("axiom: A\nA --> B(srand(1, 2))\n", "c.l");
   ASSERT_FALSE(r.grammar);
   const Diagnostic& d = r.diagnostics.items[0];
-  EXPECT_EQ(d.message, "cpfg function 'bran' is not supported by Sylva");
+  EXPECT_EQ(d.message, "cpfg function 'srand' is not supported by Sylva");
   EXPECT_EQ(d.loc.line, 2);
   EXPECT_EQ(d.loc.column, 9);
 }
