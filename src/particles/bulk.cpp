@@ -26,7 +26,7 @@ Vec3f Round(const Vec3& x) {
 // on a thin one, where the next step could not tell its side. A rounded
 // point that crosses or touches one is pushed off it along the contact
 // normal by a few single-precision ulps and rounded again.
-Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x) {
+Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double radius) {
   Vec3f xf = Round(x);
   const double skin = 4 * double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
   Vec3 base = x;
@@ -40,7 +40,7 @@ Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x) {
     bool crossed = false;
     for (const Collider& c : colliders) {
       Contact ct;
-      if (c.Intersect(x, beyond, &ct)) {
+      if (c.Intersect(x, beyond, &ct, radius)) {
         base += skin * ct.normal;
         xf = Round(base);
         crossed = true;
@@ -65,7 +65,7 @@ uint32_t BulkState::Add(const Vec3& p, const Vec3& v, double m, double life) {
   birth.push_back(float(time));
   lifetime.push_back(float(std::min(life, 1e30)));
   color.push_back(Vec3f(1, 1, 1));
-  radius.push_back(0.05f);
+  radius.push_back(0.0f);
   id.push_back(nextId);
   return nextId++;
 }
@@ -122,22 +122,29 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       faulted_.store(true, std::memory_order_relaxed);
     if (colliders_.empty()) continue;
     std::memset(flags, 0, m);
+    // The chunk's largest radius: planes moved out by it screen every
+    // particle of the chunk.
+    float maxRadius = 0;
+    for (size_t i = c; i < ce; ++i) maxRadius = std::max(maxRadius, s.radius[i]);
     for (const Collider& col : colliders_) {
       if (col.kind == Collider::Kind::kPlane) {
-        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a, c, ce, flags);
+        const Vec3 p = col.point + double(maxRadius) * col.normal;
+        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), p.data(), a, c, ce, flags);
         continue;
       }
       for (size_t j = 0; j < m; ++j) {
-        flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j));
+        flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j),
+                               double(s.radius[c + j]));
       }
     }
     for (size_t j = 0; j < m; ++j) {
       const size_t i = c + j;
       if (!flags[j] || s.invMass[i] == 0) continue;
       Vec3 x = s.position(i), v = s.velocity(i);
+      const double r = double(s.radius[i]);
       const ContactOutcome out =
           RespondToContacts(colliders_, Vec3(old[0][j], old[1][j], old[2][j]),
-                            Vec3(old[3][j], old[4][j], old[5][j]), x, v, h);
+                            Vec3(old[3][j], old[4][j], old[5][j]), x, v, h, r);
       if (out == ContactOutcome::kNone) continue;
       if (out == ContactOutcome::kKilled) {
         // Dies at its age at the start of the step (rounded down), so it is
@@ -155,7 +162,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
         }
         faulted_.store(true, std::memory_order_relaxed);
       }
-      const Vec3f xf = RoundOutside(colliders_, x);
+      const Vec3f xf = RoundOutside(colliders_, x, r);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
       if (!MaybeWithinLimit(xf.cast<double>(), v, limit2_))

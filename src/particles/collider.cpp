@@ -59,7 +59,79 @@ Vec3 UnitOr(const Vec3& d, const Vec3& fallback) {
   return len > 0 ? Vec3(d / len) : fallback;
 }
 
+Vec3 ClosestOnSegment(const Vec3& p0, const Vec3& p1, const Vec3& x) {
+  const Vec3 e = p1 - p0;
+  const double ee = e.squaredNorm();
+  const double t = ee > 0 ? std::clamp(e.dot(x - p0) / ee, 0.0, 1.0) : 0.0;
+  return p0 + t * e;
+}
+
+// Whether q, on the plane of the convex polygon `poly` (counter-clockwise
+// about the unit normal n), lies inside it.
+bool InsidePolygon(const Vec3* poly, size_t count, const Vec3& n, const Vec3& q) {
+  for (size_t i = 0; i < count; ++i) {
+    const Vec3& p0 = poly[i];
+    const Vec3& p1 = poly[(i + 1) % count];
+    if ((p1 - p0).cross(q - p0).dot(n) < -1e-12 * (p1 - p0).squaredNorm()) return false;
+  }
+  return true;
+}
+
+// First entry of the path a -> b into a convex planar polygon grown by r > 0
+// (its two faces offset by r along the unit normal n, and a capsule of
+// radius r about each edge): where a ball of radius r on the path first
+// touches the polygon. The contact point is the ball's centre, nudged out by
+// the skin; a path that starts within r of the polygon reports s = 0 at the
+// nearest point at distance r.
+bool IntersectGrown(const Vec3* poly, size_t count, const Vec3& n, const Vec3& a, const Vec3& b,
+                    double r, double sBound, Contact* c) {
+  const Vec3 d = b - a;
+  const double d0 = n.dot(a - poly[0]), d1 = n.dot(b - poly[0]);
+  const double side = d0 > 0 ? 1 : d0 < 0 ? -1 : (d1 <= 0 ? 1 : -1);
+  const double e0 = side * d0, e1 = side * d1;
+  if (std::min(e0, e1) > r) return false;  // stays beyond the slab on one side
+  // Starts within r of the face: inside the grown polygon if its foot is.
+  if (e0 < r) {
+    const Vec3 foot = a - d0 * n;
+    if (InsidePolygon(poly, count, n, foot)) {
+      c->s = 0;
+      c->normal = side * n;
+      c->point = Skin(foot + r * c->normal, c->normal);
+      return true;
+    }
+  }
+  double best = sBound;
+  Vec3 bestNormal = Vec3::Zero(), bestPoint = Vec3::Zero();
+  if (e0 >= r && e1 < r) {  // the offset face
+    const double s = (e0 - r) / (e0 - e1);
+    const Vec3 q = a + s * d;
+    if (s < best && InsidePolygon(poly, count, n, q - n.dot(q - poly[0]) * n)) {
+      best = s;
+      bestNormal = side * n;
+      bestPoint = q;
+    }
+  }
+  for (size_t i = 0; i < count; ++i) {  // the rim
+    const Capsule cap{poly[i], poly[(i + 1) % count], r};
+    double s;
+    Vec3 m;
+    if (!IntersectCapsule(cap, a, b, &s, &m) || !(s < best)) continue;
+    best = s;
+    bestNormal = m;
+    bestPoint = s == 0 ? Vec3(ClosestOnSegment(cap.a, cap.b, a) + r * m) : Vec3(a + s * d);
+  }
+  if (!(best < sBound) || best > 1) return false;
+  c->s = best;
+  c->normal = bestNormal;
+  c->point = Skin(bestPoint, bestNormal);
+  return true;
+}
+
 }  // namespace
+
+bool Collider::IntersectGrownPolygon(const Vec3& a, const Vec3& b, double r, Contact* c) const {
+  return IntersectGrown(polygon.data(), polygon.size(), normal, a, b, r, 2, c);
+}
 
 // --- TriangleBvh ---
 
@@ -83,9 +155,49 @@ uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
       [&](const std::array<uint32_t, 3>& t) { return Vec3(v_[t[0]] + v_[t[1]] + v_[t[2]]); });
 }
 
-bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
+bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r) const {
+  if (nodes_.empty()) return false;
+  const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
+  uint32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if ((lo.array() > node.hi.array()).any() || (hi.array() < node.lo.array()).any()) continue;
+    if (node.count > 0) return true;
+    if (top + 2 > 128) return true;  // cannot happen for depth < 64
+    stack[top++] = node.left;
+    stack[top++] = node.right;
+  }
+  return false;
+}
+
+bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r) const {
   if (nodes_.empty()) return false;
   const Vec3 d = b - a;
+  if (r > 0) {
+    double best = 2;
+    Contact found;
+    WalkSegment(
+        nodes_, a, d, best,
+        [&](uint32_t first, uint32_t count) {
+          for (uint32_t i = first; i < first + count; ++i) {
+            const Vec3 tri[3] = {v_[tris_[i][0]], v_[tris_[i][1]], v_[tris_[i][2]]};
+            const Vec3 n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+            const double nn = n.squaredNorm();
+            if (!(nn > 0)) continue;  // degenerate
+            Contact ct;
+            if (IntersectGrown(tri, 3, n / std::sqrt(nn), a, b, r, best, &ct)) {
+              best = ct.s;
+              found = ct;
+            }
+          }
+        },
+        r);
+    if (best > 1) return false;
+    *c = found;
+    return true;
+  }
   double best = 2;
   Vec3 bestNormal = Vec3::Zero();
   WalkSegment(nodes_, a, d, best, [&](uint32_t first, uint32_t count) {
@@ -212,19 +324,35 @@ Collider Collider::Capsules(std::shared_ptr<const CapsuleBvh> bvh) {
   return c;
 }
 
-bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
+bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r) const {
   const Vec3 d = b - a;
+  // The solid grown by r (inside kinds: the room shrunk by r).
+  const double R = inside ? std::max(radius - r, 0.0) : radius + r;
+  Vec3 L = lo, H = hi;
+  if (r > 0) {
+    for (int k = 0; k < 3; ++k) {
+      if (!inside) {
+        L[k] -= r;
+        H[k] += r;
+      } else if (hi[k] - lo[k] > 2 * r) {
+        L[k] += r;
+        H[k] -= r;
+      } else {
+        L[k] = H[k] = 0.5 * (lo[k] + hi[k]);
+      }
+    }
+  }
   switch (kind) {
     case Kind::kPlane:
-      return Intersect(a, b, c);  // inline in the header
+      return Intersect(a, b, c, r);  // inline in the header
     case Kind::kSphere: {
       const Vec3 ac = a - point;
-      const double C = ac.squaredNorm() - radius * radius;
+      const double C = ac.squaredNorm() - R * R;
       if (!inside) {
         if (C < 0) {  // starts inside the ball
           c->s = 0;
           c->normal = UnitOr(ac, Vec3(0, 1, 0));
-          c->point = point + radius * c->normal;
+          c->point = point + R * c->normal;
           return true;
         }
         double s0, s1;
@@ -234,34 +362,34 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
         if (C > 0) {  // starts outside the bowl
           c->s = 0;
           const Vec3 u = UnitOr(ac, Vec3(0, 1, 0));
-          c->point = point + radius * u;
+          c->point = point + R * u;
           c->normal = -u;
           return true;
         }
-        if ((b - point).squaredNorm() <= radius * radius) return false;
+        if ((b - point).squaredNorm() <= R * R) return false;
         double s0, s1;
         if (!Roots(d.squaredNorm(), 2 * d.dot(ac), C, &s0, &s1)) return false;
         c->s = std::clamp(s1, 0.0, 1.0);
       }
       const Vec3 u = UnitOr(a + c->s * d - point, Vec3(0, 1, 0));
-      c->point = point + radius * u;
+      c->point = point + R * u;
       c->normal = inside ? Vec3(-u) : u;
       return true;
     }
     case Kind::kBox: {
       if (!inside) {
-        if ((a.array() > lo.array()).all() && (a.array() < hi.array()).all()) {
+        if ((a.array() > L.array()).all() && (a.array() < H.array()).all()) {
           c->s = 0;
-          return Project(a, &c->point, &c->normal);
+          return Project(a, &c->point, &c->normal, r);
         }
         double t0 = -HUGE_VAL, t1 = HUGE_VAL;
         int axis = -1;
         for (int k = 0; k < 3; ++k) {
           if (d[k] == 0) {
-            if (a[k] < lo[k] || a[k] > hi[k]) return false;
+            if (a[k] < L[k] || a[k] > H[k]) return false;
             continue;
           }
-          double ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
+          double ta = (L[k] - a[k]) / d[k], tb = (H[k] - a[k]) / d[k];
           if (ta > tb) std::swap(ta, tb);
           if (ta > t0) {
             t0 = ta;
@@ -275,19 +403,19 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
         c->point = a + t0 * d;
         c->normal = Vec3::Zero();
         c->normal[axis] = d[axis] > 0 ? -1 : 1;
-        c->point[axis] = d[axis] > 0 ? lo[axis] : hi[axis];
+        c->point[axis] = d[axis] > 0 ? L[axis] : H[axis];
         return true;
       }
-      if ((a.array() < lo.array()).any() || (a.array() > hi.array()).any()) {
+      if ((a.array() < L.array()).any() || (a.array() > H.array()).any()) {
         c->s = 0;
-        return Project(a, &c->point, &c->normal);
+        return Project(a, &c->point, &c->normal, r);
       }
       double best = 2;
       int axis = -1;
       for (int k = 0; k < 3; ++k) {
         double s = 2;
-        if (b[k] < lo[k]) s = (a[k] - lo[k]) / (a[k] - b[k]);
-        if (b[k] > hi[k]) s = (hi[k] - a[k]) / (b[k] - a[k]);
+        if (b[k] < L[k]) s = (a[k] - L[k]) / (a[k] - b[k]);
+        if (b[k] > H[k]) s = (H[k] - a[k]) / (b[k] - a[k]);
         if (s < best) {
           best = s;
           axis = k;
@@ -295,13 +423,14 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
       }
       if (axis < 0) return false;
       c->s = best;
-      c->point = (a + best * d).cwiseMax(lo).cwiseMin(hi);
+      c->point = (a + best * d).cwiseMax(L).cwiseMin(H);
       c->normal = Vec3::Zero();
-      c->normal[axis] = b[axis] < lo[axis] ? 1 : -1;
-      c->point[axis] = b[axis] < lo[axis] ? lo[axis] : hi[axis];
+      c->normal[axis] = b[axis] < L[axis] ? 1 : -1;
+      c->point[axis] = b[axis] < L[axis] ? L[axis] : H[axis];
       return true;
     }
     case Kind::kPolygon: {
+      if (r > 0) return IntersectGrownPolygon(a, b, r, c);
       double s, side;
       if (!CrossPlane(a, b, point, normal, &s, &side)) return false;
       const Vec3 q = a + s * d;
@@ -316,58 +445,73 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
       return true;
     }
     case Kind::kMesh:
-      return mesh && mesh->Intersect(a, b, c);
+      return mesh && mesh->Intersect(a, b, c, r);
     case Kind::kCapsules:
-      return capsules && capsules->Intersect(a, b, c);
+      return capsules && capsules->Intersect(a, b, c, r);
   }
   return false;
 }
 
-bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n) const {
+bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n, double r) const {
+  const double R = inside ? std::max(radius - r, 0.0) : radius + r;
+  Vec3 L = lo, H = hi;
+  if (r > 0) {
+    for (int k = 0; k < 3; ++k) {
+      if (!inside) {
+        L[k] -= r;
+        H[k] += r;
+      } else if (hi[k] - lo[k] > 2 * r) {
+        L[k] += r;
+        H[k] -= r;
+      } else {
+        L[k] = H[k] = 0.5 * (lo[k] + hi[k]);
+      }
+    }
+  }
   switch (kind) {
     case Kind::kPlane:
-      return Project(x, surface, n);  // inline in the header
+      return Project(x, surface, n, r);  // inline in the header
     case Kind::kSphere: {
-      const Vec3 r = x - point;
-      const double r2 = r.squaredNorm();
-      if (inside ? r2 <= radius * radius : r2 >= radius * radius) return false;
-      const Vec3 u = UnitOr(r, Vec3(0, 1, 0));
-      *surface = point + radius * u;
+      const Vec3 rel = x - point;
+      const double r2 = rel.squaredNorm();
+      if (inside ? r2 <= R * R : r2 >= R * R) return false;
+      const Vec3 u = UnitOr(rel, Vec3(0, 1, 0));
+      *surface = point + R * u;
       *n = inside ? Vec3(-u) : u;
       return true;
     }
     case Kind::kBox: {
       if (!inside) {
-        if (!((x.array() > lo.array()).all() && (x.array() < hi.array()).all())) return false;
+        if (!((x.array() > L.array()).all() && (x.array() < H.array()).all())) return false;
         // Out through the nearest face.
         double best = HUGE_VAL;
         int axis = 0;
         double sign = 1;
         for (int k = 0; k < 3; ++k) {
-          if (x[k] - lo[k] < best) {
-            best = x[k] - lo[k];
+          if (x[k] - L[k] < best) {
+            best = x[k] - L[k];
             axis = k;
             sign = -1;
           }
-          if (hi[k] - x[k] < best) {
-            best = hi[k] - x[k];
+          if (H[k] - x[k] < best) {
+            best = H[k] - x[k];
             axis = k;
             sign = 1;
           }
         }
         *surface = x;
-        (*surface)[axis] = sign < 0 ? lo[axis] : hi[axis];
+        (*surface)[axis] = sign < 0 ? L[axis] : H[axis];
         *n = Vec3::Zero();
         (*n)[axis] = sign;
         return true;
       }
-      const Vec3 clamped = x.cwiseMax(lo).cwiseMin(hi);
+      const Vec3 clamped = x.cwiseMax(L).cwiseMin(H);
       if (clamped == x) return false;
       int axis;
       (clamped - x).cwiseAbs().maxCoeff(&axis);
       *surface = clamped;
       *n = Vec3::Zero();
-      (*n)[axis] = x[axis] < lo[axis] ? 1 : -1;
+      (*n)[axis] = x[axis] < L[axis] ? 1 : -1;
       return true;
     }
     case Kind::kPolygon:
@@ -446,12 +590,12 @@ namespace {
                                                           const Vec3& a, const Vec3& x,
                                                           const Vec3& u,
                                                           const Collider* const* restingOn,
-                                                          Contact* best, bool* grazed) {
+                                                          Contact* best, bool* grazed, double r) {
   best->s = 2;
   const Collider* hit = nullptr;
   for (const Collider& c : colliders) {
     Contact ct;
-    if (!c.Intersect(a, x, &ct) || ct.s >= best->s) continue;
+    if (!c.Intersect(a, x, &ct, r) || ct.s >= best->s) continue;
     if (ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
         u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff())) {
       *grazed = true;
@@ -470,10 +614,10 @@ namespace {
 // Projects x out of every half-space solid it ended in, removing the
 // velocity into it.
 [[gnu::always_inline]] inline void ProjectOut(const std::vector<Collider>& colliders, Vec3& x,
-                                              Vec3& v) {
+                                              Vec3& v, double r) {
   for (const Collider& c : colliders) {
     Vec3 sp, sn;
-    if (c.Project(x, &sp, &sn)) {
+    if (c.Project(x, &sp, &sn, r)) {
       x = sp;
       const double vn = v.dot(sn);
       if (vn < 0) v -= vn * sn;
@@ -484,7 +628,7 @@ namespace {
 }  // namespace
 
 ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
-                                 Vec3& v, double h) {
+                                 Vec3& v, double h, double radius) {
   // The step as a path of constant acceleration from a, through x at its
   // end: p(tau) = a + tau u + tau^2 A / 2 for tau = t / h in [0, 1], with
   // u = h w (w the path's velocity at a) and A = h^2 acc, so that nothing
@@ -505,10 +649,10 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     const Collider* none[2] = {nullptr, nullptr};
     Contact c0;
     bool grazed0 = false;
-    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0);
+    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0, radius);
     if (!hit) {
       if (!grazed0) return ContactOutcome::kNone;
-      ProjectOut(colliders, x, v);
+      ProjectOut(colliders, x, v, radius);
       return ContactOutcome::kResponded;
     }
     const Vec3& n = c0.normal;
@@ -522,10 +666,10 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
       const Collider* resting0[2] = {hit, nullptr};
       Contact c1;
       bool grazed1 = false;
-      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1)) {
+      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1, radius)) {
         x = x1;
         v = out;
-        ProjectOut(colliders, x, v);
+        ProjectOut(colliders, x, v, radius);
         return ContactOutcome::kResponded;
       }
     }
@@ -540,7 +684,7 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
   bool grazed = false;
   for (;;) {
     Contact best;
-    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed);
+    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed, radius);
     if (!hit) break;
     const Vec3& n = best.normal;
     if (++contacts > kMaxContacts) [[unlikely]] {
@@ -630,7 +774,7 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
   }
   // Never leave a particle inside a solid.
   if (contacts == 0 && !grazed) return ContactOutcome::kNone;
-  ProjectOut(colliders, x, v);
+  ProjectOut(colliders, x, v, radius);
   return ContactOutcome::kResponded;
 }
 

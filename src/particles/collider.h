@@ -26,6 +26,7 @@
 // systems (System, double precision, and BulkSystem, single).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -57,7 +58,18 @@ class TriangleBvh {
  public:
   TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint32_t, 3>> triangles);
   // First crossing of the segment a -> b with any triangle, either side.
-  bool Intersect(const Vec3& a, const Vec3& b, Contact* c) const;
+  // With r > 0, the first entry into the triangles grown by r (the set of
+  // points within r of a triangle: two faces offset by r, and a capsule of
+  // radius r about every edge): where a ball of radius r centred on the
+  // path first touches a triangle. The contact point is the ball's centre.
+  bool Intersect(const Vec3& a, const Vec3& b, Contact* c, double r = 0) const;
+  // The bounding box of every triangle.
+  Vec3 lo() const { return nodes_.empty() ? Vec3::Zero() : nodes_[0].lo; }
+  Vec3 hi() const { return nodes_.empty() ? Vec3::Zero() : nodes_[0].hi; }
+  // Whether the box of the segment a -> b grown by r overlaps the box of a
+  // leaf of the hierarchy (a few triangles): false means no triangle is
+  // within r of the path. The broad phase of a mesh collider.
+  bool Near(const Vec3& a, const Vec3& b, double r) const;
   size_t triangleCount() const { return tris_.size(); }
   size_t nodeCount() const { return nodes_.size(); }
   int depth() const { return depth_; }
@@ -119,19 +131,31 @@ struct Collider {
 
   // First entry of the path a -> b into the solid. A path that starts inside
   // (a half-space kind only) reports s = 0 at the nearest surface point.
-  bool Intersect(const Vec3& a, const Vec3& b, Contact* c) const;
-  // A cheap test that is false only when the path a -> b certainly does not
-  // touch the collider (the per-particle fast path).
-  [[gnu::always_inline]] bool MayHit(const Vec3& a, const Vec3& b) const;
-  // Half-space kinds (plane, sphere, box): if x is inside the solid, the
-  // nearest surface point and its outward normal. Thin kinds return false.
-  bool Project(const Vec3& x, Vec3* surface, Vec3* normal) const;
+  //
+  // The particle's radius r (m, >= 0) counts in every kind: the path is
+  // that of the centre of a ball of radius r, tested against the solid
+  // grown by r (plane and polygon faces offset by r; a sphere's radius plus
+  // r, or minus r inside a bowl; a box's faces moved out by r, or in by r
+  // inside a container; a polygon's rim, a triangle's edges and capsules
+  // grown by r). The contact point is where the centre is at contact, so
+  // the centre stays at least r from the surface. r = 0 is a point.
+  bool Intersect(const Vec3& a, const Vec3& b, Contact* c, double r = 0) const;
+  // A cheap test that is false only when the path a -> b of a ball of
+  // radius r certainly does not touch the collider (the per-particle fast
+  // path; for a mesh, a walk down its hierarchy: TriangleBvh::Near).
+  [[gnu::always_inline]] bool MayHit(const Vec3& a, const Vec3& b, double r = 0) const;
+  // Half-space kinds (plane, sphere, box): if x, the centre of a ball of
+  // radius r, is inside the solid grown by r, the nearest point of its
+  // grown surface (at r from the surface) and its outward normal. Thin
+  // kinds return false.
+  bool Project(const Vec3& x, Vec3* surface, Vec3* normal, double r = 0) const;
 
  private:
   // Every kind, out of line; Intersect and Project inline the plane, the
   // kind of most resting contacts.
-  bool IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const;
-  bool ProjectAny(const Vec3& x, Vec3* surface, Vec3* normal) const;
+  bool IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r) const;
+  bool ProjectAny(const Vec3& x, Vec3* surface, Vec3* normal, double r) const;
+  bool IntersectGrownPolygon(const Vec3& a, const Vec3& b, double r, Contact* c) const;
 };
 
 // The first field of `c` outside its range (for its kind), or ok.
@@ -172,16 +196,20 @@ constexpr int kInelasticContacts = 16;
 // times that from the tangential one; against two surfaces at once the
 // particle slides along their crease). A particle that touched anything is
 // finally projected out of every half-space solid. x and v are updated.
+// `radius` is the particle's (m, >= 0; see Collider::Intersect): its centre
+// stays at least that far from every surface.
 ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
-                                 Vec3& v, double h);
+                                 Vec3& v, double h, double radius = 0);
 
 // --- inline ---
 
-inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
-  if (kind != Kind::kPlane) return IntersectAny(a, b, c);
-  const double d1 = normal.dot(b - point);
+inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r) const {
+  if (kind != Kind::kPlane) return IntersectAny(a, b, c, r);
+  // The plane moved out by r.
+  const Vec3 p = r == 0 ? point : Vec3(point + r * normal);
+  const double d1 = normal.dot(b - p);
   if (d1 >= 0) return false;
-  const double d0 = normal.dot(a - point);
+  const double d0 = normal.dot(a - p);
   c->normal = normal;
   if (d0 <= 0) {  // starts on or below the surface
     c->s = 0;
@@ -189,42 +217,45 @@ inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c) const 
   } else {
     c->s = d0 / (d0 - d1);
     c->point = a + c->s * (b - a);
-    c->point -= normal.dot(c->point - point) * normal;  // exactly on the plane
+    c->point -= normal.dot(c->point - p) * normal;  // exactly on the plane
   }
   return true;
 }
 
-inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n) const {
-  if (kind != Kind::kPlane) return ProjectAny(x, surface, n);
-  const double d = normal.dot(x - point);
+inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n, double r) const {
+  if (kind != Kind::kPlane) return ProjectAny(x, surface, n, r);
+  const double d = normal.dot(x - point) - r;
   if (d >= 0) return false;
   *surface = x - d * normal;
   *n = normal;
   return true;
 }
 
-[[gnu::always_inline]] inline bool Collider::MayHit(const Vec3& a, const Vec3& b) const {
+[[gnu::always_inline]] inline bool Collider::MayHit(const Vec3& a, const Vec3& b, double r) const {
   switch (kind) {
     case Kind::kPlane:
-      return normal.dot(b - point) < 0;
-    case Kind::kSphere:
-      if (inside)
-        return (b - point).squaredNorm() > radius * radius ||
-               (a - point).squaredNorm() > radius * radius;
-      return ((a.cwiseMin(b) - point).array() <= radius).all() &&
-             ((a.cwiseMax(b) - point).array() >= -radius).all();
+      return normal.dot(b - point) < r;
+    case Kind::kSphere: {
+      const double R = inside ? std::max(radius - r, 0.0) : radius + r;
+      if (inside) return (b - point).squaredNorm() > R * R || (a - point).squaredNorm() > R * R;
+      return ((a.cwiseMin(b) - point).array() <= R).all() &&
+             ((a.cwiseMax(b) - point).array() >= -R).all();
+    }
     case Kind::kBox:
       if (inside) {
-        return (b.array() < lo.array()).any() || (b.array() > hi.array()).any() ||
-               (a.array() < lo.array()).any() || (a.array() > hi.array()).any();
+        const Vec3 L = lo.array() + r, H = hi.array() - r;
+        return (b.array() < L.array()).any() || (b.array() > H.array()).any() ||
+               (a.array() < L.array()).any() || (a.array() > H.array()).any();
       }
-      return (a.cwiseMin(b).array() <= hi.array()).all() &&
-             (a.cwiseMax(b).array() >= lo.array()).all();
+      return (a.cwiseMin(b).array() <= hi.array() + r).all() &&
+             (a.cwiseMax(b).array() >= lo.array() - r).all();
     case Kind::kPolygon: {
       const double d0 = normal.dot(a - point), d1 = normal.dot(b - point);
-      return (d0 <= 0 && d1 >= 0) || (d0 >= 0 && d1 <= 0);
+      if (r == 0) return (d0 <= 0 && d1 >= 0) || (d0 >= 0 && d1 <= 0);
+      return std::min(d0, d1) <= r && std::max(d0, d1) >= -r;
     }
     case Kind::kMesh:
+      return mesh && mesh->Near(a, b, r);
     case Kind::kCapsules:
       return true;
   }

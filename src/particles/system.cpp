@@ -35,7 +35,7 @@ uint32_t ParticleState::Add(const Vec3& p, const Vec3& v, double m, double life)
   age.push_back(0);
   lifetime.push_back(life);
   color.push_back(Vec3f(1, 1, 1));
-  radius.push_back(0.05f);
+  radius.push_back(0.0f);
   id.push_back(nextId);
   return nextId++;
 }
@@ -361,7 +361,7 @@ uint64_t System::Hash() const {
 // Contact response for particle i (see RespondToContacts); kill and stick
 // change its cold data.
 [[gnu::noinline]] void System::Collide(size_t i, Vec3 a, Vec3 va, Vec3& x, Vec3& v, double h) {
-  switch (RespondToContacts(colliders_, a, va, x, v, h)) {
+  switch (RespondToContacts(colliders_, a, va, x, v, h, double(state.radius[i]))) {
     case ContactOutcome::kKilled:
       state.lifetime[i] = std::min(state.lifetime[i], state.age[i]);
       break;
@@ -388,8 +388,9 @@ uint64_t System::Hash() const {
     x1 = x0;
     v1 = Vec3::Zero();
   } else {
+    const double r = double(state.radius[i]);
     for (const Collider& c : colliders_) {
-      if (c.MayHit(x0, x1)) {
+      if (c.MayHit(x0, x1, r)) {
         Collide(i, x0, v0, x1, v1, h);
         break;
       }

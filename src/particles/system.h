@@ -52,7 +52,9 @@ struct ParticleState {
   // cold
   std::vector<double> mass, invMass, age, lifetime;
   std::vector<Vec3f> color;
-  std::vector<float> radius;  // drawn size, metres
+  // Metres, >= 0: the particle is a ball of this radius to every collider
+  // (its centre stays at least this far from a surface) and its drawn size.
+  std::vector<float> radius;
   std::vector<uint32_t> id;
   uint32_t nextId = 0;
   // The time and step number forces are evaluated at (set by the system).
@@ -60,7 +62,8 @@ struct ParticleState {
   uint64_t step = 0;
 
   size_t size() const { return position.size(); }
-  // Adds a particle; mass 0 or less means immovable (infinite mass).
+  // Adds a particle of radius 0 (a point: set radius.back() for a ball);
+  // mass 0 or less means immovable (infinite mass).
   uint32_t Add(const Vec3& p, const Vec3& v, double mass = 1, double lifetime = 1e300);
 };
 
