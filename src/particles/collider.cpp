@@ -111,8 +111,14 @@ bool IntersectGrown(const Vec3* poly, size_t count, const Vec3& n, const Vec3& a
       bestPoint = q;
     }
   }
-  for (size_t i = 0; i < count; ++i) {  // the rim
+  // The rim: only edges whose box, grown by r, meets the path's box.
+  const Vec3 plo = a.cwiseMin(b) - Vec3::Constant(r), phi = a.cwiseMax(b) + Vec3::Constant(r);
+  for (size_t i = 0; i < count; ++i) {
     const Capsule cap{poly[i], poly[(i + 1) % count], r};
+    if ((cap.a.cwiseMin(cap.b).array() > phi.array()).any() ||
+        (cap.a.cwiseMax(cap.b).array() < plo.array()).any()) {
+      continue;
+    }
     double s;
     Vec3 m;
     if (!IntersectCapsule(cap, a, b, &s, &m) || !(s < best)) continue;
@@ -140,7 +146,10 @@ TriangleBvh::TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint
   for (const auto& t : tris_) {
     for (uint32_t k : t) SYLVA_ASSERT(k < v_.size());
   }
-  if (!tris_.empty()) Build(0, uint32_t(tris_.size()), 1);
+  if (!tris_.empty()) {
+    Build(0, uint32_t(tris_.size()), 1);
+    BuildGrid();
+  }
 }
 
 uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
@@ -158,6 +167,25 @@ uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
 bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r) const {
   if (nodes_.empty()) return false;
   const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
+  if (dims_[0] > 0) {  // the grid: whether a cell the box covers lists a triangle
+    const Vec3 glo = (lo - gridLo_) / cell_, ghi = (hi - gridLo_) / cell_;
+    if (((ghi - glo).array() + 1).prod() <= 8.5) {
+      int l[3], h[3];
+      for (int k = 0; k < 3; ++k) {
+        if (!(ghi[k] >= 0 && glo[k] < dims_[k])) return false;
+        l[k] = std::max(0, int(std::floor(glo[k])));
+        h[k] = std::min(dims_[k] - 1, int(std::floor(ghi[k])));
+      }
+      for (int z = l[2]; z <= h[2]; ++z)
+        for (int y = l[1]; y <= h[1]; ++y)
+          for (int x = l[0]; x <= h[0]; ++x) {
+            const size_t cell =
+                (size_t(z) * size_t(dims_[1]) + size_t(y)) * size_t(dims_[0]) + size_t(x);
+            if (start_[cell + 1] > start_[cell]) return true;
+          }
+      return false;
+    }
+  }
   uint32_t stack[128];
   int top = 0;
   stack[top++] = 0;
@@ -172,57 +200,127 @@ bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r) const {
   return false;
 }
 
+// Triangle i against the path a -> b (of a ball of radius r): its entry s
+// if below `best`, with the normal (and, for r > 0, the point).
+bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r, double best,
+                              Contact* c) const {
+  const Vec3 &v0 = v_[tris_[i][0]], &v1 = v_[tris_[i][1]], &v2 = v_[tris_[i][2]];
+  const Vec3 n = (v1 - v0).cross(v2 - v0);
+  const double nn = n.squaredNorm();
+  if (!(nn > 0)) return false;  // degenerate
+  if (r > 0) {
+    // The triangle's box against the path's box grown by r.
+    const Vec3 plo = a.cwiseMin(b) - Vec3::Constant(r), phi = a.cwiseMax(b) + Vec3::Constant(r);
+    if ((v0.cwiseMin(v1).cwiseMin(v2).array() > phi.array()).any() ||
+        (v0.cwiseMax(v1).cwiseMax(v2).array() < plo.array()).any()) {
+      return false;
+    }
+    const Vec3 tri[3] = {v0, v1, v2};
+    return IntersectGrown(tri, 3, n / std::sqrt(nn), a, b, r, best, c);
+  }
+  double s, side;
+  if (!CrossPlane(a, b, v0, n, &s, &side) || s >= best) return false;
+  const Vec3 q = a + s * (b - a);
+  const double tol = -1e-12 * nn;
+  if ((v1 - v0).cross(q - v0).dot(n) < tol || (v2 - v1).cross(q - v1).dot(n) < tol ||
+      (v0 - v2).cross(q - v2).dot(n) < tol) {
+    return false;
+  }
+  c->s = s;
+  c->normal = side * n / std::sqrt(nn);
+  return true;
+}
+
 bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r) const {
   if (nodes_.empty()) return false;
   const Vec3 d = b - a;
-  if (r > 0) {
-    double best = 2;
-    Contact found;
+  double best = 2;
+  Contact found;
+  auto test = [&](uint32_t i) {
+    Contact ct;
+    if (HitTriangle(i, a, b, r, best, &ct) && ct.s < best) {
+      best = ct.s;
+      found = ct;
+    }
+  };
+  // A short path (its grown box within 8 cells): the grid's lists; a
+  // triangle listed in several cells is tested again, to the same answer.
+  const Vec3 glo = (a.cwiseMin(b) - Vec3::Constant(r) - gridLo_) / cell_;
+  const Vec3 ghi = (a.cwiseMax(b) + Vec3::Constant(r) - gridLo_) / cell_;
+  if (dims_[0] > 0 && ((ghi - glo).array() + 1).prod() <= 8.5) {
+    int l[3], h[3];
+    for (int k = 0; k < 3; ++k) {
+      if (!(ghi[k] >= 0 && glo[k] < dims_[k])) return false;  // outside the grid: no triangle
+      l[k] = std::max(0, int(std::floor(glo[k])));
+      h[k] = std::min(dims_[k] - 1, int(std::floor(ghi[k])));
+    }
+    for (int z = l[2]; z <= h[2]; ++z)
+      for (int y = l[1]; y <= h[1]; ++y)
+        for (int x = l[0]; x <= h[0]; ++x) {
+          const size_t cell =
+              (size_t(z) * size_t(dims_[1]) + size_t(y)) * size_t(dims_[0]) + size_t(x);
+          for (uint32_t t = start_[cell]; t < start_[cell + 1]; ++t) test(items_[t]);
+        }
+  } else {
     WalkSegment(
         nodes_, a, d, best,
         [&](uint32_t first, uint32_t count) {
-          for (uint32_t i = first; i < first + count; ++i) {
-            const Vec3 tri[3] = {v_[tris_[i][0]], v_[tris_[i][1]], v_[tris_[i][2]]};
-            const Vec3 n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
-            const double nn = n.squaredNorm();
-            if (!(nn > 0)) continue;  // degenerate
-            Contact ct;
-            if (IntersectGrown(tri, 3, n / std::sqrt(nn), a, b, r, best, &ct)) {
-              best = ct.s;
-              found = ct;
-            }
-          }
+          for (uint32_t i = first; i < first + count; ++i) test(i);
         },
         r);
-    if (best > 1) return false;
-    *c = found;
-    return true;
   }
-  double best = 2;
-  Vec3 bestNormal = Vec3::Zero();
-  WalkSegment(nodes_, a, d, best, [&](uint32_t first, uint32_t count) {
-    for (uint32_t i = first; i < first + count; ++i) {
-      const Vec3 &v0 = v_[tris_[i][0]], &v1 = v_[tris_[i][1]], &v2 = v_[tris_[i][2]];
-      const Vec3 n = (v1 - v0).cross(v2 - v0);
-      const double nn = n.squaredNorm();
-      if (!(nn > 0)) continue;  // degenerate
-      double s, side;
-      if (!CrossPlane(a, b, v0, n, &s, &side) || s >= best) continue;
-      const Vec3 q = a + s * d;
-      const double tol = -1e-12 * nn;
-      if ((v1 - v0).cross(q - v0).dot(n) < tol || (v2 - v1).cross(q - v1).dot(n) < tol ||
-          (v0 - v2).cross(q - v2).dot(n) < tol) {
-        continue;
-      }
-      best = s;
-      bestNormal = side * n / std::sqrt(nn);
-    }
-  });
   if (best > 1) return false;
-  c->s = best;
-  c->normal = bestNormal;
-  c->point = Skin(a + best * d, bestNormal);
+  *c = found;
+  if (r == 0) c->point = Skin(a + best * d, found.normal);
   return true;
+}
+
+void TriangleBvh::BuildGrid() {
+  // About eight cells a triangle, at most 256 an axis.
+  Vec3 lo = nodes_[0].lo, hi = nodes_[0].hi;
+  const Vec3 extent = (hi - lo).cwiseMax(Vec3::Constant(1e-9));
+  if (!extent.allFinite()) return;
+  double cell = std::cbrt(extent.prod() / (8.0 * double(tris_.size())));
+  cell = std::max({cell, extent.maxCoeff() / 256, 1e-9});
+  int dims[3];
+  for (int k = 0; k < 3; ++k) dims[k] = std::clamp(int(std::ceil(extent[k] / cell)), 1, 256);
+  const size_t cells = size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]);
+  auto range = [&](const std::array<uint32_t, 3>& t, int l[3], int h[3]) {
+    const Vec3 tl = v_[t[0]].cwiseMin(v_[t[1]]).cwiseMin(v_[t[2]]);
+    const Vec3 th = v_[t[0]].cwiseMax(v_[t[1]]).cwiseMax(v_[t[2]]);
+    for (int k = 0; k < 3; ++k) {
+      l[k] = std::clamp(int(std::floor((tl[k] - lo[k]) / cell)), 0, dims[k] - 1);
+      h[k] = std::clamp(int(std::floor((th[k] - lo[k]) / cell)), 0, dims[k] - 1);
+    }
+  };
+  // Counting pass, prefix sums, then the lists in triangle order.
+  std::vector<uint32_t> count(cells + 1, 0);
+  size_t total = 0;
+  for (const auto& t : tris_) {
+    int l[3], h[3];
+    range(t, l, h);
+    total += size_t(h[0] - l[0] + 1) * size_t(h[1] - l[1] + 1) * size_t(h[2] - l[2] + 1);
+    if (total > (size_t(1) << 26)) return;  // lists past 256 MiB: the hierarchy alone
+    for (int z = l[2]; z <= h[2]; ++z)
+      for (int y = l[1]; y <= h[1]; ++y)
+        for (int x = l[0]; x <= h[0]; ++x)
+          ++count[(size_t(z) * size_t(dims[1]) + size_t(y)) * size_t(dims[0]) + size_t(x) + 1];
+  }
+  for (size_t i = 1; i <= cells; ++i) count[i] += count[i - 1];
+  start_ = count;
+  items_.resize(total);
+  for (uint32_t ti = 0; ti < tris_.size(); ++ti) {
+    int l[3], h[3];
+    range(tris_[ti], l, h);
+    for (int z = l[2]; z <= h[2]; ++z)
+      for (int y = l[1]; y <= h[1]; ++y)
+        for (int x = l[0]; x <= h[0]; ++x)
+          items_[count[(size_t(z) * size_t(dims[1]) + size_t(y)) * size_t(dims[0]) + size_t(x)]++] =
+              ti;
+  }
+  gridLo_ = lo;
+  cell_ = cell;
+  for (int k = 0; k < 3; ++k) dims_[k] = dims[k];
 }
 
 // --- Collider ---
@@ -267,9 +365,21 @@ Status Validate(const Collider& c) {
       if (!c.capsules) return Error("Collider.capsules is null");
       break;
   }
+  SYLVA_CHECK_OK(Finite("Collider.velocity", c.velocity, 1e12, "m/s"));
+  if (c.moving() && (c.kind == Collider::Kind::kMesh || c.kind == Collider::Kind::kCapsules)) {
+    return Error("Collider.velocity " + Vec(c.velocity) +
+                 ": a mesh or capsules collider cannot move (only plane, sphere, box and polygon)");
+  }
   SYLVA_CHECK_OK(Range("Collider.restitution", c.restitution, 0, 1));
   SYLVA_CHECK_OK(Range("Collider.friction", c.friction, 0, 1e3));
   return {};
+}
+
+void Collider::Translate(const Vec3& d) {
+  point += d;
+  lo += d;
+  hi += d;
+  for (Vec3& p : polygon) p += d;
 }
 
 Collider Collider::Plane(const Vec3& point, const Vec3& normal) {
@@ -586,18 +696,23 @@ namespace {
 // the surface), and a sphere the particle rests on this step (the path left
 // along its tangent, which the surface bends away from; the projection puts
 // the end back on it). u is h times the path's velocity at a.
-[[gnu::always_inline]] inline const Collider* FindContact(const std::vector<Collider>& colliders,
-                                                          const Vec3& a, const Vec3& x,
-                                                          const Vec3& u,
-                                                          const Collider* const* restingOn,
-                                                          Contact* best, bool* grazed, double r) {
+[[gnu::always_inline]] inline const Collider* FindContact(
+    const std::vector<Collider>& colliders, const Vec3& a, const Vec3& x, const Vec3& u,
+    const Collider* const* restingOn, Contact* best, bool* grazed, double r, double e, double h) {
   best->s = 2;
   const Collider* hit = nullptr;
   for (const Collider& c : colliders) {
     Contact ct;
-    if (!c.Intersect(a, x, &ct, r) || ct.s >= best->s) continue;
-    if (ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
-        u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff())) {
+    // A moving collider: the path in its frame at the start of the step (a
+    // is e of the step in, x at its end). The contact found is in that
+    // frame too.
+    const bool moving = c.moving();
+    const Vec3 w = moving ? Vec3(h * c.velocity) : Vec3::Zero();
+    const Vec3 ar = moving ? Vec3(a - e * w) : a, xr = moving ? Vec3(x - w) : x;
+    const Vec3 ur = moving ? Vec3(u - w) : u;
+    if (!c.Intersect(ar, xr, &ct, r) || ct.s >= best->s) continue;
+    if (ct.normal.dot(ct.point - xr) <= 1e-12 * std::max(1.0, xr.cwiseAbs().maxCoeff()) &&
+        ur.dot(ct.normal) >= -1e-12 * std::max(1e-300, ur.cwiseAbs().maxCoeff())) {
       *grazed = true;
       continue;
     }
@@ -614,12 +729,23 @@ namespace {
 // Projects x out of every half-space solid it ended in, removing the
 // velocity into it.
 [[gnu::always_inline]] inline void ProjectOut(const std::vector<Collider>& colliders, Vec3& x,
-                                              Vec3& v, double r) {
+                                              Vec3& v, double r, double h) {
   for (const Collider& c : colliders) {
     Vec3 sp, sn;
-    if (c.Project(x, &sp, &sn, r)) {
-      x = sp;
-      const double vn = v.dot(sn);
+    if (!c.moving()) {
+      if (c.Project(x, &sp, &sn, r)) {
+        x = sp;
+        const double vn = v.dot(sn);
+        if (vn < 0) v -= vn * sn;
+      }
+      continue;
+    }
+    // Where the collider is at the end of the step; the velocity relative
+    // to it.
+    const Vec3 w = h * c.velocity;
+    if (c.Project(x - w, &sp, &sn, r)) {
+      x = sp + w;
+      const double vn = (v - c.velocity).dot(sn);
       if (vn < 0) v -= vn * sn;
     }
   }
@@ -649,14 +775,14 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     const Collider* none[2] = {nullptr, nullptr};
     Contact c0;
     bool grazed0 = false;
-    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0, radius);
+    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0, radius, 0, h);
     if (!hit) {
       if (!grazed0) return ContactOutcome::kNone;
-      ProjectOut(colliders, x, v, radius);
+      ProjectOut(colliders, x, v, radius, h);
       return ContactOutcome::kResponded;
     }
     const Vec3& n = c0.normal;
-    if (c0.s == 0 && hit->response == Response::kBounce &&
+    if (c0.s == 0 && !hit->moving() && hit->response == Response::kBounce &&
         !(-u.dot(n) > std::max(0.0, -h * dv.dot(n)))) {
       const double en = v.dot(n);
       const double jn = std::max(0.0, -en);
@@ -666,10 +792,10 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
       const Collider* resting0[2] = {hit, nullptr};
       Contact c1;
       bool grazed1 = false;
-      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1, radius)) {
+      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1, radius, 0, h)) {
         x = x1;
         v = out;
-        ProjectOut(colliders, x, v, radius);
+        ProjectOut(colliders, x, v, radius, h);
         return ContactOutcome::kResponded;
       }
     }
@@ -684,7 +810,8 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
   bool grazed = false;
   for (;;) {
     Contact best;
-    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed, radius);
+    const double e = 1 - rem;  // of the step, at a
+    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed, radius, e, h);
     if (!hit) break;
     const Vec3& n = best.normal;
     if (++contacts > kMaxContacts) [[unlikely]] {
@@ -692,6 +819,16 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
       x = a;
       v = Vec3::Zero();
       return ContactOutcome::kUnresolved;
+    }
+    // A moving collider: into its frame at the start of the step (h times
+    // its velocity is w); back out below.
+    const bool moving = hit->moving();
+    const Vec3 w = moving ? Vec3(h * hit->velocity) : Vec3::Zero();
+    if (moving) {
+      a -= e * w;
+      x -= w;
+      u -= w;
+      v -= hit->velocity;
     }
     // Time of impact along the path. On a flat face (plane, polygon, box,
     // triangle) it is exact: the root of the path against the face's
@@ -709,12 +846,12 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     const Vec3 uc = u + tau * A;  // h times the path's velocity at the contact
     const double r = rem - tau;
     if (hit->response == Response::kKill) [[unlikely]] {
-      x = point;
-      v = (uc + hOffset) * (1 / h);
+      x = point + (e + tau) * w;
+      v = (uc + hOffset) * (1 / h) + hit->velocity;
       return ContactOutcome::kKilled;
     }
     if (hit->response == Response::kStick) [[unlikely]] {
-      x = point;
+      x = point + (e + tau) * w;  // where it met the collider; it stays there
       v = Vec3::Zero();
       return ContactOutcome::kStuck;
     }
@@ -729,7 +866,7 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     // without end, nearer and nearer its crease): every further contact is
     // resting or sliding, which ends on the crease.
     const bool twoSurfaces = best.s == 0 && restingCount > 0;
-    if (twoSurfaces) [[unlikely]] {
+    if (twoSurfaces && !moving) [[unlikely]] {
       point = CreasePoint(a, n, best.point, resting[restingCount - 1],
                           restingPoint[restingCount - 1], point);
     }
@@ -769,12 +906,18 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
       A = Vec3::Zero();
       hOffset = Vec3::Zero();
     }
+    if (moving) {  // back to the world
+      point += (e + tau) * w;
+      x += w;
+      u += w;
+      v += hit->velocity;
+    }
     a = point;
     rem = r;
   }
   // Never leave a particle inside a solid.
   if (contacts == 0 && !grazed) return ContactOutcome::kNone;
-  ProjectOut(colliders, x, v, radius);
+  ProjectOut(colliders, x, v, radius, h);
   return ContactOutcome::kResponded;
 }
 

@@ -53,7 +53,9 @@ struct Contact {
 };
 
 // Triangles with an axis-aligned bounding-volume hierarchy (median split on
-// the longest axis of the centroids' box, at most 4 triangles a leaf).
+// the longest axis of the centroids' box, at most 4 triangles a leaf) for
+// long paths, and a uniform grid for short ones (a particle's step); both
+// give the same first crossing.
 class TriangleBvh {
  public:
   TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint32_t, 3>> triangles);
@@ -81,10 +83,21 @@ class TriangleBvh {
     uint32_t left = 0, right = 0;
   };
   uint32_t Build(uint32_t first, uint32_t count, int depth);
+  void BuildGrid();
+  bool HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r, double best,
+                   Contact* c) const;
   std::vector<Vec3> v_;
   std::vector<std::array<uint32_t, 3>> tris_;
   std::vector<Node> nodes_;
   int depth_ = 0;
+  // A uniform grid (about eight cells a triangle, at most 256 an axis) for
+  // short paths, the common query: cell (x, y, z) lists the triangles whose
+  // boxes touch it, items_[start_[cell] .. start_[cell + 1]). 4 bytes a cell
+  // and a listing.
+  Vec3 gridLo_ = Vec3::Zero();
+  double cell_ = 1;
+  int dims_[3] = {0, 0, 0};
+  std::vector<uint32_t> start_, items_;
 };
 
 // A collider is a plain description; the factories below fill it, and
@@ -103,6 +116,13 @@ struct Collider {
   std::vector<Vec3> polygon;                // convex, counter-clockwise about normal, >= 3 vertices
   std::shared_ptr<const TriangleBvh> mesh;  // not null for kMesh
   std::shared_ptr<const CapsuleBvh> capsules;  // not null for kCapsules
+  // Kinematic motion: the solid translates at this velocity (m/s, each
+  // component within +-1e12), and a contact responds to the particle's
+  // velocity relative to it (a moving plane or ball pushes and carries
+  // particles). System::Step and BulkSystem::Step move it by h times its
+  // velocity after each step (Translate). Plane, sphere, box and polygon;
+  // a mesh or capsules with a velocity fail Validate (not supported yet).
+  Vec3 velocity{0, 0, 0};
   // Material.
   double restitution = 1;  // e: normal speed out / in, 0..1
   double friction = 0;     // Coulomb mu, 0..1e3: tangential impulse <= mu * normal impulse
@@ -128,6 +148,13 @@ struct Collider {
     response = r;
     return *this;
   }
+  Collider& Velocity(const Vec3& v) {
+    velocity = v;
+    return *this;
+  }
+  bool moving() const { return velocity.x() != 0 || velocity.y() != 0 || velocity.z() != 0; }
+  // Moves the solid by d (point, polygon vertices, box corners).
+  void Translate(const Vec3& d);
 
   // First entry of the path a -> b into the solid. A path that starts inside
   // (a half-space kind only) reports s = 0 at the nearest surface point.
@@ -187,7 +214,12 @@ constexpr int kInelasticContacts = 16;
 // v) over h seconds. The step's path is the one of constant acceleration
 // (v - va) / h from a through x; contacts are found along its chord and
 // their time of impact is exact on flat faces (the root of the path against
-// the face's plane). Any number of contacts a step, until the path meets no
+// the face's plane). A moving collider (Collider::velocity) is where it is
+// at the start of the step and moves by h velocity over it: its contacts
+// are found and answered in its own frame, in which the path is the
+// particle's relative one, so the time of impact and the response (bounce,
+// rest, friction) use the relative velocity, exact for a steady
+// translation. Any number of contacts a step, until the path meets no
 // collider, up to kMaxContacts (then kUnresolved): a bounce reflects the
 // path's velocity at the time of impact (normal speed times e, Coulomb
 // friction) and goes on along the rest of the path, so at e = 1 the

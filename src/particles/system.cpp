@@ -301,6 +301,12 @@ void System::ForChunks(size_t n, Fn&& fn) const {
   ForRanges(pool_, n, BalancedGrain(pool_, n, 256, kChunk), fn);
 }
 
+void System::MoveColliders(double h) {
+  for (Collider& c : colliders_) {
+    if (c.moving()) c.Translate(h * c.velocity);
+  }
+}
+
 void System::NonLocalForces(const Vec3* x, const Vec3* v) const {
   if (!hasNonLocal_) return;
   const size_t n = state.size();
@@ -390,7 +396,8 @@ uint64_t System::Hash() const {
   } else {
     const double r = double(state.radius[i]);
     for (const Collider& c : colliders_) {
-      if (c.MayHit(x0, x1, r)) {
+      // A moving collider: the path in its frame at the start of the step.
+      if (c.moving() ? c.MayHit(x0, x1 - h * c.velocity, r) : c.MayHit(x0, x1, r)) {
         Collide(i, x0, v0, x1, v1, h);
         break;
       }
@@ -539,6 +546,7 @@ Status System::Step(double h, Integrator integrator) {
       break;
   }
   if (pairRadius_ > 0) ParticleCollisions();
+  MoveColliders(h);
   state.time = time;
   Status status = CheckFaults("in");
   time += h;
@@ -868,6 +876,7 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
         for (size_t i = b; i < e; ++i) Finish(i, X[i], V[i], x_[i], v_[i], h);
       });
       if (pairRadius_ > 0) ParticleCollisions();
+      MoveColliders(h);
       state.time = time;
       Status s = CheckFaults("in adaptive");
       time += h;

@@ -281,6 +281,8 @@ class System {
   int threads() const;
   void AddForce(std::shared_ptr<Force> f);
   // Adds a collider that passes Validate(Collider), else its Diagnostic.
+  // One with a velocity moves by h times it after every step (colliders()
+  // gives where they are).
   [[nodiscard]] Status AddCollider(Collider c);
   const std::vector<Collider>& colliders() const { return colliders_; }
   [[nodiscard]] Status AddPlane(const Plane& p) {
@@ -330,6 +332,8 @@ class System {
   template <int K, typename Fn>
   std::array<double, K> SumChunks(size_t n, Fn&& fn) const;
   void ParticleCollisions();
+  // Moves every moving collider by h times its velocity (after a step).
+  void MoveColliders(double h);
   Status CheckFaults(const char* what);
   Status CheckStep(const char* what, double h) const;
 
