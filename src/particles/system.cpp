@@ -486,6 +486,7 @@ Status System::Step(double h, Integrator integrator) {
   state.time = time;
   state.step = steps;
   faulted_ = false;
+  if (pairRadius_ > 0) SavePairStart();
   switch (integrator) {
     case Integrator::kExplicitEuler:
     case Integrator::kSymplecticEuler: {
@@ -545,7 +546,7 @@ Status System::Step(double h, Integrator integrator) {
       SYLVA_CHECK_OK(ImplicitEuler(h));
       break;
   }
-  if (pairRadius_ > 0) ParticleCollisions();
+  if (pairRadius_ > 0) ParticleCollisions(h);
   MoveColliders(h);
   state.time = time;
   Status status = CheckFaults("in");
@@ -734,34 +735,9 @@ Status System::NonFiniteSolve(const char* what, const Vec3* a, int iteration) {
   return d;
 }
 
-void System::ParticleCollisions() {
-  const size_t n = state.size();
-  std::vector<Vec3>& X = state.position;
-  std::vector<Vec3>& V = state.velocity;
-  const double reach = 2 * pairRadius_;
-  pairGrid_->Build(X.data(), n, reach, pool_);
-  const double* w = state.invMass.data();
-  // Gauss-Seidel over the pairs in index order: serial, so deterministic.
-  for (size_t i = 0; i < n; ++i) {
-    pairGrid_->ForEachNeighbour(X.data(), i, reach, [&](size_t j) {
-      if (j < i) return;
-      const double ws = w[i] + w[j];
-      if (ws == 0) return;
-      const Vec3 d = X[i] - X[j];
-      const double dist = d.norm();
-      if (!(dist > 0) || dist >= reach) return;
-      const Vec3 nrm = d / dist;
-      const double rel = (V[i] - V[j]).dot(nrm);
-      if (rel < 0) {  // approaching: exchange a momentum-conserving impulse
-        const double J = -(1 + pairRestitution_) * rel / ws;
-        V[i] += J * w[i] * nrm;
-        V[j] -= J * w[j] * nrm;
-      }
-      const double overlap = reach - dist;  // separate, heavier moves less
-      X[i] += overlap * (w[i] / ws) * nrm;
-      X[j] -= overlap * (w[j] / ws) * nrm;
-    });
-  }
+void System::SavePairStart() {
+  pairX0_.assign(state.position.begin(), state.position.end());
+  pairV0_.assign(state.velocity.begin(), state.velocity.end());
 }
 
 // Dormand & Prince (1980) RK5(4)7M.
@@ -872,10 +848,11 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
     }
     if (err <= 1) {
       faulted_ = false;
+      if (pairRadius_ > 0) SavePairStart();
       ForChunks(n, [&](size_t b, size_t e) {
         for (size_t i = b; i < e; ++i) Finish(i, X[i], V[i], x_[i], v_[i], h);
       });
-      if (pairRadius_ > 0) ParticleCollisions();
+      if (pairRadius_ > 0) ParticleCollisions(h);
       MoveColliders(h);
       state.time = time;
       Status s = CheckFaults("in adaptive");
