@@ -87,9 +87,11 @@ void System::ParticleCollisions(double h) {
     return state.radius[i] > 0 ? double(state.radius[i]) : pairRadius_;
   };
   double maxR = 0, maxMove = 0;
+  pairMove_.resize(n);
   for (size_t i = 0; i < n; ++i) {
     maxR = std::max(maxR, radius(i));
-    maxMove = std::max(maxMove, (X[i] - X0[i]).norm());
+    pairMove_[i] = (X[i] - X0[i]).norm();
+    maxMove = std::max(maxMove, pairMove_[i]);
   }
   if (!(maxMove <= 1e12)) return;  // an explosion: the fault scan reports it
   const double reach = 2 * maxR + 2 * maxMove;
@@ -101,6 +103,9 @@ void System::ParticleCollisions(double h) {
       if (w[i] + w[j] == 0) return;
       const double R = radius(i) + radius(j);
       const Vec3 d0 = X0[i] - X0[j];
+      // Too far apart for their two steps to meet.
+      const double meet = R + pairMove_[i] + pairMove_[j];
+      if (d0.squaredNorm() > meet * meet) return;
       const Vec3 dd = (X[i] - X0[i]) - (X[j] - X0[j]);
       const double t = TimeOfImpact(d0, dd, R);
       if (t < 0) return;
