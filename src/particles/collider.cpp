@@ -703,16 +703,22 @@ namespace {
   const Collider* hit = nullptr;
   for (const Collider& c : colliders) {
     Contact ct;
-    // A moving collider: the path in its frame at the start of the step (a
-    // is e of the step in, x at its end). The contact found is in that
-    // frame too.
-    const bool moving = c.moving();
-    const Vec3 w = moving ? Vec3(h * c.velocity) : Vec3::Zero();
-    const Vec3 ar = moving ? Vec3(a - e * w) : a, xr = moving ? Vec3(x - w) : x;
-    const Vec3 ur = moving ? Vec3(u - w) : u;
-    if (!c.Intersect(ar, xr, &ct, r) || ct.s >= best->s) continue;
-    if (ct.normal.dot(ct.point - xr) <= 1e-12 * std::max(1.0, xr.cwiseAbs().maxCoeff()) &&
-        ur.dot(ct.normal) >= -1e-12 * std::max(1e-300, ur.cwiseAbs().maxCoeff())) {
+    bool sliding;
+    if (!c.moving()) [[likely]] {
+      if (!c.Intersect(a, x, &ct, r) || ct.s >= best->s) continue;
+      sliding = ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
+                u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff());
+    } else {
+      // A moving collider: the path in its frame at the start of the step
+      // (a is e of the step in, x at its end). The contact found is in that
+      // frame too.
+      const Vec3 w = h * c.velocity;
+      const Vec3 ar = a - e * w, xr = x - w, ur = u - w;
+      if (!c.Intersect(ar, xr, &ct, r) || ct.s >= best->s) continue;
+      sliding = ct.normal.dot(ct.point - xr) <= 1e-12 * std::max(1.0, xr.cwiseAbs().maxCoeff()) &&
+                ur.dot(ct.normal) >= -1e-12 * std::max(1e-300, ur.cwiseAbs().maxCoeff());
+    }
+    if (sliding) {
       *grazed = true;
       continue;
     }

@@ -238,10 +238,9 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
 inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r) const {
   if (kind != Kind::kPlane) return IntersectAny(a, b, c, r);
   // The plane moved out by r.
-  const Vec3 p = r == 0 ? point : Vec3(point + r * normal);
-  const double d1 = normal.dot(b - p);
+  const double d1 = normal.dot(b - point) - r;
   if (d1 >= 0) return false;
-  const double d0 = normal.dot(a - p);
+  const double d0 = normal.dot(a - point) - r;
   c->normal = normal;
   if (d0 <= 0) {  // starts on or below the surface
     c->s = 0;
@@ -249,7 +248,7 @@ inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c, double
   } else {
     c->s = d0 / (d0 - d1);
     c->point = a + c->s * (b - a);
-    c->point -= normal.dot(c->point - p) * normal;  // exactly on the plane
+    c->point -= (normal.dot(c->point - point) - r) * normal;  // exactly on the plane
   }
   return true;
 }
