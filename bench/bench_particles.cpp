@@ -107,6 +107,105 @@ BENCHMARK(BM_BulkStep)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+// Issue 17's snow on terrain: 100,000 flakes (radius argument 2 in mm: 0, a
+// point, or 10; builds before particles had a radius see points; friction 0.8,
+// no bounce, drag to about 5 m/s) over a 40 m square, each starting 0-12 m
+// above the ground, BulkSystem at 60 Hz. Argument 0: the ground, 0 = the
+// plane y = 0, 1 = a height field of 128 x 128 cells (32,768 triangles, 0 to
+// 2 m of sines) as a mesh collider; argument 1: threads. One simulated
+// second runs before the timing, so about a third of the flakes lie on the
+// ground and the rest fall; the state runs on between iterations.
+float GroundHeight(double x, double z) {
+  return float(1 + 0.6 * std::sin(0.35 * x) * std::cos(0.27 * z) +
+               0.4 * std::sin(0.9 * x + 0.5 * z));
+}
+void BM_SnowOnGround(benchmark::State& state) {
+  const bool terrain = state.range(0) == 1;
+  particles::BulkSystem sys(int(state.range(1)));
+  particles::Collider ground = particles::Collider::Plane(Vec3::Zero(), Vec3::UnitY());
+  if (terrain) {
+    const int n = 128;
+    std::vector<Vec3> v;
+    std::vector<std::array<uint32_t, 3>> t;
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        const double x = -20 + 40.0 * i / n, z = -20 + 40.0 * j / n;
+        v.emplace_back(x, GroundHeight(x, z), z);
+      }
+    auto at = [&](int i, int j) { return uint32_t(j * (n + 1) + i); };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        t.push_back({at(i, j), at(i, j + 1), at(i + 1, j)});
+        t.push_back({at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)});
+      }
+    ground = particles::Collider::Mesh(std::make_shared<particles::TriangleBvh>(v, t));
+  }
+  if (!sys.AddCollider(ground.Restitution(0).Friction(0.8)).ok())
+    return state.SkipWithError("bad ground");
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-19.5, 19.5), up(0.05, 12);
+  for (int i = 0; i < 100000; ++i) {
+    const double x = u(rng), z = u(rng);
+    sys.state.Add(Vec3(x, (terrain ? GroundHeight(x, z) : 0) + up(rng), z), Vec3(0, -1, 0));
+    sys.state.radius.back() = float(state.range(2)) * 1e-3f;
+  }
+  sys.fields.gravity = Vec3(0, -9.81, 0);
+  sys.fields.linearDrag = 2;
+  sys.fields.wind = Vec3(0.5, 0, 0.2);
+  for (int s = 0; s < 60; ++s) {
+    if (Status st = sys.Step(1.0 / 60); !st.ok())
+      return state.SkipWithError(st.error().message.c_str());
+  }
+  for (auto _ : state) {
+    if (Status st = sys.Step(1.0 / 60); !st.ok())
+      return state.SkipWithError(st.error().message.c_str());
+  }
+  state.SetItemsProcessed(100000 * state.iterations());
+}
+BENCHMARK(BM_SnowOnGround)
+    ->ArgsProduct({{0, 1}, {1, 2}, {0, 10}})
+    ->Iterations(30)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Issue 17's self-colliding balls: 10,000 balls of radius 0.05 m
+// (restitution 0.3) in a box 2 m wide, under gravity, System with
+// symplectic Euler at 60 Hz; argument: threads. One simulated second runs
+// before the timing (the balls fall and pile up); the state runs on.
+void BM_SelfCollidingBalls(benchmark::State& state) {
+  particles::System sys(int(state.range(0)));
+  sys.AddForce(std::make_shared<particles::Gravity>(Vec3(0, -9.81, 0)));
+  if (!sys.AddCollider(particles::Collider::Box(Vec3(-1, 0, -1), Vec3(1, 10, 1), true)
+                           .Restitution(0.3)
+                           .Friction(0.5))
+           .ok())
+    return state.SkipWithError("bad box");
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-0.004, 0.004);
+  for (int k = 0; k < 10000; ++k) {
+    const int x = k % 18, z = (k / 18) % 18, y = k / 324;
+    sys.state.Add(Vec3(-0.9 + 0.106 * x + u(rng), 0.06 + 0.11 * y, -0.9 + 0.106 * z + u(rng)),
+                  Vec3::Zero());
+    sys.state.radius.back() = 0.05f;
+  }
+  if (!sys.EnableParticleCollisions(0.05, 0.3).ok()) return state.SkipWithError("bad pairs");
+  for (int s = 0; s < 60; ++s) {
+    if (Status st = sys.Step(1.0 / 60, particles::Integrator::kSymplecticEuler); !st.ok())
+      return state.SkipWithError(st.error().message.c_str());
+  }
+  for (auto _ : state) {
+    if (Status st = sys.Step(1.0 / 60, particles::Integrator::kSymplecticEuler); !st.ok())
+      return state.SkipWithError(st.error().message.c_str());
+  }
+  state.SetItemsProcessed(10000 * state.iterations());
+}
+BENCHMARK(BM_SelfCollidingBalls)
+    ->Arg(1)
+    ->Arg(2)
+    ->Iterations(30)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 // Issue 17's cube: 2,000 particles at 150 m/s in random directions inside a
 // closed cube of six polygon colliders, 1 m wide, restitution 1, no forces,
 // at 60 Hz: about 2.5 crossings of the cube a step, so most particles meet

@@ -91,14 +91,16 @@ int main(int argc, char** argv) {
   }
 
   // Where the flakes are: on the ground, stuck to the ball, in the air; none
-  // may be below the ground or inside the ball.
+  // may be closer to the ground or the ball than its radius (a flake is a
+  // ball of its radius to the colliders).
   int onGround = 0, onBall = 0, falling = 0, inside = 0;
   for (size_t i = 0; i < snow.state.size(); ++i) {
     const Vec3 p = snow.state.position(i);
-    if (p.y() < -1e-6 || (p - ballCentre).norm() < ballRadius - 1e-5) ++inside;
+    const double r = double(snow.state.radius[i]);
+    if (p.y() < r - 1e-6 || (p - ballCentre).norm() < ballRadius + r - 1e-5) ++inside;
     if (snow.state.invMass[i] == 0) {
       ++onBall;
-    } else if (p.y() < 1e-4 && snow.state.velocity(i).norm() < 1e-6) {
+    } else if (p.y() < r + 1e-4 && snow.state.velocity(i).norm() < 1e-6) {
       ++onGround;
     } else {
       ++falling;

@@ -26,7 +26,7 @@ Vec3f Round(const Vec3& x) {
 // on a thin one, where the next step could not tell its side. A rounded
 // point that crosses or touches one is pushed off it along the contact
 // normal by a few single-precision ulps and rounded again.
-Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x) {
+Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double radius, double h) {
   Vec3f xf = Round(x);
   const double skin = 4 * double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
   Vec3 base = x;
@@ -40,7 +40,8 @@ Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x) {
     bool crossed = false;
     for (const Collider& c : colliders) {
       Contact ct;
-      if (c.Intersect(x, beyond, &ct)) {
+      const Vec3 w = h * c.velocity;  // where a moving collider ends the step
+      if (c.Intersect(x - w, beyond - w, &ct, radius)) {
         base += skin * ct.normal;
         xf = Round(base);
         crossed = true;
@@ -65,7 +66,7 @@ uint32_t BulkState::Add(const Vec3& p, const Vec3& v, double m, double life) {
   birth.push_back(float(time));
   lifetime.push_back(float(std::min(life, 1e30)));
   color.push_back(Vec3f(1, 1, 1));
-  radius.push_back(0.05f);
+  radius.push_back(0.0f);
   id.push_back(nextId);
   return nextId++;
 }
@@ -122,22 +123,31 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       faulted_.store(true, std::memory_order_relaxed);
     if (colliders_.empty()) continue;
     std::memset(flags, 0, m);
+    // The chunk's largest radius: planes moved out by it screen every
+    // particle of the chunk.
+    float maxRadius = 0;
+    for (size_t i = c; i < ce; ++i) maxRadius = std::max(maxRadius, s.radius[i]);
     for (const Collider& col : colliders_) {
-      if (col.kind == Collider::Kind::kPlane) {
-        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a, c, ce, flags);
+      if (col.kind == Collider::Kind::kPlane && !col.moving()) {
+        const Vec3 p = col.point + double(maxRadius) * col.normal;
+        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), p.data(), a, c, ce, flags);
         continue;
       }
+      // A moving collider: the path in its frame at the start of the step.
+      const Vec3 shift = h * col.velocity;
       for (size_t j = 0; j < m; ++j) {
-        flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j));
+        flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
+                               double(s.radius[c + j]));
       }
     }
     for (size_t j = 0; j < m; ++j) {
       const size_t i = c + j;
       if (!flags[j] || s.invMass[i] == 0) continue;
       Vec3 x = s.position(i), v = s.velocity(i);
+      const double r = double(s.radius[i]);
       const ContactOutcome out =
           RespondToContacts(colliders_, Vec3(old[0][j], old[1][j], old[2][j]),
-                            Vec3(old[3][j], old[4][j], old[5][j]), x, v, h);
+                            Vec3(old[3][j], old[4][j], old[5][j]), x, v, h, r);
       if (out == ContactOutcome::kNone) continue;
       if (out == ContactOutcome::kKilled) {
         // Dies at its age at the start of the step (rounded down), so it is
@@ -155,7 +165,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
         }
         faulted_.store(true, std::memory_order_relaxed);
       }
-      const Vec3f xf = RoundOutside(colliders_, x);
+      const Vec3f xf = RoundOutside(colliders_, x, r, h);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
       if (!MaybeWithinLimit(xf.cast<double>(), v, limit2_))
@@ -206,6 +216,9 @@ Status BulkSystem::Step(double h) {
       (BalancedGrain(pool_, n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
   // Contacts see the step the kernel took (h rounded to a float).
   ForRanges(pool_, n, grain, [&](size_t b, size_t e) { StepRange(b, e, double(q.h), q); });
+  for (Collider& c : colliders_) {
+    if (c.moving()) c.Translate(double(q.h) * c.velocity);
+  }
   Status status = Fault();
   state.time += h;
   ++steps;

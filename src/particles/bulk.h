@@ -55,7 +55,7 @@ struct BulkState {
   std::vector<float> birth;
   std::vector<float> lifetime;  // s of age
   std::vector<Vec3f> color;
-  std::vector<float> radius;  // drawn size, metres
+  std::vector<float> radius;  // m, >= 0: the ball every collider sees, and the drawn size
   std::vector<uint32_t> id;
   uint32_t nextId = 0;
   double time = 0;  // the clock (s), advanced by BulkSystem::Step
@@ -63,8 +63,8 @@ struct BulkState {
   size_t size() const { return px.size(); }
   double age(size_t i) const { return time - double(birth[i]); }
   bool dead(size_t i) const { return age(i) >= double(lifetime[i]); }
-  // Adds a particle born now (rounded to single precision); mass 0 or less
-  // means immovable. Returns its id.
+  // Adds a particle born now (rounded to single precision), of radius 0 (a
+  // point); mass 0 or less means immovable. Returns its id.
   uint32_t Add(const Vec3& p, const Vec3& v, double mass = 1, double lifetime = 1e30);
   Vec3 position(size_t i) const { return Vec3(px[i], py[i], pz[i]); }
   Vec3 velocity(size_t i) const { return Vec3(vx[i], vy[i], vz[i]); }

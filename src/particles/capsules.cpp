@@ -34,6 +34,16 @@ Vec3 OutwardNormal(const Capsule& c, const Vec3& x, const Vec3& fallback) {
   return len > 0 ? Vec3(d / len) : fallback;
 }
 
+// The contact point of an entry at s with normal n, on the surface, nudged
+// out by a relative 1e-9 so rounding keeps it outside (as thin colliders
+// do); a path that starts inside (s = 0) gets the nearest surface point.
+Vec3 SurfacePoint(const Capsule& cap, const Vec3& a, const Vec3& b, double s, const Vec3& n) {
+  Vec3 p = a + s * (b - a);
+  if (s == 0 && (a - Closest(cap, a)).squaredNorm() < cap.radius * cap.radius)
+    p = Closest(cap, a) + cap.radius * n;
+  return p + n * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff()));
+}
+
 }  // namespace
 
 bool IntersectCapsule(const Capsule& cap, const Vec3& a, const Vec3& b, double* s, Vec3* normal) {
@@ -129,8 +139,10 @@ void CapsuleBvh::BuildGrid() {
   }
 }
 
-bool CapsuleBvh::IntersectGrid(const Vec3& a, const Vec3& b, Contact* c) const {
-  const Vec3 lo = (a.cwiseMin(b) - gridLo_) / cell_, hi = (a.cwiseMax(b) - gridLo_) / cell_;
+bool CapsuleBvh::IntersectGrid(const Vec3& a, const Vec3& b, Contact* c, double r) const {
+  const Vec3 pad = Vec3::Constant(r);
+  const Vec3 lo = (a.cwiseMin(b) - pad - gridLo_) / cell_,
+             hi = (a.cwiseMax(b) + pad - gridLo_) / cell_;
   int l[3], h[3];
   for (int k = 0; k < 3; ++k) {
     if (hi[k] < 0 || lo[k] >= dims_[k]) return false;  // wholly outside the grid: no capsule
@@ -139,6 +151,7 @@ bool CapsuleBvh::IntersectGrid(const Vec3& a, const Vec3& b, Contact* c) const {
   }
   double best = 2;
   Vec3 bestNormal = Vec3::Zero();
+  Capsule bestCap;
   for (int k = l[2]; k <= h[2]; ++k)
     for (int j = l[1]; j <= h[1]; ++j)
       for (int i = l[0]; i <= h[0]; ++i) {
@@ -147,17 +160,19 @@ bool CapsuleBvh::IntersectGrid(const Vec3& a, const Vec3& b, Contact* c) const {
         for (uint32_t t = start_[cellIndex]; t < start_[cellIndex + 1]; ++t) {
           double s;
           Vec3 n;
-          if (IntersectCapsule(capsules_[items_[t]], a, b, &s, &n) && s < best) {
+          Capsule cap = capsules_[items_[t]];
+          cap.radius += r;
+          if (IntersectCapsule(cap, a, b, &s, &n) && s < best) {
             best = s;
             bestNormal = n;
+            bestCap = cap;
           }
         }
       }
   if (best > 1) return false;
   c->s = best;
   c->normal = bestNormal;
-  const Vec3 p = a + best * (b - a);
-  c->point = p + bestNormal * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff()));
+  c->point = SurfacePoint(bestCap, a, b, best, bestNormal);
   return true;
 }
 
@@ -171,33 +186,39 @@ uint32_t CapsuleBvh::Build(uint32_t first, uint32_t count, int depth) {
       [](const Capsule& c) { return Vec3(c.a + c.b); });
 }
 
-bool CapsuleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
+bool CapsuleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r) const {
   if (nodes_.empty()) return false;
   // A short path (its box within 8 cells): the grid's lists.
   if (dims_[0] > 0) {
-    const Vec3 span = (b - a).cwiseAbs() / cell_;
-    if (span.allFinite() && (span.array() + 1).prod() <= 8.5) return IntersectGrid(a, b, c);
+    const Vec3 span = ((b - a).cwiseAbs().array() + 2 * r) / cell_;
+    if (span.allFinite() && (span.array() + 1).prod() <= 8.5) return IntersectGrid(a, b, c, r);
   }
   const Vec3 d = b - a;
   double best = 2;
   Vec3 bestNormal = Vec3::Zero();
-  WalkSegment(nodes_, a, d, best, [&](uint32_t first, uint32_t count) {
-    for (uint32_t i = first; i < first + count; ++i) {
-      double s;
-      Vec3 n;
-      if (IntersectCapsule(capsules_[i], a, b, &s, &n) && s < best) {
-        best = s;
-        bestNormal = n;
-      }
-    }
-  });
+  Capsule bestCap;
+  WalkSegment(
+      nodes_, a, d, best,
+      [&](uint32_t first, uint32_t count) {
+        for (uint32_t i = first; i < first + count; ++i) {
+          double s;
+          Vec3 n;
+          Capsule cap = capsules_[i];
+          cap.radius += r;
+          if (IntersectCapsule(cap, a, b, &s, &n) && s < best) {
+            best = s;
+            bestNormal = n;
+            bestCap = cap;
+          }
+        }
+      },
+      r);
   if (best > 1) return false;
   c->s = best;
   c->normal = bestNormal;
   // On the surface, nudged out by a relative 1e-9 so rounding keeps the
   // point outside (as thin colliders do).
-  const Vec3 p = a + best * d;
-  c->point = p + bestNormal * (1e-9 * std::max(1.0, p.cwiseAbs().maxCoeff()));
+  c->point = SurfacePoint(bestCap, a, b, best, bestNormal);
   return true;
 }
 

@@ -41,8 +41,9 @@ class CapsuleBvh {
   // Capsules with a non-finite coordinate or a radius not above 0 are
   // dropped (counted by dropped()).
   explicit CapsuleBvh(std::vector<Capsule> capsules);
-  // First entry of the segment a -> b into any capsule.
-  bool Intersect(const Vec3& a, const Vec3& b, Contact* c) const;
+  // First entry of the segment a -> b into any capsule; with r > 0, into
+  // the capsules grown by r (a ball of radius r on the path touching one).
+  bool Intersect(const Vec3& a, const Vec3& b, Contact* c, double r = 0) const;
   size_t size() const { return capsules_.size(); }
   size_t dropped() const { return dropped_; }
   int depth() const { return depth_; }
@@ -57,7 +58,7 @@ class CapsuleBvh {
   };
   uint32_t Build(uint32_t first, uint32_t count, int depth);
   void BuildGrid();
-  bool IntersectGrid(const Vec3& a, const Vec3& b, Contact* c) const;
+  bool IntersectGrid(const Vec3& a, const Vec3& b, Contact* c, double r) const;
   std::vector<Capsule> capsules_;
   std::vector<Node> nodes_;
   // The grid: cell (i, j, k) lists items_[start_[cell] .. start_[cell + 1]).

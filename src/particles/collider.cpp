@@ -59,7 +59,85 @@ Vec3 UnitOr(const Vec3& d, const Vec3& fallback) {
   return len > 0 ? Vec3(d / len) : fallback;
 }
 
+Vec3 ClosestOnSegment(const Vec3& p0, const Vec3& p1, const Vec3& x) {
+  const Vec3 e = p1 - p0;
+  const double ee = e.squaredNorm();
+  const double t = ee > 0 ? std::clamp(e.dot(x - p0) / ee, 0.0, 1.0) : 0.0;
+  return p0 + t * e;
+}
+
+// Whether q, on the plane of the convex polygon `poly` (counter-clockwise
+// about the unit normal n), lies inside it.
+bool InsidePolygon(const Vec3* poly, size_t count, const Vec3& n, const Vec3& q) {
+  for (size_t i = 0; i < count; ++i) {
+    const Vec3& p0 = poly[i];
+    const Vec3& p1 = poly[(i + 1) % count];
+    if ((p1 - p0).cross(q - p0).dot(n) < -1e-12 * (p1 - p0).squaredNorm()) return false;
+  }
+  return true;
+}
+
+// First entry of the path a -> b into a convex planar polygon grown by r > 0
+// (its two faces offset by r along the unit normal n, and a capsule of
+// radius r about each edge): where a ball of radius r on the path first
+// touches the polygon. The contact point is the ball's centre, nudged out by
+// the skin; a path that starts within r of the polygon reports s = 0 at the
+// nearest point at distance r.
+bool IntersectGrown(const Vec3* poly, size_t count, const Vec3& n, const Vec3& a, const Vec3& b,
+                    double r, double sBound, Contact* c) {
+  const Vec3 d = b - a;
+  const double d0 = n.dot(a - poly[0]), d1 = n.dot(b - poly[0]);
+  const double side = d0 > 0 ? 1 : d0 < 0 ? -1 : (d1 <= 0 ? 1 : -1);
+  const double e0 = side * d0, e1 = side * d1;
+  if (std::min(e0, e1) > r) return false;  // stays beyond the slab on one side
+  // Starts within r of the face: inside the grown polygon if its foot is.
+  if (e0 < r) {
+    const Vec3 foot = a - d0 * n;
+    if (InsidePolygon(poly, count, n, foot)) {
+      c->s = 0;
+      c->normal = side * n;
+      c->point = Skin(foot + r * c->normal, c->normal);
+      return true;
+    }
+  }
+  double best = sBound;
+  Vec3 bestNormal = Vec3::Zero(), bestPoint = Vec3::Zero();
+  if (e0 >= r && e1 < r) {  // the offset face
+    const double s = (e0 - r) / (e0 - e1);
+    const Vec3 q = a + s * d;
+    if (s < best && InsidePolygon(poly, count, n, q - n.dot(q - poly[0]) * n)) {
+      best = s;
+      bestNormal = side * n;
+      bestPoint = q;
+    }
+  }
+  // The rim: only edges whose box, grown by r, meets the path's box.
+  const Vec3 plo = a.cwiseMin(b) - Vec3::Constant(r), phi = a.cwiseMax(b) + Vec3::Constant(r);
+  for (size_t i = 0; i < count; ++i) {
+    const Capsule cap{poly[i], poly[(i + 1) % count], r};
+    if ((cap.a.cwiseMin(cap.b).array() > phi.array()).any() ||
+        (cap.a.cwiseMax(cap.b).array() < plo.array()).any()) {
+      continue;
+    }
+    double s;
+    Vec3 m;
+    if (!IntersectCapsule(cap, a, b, &s, &m) || !(s < best)) continue;
+    best = s;
+    bestNormal = m;
+    bestPoint = s == 0 ? Vec3(ClosestOnSegment(cap.a, cap.b, a) + r * m) : Vec3(a + s * d);
+  }
+  if (!(best < sBound) || best > 1) return false;
+  c->s = best;
+  c->normal = bestNormal;
+  c->point = Skin(bestPoint, bestNormal);
+  return true;
+}
+
 }  // namespace
+
+bool Collider::IntersectGrownPolygon(const Vec3& a, const Vec3& b, double r, Contact* c) const {
+  return IntersectGrown(polygon.data(), polygon.size(), normal, a, b, r, 2, c);
+}
 
 // --- TriangleBvh ---
 
@@ -68,7 +146,10 @@ TriangleBvh::TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint
   for (const auto& t : tris_) {
     for (uint32_t k : t) SYLVA_ASSERT(k < v_.size());
   }
-  if (!tris_.empty()) Build(0, uint32_t(tris_.size()), 1);
+  if (!tris_.empty()) {
+    Build(0, uint32_t(tris_.size()), 1);
+    BuildGrid();
+  }
 }
 
 uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
@@ -83,34 +164,163 @@ uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
       [&](const std::array<uint32_t, 3>& t) { return Vec3(v_[t[0]] + v_[t[1]] + v_[t[2]]); });
 }
 
-bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
+bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r) const {
+  if (nodes_.empty()) return false;
+  const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
+  if (dims_[0] > 0) {  // the grid: whether a cell the box covers lists a triangle
+    const Vec3 glo = (lo - gridLo_) / cell_, ghi = (hi - gridLo_) / cell_;
+    if (((ghi - glo).array() + 1).prod() <= 8.5) {
+      int l[3], h[3];
+      for (int k = 0; k < 3; ++k) {
+        if (!(ghi[k] >= 0 && glo[k] < dims_[k])) return false;
+        l[k] = std::max(0, int(std::floor(glo[k])));
+        h[k] = std::min(dims_[k] - 1, int(std::floor(ghi[k])));
+      }
+      for (int z = l[2]; z <= h[2]; ++z)
+        for (int y = l[1]; y <= h[1]; ++y)
+          for (int x = l[0]; x <= h[0]; ++x) {
+            const size_t cell =
+                (size_t(z) * size_t(dims_[1]) + size_t(y)) * size_t(dims_[0]) + size_t(x);
+            if (start_[cell + 1] > start_[cell]) return true;
+          }
+      return false;
+    }
+  }
+  uint32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if ((lo.array() > node.hi.array()).any() || (hi.array() < node.lo.array()).any()) continue;
+    if (node.count > 0) return true;
+    if (top + 2 > 128) return true;  // cannot happen for depth < 64
+    stack[top++] = node.left;
+    stack[top++] = node.right;
+  }
+  return false;
+}
+
+// Triangle i against the path a -> b (of a ball of radius r): its entry s
+// if below `best`, with the normal (and, for r > 0, the point).
+bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r, double best,
+                              Contact* c) const {
+  const Vec3 &v0 = v_[tris_[i][0]], &v1 = v_[tris_[i][1]], &v2 = v_[tris_[i][2]];
+  const Vec3 n = (v1 - v0).cross(v2 - v0);
+  const double nn = n.squaredNorm();
+  if (!(nn > 0)) return false;  // degenerate
+  if (r > 0) {
+    // The triangle's box against the path's box grown by r.
+    const Vec3 plo = a.cwiseMin(b) - Vec3::Constant(r), phi = a.cwiseMax(b) + Vec3::Constant(r);
+    if ((v0.cwiseMin(v1).cwiseMin(v2).array() > phi.array()).any() ||
+        (v0.cwiseMax(v1).cwiseMax(v2).array() < plo.array()).any()) {
+      return false;
+    }
+    const Vec3 tri[3] = {v0, v1, v2};
+    return IntersectGrown(tri, 3, n / std::sqrt(nn), a, b, r, best, c);
+  }
+  double s, side;
+  if (!CrossPlane(a, b, v0, n, &s, &side) || s >= best) return false;
+  const Vec3 q = a + s * (b - a);
+  const double tol = -1e-12 * nn;
+  if ((v1 - v0).cross(q - v0).dot(n) < tol || (v2 - v1).cross(q - v1).dot(n) < tol ||
+      (v0 - v2).cross(q - v2).dot(n) < tol) {
+    return false;
+  }
+  c->s = s;
+  c->normal = side * n / std::sqrt(nn);
+  return true;
+}
+
+bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r) const {
   if (nodes_.empty()) return false;
   const Vec3 d = b - a;
   double best = 2;
-  Vec3 bestNormal = Vec3::Zero();
-  WalkSegment(nodes_, a, d, best, [&](uint32_t first, uint32_t count) {
-    for (uint32_t i = first; i < first + count; ++i) {
-      const Vec3 &v0 = v_[tris_[i][0]], &v1 = v_[tris_[i][1]], &v2 = v_[tris_[i][2]];
-      const Vec3 n = (v1 - v0).cross(v2 - v0);
-      const double nn = n.squaredNorm();
-      if (!(nn > 0)) continue;  // degenerate
-      double s, side;
-      if (!CrossPlane(a, b, v0, n, &s, &side) || s >= best) continue;
-      const Vec3 q = a + s * d;
-      const double tol = -1e-12 * nn;
-      if ((v1 - v0).cross(q - v0).dot(n) < tol || (v2 - v1).cross(q - v1).dot(n) < tol ||
-          (v0 - v2).cross(q - v2).dot(n) < tol) {
-        continue;
-      }
-      best = s;
-      bestNormal = side * n / std::sqrt(nn);
+  Contact found;
+  auto test = [&](uint32_t i) {
+    Contact ct;
+    if (HitTriangle(i, a, b, r, best, &ct) && ct.s < best) {
+      best = ct.s;
+      found = ct;
     }
-  });
+  };
+  // A short path (its grown box within 8 cells): the grid's lists; a
+  // triangle listed in several cells is tested again, to the same answer.
+  const Vec3 glo = (a.cwiseMin(b) - Vec3::Constant(r) - gridLo_) / cell_;
+  const Vec3 ghi = (a.cwiseMax(b) + Vec3::Constant(r) - gridLo_) / cell_;
+  if (dims_[0] > 0 && ((ghi - glo).array() + 1).prod() <= 8.5) {
+    int l[3], h[3];
+    for (int k = 0; k < 3; ++k) {
+      if (!(ghi[k] >= 0 && glo[k] < dims_[k])) return false;  // outside the grid: no triangle
+      l[k] = std::max(0, int(std::floor(glo[k])));
+      h[k] = std::min(dims_[k] - 1, int(std::floor(ghi[k])));
+    }
+    for (int z = l[2]; z <= h[2]; ++z)
+      for (int y = l[1]; y <= h[1]; ++y)
+        for (int x = l[0]; x <= h[0]; ++x) {
+          const size_t cell =
+              (size_t(z) * size_t(dims_[1]) + size_t(y)) * size_t(dims_[0]) + size_t(x);
+          for (uint32_t t = start_[cell]; t < start_[cell + 1]; ++t) test(items_[t]);
+        }
+  } else {
+    WalkSegment(
+        nodes_, a, d, best,
+        [&](uint32_t first, uint32_t count) {
+          for (uint32_t i = first; i < first + count; ++i) test(i);
+        },
+        r);
+  }
   if (best > 1) return false;
-  c->s = best;
-  c->normal = bestNormal;
-  c->point = Skin(a + best * d, bestNormal);
+  *c = found;
+  if (r == 0) c->point = Skin(a + best * d, found.normal);
   return true;
+}
+
+void TriangleBvh::BuildGrid() {
+  // About eight cells a triangle, at most 256 an axis.
+  Vec3 lo = nodes_[0].lo, hi = nodes_[0].hi;
+  const Vec3 extent = (hi - lo).cwiseMax(Vec3::Constant(1e-9));
+  if (!extent.allFinite()) return;
+  double cell = std::cbrt(extent.prod() / (8.0 * double(tris_.size())));
+  cell = std::max({cell, extent.maxCoeff() / 256, 1e-9});
+  int dims[3];
+  for (int k = 0; k < 3; ++k) dims[k] = std::clamp(int(std::ceil(extent[k] / cell)), 1, 256);
+  const size_t cells = size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]);
+  auto range = [&](const std::array<uint32_t, 3>& t, int l[3], int h[3]) {
+    const Vec3 tl = v_[t[0]].cwiseMin(v_[t[1]]).cwiseMin(v_[t[2]]);
+    const Vec3 th = v_[t[0]].cwiseMax(v_[t[1]]).cwiseMax(v_[t[2]]);
+    for (int k = 0; k < 3; ++k) {
+      l[k] = std::clamp(int(std::floor((tl[k] - lo[k]) / cell)), 0, dims[k] - 1);
+      h[k] = std::clamp(int(std::floor((th[k] - lo[k]) / cell)), 0, dims[k] - 1);
+    }
+  };
+  // Counting pass, prefix sums, then the lists in triangle order.
+  std::vector<uint32_t> count(cells + 1, 0);
+  size_t total = 0;
+  for (const auto& t : tris_) {
+    int l[3], h[3];
+    range(t, l, h);
+    total += size_t(h[0] - l[0] + 1) * size_t(h[1] - l[1] + 1) * size_t(h[2] - l[2] + 1);
+    if (total > (size_t(1) << 26)) return;  // lists past 256 MiB: the hierarchy alone
+    for (int z = l[2]; z <= h[2]; ++z)
+      for (int y = l[1]; y <= h[1]; ++y)
+        for (int x = l[0]; x <= h[0]; ++x)
+          ++count[(size_t(z) * size_t(dims[1]) + size_t(y)) * size_t(dims[0]) + size_t(x) + 1];
+  }
+  for (size_t i = 1; i <= cells; ++i) count[i] += count[i - 1];
+  start_ = count;
+  items_.resize(total);
+  for (uint32_t ti = 0; ti < tris_.size(); ++ti) {
+    int l[3], h[3];
+    range(tris_[ti], l, h);
+    for (int z = l[2]; z <= h[2]; ++z)
+      for (int y = l[1]; y <= h[1]; ++y)
+        for (int x = l[0]; x <= h[0]; ++x)
+          items_[count[(size_t(z) * size_t(dims[1]) + size_t(y)) * size_t(dims[0]) + size_t(x)]++] =
+              ti;
+  }
+  gridLo_ = lo;
+  cell_ = cell;
+  for (int k = 0; k < 3; ++k) dims_[k] = dims[k];
 }
 
 // --- Collider ---
@@ -155,9 +365,21 @@ Status Validate(const Collider& c) {
       if (!c.capsules) return Error("Collider.capsules is null");
       break;
   }
+  SYLVA_CHECK_OK(Finite("Collider.velocity", c.velocity, 1e12, "m/s"));
+  if (c.moving() && (c.kind == Collider::Kind::kMesh || c.kind == Collider::Kind::kCapsules)) {
+    return Error("Collider.velocity " + Vec(c.velocity) +
+                 ": a mesh or capsules collider cannot move (only plane, sphere, box and polygon)");
+  }
   SYLVA_CHECK_OK(Range("Collider.restitution", c.restitution, 0, 1));
   SYLVA_CHECK_OK(Range("Collider.friction", c.friction, 0, 1e3));
   return {};
+}
+
+void Collider::Translate(const Vec3& d) {
+  point += d;
+  lo += d;
+  hi += d;
+  for (Vec3& p : polygon) p += d;
 }
 
 Collider Collider::Plane(const Vec3& point, const Vec3& normal) {
@@ -212,19 +434,35 @@ Collider Collider::Capsules(std::shared_ptr<const CapsuleBvh> bvh) {
   return c;
 }
 
-bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
+bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r) const {
   const Vec3 d = b - a;
+  // The solid grown by r (inside kinds: the room shrunk by r).
+  const double R = inside ? std::max(radius - r, 0.0) : radius + r;
+  Vec3 L = lo, H = hi;
+  if (r > 0) {
+    for (int k = 0; k < 3; ++k) {
+      if (!inside) {
+        L[k] -= r;
+        H[k] += r;
+      } else if (hi[k] - lo[k] > 2 * r) {
+        L[k] += r;
+        H[k] -= r;
+      } else {
+        L[k] = H[k] = 0.5 * (lo[k] + hi[k]);
+      }
+    }
+  }
   switch (kind) {
     case Kind::kPlane:
-      return Intersect(a, b, c);  // inline in the header
+      return Intersect(a, b, c, r);  // inline in the header
     case Kind::kSphere: {
       const Vec3 ac = a - point;
-      const double C = ac.squaredNorm() - radius * radius;
+      const double C = ac.squaredNorm() - R * R;
       if (!inside) {
         if (C < 0) {  // starts inside the ball
           c->s = 0;
           c->normal = UnitOr(ac, Vec3(0, 1, 0));
-          c->point = point + radius * c->normal;
+          c->point = point + R * c->normal;
           return true;
         }
         double s0, s1;
@@ -234,34 +472,34 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
         if (C > 0) {  // starts outside the bowl
           c->s = 0;
           const Vec3 u = UnitOr(ac, Vec3(0, 1, 0));
-          c->point = point + radius * u;
+          c->point = point + R * u;
           c->normal = -u;
           return true;
         }
-        if ((b - point).squaredNorm() <= radius * radius) return false;
+        if ((b - point).squaredNorm() <= R * R) return false;
         double s0, s1;
         if (!Roots(d.squaredNorm(), 2 * d.dot(ac), C, &s0, &s1)) return false;
         c->s = std::clamp(s1, 0.0, 1.0);
       }
       const Vec3 u = UnitOr(a + c->s * d - point, Vec3(0, 1, 0));
-      c->point = point + radius * u;
+      c->point = point + R * u;
       c->normal = inside ? Vec3(-u) : u;
       return true;
     }
     case Kind::kBox: {
       if (!inside) {
-        if ((a.array() > lo.array()).all() && (a.array() < hi.array()).all()) {
+        if ((a.array() > L.array()).all() && (a.array() < H.array()).all()) {
           c->s = 0;
-          return Project(a, &c->point, &c->normal);
+          return Project(a, &c->point, &c->normal, r);
         }
         double t0 = -HUGE_VAL, t1 = HUGE_VAL;
         int axis = -1;
         for (int k = 0; k < 3; ++k) {
           if (d[k] == 0) {
-            if (a[k] < lo[k] || a[k] > hi[k]) return false;
+            if (a[k] < L[k] || a[k] > H[k]) return false;
             continue;
           }
-          double ta = (lo[k] - a[k]) / d[k], tb = (hi[k] - a[k]) / d[k];
+          double ta = (L[k] - a[k]) / d[k], tb = (H[k] - a[k]) / d[k];
           if (ta > tb) std::swap(ta, tb);
           if (ta > t0) {
             t0 = ta;
@@ -275,19 +513,19 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
         c->point = a + t0 * d;
         c->normal = Vec3::Zero();
         c->normal[axis] = d[axis] > 0 ? -1 : 1;
-        c->point[axis] = d[axis] > 0 ? lo[axis] : hi[axis];
+        c->point[axis] = d[axis] > 0 ? L[axis] : H[axis];
         return true;
       }
-      if ((a.array() < lo.array()).any() || (a.array() > hi.array()).any()) {
+      if ((a.array() < L.array()).any() || (a.array() > H.array()).any()) {
         c->s = 0;
-        return Project(a, &c->point, &c->normal);
+        return Project(a, &c->point, &c->normal, r);
       }
       double best = 2;
       int axis = -1;
       for (int k = 0; k < 3; ++k) {
         double s = 2;
-        if (b[k] < lo[k]) s = (a[k] - lo[k]) / (a[k] - b[k]);
-        if (b[k] > hi[k]) s = (hi[k] - a[k]) / (b[k] - a[k]);
+        if (b[k] < L[k]) s = (a[k] - L[k]) / (a[k] - b[k]);
+        if (b[k] > H[k]) s = (H[k] - a[k]) / (b[k] - a[k]);
         if (s < best) {
           best = s;
           axis = k;
@@ -295,13 +533,14 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
       }
       if (axis < 0) return false;
       c->s = best;
-      c->point = (a + best * d).cwiseMax(lo).cwiseMin(hi);
+      c->point = (a + best * d).cwiseMax(L).cwiseMin(H);
       c->normal = Vec3::Zero();
-      c->normal[axis] = b[axis] < lo[axis] ? 1 : -1;
-      c->point[axis] = b[axis] < lo[axis] ? lo[axis] : hi[axis];
+      c->normal[axis] = b[axis] < L[axis] ? 1 : -1;
+      c->point[axis] = b[axis] < L[axis] ? L[axis] : H[axis];
       return true;
     }
     case Kind::kPolygon: {
+      if (r > 0) return IntersectGrownPolygon(a, b, r, c);
       double s, side;
       if (!CrossPlane(a, b, point, normal, &s, &side)) return false;
       const Vec3 q = a + s * d;
@@ -316,58 +555,73 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const {
       return true;
     }
     case Kind::kMesh:
-      return mesh && mesh->Intersect(a, b, c);
+      return mesh && mesh->Intersect(a, b, c, r);
     case Kind::kCapsules:
-      return capsules && capsules->Intersect(a, b, c);
+      return capsules && capsules->Intersect(a, b, c, r);
   }
   return false;
 }
 
-bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n) const {
+bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n, double r) const {
+  const double R = inside ? std::max(radius - r, 0.0) : radius + r;
+  Vec3 L = lo, H = hi;
+  if (r > 0) {
+    for (int k = 0; k < 3; ++k) {
+      if (!inside) {
+        L[k] -= r;
+        H[k] += r;
+      } else if (hi[k] - lo[k] > 2 * r) {
+        L[k] += r;
+        H[k] -= r;
+      } else {
+        L[k] = H[k] = 0.5 * (lo[k] + hi[k]);
+      }
+    }
+  }
   switch (kind) {
     case Kind::kPlane:
-      return Project(x, surface, n);  // inline in the header
+      return Project(x, surface, n, r);  // inline in the header
     case Kind::kSphere: {
-      const Vec3 r = x - point;
-      const double r2 = r.squaredNorm();
-      if (inside ? r2 <= radius * radius : r2 >= radius * radius) return false;
-      const Vec3 u = UnitOr(r, Vec3(0, 1, 0));
-      *surface = point + radius * u;
+      const Vec3 rel = x - point;
+      const double r2 = rel.squaredNorm();
+      if (inside ? r2 <= R * R : r2 >= R * R) return false;
+      const Vec3 u = UnitOr(rel, Vec3(0, 1, 0));
+      *surface = point + R * u;
       *n = inside ? Vec3(-u) : u;
       return true;
     }
     case Kind::kBox: {
       if (!inside) {
-        if (!((x.array() > lo.array()).all() && (x.array() < hi.array()).all())) return false;
+        if (!((x.array() > L.array()).all() && (x.array() < H.array()).all())) return false;
         // Out through the nearest face.
         double best = HUGE_VAL;
         int axis = 0;
         double sign = 1;
         for (int k = 0; k < 3; ++k) {
-          if (x[k] - lo[k] < best) {
-            best = x[k] - lo[k];
+          if (x[k] - L[k] < best) {
+            best = x[k] - L[k];
             axis = k;
             sign = -1;
           }
-          if (hi[k] - x[k] < best) {
-            best = hi[k] - x[k];
+          if (H[k] - x[k] < best) {
+            best = H[k] - x[k];
             axis = k;
             sign = 1;
           }
         }
         *surface = x;
-        (*surface)[axis] = sign < 0 ? lo[axis] : hi[axis];
+        (*surface)[axis] = sign < 0 ? L[axis] : H[axis];
         *n = Vec3::Zero();
         (*n)[axis] = sign;
         return true;
       }
-      const Vec3 clamped = x.cwiseMax(lo).cwiseMin(hi);
+      const Vec3 clamped = x.cwiseMax(L).cwiseMin(H);
       if (clamped == x) return false;
       int axis;
       (clamped - x).cwiseAbs().maxCoeff(&axis);
       *surface = clamped;
       *n = Vec3::Zero();
-      (*n)[axis] = x[axis] < lo[axis] ? 1 : -1;
+      (*n)[axis] = x[axis] < L[axis] ? 1 : -1;
       return true;
     }
     case Kind::kPolygon:
@@ -442,18 +696,29 @@ namespace {
 // the surface), and a sphere the particle rests on this step (the path left
 // along its tangent, which the surface bends away from; the projection puts
 // the end back on it). u is h times the path's velocity at a.
-[[gnu::always_inline]] inline const Collider* FindContact(const std::vector<Collider>& colliders,
-                                                          const Vec3& a, const Vec3& x,
-                                                          const Vec3& u,
-                                                          const Collider* const* restingOn,
-                                                          Contact* best, bool* grazed) {
+[[gnu::always_inline]] inline const Collider* FindContact(
+    const std::vector<Collider>& colliders, const Vec3& a, const Vec3& x, const Vec3& u,
+    const Collider* const* restingOn, Contact* best, bool* grazed, double r, double e, double h) {
   best->s = 2;
   const Collider* hit = nullptr;
   for (const Collider& c : colliders) {
     Contact ct;
-    if (!c.Intersect(a, x, &ct) || ct.s >= best->s) continue;
-    if (ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
-        u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff())) {
+    bool sliding;
+    if (!c.moving()) [[likely]] {
+      if (!c.Intersect(a, x, &ct, r) || ct.s >= best->s) continue;
+      sliding = ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
+                u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff());
+    } else {
+      // A moving collider: the path in its frame at the start of the step
+      // (a is e of the step in, x at its end). The contact found is in that
+      // frame too.
+      const Vec3 w = h * c.velocity;
+      const Vec3 ar = a - e * w, xr = x - w, ur = u - w;
+      if (!c.Intersect(ar, xr, &ct, r) || ct.s >= best->s) continue;
+      sliding = ct.normal.dot(ct.point - xr) <= 1e-12 * std::max(1.0, xr.cwiseAbs().maxCoeff()) &&
+                ur.dot(ct.normal) >= -1e-12 * std::max(1e-300, ur.cwiseAbs().maxCoeff());
+    }
+    if (sliding) {
       *grazed = true;
       continue;
     }
@@ -470,12 +735,23 @@ namespace {
 // Projects x out of every half-space solid it ended in, removing the
 // velocity into it.
 [[gnu::always_inline]] inline void ProjectOut(const std::vector<Collider>& colliders, Vec3& x,
-                                              Vec3& v) {
+                                              Vec3& v, double r, double h) {
   for (const Collider& c : colliders) {
     Vec3 sp, sn;
-    if (c.Project(x, &sp, &sn)) {
-      x = sp;
-      const double vn = v.dot(sn);
+    if (!c.moving()) {
+      if (c.Project(x, &sp, &sn, r)) {
+        x = sp;
+        const double vn = v.dot(sn);
+        if (vn < 0) v -= vn * sn;
+      }
+      continue;
+    }
+    // Where the collider is at the end of the step; the velocity relative
+    // to it.
+    const Vec3 w = h * c.velocity;
+    if (c.Project(x - w, &sp, &sn, r)) {
+      x = sp + w;
+      const double vn = (v - c.velocity).dot(sn);
       if (vn < 0) v -= vn * sn;
     }
   }
@@ -484,7 +760,7 @@ namespace {
 }  // namespace
 
 ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
-                                 Vec3& v, double h) {
+                                 Vec3& v, double h, double radius) {
   // The step as a path of constant acceleration from a, through x at its
   // end: p(tau) = a + tau u + tau^2 A / 2 for tau = t / h in [0, 1], with
   // u = h w (w the path's velocity at a) and A = h^2 acc, so that nothing
@@ -505,14 +781,14 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     const Collider* none[2] = {nullptr, nullptr};
     Contact c0;
     bool grazed0 = false;
-    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0);
+    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0, radius, 0, h);
     if (!hit) {
       if (!grazed0) return ContactOutcome::kNone;
-      ProjectOut(colliders, x, v);
+      ProjectOut(colliders, x, v, radius, h);
       return ContactOutcome::kResponded;
     }
     const Vec3& n = c0.normal;
-    if (c0.s == 0 && hit->response == Response::kBounce &&
+    if (c0.s == 0 && !hit->moving() && hit->response == Response::kBounce &&
         !(-u.dot(n) > std::max(0.0, -h * dv.dot(n)))) {
       const double en = v.dot(n);
       const double jn = std::max(0.0, -en);
@@ -522,10 +798,10 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
       const Collider* resting0[2] = {hit, nullptr};
       Contact c1;
       bool grazed1 = false;
-      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1)) {
+      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1, radius, 0, h)) {
         x = x1;
         v = out;
-        ProjectOut(colliders, x, v);
+        ProjectOut(colliders, x, v, radius, h);
         return ContactOutcome::kResponded;
       }
     }
@@ -540,7 +816,8 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
   bool grazed = false;
   for (;;) {
     Contact best;
-    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed);
+    const double e = 1 - rem;  // of the step, at a
+    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed, radius, e, h);
     if (!hit) break;
     const Vec3& n = best.normal;
     if (++contacts > kMaxContacts) [[unlikely]] {
@@ -548,6 +825,16 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
       x = a;
       v = Vec3::Zero();
       return ContactOutcome::kUnresolved;
+    }
+    // A moving collider: into its frame at the start of the step (h times
+    // its velocity is w); back out below.
+    const bool moving = hit->moving();
+    const Vec3 w = moving ? Vec3(h * hit->velocity) : Vec3::Zero();
+    if (moving) {
+      a -= e * w;
+      x -= w;
+      u -= w;
+      v -= hit->velocity;
     }
     // Time of impact along the path. On a flat face (plane, polygon, box,
     // triangle) it is exact: the root of the path against the face's
@@ -565,12 +852,12 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     const Vec3 uc = u + tau * A;  // h times the path's velocity at the contact
     const double r = rem - tau;
     if (hit->response == Response::kKill) [[unlikely]] {
-      x = point;
-      v = (uc + hOffset) * (1 / h);
+      x = point + (e + tau) * w;
+      v = (uc + hOffset) * (1 / h) + hit->velocity;
       return ContactOutcome::kKilled;
     }
     if (hit->response == Response::kStick) [[unlikely]] {
-      x = point;
+      x = point + (e + tau) * w;  // where it met the collider; it stays there
       v = Vec3::Zero();
       return ContactOutcome::kStuck;
     }
@@ -585,7 +872,7 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
     // without end, nearer and nearer its crease): every further contact is
     // resting or sliding, which ends on the crease.
     const bool twoSurfaces = best.s == 0 && restingCount > 0;
-    if (twoSurfaces) [[unlikely]] {
+    if (twoSurfaces && !moving) [[unlikely]] {
       point = CreasePoint(a, n, best.point, resting[restingCount - 1],
                           restingPoint[restingCount - 1], point);
     }
@@ -625,12 +912,18 @@ ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
       A = Vec3::Zero();
       hOffset = Vec3::Zero();
     }
+    if (moving) {  // back to the world
+      point += (e + tau) * w;
+      x += w;
+      u += w;
+      v += hit->velocity;
+    }
     a = point;
     rem = r;
   }
   // Never leave a particle inside a solid.
   if (contacts == 0 && !grazed) return ContactOutcome::kNone;
-  ProjectOut(colliders, x, v);
+  ProjectOut(colliders, x, v, radius, h);
   return ContactOutcome::kResponded;
 }
 

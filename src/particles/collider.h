@@ -26,6 +26,7 @@
 // systems (System, double precision, and BulkSystem, single).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -52,12 +53,25 @@ struct Contact {
 };
 
 // Triangles with an axis-aligned bounding-volume hierarchy (median split on
-// the longest axis of the centroids' box, at most 4 triangles a leaf).
+// the longest axis of the centroids' box, at most 4 triangles a leaf) for
+// long paths, and a uniform grid for short ones (a particle's step); both
+// give the same first crossing.
 class TriangleBvh {
  public:
   TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint32_t, 3>> triangles);
   // First crossing of the segment a -> b with any triangle, either side.
-  bool Intersect(const Vec3& a, const Vec3& b, Contact* c) const;
+  // With r > 0, the first entry into the triangles grown by r (the set of
+  // points within r of a triangle: two faces offset by r, and a capsule of
+  // radius r about every edge): where a ball of radius r centred on the
+  // path first touches a triangle. The contact point is the ball's centre.
+  bool Intersect(const Vec3& a, const Vec3& b, Contact* c, double r = 0) const;
+  // The bounding box of every triangle.
+  Vec3 lo() const { return nodes_.empty() ? Vec3::Zero() : nodes_[0].lo; }
+  Vec3 hi() const { return nodes_.empty() ? Vec3::Zero() : nodes_[0].hi; }
+  // Whether the box of the segment a -> b grown by r overlaps the box of a
+  // leaf of the hierarchy (a few triangles): false means no triangle is
+  // within r of the path. The broad phase of a mesh collider.
+  bool Near(const Vec3& a, const Vec3& b, double r) const;
   size_t triangleCount() const { return tris_.size(); }
   size_t nodeCount() const { return nodes_.size(); }
   int depth() const { return depth_; }
@@ -69,10 +83,21 @@ class TriangleBvh {
     uint32_t left = 0, right = 0;
   };
   uint32_t Build(uint32_t first, uint32_t count, int depth);
+  void BuildGrid();
+  bool HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r, double best,
+                   Contact* c) const;
   std::vector<Vec3> v_;
   std::vector<std::array<uint32_t, 3>> tris_;
   std::vector<Node> nodes_;
   int depth_ = 0;
+  // A uniform grid (about eight cells a triangle, at most 256 an axis) for
+  // short paths, the common query: cell (x, y, z) lists the triangles whose
+  // boxes touch it, items_[start_[cell] .. start_[cell + 1]). 4 bytes a cell
+  // and a listing.
+  Vec3 gridLo_ = Vec3::Zero();
+  double cell_ = 1;
+  int dims_[3] = {0, 0, 0};
+  std::vector<uint32_t> start_, items_;
 };
 
 // A collider is a plain description; the factories below fill it, and
@@ -91,6 +116,13 @@ struct Collider {
   std::vector<Vec3> polygon;                // convex, counter-clockwise about normal, >= 3 vertices
   std::shared_ptr<const TriangleBvh> mesh;  // not null for kMesh
   std::shared_ptr<const CapsuleBvh> capsules;  // not null for kCapsules
+  // Kinematic motion: the solid translates at this velocity (m/s, each
+  // component within +-1e12), and a contact responds to the particle's
+  // velocity relative to it (a moving plane or ball pushes and carries
+  // particles). System::Step and BulkSystem::Step move it by h times its
+  // velocity after each step (Translate). Plane, sphere, box and polygon;
+  // a mesh or capsules with a velocity fail Validate (not supported yet).
+  Vec3 velocity{0, 0, 0};
   // Material.
   double restitution = 1;  // e: normal speed out / in, 0..1
   double friction = 0;     // Coulomb mu, 0..1e3: tangential impulse <= mu * normal impulse
@@ -116,22 +148,41 @@ struct Collider {
     response = r;
     return *this;
   }
+  Collider& Velocity(const Vec3& v) {
+    velocity = v;
+    return *this;
+  }
+  bool moving() const { return velocity.x() != 0 || velocity.y() != 0 || velocity.z() != 0; }
+  // Moves the solid by d (point, polygon vertices, box corners).
+  void Translate(const Vec3& d);
 
   // First entry of the path a -> b into the solid. A path that starts inside
   // (a half-space kind only) reports s = 0 at the nearest surface point.
-  bool Intersect(const Vec3& a, const Vec3& b, Contact* c) const;
-  // A cheap test that is false only when the path a -> b certainly does not
-  // touch the collider (the per-particle fast path).
-  [[gnu::always_inline]] bool MayHit(const Vec3& a, const Vec3& b) const;
-  // Half-space kinds (plane, sphere, box): if x is inside the solid, the
-  // nearest surface point and its outward normal. Thin kinds return false.
-  bool Project(const Vec3& x, Vec3* surface, Vec3* normal) const;
+  //
+  // The particle's radius r (m, >= 0) counts in every kind: the path is
+  // that of the centre of a ball of radius r, tested against the solid
+  // grown by r (plane and polygon faces offset by r; a sphere's radius plus
+  // r, or minus r inside a bowl; a box's faces moved out by r, or in by r
+  // inside a container; a polygon's rim, a triangle's edges and capsules
+  // grown by r). The contact point is where the centre is at contact, so
+  // the centre stays at least r from the surface. r = 0 is a point.
+  bool Intersect(const Vec3& a, const Vec3& b, Contact* c, double r = 0) const;
+  // A cheap test that is false only when the path a -> b of a ball of
+  // radius r certainly does not touch the collider (the per-particle fast
+  // path; for a mesh, a walk down its hierarchy: TriangleBvh::Near).
+  [[gnu::always_inline]] bool MayHit(const Vec3& a, const Vec3& b, double r = 0) const;
+  // Half-space kinds (plane, sphere, box): if x, the centre of a ball of
+  // radius r, is inside the solid grown by r, the nearest point of its
+  // grown surface (at r from the surface) and its outward normal. Thin
+  // kinds return false.
+  bool Project(const Vec3& x, Vec3* surface, Vec3* normal, double r = 0) const;
 
  private:
   // Every kind, out of line; Intersect and Project inline the plane, the
   // kind of most resting contacts.
-  bool IntersectAny(const Vec3& a, const Vec3& b, Contact* c) const;
-  bool ProjectAny(const Vec3& x, Vec3* surface, Vec3* normal) const;
+  bool IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r) const;
+  bool ProjectAny(const Vec3& x, Vec3* surface, Vec3* normal, double r) const;
+  bool IntersectGrownPolygon(const Vec3& a, const Vec3& b, double r, Contact* c) const;
 };
 
 // The first field of `c` outside its range (for its kind), or ok.
@@ -163,7 +214,12 @@ constexpr int kInelasticContacts = 16;
 // v) over h seconds. The step's path is the one of constant acceleration
 // (v - va) / h from a through x; contacts are found along its chord and
 // their time of impact is exact on flat faces (the root of the path against
-// the face's plane). Any number of contacts a step, until the path meets no
+// the face's plane). A moving collider (Collider::velocity) is where it is
+// at the start of the step and moves by h velocity over it: its contacts
+// are found and answered in its own frame, in which the path is the
+// particle's relative one, so the time of impact and the response (bounce,
+// rest, friction) use the relative velocity, exact for a steady
+// translation. Any number of contacts a step, until the path meets no
 // collider, up to kMaxContacts (then kUnresolved): a bounce reflects the
 // path's velocity at the time of impact (normal speed times e, Coulomb
 // friction) and goes on along the rest of the path, so at e = 1 the
@@ -172,16 +228,19 @@ constexpr int kInelasticContacts = 16;
 // times that from the tangential one; against two surfaces at once the
 // particle slides along their crease). A particle that touched anything is
 // finally projected out of every half-space solid. x and v are updated.
+// `radius` is the particle's (m, >= 0; see Collider::Intersect): its centre
+// stays at least that far from every surface.
 ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
-                                 Vec3& v, double h);
+                                 Vec3& v, double h, double radius = 0);
 
 // --- inline ---
 
-inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c) const {
-  if (kind != Kind::kPlane) return IntersectAny(a, b, c);
-  const double d1 = normal.dot(b - point);
+inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r) const {
+  if (kind != Kind::kPlane) return IntersectAny(a, b, c, r);
+  // The plane moved out by r.
+  const double d1 = normal.dot(b - point) - r;
   if (d1 >= 0) return false;
-  const double d0 = normal.dot(a - point);
+  const double d0 = normal.dot(a - point) - r;
   c->normal = normal;
   if (d0 <= 0) {  // starts on or below the surface
     c->s = 0;
@@ -189,42 +248,45 @@ inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c) const 
   } else {
     c->s = d0 / (d0 - d1);
     c->point = a + c->s * (b - a);
-    c->point -= normal.dot(c->point - point) * normal;  // exactly on the plane
+    c->point -= (normal.dot(c->point - point) - r) * normal;  // exactly on the plane
   }
   return true;
 }
 
-inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n) const {
-  if (kind != Kind::kPlane) return ProjectAny(x, surface, n);
-  const double d = normal.dot(x - point);
+inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n, double r) const {
+  if (kind != Kind::kPlane) return ProjectAny(x, surface, n, r);
+  const double d = normal.dot(x - point) - r;
   if (d >= 0) return false;
   *surface = x - d * normal;
   *n = normal;
   return true;
 }
 
-[[gnu::always_inline]] inline bool Collider::MayHit(const Vec3& a, const Vec3& b) const {
+[[gnu::always_inline]] inline bool Collider::MayHit(const Vec3& a, const Vec3& b, double r) const {
   switch (kind) {
     case Kind::kPlane:
-      return normal.dot(b - point) < 0;
-    case Kind::kSphere:
-      if (inside)
-        return (b - point).squaredNorm() > radius * radius ||
-               (a - point).squaredNorm() > radius * radius;
-      return ((a.cwiseMin(b) - point).array() <= radius).all() &&
-             ((a.cwiseMax(b) - point).array() >= -radius).all();
+      return normal.dot(b - point) < r;
+    case Kind::kSphere: {
+      const double R = inside ? std::max(radius - r, 0.0) : radius + r;
+      if (inside) return (b - point).squaredNorm() > R * R || (a - point).squaredNorm() > R * R;
+      return ((a.cwiseMin(b) - point).array() <= R).all() &&
+             ((a.cwiseMax(b) - point).array() >= -R).all();
+    }
     case Kind::kBox:
       if (inside) {
-        return (b.array() < lo.array()).any() || (b.array() > hi.array()).any() ||
-               (a.array() < lo.array()).any() || (a.array() > hi.array()).any();
+        const Vec3 L = lo.array() + r, H = hi.array() - r;
+        return (b.array() < L.array()).any() || (b.array() > H.array()).any() ||
+               (a.array() < L.array()).any() || (a.array() > H.array()).any();
       }
-      return (a.cwiseMin(b).array() <= hi.array()).all() &&
-             (a.cwiseMax(b).array() >= lo.array()).all();
+      return (a.cwiseMin(b).array() <= hi.array() + r).all() &&
+             (a.cwiseMax(b).array() >= lo.array() - r).all();
     case Kind::kPolygon: {
       const double d0 = normal.dot(a - point), d1 = normal.dot(b - point);
-      return (d0 <= 0 && d1 >= 0) || (d0 >= 0 && d1 <= 0);
+      if (r == 0) return (d0 <= 0 && d1 >= 0) || (d0 >= 0 && d1 <= 0);
+      return std::min(d0, d1) <= r && std::max(d0, d1) >= -r;
     }
     case Kind::kMesh:
+      return mesh && mesh->Near(a, b, r);
     case Kind::kCapsules:
       return true;
   }

@@ -75,17 +75,22 @@ uint32_t BuildMedianSplit(std::vector<Node>& nodes, std::vector<Item>& items, ui
 // Visits the leaves of a hierarchy (nodes with lo, hi, first, count, left,
 // right; node 0 the root, count 0 for an inner node) whose boxes the
 // segment a + t d meets for t in [0, min(best, 1)]: leaf(first, count) may
-// lower `best` (the first entry found so far), which prunes the rest.
+// lower `best` (the first entry found so far), which prunes the rest. With
+// pad > 0, the boxes grown by pad in every direction (a ball's path).
 template <typename Node, typename Leaf>
 void WalkSegment(const std::vector<Node>& nodes, const Vec3& a, const Vec3& d, const double& best,
-                 Leaf&& leaf) {
+                 Leaf&& leaf, double pad = 0) {
   if (nodes.empty()) return;
   uint32_t stack[128];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes[stack[--top]];
-    if (!SegmentBox(a, d, node.lo, node.hi, std::min(best, 1.0))) continue;
+    if (pad == 0 ? !SegmentBox(a, d, node.lo, node.hi, std::min(best, 1.0))
+                 : !SegmentBox(a, d, node.lo - Vec3::Constant(pad), node.hi + Vec3::Constant(pad),
+                               std::min(best, 1.0))) {
+      continue;
+    }
     if (node.count == 0) {
       if (top + 2 > 128) continue;  // cannot happen for depth < 64
       stack[top++] = node.left;

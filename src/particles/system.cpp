@@ -35,7 +35,7 @@ uint32_t ParticleState::Add(const Vec3& p, const Vec3& v, double m, double life)
   age.push_back(0);
   lifetime.push_back(life);
   color.push_back(Vec3f(1, 1, 1));
-  radius.push_back(0.05f);
+  radius.push_back(0.0f);
   id.push_back(nextId);
   return nextId++;
 }
@@ -311,6 +311,12 @@ void System::ForChunks(size_t n, Fn&& fn) const {
   ForRanges(pool_, n, BalancedGrain(pool_, n, 256, kChunk), fn);
 }
 
+void System::MoveColliders(double h) {
+  for (Collider& c : colliders_) {
+    if (c.moving()) c.Translate(h * c.velocity);
+  }
+}
+
 void System::NonLocalForces(const Vec3* x, const Vec3* v) const {
   if (!hasNonLocal_) return;
   const size_t n = state.size();
@@ -371,7 +377,7 @@ uint64_t System::Hash() const {
 // Contact response for particle i (see RespondToContacts); kill and stick
 // change its cold data.
 [[gnu::noinline]] void System::Collide(size_t i, Vec3 a, Vec3 va, Vec3& x, Vec3& v, double h) {
-  switch (RespondToContacts(colliders_, a, va, x, v, h)) {
+  switch (RespondToContacts(colliders_, a, va, x, v, h, double(state.radius[i]))) {
     case ContactOutcome::kKilled:
       state.lifetime[i] = std::min(state.lifetime[i], state.age[i]);
       break;
@@ -398,8 +404,10 @@ uint64_t System::Hash() const {
     x1 = x0;
     v1 = Vec3::Zero();
   } else {
+    const double r = double(state.radius[i]);
     for (const Collider& c : colliders_) {
-      if (c.MayHit(x0, x1)) {
+      // A moving collider: the path in its frame at the start of the step.
+      if (c.moving() ? c.MayHit(x0, x1 - h * c.velocity, r) : c.MayHit(x0, x1, r)) {
         Collide(i, x0, v0, x1, v1, h);
         break;
       }
@@ -488,6 +496,7 @@ Status System::Step(double h, Integrator integrator) {
   state.time = time;
   state.step = steps;
   faulted_ = false;
+  if (pairRadius_ > 0) SavePairStart();
   switch (integrator) {
     case Integrator::kExplicitEuler:
     case Integrator::kSymplecticEuler: {
@@ -547,7 +556,8 @@ Status System::Step(double h, Integrator integrator) {
       SYLVA_CHECK_OK(ImplicitEuler(h));
       break;
   }
-  if (pairRadius_ > 0) ParticleCollisions();
+  if (pairRadius_ > 0) ParticleCollisions(h);
+  MoveColliders(h);
   state.time = time;
   Status status = CheckFaults("in");
   time += h;
@@ -735,34 +745,9 @@ Status System::NonFiniteSolve(const char* what, const Vec3* a, int iteration) {
   return d;
 }
 
-void System::ParticleCollisions() {
-  const size_t n = state.size();
-  std::vector<Vec3>& X = state.position;
-  std::vector<Vec3>& V = state.velocity;
-  const double reach = 2 * pairRadius_;
-  pairGrid_->Build(X.data(), n, reach, pool_);
-  const double* w = state.invMass.data();
-  // Gauss-Seidel over the pairs in index order: serial, so deterministic.
-  for (size_t i = 0; i < n; ++i) {
-    pairGrid_->ForEachNeighbour(X.data(), i, reach, [&](size_t j) {
-      if (j < i) return;
-      const double ws = w[i] + w[j];
-      if (ws == 0) return;
-      const Vec3 d = X[i] - X[j];
-      const double dist = d.norm();
-      if (!(dist > 0) || dist >= reach) return;
-      const Vec3 nrm = d / dist;
-      const double rel = (V[i] - V[j]).dot(nrm);
-      if (rel < 0) {  // approaching: exchange a momentum-conserving impulse
-        const double J = -(1 + pairRestitution_) * rel / ws;
-        V[i] += J * w[i] * nrm;
-        V[j] -= J * w[j] * nrm;
-      }
-      const double overlap = reach - dist;  // separate, heavier moves less
-      X[i] += overlap * (w[i] / ws) * nrm;
-      X[j] -= overlap * (w[j] / ws) * nrm;
-    });
-  }
+void System::SavePairStart() {
+  pairX0_.assign(state.position.begin(), state.position.end());
+  pairV0_.assign(state.velocity.begin(), state.velocity.end());
 }
 
 // Dormand & Prince (1980) RK5(4)7M.
@@ -873,10 +858,12 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
     }
     if (err <= 1) {
       faulted_ = false;
+      if (pairRadius_ > 0) SavePairStart();
       ForChunks(n, [&](size_t b, size_t e) {
         for (size_t i = b; i < e; ++i) Finish(i, X[i], V[i], x_[i], v_[i], h);
       });
-      if (pairRadius_ > 0) ParticleCollisions();
+      if (pairRadius_ > 0) ParticleCollisions(h);
+      MoveColliders(h);
       state.time = time;
       Status s = CheckFaults("in adaptive");
       time += h;

@@ -52,7 +52,9 @@ struct ParticleState {
   // cold
   std::vector<double> mass, invMass, age, lifetime;
   std::vector<Vec3f> color;
-  std::vector<float> radius;  // drawn size, metres
+  // Metres, >= 0: the particle is a ball of this radius to every collider
+  // (its centre stays at least this far from a surface) and its drawn size.
+  std::vector<float> radius;
   std::vector<uint32_t> id;
   uint32_t nextId = 0;
   // The time and step number forces are evaluated at (set by the system).
@@ -60,7 +62,8 @@ struct ParticleState {
   uint64_t step = 0;
 
   size_t size() const { return position.size(); }
-  // Adds a particle; mass 0 or less means immovable (infinite mass).
+  // Adds a particle of radius 0 (a point: set radius.back() for a ball);
+  // mass 0 or less means immovable (infinite mass).
   uint32_t Add(const Vec3& p, const Vec3& v, double mass = 1, double lifetime = 1e300);
 };
 
@@ -281,15 +284,20 @@ class System {
   int threads() const;
   void AddForce(std::shared_ptr<Force> f);
   // Adds a collider that passes Validate(Collider), else its Diagnostic.
+  // One with a velocity moves by h times it after every step (colliders()
+  // gives where they are).
   [[nodiscard]] Status AddCollider(Collider c);
   const std::vector<Collider>& colliders() const { return colliders_; }
   [[nodiscard]] Status AddPlane(const Plane& p) {
     return AddCollider(
         Collider::Plane(p.point, p.normal).Restitution(p.restitution).Friction(p.friction));
   }
-  // Particles as spheres of this radius that collide with each other (found
-  // on a grid), with the given restitution; resolved after every step.
-  // radius 1e-12..1e12 m, restitution 0..1, else a Diagnostic.
+  // Particles as balls that collide with each other, with the given
+  // restitution, resolved after every step (pairs.cpp): each a ball of its
+  // own state.radius, or of `radius` where that is 0. Contacts are swept
+  // (balls do not pass through each other however fast), solved in
+  // parallel and bit-identical for any thread count. radius 1e-12..1e12 m,
+  // restitution 0..1, else a Diagnostic.
   [[nodiscard]] Status EnableParticleCollisions(double radius, double restitution);
 
   // Accelerations for positions x and velocities v (all particles).
@@ -329,7 +337,11 @@ class System {
   // count.
   template <int K, typename Fn>
   std::array<double, K> SumChunks(size_t n, Fn&& fn) const;
-  void ParticleCollisions();
+  void ParticleCollisions(double h);
+  // Saves the state at the start of a step for the pair contacts.
+  void SavePairStart();
+  // Moves every moving collider by h times its velocity (after a step).
+  void MoveColliders(double h);
   Status CheckFaults(const char* what);
   Status CheckStep(const char* what, double h) const;
 
@@ -341,6 +353,20 @@ class System {
   bool hasNonLocal_ = false;
   double pairRadius_ = 0, pairRestitution_ = 1;
   std::unique_ptr<NeighbourGrid> pairGrid_;
+  // The pair contacts of a step (pairs.cpp): 72 bytes each.
+  struct PairContact {
+    Vec3 n;          // unit, from the other particle toward this one, at impact
+    double t;        // time of impact, fraction of the step
+    double R;        // the two radii
+    double vn0;      // relative normal speed before the solve (negative: approaching)
+    double impulse;  // summed over the velocity passes (N s times the inverse mass sum's unit)
+    uint32_t j;      // the other particle
+    bool bounce;     // faster than the step's forces: leaves at e times vn0
+  };
+  std::vector<Vec3> pairX0_, pairV0_, pairV_, pairScratch_;
+  std::vector<double> pairMove_;     // each particle's displacement over the step
+  std::vector<uint32_t> pairStart_;  // particle i's contacts: [start[i], start[i + 1])
+  std::vector<PairContact> pairs_;
   std::optional<Diagnostic> fault_;
   SolveStats solve_;
   double adaptiveStep_ = 0;

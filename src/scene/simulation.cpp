@@ -610,8 +610,9 @@ Status Simulation::Impl::Emit(ParticleSystem& ps, double step) {
       Vec3 at = b.x + b.v * remaining;
       particles::Contact contact;
       for (const particles::Collider& c : ps.system->colliders())
-        if (at != b.x && c.Intersect(b.x, at, &contact)) at = b.x;
+        if (at != b.x && c.Intersect(b.x, at, &contact, e.radius)) at = b.x;
       st.Add(at, b.v, b.mass, b.lifetime);
+      st.radius.back() = float(e.radius);  // the ball the colliders see
       st.age.back() = remaining;
       if (ps.springs) {
         if (Status s = ps.Join(st.size() - 1); !s.ok()) {
@@ -697,7 +698,9 @@ Status Simulation::Impl::Step() {
             break;
           }
           Birth b{st.position[i], Vec3::Zero(), 1, 1};
+          float radius = 0;
           if (!death.target->sources.empty()) {
+            radius = float(death.target->sources[0].def->radius);
             Source& src = death.target->sources[0];
             const Birth drawn = Draw(src);
             b.v = drawn.v;
@@ -705,6 +708,7 @@ Status Simulation::Impl::Step() {
             b.mass = drawn.mass;
           }
           target.Add(st.position[i], st.velocity[i] + b.v, b.mass, b.lifetime);
+          target.radius.back() = radius;
         }
       }
     }

@@ -105,12 +105,15 @@ TEST(SceneSimulation, SnowThatLandsOnABranchStaysThere) {
   ASSERT_TRUE(run->sim->AdvanceTo(3).ok());
   const std::vector<Row> rows = Rows(*run->sim);
   size_t onTree = 0, onGround = 0, below = 0;
+  // A flake is a ball of the emitter's radius (0.01 m by default) to the
+  // colliders: on the ground its centre is at y = 0.01.
+  const double radius = 0.01;
   for (const Row& r : rows) {
-    if (r.x.y() < -1e-9) ++below;
+    if (r.x.y() < radius - 1e-9) ++below;
     if (r.v.norm() == 0 && r.x.y() > 0.05) ++onTree;
-    if (r.v.norm() == 0 && std::abs(r.x.y()) <= 1e-9) ++onGround;
+    if (r.v.norm() == 0 && std::abs(r.x.y() - radius) <= 1e-9) ++onGround;
   }
-  EXPECT_EQ(below, 0u) << "flakes below the ground";
+  EXPECT_EQ(below, 0u) << "flakes closer to the ground than their radius";
   EXPECT_GT(onTree, 100u) << "flakes resting above the ground (on branches) of " << rows.size();
   EXPECT_GT(onGround, 1000u) << "flakes resting on the ground of " << rows.size();
   // What rests stays: three more seconds move none of the resting flakes.
