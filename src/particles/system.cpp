@@ -292,6 +292,15 @@ Status System::AddCollider(Collider c) {
   return {};
 }
 
+Status System::SetCollider(size_t index, Collider c) {
+  if (index >= colliders_.size())
+    return check::Error("System.SetCollider: collider " + std::to_string(index) + " of " +
+                        std::to_string(colliders_.size()));
+  SYLVA_CHECK_OK(Validate(c));
+  colliders_[index] = std::move(c);
+  return {};
+}
+
 Status System::EnableParticleCollisions(double radius, double restitution) {
   SYLVA_CHECK_OK(check::Range("System.EnableParticleCollisions radius", radius, 1e-12, 1e12, "m"));
   SYLVA_CHECK_OK(check::Range("System.EnableParticleCollisions restitution", restitution, 0, 1));

@@ -287,6 +287,10 @@ class System {
   // One with a velocity moves by h times it after every step (colliders()
   // gives where they are).
   [[nodiscard]] Status AddCollider(Collider c);
+  // Replaces collider `index` (a solid whose shape changes, such as a cloth
+  // rebuilt each step); the same checks as AddCollider, and an index past
+  // the colliders is an error.
+  [[nodiscard]] Status SetCollider(size_t index, Collider c);
   const std::vector<Collider>& colliders() const { return colliders_; }
   [[nodiscard]] Status AddPlane(const Plane& p) {
     return AddCollider(

@@ -311,6 +311,13 @@ struct ParticleSystem {
     uint32_t a, b;
     double rest;
   };
+  // Colliders that are cloth: rebuilt from the sheet before every step.
+  struct ClothCollider {
+    size_t cloth;     // index into Impl::cloths
+    size_t collider;  // index into the system's colliders
+    const CollideDef* def;
+  };
+  std::vector<ClothCollider> clothColliders;
   const SpringsDef* springsDef = nullptr;
   std::shared_ptr<particles::Springs> springs;
   std::vector<Joint> joints;
@@ -496,6 +503,10 @@ struct Simulation::Impl {
                      DiagnosticList& diags, std::vector<particles::Collider>& out);
   Status AddColliders(particles::System& system, const std::vector<CollideDef>& collides,
                       DiagnosticList& diags);
+  // The cloths a particle system collides with: a triangle collider each,
+  // added to the system now and rebuilt from the sheet before every step.
+  Status AddClothColliders(ParticleSystem& ps);
+  Status RefreshClothColliders(ParticleSystem& ps);
   std::shared_ptr<const particles::TriangleBvh> BvhOf(const std::string& id);
   Status Emit(ParticleSystem& ps, double h);
   Status Step();
@@ -541,9 +552,11 @@ Status Simulation::Impl::CollidersOf(const std::vector<CollideDef>& collides,
         bool isCloth = false;
         for (const ClothDef& cl : scene->cloths) isCloth = isCloth || cl.id == id;
         if (isCloth) {
-          if (id != selfId)  // a cloth with itself: its self-collision (the caller)
-            diags.Add(
-                Warn(c.withLoc, "collisions with a cloth ('" + id + "') are not simulated yet"));
+          // A cloth with itself: its self-collision (the caller). Particles
+          // with a cloth: ClothCollidersOf, once the cloths exist.
+          if (id != selfId && !selfId.empty())
+            diags.Add(Warn(c.withLoc, "collisions of a cloth with another cloth ('" + id +
+                                          "') are not simulated yet"));
           continue;
         }
         const auto pts = built->points.find(id);
@@ -581,6 +594,43 @@ Status Simulation::Impl::AddColliders(particles::System& system,
     SYLVA_ASSERT(s.ok());  // validated above
   }
   return {};
+}
+
+Status Simulation::Impl::RefreshClothColliders(ParticleSystem& ps) {
+  for (const ParticleSystem::ClothCollider& cc : ps.clothColliders) {
+    const particles::Cloth& cloth = *cloths[cc.cloth].cloth;
+    std::vector<std::array<uint32_t, 3>> triangles(cloth.triangles().begin(),
+                                                   cloth.triangles().end());
+    auto bvh =
+        std::make_shared<const particles::TriangleBvh>(cloth.positions(), std::move(triangles));
+    particles::Collider c = particles::Collider::Mesh(std::move(bvh));
+    c.Restitution(cc.def->restitution)
+        .Friction(std::min(cc.def->friction, 1e3))
+        .Respond(cc.def->stick ? particles::Response::kStick : particles::Response::kBounce);
+    if (Status s = ps.system->SetCollider(cc.collider, std::move(c)); !s.ok()) {
+      Diagnostic d = s.error();
+      d.loc = cc.def->loc;
+      return d;
+    }
+  }
+  return {};
+}
+
+Status Simulation::Impl::AddClothColliders(ParticleSystem& ps) {
+  for (const CollideDef& c : ps.def->collides) {
+    for (const std::string& id : c.with) {
+      for (size_t k = 0; k < cloths.size(); ++k) {
+        if (cloths[k].def->id != id) continue;
+        ps.clothColliders.push_back({k, ps.system->colliders().size(), &c});
+        // A placeholder (the ground plane far below) until the refresh.
+        if (Status s = ps.system->AddCollider(
+                particles::Collider::Plane(Vec3(0, -1e12, 0), Vec3::UnitY()));
+            !s.ok())
+          return s;
+      }
+    }
+  }
+  return RefreshClothColliders(ps);
 }
 
 Status Simulation::Impl::Emit(ParticleSystem& ps, double step) {
@@ -673,6 +723,7 @@ Status Simulation::Impl::Step() {
     const int sub = ps->def->substeps;
     for (int k = 0; k < sub; ++k) {
       const double hs = h / sub;
+      if (Status s = RefreshClothColliders(*ps); !s.ok()) return s;
       if (Status s = Emit(*ps, hs); !s.ok()) return s;
       if (ps->flutter) ps->TurnLeaves(hs, hasWind ? &wind : nullptr, time);
       if (hasWind && scene->wind)
@@ -1193,6 +1244,8 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
     m.flocks.push_back(std::move(flock));
   }
   if (Status s = m.PlaceCentres(); !s.ok()) return s.error();
+  for (auto& ps : m.systems)
+    if (Status s = m.AddClothColliders(*ps); !s.ok()) return s.error();
   return sim;
 }
 
