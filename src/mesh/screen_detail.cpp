@@ -18,6 +18,19 @@ int SidesForPixelRadius(double radiusPx, double eps) {
   return int(std::clamp(c, 3.0, 256.0));
 }
 
+int ChainLevel(double radiusPx, double eps, bool coverage) {
+  if (coverage && radiusPx < kLinePixels / 2) return 0;
+  if (radiusPx < 3 * eps) return 1;
+  return SidesForPixelRadius(radiusPx, eps);
+}
+
+int ChainLevelAfter(int last, double radiusPx, double eps, bool coverage) {
+  const int lo = ChainLevel(radiusPx, eps, coverage);
+  if (last < 0) return lo;
+  const int hi = ChainLevel(radiusPx * (1 + kHysteresis), eps, coverage);
+  return std::clamp(last, lo, hi);
+}
+
 double PixelsPerUnit(const ScreenView& view, const Vec3& p) {
   const Mat4& m = view.viewProjection;
   const Vec4 c = m * Vec4(p.x(), p.y(), p.z(), 1);

@@ -4,6 +4,7 @@
 #include <stb_image_write.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -48,8 +49,12 @@ struct Renderer::Gl {
   GLuint groundVao = 0, groundBuffers[3] = {0, 0, 0};
   GLsizei groundCount = 0;
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};  // mesh bounds
-  GLuint meshVao = 0, meshBuffers[3] = {0, 0, 0}, meshIndex = 0;
+  GLuint meshVao = 0, meshBuffers[3] = {0, 0, 0}, meshIndex = 0, meshCoverage = 0;
   GLsizei meshIndexCount = 0;
+  // Indices [0, opaqueIndexCount) are opaque; the rest have coverage < 1
+  // somewhere and are blended after everything opaque, without depth writes.
+  GLsizei opaqueIndexCount = 0;
+  bool haveCoverage = false;
   GLuint lineVao = 0, lineBuffers[2] = {0, 0};
   GLsizei lineVertexCount = 0;
   GLuint pointProgram = 0, pointVao = 0, pointBuffers[3] = {0, 0, 0};
@@ -188,6 +193,7 @@ Expected<std::unique_ptr<Renderer>> Renderer::Create(const std::string& shaderDi
   glGenVertexArrays(1, &g.meshVao);
   glGenBuffers(3, g.meshBuffers);
   glGenBuffers(1, &g.meshIndex);
+  glGenBuffers(1, &g.meshCoverage);
   glGenVertexArrays(1, &g.lineVao);
   glGenBuffers(2, g.lineBuffers);
   return r;
@@ -206,6 +212,7 @@ Renderer::~Renderer() {
   glDeleteProgram(g.lineProgram);
   glDeleteBuffers(3, g.meshBuffers);
   glDeleteBuffers(1, &g.meshIndex);
+  glDeleteBuffers(1, &g.meshCoverage);
   glDeleteBuffers(2, g.lineBuffers);
   glDeleteVertexArrays(1, &g.meshVao);
   glDeleteVertexArrays(1, &g.lineVao);
@@ -271,9 +278,37 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
   glBindVertexArray(g.meshVao);
   UploadVertexAttributes(g.meshBuffers, m, color);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.meshIndex);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
-               GL_STATIC_DRAW);
   g.meshIndexCount = GLsizei(m.indices.size());
+  g.opaqueIndexCount = g.meshIndexCount;
+  g.haveCoverage = m.coverage.size() == m.vertexCount() &&
+                   std::any_of(m.coverage.begin(), m.coverage.end(), [](float c) { return c < 1; });
+  if (g.haveCoverage) {
+    // Opaque triangles first, then those with partial coverage (in order).
+    std::vector<uint32_t> sorted;
+    sorted.reserve(m.indices.size());
+    auto partial = [&](size_t t) {
+      return m.coverage[m.indices[3 * t]] < 1 || m.coverage[m.indices[3 * t + 1]] < 1 ||
+             m.coverage[m.indices[3 * t + 2]] < 1;
+    };
+    for (int pass = 0; pass < 2; ++pass) {
+      for (size_t t = 0; t < m.triangleCount(); ++t) {
+        if (partial(t) != (pass == 1)) continue;
+        sorted.insert(sorted.end(), &m.indices[3 * t], &m.indices[3 * t] + 3);
+      }
+      if (pass == 0) g.opaqueIndexCount = GLsizei(sorted.size());
+    }
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(sorted.size() * 4), sorted.data(),
+                 GL_STATIC_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, g.meshCoverage);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.coverage.size() * 4), m.coverage.data(),
+                 GL_STATIC_DRAW);
+    glEnableVertexAttribArray(3);
+    glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, 4, nullptr);
+  } else {
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
+                 GL_STATIC_DRAW);
+    glDisableVertexAttribArray(3);  // the generic value, 1, set in Draw
+  }
   glBindVertexArray(0);
   g.lo = g.hi = Vec3::Zero();
   if (m.vertexCount()) {
@@ -354,6 +389,9 @@ void Renderer::RenderShadowMap() {
   glUseProgram(g.shadowProgram);
   glUniformMatrix4fv(g.shadowLightViewProj, 1, GL_FALSE, g.lightViewProj.data());
   glBindVertexArray(g.meshVao);
+  // Coverage lines and points, drawn wider than they are, cast a
+  // screen-door shadow (shadow.frag) of their mean darkness.
+  glVertexAttrib1f(3, 1.0f);  // coverage of a mesh without any
   glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
   glBindVertexArray(0);
   glDisable(GL_POLYGON_OFFSET_FILL);
@@ -435,7 +473,8 @@ void Renderer::Draw(const Camera& camera) {
     glUniform1i(g.meshShadow, 0);
     glBindVertexArray(g.meshVao);
     glUniform1i(g.meshWire, 0);
-    glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
+    glVertexAttrib1f(3, 1.0f);  // coverage of a mesh without any
+    glDrawElements(GL_TRIANGLES, g.opaqueIndexCount, GL_UNSIGNED_INT, nullptr);
     if (wireframe_) {
       // The triangles' edges over the shaded mesh, pulled toward the eye.
       glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
@@ -450,6 +489,19 @@ void Renderer::Draw(const Camera& camera) {
     if (ground_) {
       glBindVertexArray(g.groundVao);
       glDrawArrays(GL_TRIANGLES, 0, g.groundCount);
+    }
+    if (g.opaqueIndexCount < g.meshIndexCount) {
+      // Coverage in alpha, blended over everything opaque in the encoded
+      // (sRGB) values the target holds, as the multisample resolve averages
+      // them; depth tested but not written, so overlapping twigs add up.
+      glBindVertexArray(g.meshVao);
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+      glDepthMask(GL_FALSE);
+      glDrawElements(GL_TRIANGLES, g.meshIndexCount - g.opaqueIndexCount, GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(size_t(g.opaqueIndexCount) * 4));
+      glDepthMask(GL_TRUE);
+      glDisable(GL_BLEND);
     }
   }
   if (g.pointCount) {
