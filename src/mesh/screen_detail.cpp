@@ -47,6 +47,16 @@ double PixelsPerUnit(const ScreenView& view, const Vec3& p) {
   return std::sqrt((a + d) / 2 + std::sqrt(h * h + b * b));
 }
 
+Vec2 PixelOffset(const ScreenView& view, const Vec3& p, const Vec3& d) {
+  const Mat4& m = view.viewProjection;
+  const Vec4 c = m * Vec4(p.x(), p.y(), p.z(), 1);
+  if (!(c.w() > 1e-12)) return Vec2::Constant(std::numeric_limits<double>::infinity());
+  const double x = c.x() / c.w(), y = c.y() / c.w();
+  const Vec3 r3 = m.block<1, 3>(3, 0).transpose();
+  return Vec2((m.block<1, 3>(0, 0).transpose() - x * r3).dot(d) * (0.5 * view.width / c.w()),
+              (m.block<1, 3>(1, 0).transpose() - y * r3).dot(d) * (0.5 * view.height / c.w()));
+}
+
 Vec3 TowardEye(const ScreenView& view, const Vec3& p) {
   const Mat4& m = view.viewProjection;
   const Vec4 c = m * Vec4(p.x(), p.y(), p.z(), 1);

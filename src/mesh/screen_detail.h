@@ -89,6 +89,11 @@ int SidesForPixelRadius(double radiusPx, double eps);
 // moves by one unit in any direction. +inf at or behind the eye's plane.
 double PixelsPerUnit(const ScreenView& view, const Vec3& p);
 
+// How far, in pixels (x right, y up), the image of p moves when p moves by
+// one world unit along d (the Jacobian of world -> pixels at p times d).
+// Non-finite at or behind the eye's plane.
+Vec2 PixelOffset(const ScreenView& view, const Vec3& p, const Vec3& d);
+
 // The unit direction from p toward the eye (for an orthographic view, the
 // reverse of the view direction): the direction in which moving p does not
 // move its image. Zero at the eye's plane.

@@ -224,8 +224,15 @@ void EmitRibbon(const PlantGeometry& g, const std::vector<uint32_t>& chain, cons
     const float v = float(f.V[k]);
     double half = f.R[k];
     if (plan.line) {
-      const double ppu = PixelsPerUnit(view, f.P[k]);
-      const double drawn = std::max(half, kLinePixels / 2 / ppu);  // +inf ppu: the tube's
+      // Pixels per unit across the line's image: the side's image less its
+      // part along the axis's image (PixelsPerUnit, the largest stretch,
+      // overstates the width off the image centre).
+      const Vec2 s = PixelOffset(view, f.P[k], side), t = PixelOffset(view, f.P[k], f.T[k]);
+      const double tn = t.norm();
+      const double ppu = tn > 1e-12 ? std::abs(s.x() * t.y() - s.y() * t.x()) / tn : s.norm();
+      // Non-finite or zero (at the eye's plane, end-on): the tube's own width.
+      const double drawn =
+          ppu > 0 && std::isfinite(ppu) ? std::max(half, kLinePixels / 2 / ppu) : half;
       out.coverage[vbase + 2 * r] = out.coverage[vbase + 2 * r + 1] =
           float(std::clamp(half / drawn, 1e-3, 1.0));
       half = drawn;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <string>
 
@@ -93,38 +94,96 @@ double Darkness(const Image& img, const mesh::Vec3f& background) {
   return sum / (3.0 * img.width * img.height);
 }
 
-// A grid of nearly vertical twigs 0.3 px wide, 4 px apart: with screen-space
-// detail they are ribbons, and with 4x multisampling the picture keeps
-// their coverage (0.3 / 4 of each row) on average. The expected mean is
-// that of the same grid at 8 x 8 the resolution (2.4 px wide, 16-sided
-// tubes, nearly every pixel covered wholly or not at all), and the
-// ribbons darken as much as 16-sided tubes at the same resolution do.
-// (Both are about 35 % darker than the reference averaged in linear
-// light, because the renderer resolves multisamples in sRGB space.)
-TEST_F(ScreenDetailRender, SubPixelTwigsKeepTheirCoverage) {
-  const int W = 160, H = 120;
+// A grid of nearly vertical twigs radiusPx wide in radius, 4 px apart,
+// slanted by 1 in 12 so they cross every sub-pixel offset (a grid aligned
+// with the pixels would hit the same multisample positions in every row:
+// 2 of 16 samples for 0.3 px centred on a pixel edge). Twig centres in
+// pixels: x = W/2 + (x0 + yw / 12) ppu, yw the world height of a row.
+struct TwigGrid {
+  mesh::PlantGeometry geometry;
+  std::vector<double> x0;  // world x of each twig at y = 0
+  double ppu = 0;
+};
+
+TwigGrid MakeTwigGrid(const Camera& cam, int W, int H, double radiusPx) {
+  TwigGrid t;
+  t.ppu = (H / 2.0) / (std::tan(cam.fovY * kDegToRad / 2) * cam.distance);
+  const double halfW = W / 2.0 / t.ppu, halfH = H / 2.0 / t.ppu;
+  uint32_t branch = 0;
+  for (double x = -halfW + 2 / t.ppu; x < halfW; x += 4 / t.ppu) {
+    mesh::Segment s;
+    s.start = Vec3(x - halfH * 0.1, -halfH * 1.2, 0);
+    s.end = Vec3(x + halfH * 0.1, halfH * 1.2, 0);
+    s.left = Vec3(-1, 0, 0);
+    s.radiusStart = s.radiusEnd = float(radiusPx / t.ppu);
+    s.branch = s.parent = branch++;
+    t.geometry.segments.push_back(s);
+    t.x0.push_back(x);
+  }
+  t.geometry.branchCount = branch;
+  return t;
+}
+
+Camera TwigCamera() {
   Camera cam;
   cam.target = Vec3(0, 0, 0);
   cam.azimuth = 0;
   cam.elevation = 0;
   cam.distance = 10;
-  const double ppu = (H / 2.0) / (std::tan(cam.fovY * kDegToRad / 2) * cam.distance);
-  mesh::PlantGeometry g;
-  const double halfW = W / 2.0 / ppu, halfH = H / 2.0 / ppu;
-  uint32_t branch = 0;
-  for (double x = -halfW + 2 / ppu; x < halfW; x += 4 / ppu) {
-    mesh::Segment s;
-    // Slanted by 1 in 12, so the twigs cross every sub-pixel offset (a grid
-    // aligned with the pixels would hit the same multisample positions in
-    // every row: 2 of 16 samples for 0.3 px centred on a pixel edge).
-    s.start = Vec3(x - halfH * 0.1, -halfH * 1.2, 0);
-    s.end = Vec3(x + halfH * 0.1, halfH * 1.2, 0);
-    s.left = Vec3(-1, 0, 0);
-    s.radiusStart = s.radiusEnd = float(0.15 / ppu);
-    s.branch = s.parent = branch++;
-    g.segments.push_back(s);
+  return cam;
+}
+
+// The darkness each twig adds to each row: the sum over the 4 pixels
+// centred on it, for every twig and row clear of the image border; with
+// `worldX`, the twig's world x in that row.
+std::vector<double> TwigRowDarkness(const Image& img, const TwigGrid& t,
+                                    const mesh::Vec3f& background,
+                                    std::vector<double>* worldX = nullptr) {
+  const mesh::Vec3f bg = mesh::ToSrgb(background) * 255.0f;
+  std::vector<double> out;
+  for (int row = 0; row < img.height; ++row) {
+    const double yw = (img.height / 2.0 - (row + 0.5)) / t.ppu;
+    for (double x0 : t.x0) {
+      const double px = img.width / 2.0 + (x0 + yw / 12) * t.ppu;
+      const int first = int(std::ceil(px - 2 - 0.5));
+      if (first < 0 || first + 4 > img.width) continue;
+      double sum = 0;
+      for (int x = first; x < first + 4; ++x)
+        for (int c = 0; c < 3; ++c) sum += (1 - double(img.Pixel(x, row)[c]) / double(bg[c])) / 3;
+      out.push_back(sum);
+      if (worldX) worldX->push_back(x0 + yw / 12);
+    }
   }
-  g.branchCount = branch;
+  return out;
+}
+
+double Mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / double(v.size());
+}
+
+// Coefficient of variation: 0 for a twig that darkens every row alike.
+double Variation(const std::vector<double>& v) {
+  const double m = Mean(v);
+  double s = 0;
+  for (double x : v) s += (x - m) * (x - m);
+  return v.empty() || !(m > 0) ? 0 : std::sqrt(s / double(v.size())) / m;
+}
+
+// A grid of twigs 0.3 px wide without coverage lines: they are ribbons,
+// and with 4x multisampling the picture keeps their coverage (0.3 / 4 of
+// each row) on average. The expected mean is that of the same grid at
+// 8 x 8 the resolution (2.4 px wide, 16-sided tubes, nearly every pixel
+// covered wholly or not at all), and the ribbons darken as much as
+// 16-sided tubes at the same resolution do. (Both are about 35 % darker
+// than the reference averaged in linear light, because the renderer
+// resolves multisamples in sRGB space.)
+TEST_F(ScreenDetailRender, SubPixelTwigsKeepTheirCoverage) {
+  const int W = 160, H = 120;
+  const Camera cam = TwigCamera();
+  const TwigGrid grid = MakeTwigGrid(cam, W, H, 0.15);
+  const mesh::PlantGeometry& g = grid.geometry;
   const mesh::Vec3f bg = renderer_->background();
   auto draw = [&](const mesh::TessellateOptions& opt, int scale) {
     mesh::TriangleMesh m;
@@ -152,6 +211,100 @@ TEST_F(ScreenDetailRender, SubPixelTwigsKeepTheirCoverage) {
                                      << " with 16-sided tubes at the same resolution";
   RecordProperty("darkness", std::to_string(got) + " ribbons, " + std::to_string(tube) +
                                  " tubes, " + std::to_string(want) + " reference");
+}
+
+// Issue 15's coverage test: a grid of twigs 0.3 px wide drawn as coverage
+// lines (ScreenView::coverage: ribbons kLinePixels wide, alpha the true
+// width) darkens each row by the analytic coverage within 10 %: the
+// twig's width in pixels times the darkness of its colour, measured from
+// the same grid drawn 5 px wide (opaque ribbons covering every pixel, the
+// same normal toward the eye). The width is 0.3 px at the image centre;
+// perspective widens a vertical cylinder at world x (depth 10) by
+// sqrt(1 + (x / 10)^2) (up to 8 % at the border), and the slant of 1 in 12
+// widens each row's cut by sqrt(1 + 1/144). The darkness is taken in the
+// stored sRGB values: the renderer blends (and resolves multisamples) in
+// sRGB space, where alpha a gives exactly a times the opaque darkness; in
+// linear light the same picture is darker than the linear coverage (see
+// docs/lod.md). And the lines fade instead of aliasing: each twig darkens
+// every row alike (a 1 px wide line covers 4 of the 4x pattern's samples
+// in each row wherever it lies), where plain 0.3 px ribbons hit 0, 1 or 2
+// samples a row.
+TEST_F(ScreenDetailRender, SubPixelLinesKeepTheAnalyticCoverage) {
+  const int W = 160, H = 120;
+  const Camera cam = TwigCamera();
+  const mesh::Vec3f bg = renderer_->background();
+  auto draw = [&](const TwigGrid& grid, double eps, bool coverage, mesh::TriangleMesh* keep) {
+    mesh::TessellateOptions opt;
+    opt.view = mesh::ScreenView{cam.ViewProjection(double(W) / H), W, H, eps};
+    opt.view->coverage = coverage;
+    mesh::TriangleMesh m;
+    EXPECT_TRUE(mesh::Tessellate(grid.geometry, opt, m).ok());
+    EXPECT_EQ(mesh::Validate(m), "");
+    EXPECT_TRUE(renderer_->Resize(W, H).ok());
+    renderer_->SetGround(false);
+    renderer_->SetShadows(false);
+    renderer_->SetMesh(m, mesh::DefaultPalette());
+    renderer_->Draw(cam);
+    if (keep) *keep = m;
+    return renderer_->ReadPixels();
+  };
+  const TwigGrid thin = MakeTwigGrid(cam, W, H, 0.15);
+  mesh::TriangleMesh lines;
+  const Image img = draw(thin, 0.5, true, &lines);
+  ASSERT_EQ(lines.coverage.size(), lines.vertexCount());
+  ASSERT_EQ(lines.vertexCount(), 4 * thin.geometry.segments.size()) << "one line a twig";
+  auto width = [&](double x) {
+    return 0.3 * std::sqrt(1 + (x / cam.distance) * (x / cam.distance));
+  };
+  for (size_t i = 0; i < lines.vertexCount(); ++i) {
+    const double c = lines.coverage[i], want = width(lines.positions[i].x());
+    ASSERT_NEAR(c / want, 1.0, 0.02)
+        << "coverage of a twig 0.3 px wide (at the centre) drawn 1 px "
+           "wide, at x = "
+        << lines.positions[i].x() << ": " << c << ", expected " << want;
+  }
+  // eps 2: ribbons up to 6 px in radius, so the 2.5 px twigs are opaque ribbons.
+  const Image solid = draw(MakeTwigGrid(cam, W, H, 2.5), 2, true, nullptr);
+  const double opaque = Darkness(solid, bg);
+  ASSERT_GT(opaque, 0.05) << "the twigs' colour should be darker than the background";
+  std::vector<double> xs;
+  const std::vector<double> rows = TwigRowDarkness(img, thin, bg, &xs);
+  ASSERT_GT(rows.size(), size_t(W * H / 8));
+  double expected = 0;
+  for (double x : xs) expected += width(x) * std::sqrt(1 + 1.0 / 144) * opaque / double(xs.size());
+  const double got = Mean(rows);
+  EXPECT_NEAR(got / expected, 1.0, 0.1) << "darkness a twig adds to a row: " << got << ", analytic "
+                                        << expected << " (its width times " << opaque << ")";
+  // Without coverage lines: the same twigs as 0.3 px ribbons.
+  const Image ribbons = draw(thin, 0.5, false, nullptr);
+  const std::vector<double> ribbonRows = TwigRowDarkness(ribbons, thin, bg);
+  const double lineVar = Variation(rows), ribbonVar = Variation(ribbonRows);
+  EXPECT_LT(lineVar, 0.15) << "a coverage line should darken each row alike; ribbons vary by "
+                           << ribbonVar;
+  EXPECT_LT(lineVar * 3, ribbonVar)
+      << "coverage lines vary " << lineVar << " row to row, ribbons " << ribbonVar;
+  // For the record: the same comparison in linear light, where sRGB-space
+  // blending makes thin twigs darker than their coverage.
+  auto linearDarkness = [&](const Image& im) {
+    auto lin = [](double c) {
+      return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    };
+    const mesh::Vec3f bgs = mesh::ToSrgb(bg);
+    double sum = 0;
+    for (size_t i = 0; i < im.rgba.size(); i += 4)
+      for (int c = 0; c < 3; ++c) sum += 1 - lin(im.rgba[i + size_t(c)] / 255.0) / lin(bgs[c]);
+    return sum / (3.0 * im.width * im.height);
+  };
+  const double linearRatio =
+      linearDarkness(img) / (linearDarkness(solid) * Darkness(img, bg) / opaque);
+  RecordProperty("coverage", std::to_string(got) + " measured, " + std::to_string(expected) +
+                                 " analytic; row variation " + std::to_string(lineVar) +
+                                 " lines, " + std::to_string(ribbonVar) + " ribbons");
+  std::printf(
+      "coverage lines: %.5f a twig a row, analytic %.5f (ratio %.4f); ribbons %.5f\n"
+      "row-to-row variation: lines %.4f, ribbons %.4f\n"
+      "in linear light: %.3f times the linear coverage\n",
+      got, expected, got / expected, Mean(ribbonRows), lineVar, ribbonVar, linearRatio);
 }
 
 int RunCli(const std::vector<std::string>& args, std::string* out, std::string* err) {
