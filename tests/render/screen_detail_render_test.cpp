@@ -307,6 +307,103 @@ TEST_F(ScreenDetailRender, SubPixelLinesKeepTheAnalyticCoverage) {
       got, expected, got / expected, Mean(ribbonRows), lineVar, ribbonVar, linearRatio);
 }
 
+// Without popping: a slow dolly toward the tree that wobbles (three steps
+// of 3 % in, one back out, as a hand on a mouse does) changes each chain's
+// representation (coverage line, ribbon, sides) only one way with the
+// history's hysteresis: no chain flips back and forth. Without a history
+// some do, so the test can fail. And the pictures change smoothly: the
+// mean change between consecutive frames with screen-space detail exceeds
+// that with uniform 16 sides (where only the motion changes the picture)
+// by little.
+TEST_F(ScreenDetailRender, SlowDollyDoesNotFlipDetailBackAndForth) {
+  auto p =
+      sylva::testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 10, plant::Stage::kGeometry);
+  ASSERT_TRUE(p);
+  const mesh::Box box = mesh::TessellatedBounds(p->geometry, nullptr);
+  const int W = 480, H = 270;
+  Camera cam = Camera::Frame(box.lo, box.hi, double(W) / H, 30, 12, false);
+  std::vector<double> distances;
+  double d = cam.distance * 1.2;
+  for (int k = 0; k < 48; ++k) {
+    distances.push_back(d);
+    d *= k % 4 == 3 ? 1 / 0.97 : 0.97;
+  }
+  auto run = [&](bool hysteresis, bool render, std::vector<Image>* frames) {
+    mesh::DetailHistory history;
+    std::vector<std::vector<int16_t>> levels;
+    for (double dist : distances) {
+      cam.distance = dist;
+      mesh::TessellateOptions opt;
+      opt.view = mesh::ScreenView{cam.ViewProjection(double(W) / H), W, H, 0.5};
+      opt.view->coverage = true;
+      opt.history = &history;
+      if (!hysteresis) history.level.clear();
+      mesh::TriangleMesh m;
+      EXPECT_TRUE(mesh::Tessellate(p->geometry, opt, m).ok());
+      levels.push_back(history.level);
+      if (!render) continue;
+      EXPECT_TRUE(renderer_->Resize(W, H).ok());
+      renderer_->SetGround(true);
+      renderer_->SetShadows(true);
+      renderer_->SetMesh(m, mesh::DefaultPalette(), &box);
+      renderer_->Draw(cam);
+      frames->push_back(renderer_->ReadPixels());
+    }
+    // Reversals: a chain whose level changes against its previous change.
+    size_t reversals = 0, changes = 0;
+    for (size_t c = 0; c < levels[0].size(); ++c) {
+      int lastDir = 0;
+      for (size_t k = 1; k < levels.size(); ++k) {
+        const int dir = (levels[k][c] > levels[k - 1][c]) - (levels[k][c] < levels[k - 1][c]);
+        if (!dir) continue;
+        ++changes;
+        reversals += lastDir && dir != lastDir;
+        lastDir = dir;
+      }
+    }
+    return std::pair{reversals, changes};
+  };
+  std::vector<Image> lodFrames, uniformFrames;
+  const auto [reversals, changes] = run(true, true, &lodFrames);
+  const auto [without, changesWithout] = run(false, false, nullptr);
+  EXPECT_GT(changes, 0u) << "the dolly should change some chain's detail";
+  EXPECT_EQ(reversals, 0u) << reversals << " of " << changes
+                           << " detail changes went back against the previous one";
+  EXPECT_GT(without, 0u) << "without hysteresis the wobble should flip some chains ("
+                         << changesWithout << " changes)";
+  for (double dist : distances) {
+    cam.distance = dist;
+    mesh::TessellateOptions opt;
+    opt.detail.sides = 16;
+    mesh::TriangleMesh m;
+    ASSERT_TRUE(mesh::Tessellate(p->geometry, opt, m).ok());
+    renderer_->SetMesh(m, mesh::DefaultPalette(), &box);
+    renderer_->Draw(cam);
+    uniformFrames.push_back(renderer_->ReadPixels());
+  }
+  auto change = [](const Image& a, const Image& b) {
+    double sum = 0;
+    for (size_t i = 0; i < a.rgba.size(); ++i) sum += std::abs(int(a.rgba[i]) - int(b.rgba[i]));
+    return sum / double(a.rgba.size());
+  };
+  double worstExtra = 0, worstLod = 0, worstUniform = 0;
+  for (size_t k = 1; k < distances.size(); ++k) {
+    const double lod = change(lodFrames[k], lodFrames[k - 1]);
+    const double uni = change(uniformFrames[k], uniformFrames[k - 1]);
+    worstExtra = std::max(worstExtra, lod - uni);
+    worstLod = std::max(worstLod, lod);
+    worstUniform = std::max(worstUniform, uni);
+  }
+  EXPECT_LT(worstExtra, 0.25 * worstUniform)
+      << "a frame with screen-space detail changed by " << worstExtra
+      << " (mean, 8-bit) more than the uniform one; the largest change from motion alone is "
+      << worstUniform;
+  std::printf(
+      "dolly: %zu detail changes, %zu reversals (%zu without hysteresis in %zu changes); "
+      "frame-to-frame change: worst %.4f with detail, %.4f uniform, worst excess %.4f\n",
+      changes, reversals, without, changesWithout, worstLod, worstUniform, worstExtra);
+}
+
 int RunCli(const std::vector<std::string>& args, std::string* out, std::string* err) {
   std::ostringstream o, e;
   const int code = app::RunCliWithGraphics(args, o, e);
