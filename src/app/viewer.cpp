@@ -1,7 +1,10 @@
 // The viewer. Threads: the UI thread owns the window, ImGui and every GL
 // call; one worker derives, draws and tessellates jobs posted by the UI and
 // hands back meshes. Only the newest job matters: a job that is overtaken
-// is dropped when it finishes.
+// is dropped when it finishes. Every job carries the whole request (file,
+// defines, seed, step, detail, view); the worker keeps the last plant and
+// only re-tessellates it when a job differs from it in the view or the
+// detail alone (a camera move).
 #include "app/viewer.h"
 
 #include <GL/glew.h>
@@ -10,9 +13,12 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -25,9 +31,14 @@
 #include "app/viewer_window.h"
 #include "plant/plant.h"
 #include "plant/surface_library.h"
+#include "render/camera.h"
 #include "render/renderer.h"
 
 namespace sylva::app {
+
+// cli_render.cpp: the screen-space view of a camera.
+mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps);
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -36,19 +47,33 @@ using Clock = std::chrono::steady_clock;
 struct Job {
   uint64_t id = 0;
   std::string path;
+  uint64_t reload = 0;  // bumped when the file changes: the plant is rebuilt
   std::map<std::string, double> overrides;
   std::optional<uint64_t> seed;
   int steps = -1;
-  int sides = 8;
+  int sides = 8;        // uniform detail, when lod is off
+  bool lod = true;      // screen-space detail for the camera (docs/lod.md)
   bool strict = false;  // warnings are errors
+  // The view to tessellate for (with lod); empty: the framing of `sylva render`.
+  std::optional<render::Camera> camera;
+  int width = 1280, height = 720;
 };
+
+// Jobs that differ only in the view (or the detail) reuse the plant.
+bool SamePlant(const Job& a, const Job& b) {
+  return a.path == b.path && a.reload == b.reload && a.overrides == b.overrides &&
+         a.seed == b.seed && a.steps == b.steps && a.strict == b.strict;
+}
 
 struct Result {
   uint64_t id = 0;
   bool ok = false;
+  bool rebuilt = false;     // a new plant, not only a new tessellation
   std::string diagnostics;  // errors and warnings, formatted
   mesh::TriangleMesh mesh;
   mesh::Palette palette;
+  mesh::Box bounds;       // the whole plant's (ground and shadows are fitted to it)
+  render::Camera camera;  // the view it was tessellated for
   Vec3 lo{0, 0, 0}, hi{1, 1, 1};
   uint64_t modules = 0;
   int derivationLength = 0;
@@ -56,36 +81,86 @@ struct Result {
   double deriveMs = 0, turtleMs = 0, tessellateMs = 0;
 };
 
-Result RunJob(const Job& job) {
+// What the worker keeps between jobs: the last plant (geometry, before
+// tessellation) and the detail history of its chains, so a camera move
+// only re-tessellates, with hysteresis.
+struct WorkerState {
+  std::optional<Job> built;
+  std::optional<plant::Plant> plant;
+  plant::PlantSpec spec;
+  mesh::Box bounds;
+  std::string diagnostics;
+  mesh::DetailHistory history;
+};
+
+Result RunJob(const Job& job, WorkerState& st) {
   Result r;
   r.id = job.id;
-  plant::PlantSpec spec;
-  spec.path = job.path;
-  spec.defines = job.overrides;
-  spec.seed = job.seed;
-  if (job.steps >= 0) spec.steps = job.steps;
+  if (!st.plant || !st.built || !SamePlant(*st.built, job)) {
+    st.plant.reset();
+    st.built.reset();
+    st.history = {};
+    plant::PlantSpec spec;
+    spec.path = job.path;
+    spec.defines = job.overrides;
+    spec.seed = job.seed;
+    if (job.steps >= 0) spec.steps = job.steps;
+    spec.until = plant::Stage::kGeometry;
+    plant::PlantResult built = plant::BuildPlant(spec);
+    st.diagnostics = built.diagnostics.FormatAll();
+    if (!built.plant) {
+      r.diagnostics = st.diagnostics;
+      return r;
+    }
+    if (job.strict && !built.diagnostics.items.empty()) {
+      r.diagnostics = st.diagnostics + "sylva: error: --strict: warnings are treated as errors\n";
+      return r;
+    }
+    auto bounds = plant::MeshBounds(*built.plant, spec);
+    if (!bounds) {
+      r.diagnostics = st.diagnostics + bounds.error().message + "\n";
+      return r;
+    }
+    st.bounds = *bounds;
+    st.plant = std::move(built.plant);
+    st.spec = spec;
+    st.built = job;
+    r.rebuilt = true;
+  }
+  r.diagnostics = st.diagnostics;
+  plant::Plant& p = *st.plant;
+  plant::PlantSpec spec = st.spec;
   spec.detail.sides = job.sides;
-  plant::PlantResult built = plant::BuildPlant(spec);
-  r.diagnostics = built.diagnostics.FormatAll();
-  if (!built.plant) return r;
-  if (job.strict && !built.diagnostics.items.empty()) {
-    r.diagnostics += "sylva: error: --strict: warnings are treated as errors\n";
+  const bool empty = !(st.bounds.lo.array() <= st.bounds.hi.array()).all();
+  const Vec3 lo = empty ? Vec3::Zero() : st.bounds.lo, hi = empty ? Vec3::Ones() : st.bounds.hi;
+  r.camera = job.camera
+                 ? *job.camera
+                 : render::Camera::Frame(lo, hi, double(job.width) / job.height, 30, 12, false);
+  if (job.lod) {
+    spec.view = ViewOf(r.camera, job.width, job.height, 0.5);
+    spec.view->shadowFrom = render::KeyLightDirection();
+    spec.view->shadowPlaneY = lo.y();
+    spec.view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(st.bounds);
+    spec.view->coverage = true;
+    spec.history = &st.history;
+  } else {
+    st.history = {};  // levels of another detail mean nothing to the next view
+  }
+  DiagnosticList warnings;
+  if (Status s = plant::Tessellate(p, spec, warnings); !s.ok()) {
+    r.diagnostics += s.error().message + "\n";
     return r;
   }
-  plant::Plant& p = *built.plant;
   r.derivationLength = p.grammar.derivationLength;
   for (const auto& [k, v] : p.grammar.constants) r.constants.emplace_back(k, v);
   std::sort(r.constants.begin(), r.constants.end());
   r.mesh = std::move(p.mesh);
+  p.mesh = mesh::TriangleMesh();
   r.palette = p.palette;
   r.modules = p.DrawnWord().size();
-  if (r.mesh.vertexCount()) {
-    r.lo = r.hi = r.mesh.positions[0].cast<double>();
-    for (const auto& q : r.mesh.positions) {
-      r.lo = r.lo.cwiseMin(q.cast<double>());
-      r.hi = r.hi.cwiseMax(q.cast<double>());
-    }
-  }
+  r.bounds = st.bounds;
+  r.lo = lo;
+  r.hi = hi;
   r.deriveMs = p.time.parse + p.time.derive + p.time.interpret;
   r.turtleMs = p.time.turtle;
   r.tessellateMs = p.time.tessellate;
@@ -93,11 +168,20 @@ Result RunJob(const Job& job) {
   return r;
 }
 
+// The camera has moved far enough from the one the shown mesh was
+// tessellated for to re-tessellate: 5 % nearer or farther, 2 degrees
+// around, or the target 2 % of the distance away.
+bool MovedFarEnough(const render::Camera& a, const render::Camera& b) {
+  return std::abs(std::log(a.distance / b.distance)) > 0.05 ||
+         std::abs(a.azimuth - b.azimuth) > 2 || std::abs(a.elevation - b.elevation) > 2 ||
+         (a.target - b.target).norm() > 0.02 * a.distance || a.fovY != b.fovY;
+}
+
 // A live edit can ask for anything (a word or mesh larger than memory): the
 // worker reports it as a failed job and the viewer keeps the last plant.
-Result RunJobSafely(const Job& job) {
+Result RunJobSafely(const Job& job, WorkerState& state) {
   try {
-    return RunJob(job);
+    return RunJob(job, state);
   } catch (const std::bad_alloc&) {
     Result r;
     r.id = job.id;
@@ -150,7 +234,8 @@ bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double fr
     job.seed = uint64_t(std::max(seed, 0));
     changed = true;
   }
-  if (ImGui::SliderInt("sides", &job.sides, 3, 32)) changed = true;
+  if (ImGui::Checkbox("screen-space detail", &job.lod)) changed = true;
+  if (!job.lod && ImGui::SliderInt("sides", &job.sides, 3, 32)) changed = true;
   if (!shown.constants.empty() &&
       ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
     for (const auto& [name, value] : shown.constants) {
@@ -226,19 +311,29 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   (*renderer)->SetGround(true);
 
   int exitCode = kExitOk;
-  Worker<Job, Result> worker(RunJobSafely);
+  WorkerState state;  // the worker's alone; outlives it
+  Worker<Job, Result> worker([&state](const Job& j) { return RunJobSafely(j, state); });
   Job job;
   job.path = path;
   job.strict = cmd.strict;
+  job.width = width;
+  job.height = height;
   uint64_t nextId = 1;
-  auto post = [&] {
-    job.id = nextId++;
-    worker.Post(job);
-  };
-  post();
   Shown shown;
   render::Camera camera;
   bool framed = false;
+  // The view of the last job posted: the camera moving far from it posts
+  // a re-tessellation; meanwhile the shown mesh stays on screen.
+  render::Camera posted;
+  int retessellations = 0;
+  double slowestFrameMs = 0, slowestSwapMs = 0;
+  auto post = [&] {
+    job.id = nextId++;
+    job.camera = framed ? std::optional<render::Camera>(camera) : std::nullopt;
+    posted = camera;
+    worker.Post(job);
+  };
+  post();
   fs::file_time_type mtime = fs::last_write_time(path, ec);
   auto lastPoll = Clock::now();
   double frameMs = 0;
@@ -255,6 +350,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       auto t = fs::last_write_time(path, ec);
       if (!ec && t != mtime) {
         mtime = t;
+        ++job.reload;
         post();
       }
     }
@@ -263,9 +359,15 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       if (r->ok) {
         shown.constants = r->constants;
         shown.derivationLength = r->derivationLength;
-        (*renderer)->SetMesh(r->mesh, r->palette);
+        // The only work a new tessellation costs this thread: the upload.
+        const auto swapStart = Clock::now();
+        (*renderer)->SetMesh(r->mesh, r->palette, &r->bounds);
+        slowestSwapMs =
+            std::max(slowestSwapMs,
+                     std::chrono::duration<double, std::milli>(Clock::now() - swapStart).count());
         if (!framed) {
-          camera = render::Camera::Frame(r->lo, r->hi, double(width) / height, 30, 12, false);
+          camera = r->camera;
+          posted = camera;
           framed = true;
         }
         shown.plant = std::move(r);
@@ -288,6 +390,18 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       (void)(*renderer)->Resize(fbw, fbh);
     }
     mouse.Update(window.handle, camera);
+    if (framed) camera.azimuth += cmd.orbit;
+    if (fbw > 0 && fbh > 0 && (fbw != job.width || fbh != job.height)) {
+      job.width = fbw;
+      job.height = fbh;
+      if (framed && job.lod) post();
+    }
+    // Re-tessellate in the background once the camera has moved far
+    // enough, one job at a time; the shown mesh is drawn meanwhile.
+    if (framed && job.lod && !worker.Busy() && MovedFarEnough(camera, posted)) {
+      post();
+      ++retessellations;
+    }
 
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
@@ -317,6 +431,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     }
     glfwSwapBuffers(window.handle);
     frameMs = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+    if (frame > 1) slowestFrameMs = std::max(slowestFrameMs, frameMs);  // past the first upload
     if (done) break;
     // Wait for the first plant no longer than a minute when taking a screenshot.
     if (cmd.frames > 0 && frame > cmd.frames + 6000) {
@@ -324,6 +439,14 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       exitCode = kExitRuntime;
       break;
     }
+  }
+  if (cmd.frames > 0) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "frames: %d, re-tessellations: %d, slowest frame: %.1f ms, slowest mesh swap: "
+                  "%.1f ms\n",
+                  frame, retessellations, slowestFrameMs, slowestSwapMs);
+    out << line;
   }
   return exitCode;
 }

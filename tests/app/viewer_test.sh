@@ -50,6 +50,26 @@ print(f'screenshot {w}x{h}: {bark} bark-coloured pixels')
 assert bark > 300, 'the plant is not in the picture'
 PY
 
+# Re-tessellation in the background: an orbiting camera (3 degrees a
+# frame) posts a new screen-space tessellation whenever it has turned 2
+# degrees from the last one and the worker is free; the shown mesh is drawn
+# meanwhile, and swapping a new mesh in never blocks a frame for 50 ms.
+"$sylva" view "$work/tree.lsys" --screenshot "$work/orbit.png" --frames 60 --orbit 3 \
+  --size 640x360 >"$work/orbit.out"
+cat "$work/orbit.out"
+python3 - "$work/orbit.out" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+m = re.search(r'frames: (\d+), re-tessellations: (\d+), slowest frame: ([\d.]+) ms, '
+              r'slowest mesh swap: ([\d.]+) ms', text)
+assert m, text
+frames, redone, frame_ms, swap_ms = int(m[1]), int(m[2]), float(m[3]), float(m[4])
+assert redone >= 3, f'{redone} re-tessellations in {frames} frames of orbiting'
+assert swap_ms < 50, f'swapping a new tessellation in took {swap_ms} ms (target < 50)'
+print(f'{redone} re-tessellations in {frames} frames; slowest swap {swap_ms} ms, '
+      f'slowest frame {frame_ms} ms')
+PY
+
 # A running viewer, then a bad edit.
 "$sylva" view "$work/tree.lsys" --size 640x360 >"$work/view.out" 2>"$work/view.err" &
 viewer=$!
