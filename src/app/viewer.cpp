@@ -69,6 +69,8 @@ struct Result {
   uint64_t id = 0;
   bool ok = false;
   bool rebuilt = false;     // a new plant, not only a new tessellation
+  bool stale = false;       // the last good plant: the request's own failed to build
+  uint64_t failedId = 0;    // with !ok or stale: the job whose build failed
   std::string diagnostics;  // errors and warnings, formatted
   mesh::TriangleMesh mesh;
   mesh::Palette palette;
@@ -84,22 +86,24 @@ struct Result {
 // What the worker keeps between jobs: the last plant (geometry, before
 // tessellation) and the detail history of its chains, so a camera move
 // only re-tessellates, with hysteresis.
+// A request whose plant failed to build is not built again for a camera
+// move: the last good plant is re-tessellated, marked stale.
 struct WorkerState {
   std::optional<Job> built;
   std::optional<plant::Plant> plant;
   plant::PlantSpec spec;
   mesh::Box bounds;
   std::string diagnostics;
+  std::optional<Job> failed;
+  std::string failedDiagnostics;
   mesh::DetailHistory history;
 };
 
 Result RunJob(const Job& job, WorkerState& st) {
   Result r;
   r.id = job.id;
-  if (!st.plant || !st.built || !SamePlant(*st.built, job)) {
-    st.plant.reset();
-    st.built.reset();
-    st.history = {};
+  const bool failedBefore = st.failed && SamePlant(*st.failed, job);
+  if (!failedBefore && (!st.plant || !st.built || !SamePlant(*st.built, job))) {
     plant::PlantSpec spec;
     spec.path = job.path;
     spec.defines = job.overrides;
@@ -107,27 +111,38 @@ Result RunJob(const Job& job, WorkerState& st) {
     if (job.steps >= 0) spec.steps = job.steps;
     spec.until = plant::Stage::kGeometry;
     plant::PlantResult built = plant::BuildPlant(spec);
-    st.diagnostics = built.diagnostics.FormatAll();
-    if (!built.plant) {
-      r.diagnostics = st.diagnostics;
-      return r;
+    std::string diagnostics = built.diagnostics.FormatAll();
+    std::optional<mesh::Box> bounds;
+    if (built.plant && job.strict && !built.diagnostics.items.empty()) {
+      diagnostics += "sylva: error: --strict: warnings are treated as errors\n";
+    } else if (built.plant) {
+      auto b = plant::MeshBounds(*built.plant, spec);
+      if (b) bounds = *b;
+      if (!b) diagnostics += b.error().message + "\n";
     }
-    if (job.strict && !built.diagnostics.items.empty()) {
-      r.diagnostics = st.diagnostics + "sylva: error: --strict: warnings are treated as errors\n";
-      return r;
-    }
-    auto bounds = plant::MeshBounds(*built.plant, spec);
     if (!bounds) {
-      r.diagnostics = st.diagnostics + bounds.error().message + "\n";
+      st.failed = job;
+      st.failedDiagnostics = diagnostics;
+      r.diagnostics = diagnostics;
+      r.failedId = job.id;
       return r;
     }
+    st.failed.reset();
+    st.history = {};
+    st.diagnostics = diagnostics;
     st.bounds = *bounds;
     st.plant = std::move(built.plant);
     st.spec = spec;
     st.built = job;
     r.rebuilt = true;
   }
-  r.diagnostics = st.diagnostics;
+  if (failedBefore) r.failedId = st.failed->id;
+  if (!st.plant) {
+    r.diagnostics = st.failedDiagnostics;
+    return r;
+  }
+  r.stale = failedBefore;
+  r.diagnostics = failedBefore ? st.failedDiagnostics : st.diagnostics;
   plant::Plant& p = *st.plant;
   plant::PlantSpec spec = st.spec;
   spec.detail.sides = job.sides;
@@ -326,6 +341,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   // a re-tessellation; meanwhile the shown mesh stays on screen.
   render::Camera posted;
   int retessellations = 0;
+  uint64_t reportedFailure = 0;  // the job id of the last failed build reported
   double slowestFrameMs = 0, slowestSwapMs = 0;
   auto post = [&] {
     job.id = nextId++;
@@ -356,6 +372,13 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     }
     if (auto r = worker.Take()) {
       shown.diagnostics = r->diagnostics;
+      // Report each failed build once, also when a newer view of the last
+      // good plant (stale) overtook the failure itself.
+      if ((!r->ok || r->stale) && r->failedId != reportedFailure) {
+        reportedFailure = r->failedId;
+        err << "sylva view: the grammar has errors; keeping the last good plant\n"
+            << shown.diagnostics;
+      }
       if (r->ok) {
         shown.constants = r->constants;
         shown.derivationLength = r->derivationLength;
@@ -370,12 +393,10 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
           posted = camera;
           framed = true;
         }
+        shown.lastFailed = r->stale;  // a view of the last good plant keeps the errors shown
         shown.plant = std::move(r);
-        shown.lastFailed = false;
       } else {
-        // Keep the last good plant; report what went wrong.
-        err << "sylva view: the grammar has errors; keeping the last good plant\n"
-            << shown.diagnostics;
+        // Keep the last good plant (what went wrong is reported above).
         shown.lastFailed = true;
         // A screenshot of a plant that cannot be built: nothing will come.
         if (cmd.frames > 0 && !shown.plant) {

@@ -71,7 +71,9 @@ print(f'{redone} re-tessellations in {frames} frames; slowest swap {swap_ms} ms,
 PY
 
 # A running viewer, then a bad edit.
-"$sylva" view "$work/tree.lsys" --size 640x360 >"$work/view.out" 2>"$work/view.err" &
+# It orbits, so it keeps re-tessellating: after the bad edit it must go on
+# with the last good plant, not build the bad grammar again for each view.
+"$sylva" view "$work/tree.lsys" --size 640x360 --orbit 3 >"$work/view.out" 2>"$work/view.err" &
 viewer=$!
 sleep 2
 kill -0 "$viewer"
@@ -80,6 +82,9 @@ for _ in $(seq 100); do grep -q "the grammar has errors" "$work/view.err" && bre
 cat "$work/view.err"
 grep -q "tree.lsys:2:16: error: unknown name 'nope' in expression" "$work/view.err"
 kill -0 "$viewer"   # still running, with the last good plant
+sleep 1
+reports=$(grep -c "the grammar has errors" "$work/view.err")
+[[ $reports -eq 1 ]] || { echo "the bad grammar was reported $reports times while orbiting"; exit 1; }
 echo "viewer reported the error and kept running"
 
 # Hostile edits: a 50,000-term operator chain with an error at its end (the
