@@ -3,6 +3,7 @@
 // docs/cli.md says.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -23,7 +24,7 @@ namespace {
 class ScreenDetailRender : public testing::RenderFixture {};
 
 // A close-up inside the crown (most of the tree is outside the frustum),
-// without and with the ground and its shadows (a branch outside the view
+// without and with the ground, its shadows and coverage lines (a branch outside the view
 // may cast a shadow into it, so culling keeps it then).
 TEST_F(ScreenDetailRender, CullingNeverRemovesAVisiblePixel) {
   auto p =
@@ -39,7 +40,10 @@ TEST_F(ScreenDetailRender, CullingNeverRemovesAVisiblePixel) {
     view.viewProjection = cam.ViewProjection(double(W) / H);
     view.width = W;
     view.height = H;
+    // Shadows and coverage lines (sylva render's default) go together here:
+    // without, with both.
     for (bool shadows : {false, true}) {
+      view.coverage = shadows;
       view.shadowFrom = shadows ? KeyLightDirection() : Vec3::Zero();
       view.shadowPlaneY = box.lo.y();
       view.shadowTexelsPerUnit = ShadowTexelsPerUnit(box);
@@ -55,6 +59,11 @@ TEST_F(ScreenDetailRender, CullingNeverRemovesAVisiblePixel) {
         culled = stats.culled;
         items = stats.chains;
         triangles[cull] = m.triangleCount();
+        if (shadows) {
+          const size_t lines = size_t(
+              std::count_if(m.coverage.begin(), m.coverage.end(), [](float c) { return c < 1; }));
+          EXPECT_GT(lines, 0u) << "azimuth " << az << ": no coverage line to test";
+        }
         ASSERT_TRUE(renderer_->Resize(W, H).ok());
         renderer_->SetGround(shadows);
         renderer_->SetShadows(shadows);
