@@ -54,7 +54,6 @@ struct Renderer::Gl {
   // Indices [0, opaqueIndexCount) are opaque; the rest have coverage < 1
   // somewhere and are blended after everything opaque, without depth writes.
   GLsizei opaqueIndexCount = 0;
-  bool haveCoverage = false;
   GLuint lineVao = 0, lineBuffers[2] = {0, 0};
   GLsizei lineVertexCount = 0;
   GLuint pointProgram = 0, pointVao = 0, pointBuffers[3] = {0, 0, 0};
@@ -94,6 +93,42 @@ void UploadVertexAttributes(const unsigned buffers[3], const mesh::TriangleMesh&
     glEnableVertexAttribArray(GLuint(k));
     glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
   }
+}
+
+size_t UploadIndicesOpaqueFirst(const mesh::TriangleMesh& m, unsigned coverageBuffer,
+                                unsigned location) {
+  const bool partial =
+      m.coverage.size() == m.vertexCount() &&
+      std::any_of(m.coverage.begin(), m.coverage.end(), [](float c) { return c < 1; });
+  if (!partial) {
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
+                 GL_STATIC_DRAW);
+    glDisableVertexAttribArray(location);
+    return m.indices.size();
+  }
+  // Opaque triangles first, then those with partial coverage (in order).
+  std::vector<uint32_t> sorted;
+  sorted.reserve(m.indices.size());
+  auto translucent = [&](size_t t) {
+    return m.coverage[m.indices[3 * t]] < 1 || m.coverage[m.indices[3 * t + 1]] < 1 ||
+           m.coverage[m.indices[3 * t + 2]] < 1;
+  };
+  size_t opaque = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (size_t t = 0; t < m.triangleCount(); ++t) {
+      if (translucent(t) != (pass == 1)) continue;
+      sorted.insert(sorted.end(), &m.indices[3 * t], &m.indices[3 * t] + 3);
+    }
+    if (pass == 0) opaque = sorted.size();
+  }
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(sorted.size() * 4), sorted.data(),
+               GL_STATIC_DRAW);
+  glBindBuffer(GL_ARRAY_BUFFER, coverageBuffer);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.coverage.size() * 4), m.coverage.data(),
+               GL_STATIC_DRAW);
+  glEnableVertexAttribArray(location);
+  glVertexAttribPointer(location, 1, GL_FLOAT, GL_FALSE, 4, nullptr);
+  return opaque;
 }
 
 Expected<unsigned> CompileProgram(const std::string& dir, const std::string& name) {
@@ -279,36 +314,7 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
   UploadVertexAttributes(g.meshBuffers, m, color);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.meshIndex);
   g.meshIndexCount = GLsizei(m.indices.size());
-  g.opaqueIndexCount = g.meshIndexCount;
-  g.haveCoverage = m.coverage.size() == m.vertexCount() &&
-                   std::any_of(m.coverage.begin(), m.coverage.end(), [](float c) { return c < 1; });
-  if (g.haveCoverage) {
-    // Opaque triangles first, then those with partial coverage (in order).
-    std::vector<uint32_t> sorted;
-    sorted.reserve(m.indices.size());
-    auto partial = [&](size_t t) {
-      return m.coverage[m.indices[3 * t]] < 1 || m.coverage[m.indices[3 * t + 1]] < 1 ||
-             m.coverage[m.indices[3 * t + 2]] < 1;
-    };
-    for (int pass = 0; pass < 2; ++pass) {
-      for (size_t t = 0; t < m.triangleCount(); ++t) {
-        if (partial(t) != (pass == 1)) continue;
-        sorted.insert(sorted.end(), &m.indices[3 * t], &m.indices[3 * t] + 3);
-      }
-      if (pass == 0) g.opaqueIndexCount = GLsizei(sorted.size());
-    }
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(sorted.size() * 4), sorted.data(),
-                 GL_STATIC_DRAW);
-    glBindBuffer(GL_ARRAY_BUFFER, g.meshCoverage);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.coverage.size() * 4), m.coverage.data(),
-                 GL_STATIC_DRAW);
-    glEnableVertexAttribArray(3);
-    glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, 4, nullptr);
-  } else {
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
-                 GL_STATIC_DRAW);
-    glDisableVertexAttribArray(3);  // the generic value, 1, set in Draw
-  }
+  g.opaqueIndexCount = GLsizei(UploadIndicesOpaqueFirst(m, g.meshCoverage, 3));
   glBindVertexArray(0);
   g.lo = g.hi = Vec3::Zero();
   if (m.vertexCount()) {
