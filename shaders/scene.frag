@@ -15,6 +15,7 @@ uniform vec3 uLightColor[8];      // colour * intensity, linear
 uniform int uShadowLight;         // index of the shadow-casting sun, -1: none
 uniform mat4 uLightViewProj;
 uniform sampler2DShadow uShadow;
+uniform int uWire;                // 1: the wireframe overlay pass, flat dark lines
 out vec4 fragColor;
 
 vec3 EncodeSrgb(vec3 c) {
@@ -35,6 +36,10 @@ float Visibility(vec3 n) {
 }
 
 void main() {
+  if (uWire == 1) {
+    fragColor = vec4(0.08, 0.08, 0.10, 1.0);
+    return;
+  }
   vec3 n = normalize(vNormal);
   vec3 toEye = normalize(uEye - vPosition);
   if (dot(n, toEye) < 0.0) n = -n;

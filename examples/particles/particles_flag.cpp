@@ -12,6 +12,7 @@
 #include "particles/cloth.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
+#include "scene/default_scene.h"
 
 using namespace sylva;
 
@@ -94,14 +95,19 @@ int main(int argc, char** argv) {
     m.material.push_back(uint16_t((row * 3 / def.rows) % 2 == 0 ? 7 : 5));  // red and white
   }
   // The pole: a thin column of the mesh's own palette colour 0.
-  (*renderer)->SetGround(true);
-  (*renderer)->SetMesh(m, mesh::DefaultPalette());
   Vec3 lo = x[0], hi = x[0];
   for (const Vec3& p : x) {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
-  (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 25, 15, false));
+  // The default scene (a ground plane, the default lights) under the flag.
+  const draw::DrawList list = scene::DefaultScene(
+      std::make_shared<const mesh::TriangleMesh>(std::move(m)), mesh::DefaultPalette(), lo, hi);
+  if (Status s = (*renderer)->Draw(list, render::Camera::Frame(lo, hi, 480.0 / 360, 25, 15, false));
+      !s.ok()) {
+    std::fprintf(stderr, "%s", s.error().Format().c_str());
+    return 1;
+  }
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
     std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
                                         ec);  // out/ by default

@@ -73,6 +73,9 @@ static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
                   "stop with an error when the word would grow past this many modules "
                   "(default 268435456)")
       ->check(CLI::Range(uint64_t(1), lsys::kMaxModulesCap));
+  cmd->add_option("--view", f.view,
+                  "cpfg view file (.v): angle, widths, colours, tropism, view direction "
+                  "(default: NAME.v beside the grammar, if any)");
   AddMaxErrorsFlag(cmd, f);
   AddStrictFlag(cmd, f.strict);
 }
@@ -176,8 +179,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   CLI::App* vi =
       app.add_subcommand("view", "open the interactive viewer (reloads the file when it changes)");
   vi->add_option("file", view.file,
-                 "grammar file (.lsys) or scene file (.xml, played); default: a bundled ABOP "
-                 "tree");
+                 "grammar file (.lsys) or scene file (.xml, played); default: the bundled "
+                 "autumn scene");
   vi->add_option("--screenshot", view.screenshot,
                  "save this picture (.png, .jpg) after --frames frames and quit");
   vi->add_option("--frames", view.frames, "frames to draw before the screenshot")
@@ -189,9 +192,12 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   vi->add_option("--time", view.time, "scenes: start paused at this time in seconds")
       ->check(CLI::Range(0.0, 1e6));
   vi->add_option("-D,--define", view.defines,
-                 "scenes: override a <default>: NAME=VALUE (repeatable)");
-  vi->add_option("--threads", view.threads, "scenes: worker threads (default: all cores)")
+                 "override a grammar's #define or a scene's <default>: NAME=VALUE (repeatable)");
+  vi->add_option("--threads", view.threads, "worker threads (default: all cores)")
       ->check(CLI::Range(0, 256));
+  vi->add_option("-n,--steps", view.steps, "grammars: the derivation step to start at")
+      ->check(CLI::Range(0, lsys::kMaxDerivationLengthForDerive));
+  vi->add_option("--seed", view.seed, "grammars: the seed to start with");
 
   DeriveFlags check;
   CLI::App* c = app.add_subcommand(
@@ -199,6 +205,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   c->add_option("file", check.file, "grammar file (.lsys) or scene file (.xml)")->required();
   c->add_option("-D,--define", check.defines,
                 "override a grammar's #define or a scene's <default>: NAME=VALUE (repeatable)");
+  c->add_option("--view", check.view,
+                "grammars: cpfg view file (.v) to check with it (default: NAME.v beside it)");
   AddMaxErrorsFlag(c, check);
   AddStrictFlag(c, check.strict);
 
@@ -228,10 +236,9 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     app.parse(rev);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) {
+      // app.help() is the selected subcommand's help when one is given
+      // (`sylva view --help`), printed once.
       out << (e.get_name() == "CallForVersion" ? std::string(e.what()) + "\n" : app.help());
-      if (e.get_name() == "CallForHelp") {
-        for (auto* sub : app.get_subcommands()) out << sub->help();
-      }
       return kExitOk;
     }
     err << "sylva: error: " << e.what() << "\n";
@@ -262,8 +269,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
         code = g.simulate ? g.simulate(simulate, out, err) : NotBuilt("simulate -o", err);
     }
   } catch (const std::bad_alloc&) {
-    err << "sylva: error: out of memory; lower the derivation length (-n), the detail or the "
-           "limits\n";
+    err << "sylva: error: out of memory; for a grammar, lower the derivation length (-n), the "
+           "detail or the limits; for a scene, lower its counts, resolutions and steps\n";
     code = kExitRuntime;
   } catch (const std::exception& e) {
     err << "sylva: error: " << e.what() << "\n";

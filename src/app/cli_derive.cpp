@@ -15,8 +15,8 @@
 
 namespace sylva::app {
 
-static bool ParseDefines(const std::vector<std::string>& defs,
-                         std::map<std::string, double>* overrides, std::ostream& err) {
+bool ParseDefines(const std::vector<std::string>& defs, std::map<std::string, double>* overrides,
+                  std::ostream& err) {
   for (const auto& d : defs) {
     size_t eq = d.find('=');
     std::string name = d.substr(0, eq);
@@ -39,7 +39,8 @@ static bool ParseDefines(const std::vector<std::string>& defs,
   return true;
 }
 
-std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit) {
+std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit,
+                                         std::shared_ptr<const ViewFile>* view) {
   plant::PlantSpec spec;
   spec.path = f.file;
   if (!ParseDefines(f.defines, &spec.defines, err)) {
@@ -51,6 +52,9 @@ std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err
   spec.threads = f.threads;
   if (f.maxModules) spec.limits.maxModules = f.maxModules;
   if (f.maxTriangles) spec.limits.maxTriangles = f.maxTriangles;
+  std::shared_ptr<const ViewFile> v = LoadViewFiles(f.file, f.view);
+  AttachViewFile(v, spec);
+  if (view) *view = std::move(v);
   return spec;
 }
 

@@ -120,47 +120,35 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   int exit = kExitOk;
-  const auto scene = LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err,
-                               &exit, cmd.derive.strict);
-  if (!scene) return exit;
-  // One pool for the command: derivation, tessellation and simulation.
-  ThreadPool pool(cmd.derive.threads);
-  scene::BuildOptions options;
-  options.pool = &pool;
-  options.sides = cmd.sides;
-  scene::BuildResult built = scene::Build(*scene, options);
-  exit = Report(built.diagnostics, err, cmd.derive.maxErrors, cmd.derive.strict);
-  if (exit != kExitOk) return exit;
-  if (!built.scene) return kExitRuntime;
+  const auto run = StartScene({cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors,
+                               cmd.derive.strict, cmd.derive.threads, cmd.sides},
+                              err, &exit);
+  if (!run) return exit;
+  const scene::Scene* const scene = &run->scene;
+  const scene::BuiltScene* const built = &run->built;
+  scene::Simulation* const sim = run->simulation.get();
   const auto t1 = Clock::now();
-  DiagnosticList simWarnings;
-  scene::SimulationOptions simOptions;
-  simOptions.pool = &pool;
-  auto sim = scene::Simulation::Create(*scene, *built.scene, simOptions, simWarnings);
-  exit = Report(simWarnings, err, cmd.derive.maxErrors, cmd.derive.strict);
-  if (!sim) return Report(sim.error(), err);
-  if (exit != kExitOk) return exit;
   // On a terminal, progress every quarter of a simulated second (the steps
   // taken are the same either way: AdvanceTo takes whole steps).
   const double until = cmd.time.value_or(0);
   if (&err == &std::cerr && isatty(2)) {
     for (double t = 0.25; t < until; t += 0.25) {
-      if (Status s = (*sim)->AdvanceTo(t); !s.ok()) return Report(s.error(), err);
+      if (Status s = sim->AdvanceTo(t); !s.ok()) return Report(s.error(), err);
       char progress[120];
       std::snprintf(progress, sizeof progress, "\rsimulating: t = %.2f of %.2f s, %zu points",
-                    (*sim)->time(), until, (*sim)->Count());
+                    sim->time(), until, sim->Count());
       err << progress << std::flush;
     }
     if (until > 0.25) err << "\n";
   }
-  if (Status s = (*sim)->AdvanceTo(until); !s.ok()) return Report(s.error(), err);
+  if (Status s = sim->AdvanceTo(until); !s.ok()) return Report(s.error(), err);
   draw::DrawList simulated;
-  (*sim)->AddToDrawList(simulated);
+  sim->AddToDrawList(simulated);
   if (Status s = simulated.Check(); !s.ok()) return Report(s.error(), err);
   const auto t2 = Clock::now();
 
   mesh::SceneExportStats stats;
-  const mesh::ExportScene exported = ToExport(*scene, *built.scene, simulated);
+  const mesh::ExportScene exported = ToExport(*scene, *built, simulated);
   if (Status s =
           mesh::WriteSceneGltf(exported, cmd.output, format == mesh::MeshFormat::kGlb, &stats);
       !s.ok())
@@ -171,7 +159,7 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err) {
   std::snprintf(line, sizeof line,
                 "%s: t = %.3f s, %zu nodes, %zu meshes, %zu materials, %zu points, %zu line "
                 "segments; build %.2f s, simulate %.2f s, write %.2f s\n",
-                cmd.output.c_str(), (*sim)->time(), stats.nodes, stats.meshes, stats.materials,
+                cmd.output.c_str(), sim->time(), stats.nodes, stats.meshes, stats.materials,
                 stats.points, stats.lines, seconds(t0, t1), seconds(t1, t2), seconds(t2, t3));
   err << line;
   (void)out;

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <ostream>
 
 #include "app/cli.h"
@@ -11,6 +12,7 @@
 #include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
+#include "scene/default_scene.h"
 
 namespace sylva::app {
 
@@ -59,9 +61,27 @@ int ParseView(const std::string& size, const std::string& camera, ViewFlags& v, 
   return kExitOk;
 }
 
-// The camera that frames the plant (and the ground disc under a mesh), or
-// the one --camera gives. The box comes from the geometry, before
-// tessellation, so every detail (uniform or screen-space) sees one view.
+// A cpfg view file's view direction, unless --camera gives one.
+void UseViewFileDirection(const ViewFile* view, ViewFlags& v) {
+  if (!view || v.explicitCamera) return;
+  if (auto dir = ViewDirection(*view)) {
+    v.explicitCamera = true;
+    v.cam[0] = (*dir)[0];
+    v.cam[1] = (*dir)[1];
+    v.cam[2] = 0;  // framed
+  }
+}
+
+// cpfg's `scale factor:` zooms the framed view.
+void UseViewFileScale(const ViewFile* view, render::Camera& camera) {
+  if (!view || !view->scale) return;
+  camera.distance /= *view->scale;
+  camera.orthoHeight /= *view->scale;
+}
+
+// The camera that frames the plant, or the one --camera gives. The box
+// comes from the geometry, before tessellation, so every detail (uniform
+// or screen-space) sees one view.
 Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSpec& spec,
                                      const ViewFlags& v, bool lines, mesh::Box* meshBox = nullptr) {
   Vec3 lo = p.geometry.boundsMin, hi = p.geometry.boundsMax;
@@ -72,11 +92,6 @@ Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSp
     if ((box->lo.array() <= box->hi.array()).all()) {
       lo = box->lo;
       hi = box->hi;
-      // Frame the ground disc the renderer puts under the plant too.
-      const double r = 0.55 * (hi - lo).norm();
-      const Vec3 c((lo.x() + hi.x()) / 2, lo.y(), (lo.z() + hi.z()) / 2);
-      lo = lo.cwiseMin(c - Vec3(r, 0, r));
-      hi = hi.cwiseMax(c + Vec3(r, 0, r));
     }
   }
   const double aspect = double(v.width) / v.height;
@@ -124,6 +139,23 @@ render::Image Downsample(const render::Image& big, int k) {
 
 }  // namespace
 
+draw::Lines LinesOf(const plant::Plant& plant) {
+  draw::Lines out;
+  const mesh::Palette& palette = plant.palette;
+  const float lineShade = plant.grammar.palette.empty() ? std::pow(0.6f, 2.2f) : 1.0f;
+  for (const auto& s : plant.geometry.segments) {
+    // A grammar's own palette is drawn as written; the default palette is
+    // darkened (to 0.6 of its sRGB value) so lines read on white.
+    const mesh::Vec3f c =
+        palette.empty() ? mesh::Vec3f(0, 0, 0) : palette[s.color % palette.size()] * lineShade;
+    out.points.push_back(s.start.cast<float>());
+    out.points.push_back(s.end.cast<float>());
+    out.colors.push_back(c);
+    out.colors.push_back(c);
+  }
+  return out;
+}
+
 mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps) {
   mesh::ScreenView view;
   view.viewProjection = camera.ViewProjection(double(width) / height);
@@ -154,8 +186,10 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   int exit = kExitOk;
-  auto spec = SpecFrom(cmd.derive, err, &exit);
+  std::shared_ptr<const ViewFile> viewFile;
+  auto spec = SpecFrom(cmd.derive, err, &exit, &viewFile);
   if (!spec) return exit;
+  UseViewFileDirection(viewFile.get(), v);
   if (cmd.sides) spec->detail.sides = *cmd.sides;
   spec->until = plant::Stage::kGeometry;
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
@@ -165,24 +199,16 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   // 2D figures (all in the z = 0 plane, nothing but segments) draw as lines
   // in an orthographic view from +Z; everything else as a lit mesh.
   const bool lines = plant::IsLineFigure(*geometry);
-  const mesh::TriangleMesh& m = plant->mesh;
   render::LineBatch batch;
   mesh::Box bounds;
   auto camera = FrameCamera(*plant, *spec, v, lines, &bounds);
   if (!camera) return Report(camera.error(), err);
+  if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
   const int W = v.width * K, H = v.height * K;
   if (lines) {
-    const float lineShade = plant->grammar.palette.empty() ? std::pow(0.6f, 2.2f) : 1.0f;
-    for (const auto& s : geometry->segments) {
-      // A grammar's own palette is drawn as written; the default palette is
-      // darkened (to 0.6 of its sRGB value) so lines read on white.
-      const mesh::Vec3f c =
-          palette.empty() ? mesh::Vec3f(0, 0, 0) : palette[s.color % palette.size()] * lineShade;
-      batch.points.push_back(s.start.cast<float>());
-      batch.points.push_back(s.end.cast<float>());
-      batch.colors.push_back(c);
-      batch.colors.push_back(c);
-    }
+    draw::Lines figure = LinesOf(*plant);
+    batch.points = std::move(figure.points);
+    batch.colors = std::move(figure.colors);
   } else {
     // Screen-space detail unless --sides asks for uniform tubes; eps is in
     // output pixels, so K times as many in the K-times larger image.
@@ -201,6 +227,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     if (!s.ok()) return Report(s.error(), err);
     if (exit != kExitOk) return exit;
   }
+  const auto m = std::make_shared<const mesh::TriangleMesh>(std::move(plant->mesh));
 
   auto t0 = Clock::now();
   auto context = render::HeadlessContext::Create();
@@ -210,18 +237,23 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (Status s = (*renderer)->Resize(W, H); !s.ok()) return Report(s.error(), err);
   const double contextMs = MsSince(t0);
   t0 = Clock::now();
+  draw::DrawList list;
   if (lines) {
     (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
     if (Status s = (*renderer)->SetLines(batch); !s.ok()) return Report(s.error(), err);
   } else {
-    (*renderer)->SetGround(true);
-    (*renderer)->SetWireframe(cmd.wireframe);
-    // Ground and shadow map fitted to the whole plant, whatever was culled.
-    (*renderer)->SetMesh(m, palette, &bounds);
+    // The default scene: the plant on a ground plane, lit by the default
+    // rig; the shadow map fitted to the whole plant, whatever was culled.
+    list = scene::DefaultScene(m, palette, bounds.lo, bounds.hi);
+    list.wireframe = cmd.wireframe;
   }
   const double uploadMs = MsSince(t0);
   t0 = Clock::now();
-  (*renderer)->Draw(*camera);
+  if (lines) {
+    (*renderer)->Draw(*camera);
+  } else if (Status s = (*renderer)->Draw(list, *camera); !s.ok()) {
+    return Report(s.error(), err);
+  }
   render::Image image = (*renderer)->ReadPixels();
   const double drawMs = MsSince(t0);
   t0 = Clock::now();
@@ -233,7 +265,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   char line[256];
   std::snprintf(line, sizeof line, "%s: %dx%d, %s, %zu triangles, %zu lines (%s)\n",
                 cmd.output.c_str(), v.width, v.height,
-                lines ? "lines, orthographic" : "mesh, perspective", m.triangleCount(),
+                lines ? "lines, orthographic" : "mesh, perspective", m->triangleCount(),
                 batch.points.size() / 2, (*context)->Renderer().c_str());
   err << line;
   if (cmd.stats) {
@@ -248,7 +280,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
                   "parse: %.1f ms\nderive: %.1f ms\ninterpret: %.1f ms\nturtle: %.1f ms\n"
                   "tessellate: %.1f ms\ncontext: %.1f ms\nupload: %.1f ms\ndraw: %.1f ms\n"
                   "downsample: %.1f ms\nwrite: %.1f ms\ntotal: %.1f ms\n",
-                  m.triangleCount(), detail.c_str(), t.parse, t.derive, t.interpret, t.turtle,
+                  m->triangleCount(), detail.c_str(), t.parse, t.derive, t.interpret, t.turtle,
                   t.tessellate, contextMs, uploadMs, drawMs, downsampleMs, writeMs,
                   MsSince(tStart));
     out << buf;
@@ -276,14 +308,17 @@ int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err)
     return kExitBadInput;
   }
   int exit = kExitOk;
-  auto spec = SpecFrom(cmd.derive, err, &exit);
+  std::shared_ptr<const ViewFile> viewFile;
+  auto spec = SpecFrom(cmd.derive, err, &exit, &viewFile);
   if (!spec) return exit;
+  UseViewFileDirection(viewFile.get(), v);
   spec->until = plant::Stage::kGeometry;
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   // Framed as `sylva render` frames a mesh (never as a line figure).
   auto camera = FrameCamera(*plant, *spec, v, false);
   if (!camera) return Report(camera.error(), err);
+  if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
   spec->view = ViewOf(*camera, v.width, v.height, eps);
   DiagnosticList warnings;
   Status s = plant::Tessellate(*plant, *spec, warnings);

@@ -65,42 +65,33 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
     return kExitBadInput;
   }
   int exit = kExitOk;
-  const auto scene = LoadScene(cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors, err,
-                               &exit, cmd.derive.strict);
-  if (!scene) return exit;
-  // One pool for the command: derivation, tessellation and simulation.
-  ThreadPool pool(cmd.derive.threads);
-  scene::BuildOptions options;
-  options.pool = &pool;
   // Uniform tubes for what collides (the same whatever the camera); the
   // picture gets screen-space detail below unless --sides is given.
-  options.sides = cmd.sides.value_or(8);
-  scene::BuildResult built = scene::Build(*scene, options);
-  exit = Report(built.diagnostics, err, cmd.derive.maxErrors);
-  if (!built.scene) return exit == kExitOk ? kExitRuntime : exit;
+  const auto run = StartScene({cmd.derive.file, cmd.derive.defines, cmd.derive.maxErrors,
+                               cmd.derive.strict, cmd.derive.threads, cmd.sides.value_or(8)},
+                              err, &exit);
+  if (!run) return exit;
+  const scene::Scene* const scene = &run->scene;
+  scene::BuiltScene* const built = &run->built;
+  scene::Simulation* const sim = run->simulation.get();
   const auto t1 = Clock::now();
-  DiagnosticList simWarnings;
-  scene::SimulationOptions simOptions;
-  simOptions.pool = &pool;
-  auto sim = scene::Simulation::Create(*scene, *built.scene, simOptions, simWarnings);
-  exit = Report(simWarnings, err, cmd.derive.maxErrors);
-  if (!sim) return Report(sim.error(), err);
-  if (Status s = (*sim)->AdvanceTo(cmd.time); !s.ok()) return Report(s.error(), err);
+  if (Status s = sim->AdvanceTo(cmd.time); !s.ok()) return Report(s.error(), err);
   const auto t2 = Clock::now();
 
-  const render::Camera camera = SceneCamera(*scene, *built.scene, double(width) / height);
-  size_t staticTriangles = built.scene->trianglesDrawn;
+  const render::Camera camera = SceneCamera(*scene, *built, double(width) / height);
+  size_t staticTriangles = built->trianglesDrawn;
   if (!cmd.sides) {
     DiagnosticList detailWarnings;
     auto drawn =
-        scene::DetailForView(*built.scene, ViewOf(camera, width, height, lodEps), detailWarnings);
-    Report(detailWarnings, err, cmd.derive.maxErrors);
+        scene::DetailForView(*built, ViewOf(camera, width, height, lodEps), detailWarnings);
+    exit = Report(detailWarnings, err, cmd.derive.maxErrors, cmd.derive.strict);
+    if (exit != kExitOk) return exit;
     if (!drawn) return Report(drawn.error(), err);
     staticTriangles = *drawn;
   }
   const auto t2b = Clock::now();
-  draw::DrawList list = scene::MakeDrawList(*scene, *built.scene);
-  (*sim)->AddToDrawList(list);
+  draw::DrawList list = scene::MakeDrawList(*scene, *built);
+  sim->AddToDrawList(list);
   auto context = render::HeadlessContext::Create();
   if (!context) return Report(context.error(), err);
   auto renderer = render::Renderer::Create(render::FindShaderDir());
@@ -116,10 +107,10 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
                 "%s: %dx%d at t = %.3f s, %zu meshes, %zu static triangles drawn (%s), %zu "
                 "simulated points; build %.2f s, simulate %.2f s, detail %.2f s, render %.2f s "
                 "(%s)\n",
-                cmd.output.c_str(), width, height, (*sim)->time(), list.meshes.size(),
-                staticTriangles, cmd.sides ? "uniform sides" : "screen-space detail",
-                (*sim)->Count(), seconds(t0, t1), seconds(t1, t2), seconds(t2, t2b),
-                seconds(t2b, t3), (*context)->Renderer().c_str());
+                cmd.output.c_str(), width, height, sim->time(), list.meshes.size(), staticTriangles,
+                cmd.sides ? "uniform sides" : "screen-space detail", sim->Count(), seconds(t0, t1),
+                seconds(t1, t2), seconds(t2, t2b), seconds(t2b, t3),
+                (*context)->Renderer().c_str());
   if (cmd.stats) {
     std::snprintf(line, sizeof line,
                   "triangles: %zu\nbuild: %.1f ms\nsimulate: %.1f ms\ndetail: %.1f ms\nrender: "

@@ -74,6 +74,36 @@ std::string FramePath(const std::string& pattern, int index) {
   return conversions == 1 ? out : "";
 }
 
+std::unique_ptr<SceneRun> StartScene(const SceneRunOptions& o, std::ostream& err, int* exit) {
+  auto loaded = LoadScene(o.path, o.defines, o.maxErrors, err, exit, o.strict);
+  if (!loaded) return nullptr;
+  auto run = std::make_unique<SceneRun>(o.threads);
+  run->scene = std::move(*loaded);
+  scene::BuildOptions buildOptions;
+  buildOptions.pool = &run->pool;
+  buildOptions.sides = o.sides;
+  scene::BuildResult built = scene::Build(run->scene, buildOptions);
+  *exit = Report(built.diagnostics, err, o.maxErrors, o.strict);
+  if (!built.scene) {
+    if (*exit == kExitOk) *exit = kExitRuntime;
+    return nullptr;
+  }
+  if (*exit != kExitOk) return nullptr;
+  run->built = std::move(*built.scene);
+  DiagnosticList warnings;
+  scene::SimulationOptions simOptions;
+  simOptions.pool = &run->pool;
+  auto sim = scene::Simulation::Create(run->scene, run->built, simOptions, warnings);
+  *exit = Report(warnings, err, o.maxErrors, o.strict);
+  if (!sim) {
+    *exit = Report(sim.error(), err);
+    return nullptr;
+  }
+  if (*exit != kExitOk) return nullptr;
+  run->simulation = std::move(*sim);
+  return run;
+}
+
 int RunSimulate(const SimulateCommand& cmd, std::ostream& out, std::ostream& err,
                 const FrameWriter& writeFrame) {
   if (!cmd.output.empty() && FramePath(cmd.output, 0).empty()) {
@@ -83,29 +113,16 @@ int RunSimulate(const SimulateCommand& cmd, std::ostream& out, std::ostream& err
     return kExitBadInput;
   }
   int exit = kExitOk;
-  const auto loaded = LoadScene(cmd.file, cmd.defines, cmd.maxErrors, err, &exit, cmd.strict);
-  if (!loaded) return exit;
-  const scene::Scene& sc = *loaded;
+  const auto run = StartScene(
+      {cmd.file, cmd.defines, cmd.maxErrors, cmd.strict, cmd.threads, /*sides=*/8}, err, &exit);
+  if (!run) return exit;
+  const scene::Scene& sc = run->scene;
+  scene::Simulation* const sim = run->simulation.get();
   const double duration = cmd.duration.value_or(sc.simulation.duration);
   const double fps = cmd.fps.value_or(sc.simulation.fps);
-  // One pool for the command: derivation, tessellation and simulation.
-  ThreadPool pool(cmd.threads);
-  scene::BuildOptions buildOptions;
-  buildOptions.pool = &pool;
-  scene::BuildResult built = scene::Build(sc, buildOptions);
-  exit = Report(built.diagnostics, err, cmd.maxErrors, cmd.strict);
-  if (!built.scene) return exit == kExitOk ? kExitRuntime : exit;
-  if (exit != kExitOk) return exit;
-  DiagnosticList warnings;
-  scene::SimulationOptions simOptions;
-  simOptions.pool = &pool;
-  auto sim = scene::Simulation::Create(sc, *built.scene, simOptions, warnings);
-  exit = Report(warnings, err, cmd.maxErrors, cmd.strict);
-  if (!sim) return Report(sim.error(), err);
-  if (exit != kExitOk) return exit;
 
   // Bounded before any work: the steps the clock takes and the frames.
-  const double steps = duration / (*sim)->stepLength();
+  const double steps = duration / sim->stepLength();
   if (steps > scene::kMaxStepsPerAdvance || duration * fps > 1e6) {
     err << "sylva: error: --duration " << duration << " s would take " << uint64_t(steps)
         << " simulation steps and " << uint64_t(duration * fps)
@@ -117,23 +134,23 @@ int RunSimulate(const SimulateCommand& cmd, std::ostream& out, std::ostream& err
   const bool progress = isatty(2);
   for (int k = 0; k < frames; ++k) {
     const double t = double(k) / fps;
-    if (Status s = (*sim)->AdvanceTo(t); !s.ok()) return Report(s.error(), err);
+    if (Status s = sim->AdvanceTo(t); !s.ok()) return Report(s.error(), err);
     if (writeFrame) {
-      const SimulationFrame frame{sc, *built.scene, **sim, k};
+      const SimulationFrame frame{sc, run->built, *sim, k};
       const std::string path = FramePath(cmd.output, k);
       if (Status s = writeFrame(frame, path); !s.ok()) return Report(s.error(), err);
     }
     if (progress) {
       char line[160];
       std::snprintf(line, sizeof line, "\rframe %d/%d  t = %.2f s  %zu points", k + 1, frames,
-                    (*sim)->time(), (*sim)->Count());
+                    sim->time(), sim->Count());
       err << line << std::flush;
     }
   }
   if (progress) err << "\n";
   if (!cmd.dump.empty()) {
     std::ostringstream csv;
-    (*sim)->WriteCsv(csv);
+    sim->WriteCsv(csv);
     AtomicFile f;
     Status s = f.Open(cmd.dump);
     if (s.ok()) s = f.Write(csv.str());
@@ -142,7 +159,7 @@ int RunSimulate(const SimulateCommand& cmd, std::ostream& out, std::ostream& err
   }
   char line[200];
   std::snprintf(line, sizeof line, "simulated %.3f s (%d frames%s), %zu points at the end\n",
-                (*sim)->time(), frames, writeFrame ? " written" : "", (*sim)->Count());
+                sim->time(), frames, writeFrame ? " written" : "", sim->Count());
   err << line;
   (void)out;
   return kExitOk;

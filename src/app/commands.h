@@ -5,11 +5,16 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "app/view_file.h"
 #include "core/diagnostic.h"
+#include "core/parallel.h"
+#include "draw/draw_list.h"
 #include "plant/plant.h"
 #include "scene/build.h"
 #include "scene/scene.h"
@@ -28,6 +33,7 @@ struct DeriveFlags {
   uint64_t maxTriangles = 0;  // mesh and render only; 0: the library default
   int maxErrors = 20;         // errors (and warnings) printed; 0: all
   bool strict = false;        // --strict: any warning is an error (exit 2)
+  std::string view;           // --view: cpfg view file (default: FILE's NAME.v beside it)
 };
 
 struct DeriveCommand {
@@ -80,7 +86,18 @@ int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 
 // The plant spec the flags describe (steps, seed, -D, threads, limits);
 // nullopt with *exit set when a flag is malformed (printed to `err`).
-std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit);
+// The cpfg view file (and .map/.mat) of the grammar is read here and
+// attached to the spec (app/view_file.h); `view`, when given, receives it
+// (nullptr when there is none).
+std::optional<plant::PlantSpec> SpecFrom(const DeriveFlags& f, std::ostream& err, int* exit,
+                                         std::shared_ptr<const ViewFile>* view = nullptr);
+// -D NAME=VALUE arguments into `overrides`; false (the error printed) on a
+// bad name or number.
+bool ParseDefines(const std::vector<std::string>& defs, std::map<std::string, double>* overrides,
+                  std::ostream& err);
+// A 2D figure (plant::IsLineFigure) as lines: the grammar's palette as
+// written, the default one darkened so lines read on white.
+draw::Lines LinesOf(const plant::Plant& plant);
 
 // Builds the plant up to `spec.until`, printing its diagnostics (at most
 // maxErrors of them, 0: all); nullopt with *exit set on an error (or, with
@@ -129,6 +146,29 @@ std::optional<scene::Scene> LoadScene(const std::string& path,
                                       const std::vector<std::string>& defines, int maxErrors,
                                       std::ostream& err, int* exit, bool strict = false);
 int RunCheckScene(const DeriveFlags& flags, std::ostream& out, std::ostream& err);
+
+// A scene read, built and its simulation created at t = 0: the sequence
+// that render, mesh and simulate share. It lives on the heap and never
+// moves (the simulation keeps references to the scene, the built scene and
+// the pool).
+struct SceneRun {
+  explicit SceneRun(int threads) : pool(threads) {}
+  ThreadPool pool;  // one pool for the command: derivation, tessellation, simulation
+  scene::Scene scene;
+  scene::BuiltScene built;
+  std::unique_ptr<scene::Simulation> simulation;
+};
+struct SceneRunOptions {
+  std::string path;
+  std::vector<std::string> defines;
+  int maxErrors = 0;
+  bool strict = false;  // a warning of the scene, a grammar, the build or the simulation fails
+  int threads = 0;
+  int sides = 8;  // uniform tube sides of the built plants
+};
+// Reports every diagnostic to `err`; null with *exit set on an error (or a
+// warning under `strict`).
+std::unique_ptr<SceneRun> StartScene(const SceneRunOptions& options, std::ostream& err, int* exit);
 
 // Prints diagnostics; returns the exit status they call for (0 when there
 // are only warnings, 2 when there are warnings and `strict`, saying so).

@@ -23,16 +23,19 @@
 #include <map>
 #include <mutex>
 #include <ostream>
+#include <set>
 #include <sstream>
 #include <thread>
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/view_file.h"
 #include "app/viewer_window.h"
 #include "plant/plant.h"
 #include "plant/surface_library.h"
 #include "render/camera.h"
 #include "render/renderer.h"
+#include "scene/default_scene.h"
 
 namespace sylva::app {
 
@@ -44,6 +47,10 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+// The viewer's shadow map (Renderer::SetShadowMapSize): smaller than
+// `sylva render`'s, for cheaper shadow samples.
+constexpr int kViewerShadowMapSize = 2048;
+
 struct Job {
   uint64_t id = 0;
   std::string path;
@@ -51,8 +58,9 @@ struct Job {
   std::map<std::string, double> overrides;
   std::optional<uint64_t> seed;
   int steps = -1;
-  int sides = 8;        // uniform detail, when lod is off
-  bool lod = true;      // screen-space detail for the camera (docs/lod.md)
+  int sides = 8;    // uniform detail, when lod is off
+  bool lod = true;  // screen-space detail for the camera (docs/lod.md)
+  int threads = 0;
   bool strict = false;  // warnings are errors
   // The view to tessellate for (with lod); empty: the framing of `sylva render`.
   std::optional<render::Camera> camera;
@@ -62,7 +70,7 @@ struct Job {
 // Jobs that differ only in the view (or the detail) reuse the plant.
 bool SamePlant(const Job& a, const Job& b) {
   return a.path == b.path && a.reload == b.reload && a.overrides == b.overrides &&
-         a.seed == b.seed && a.steps == b.steps && a.strict == b.strict;
+         a.seed == b.seed && a.steps == b.steps && a.threads == b.threads && a.strict == b.strict;
 }
 
 struct Result {
@@ -72,14 +80,18 @@ struct Result {
   bool stale = false;       // the last good plant: the request's own failed to build
   uint64_t failedId = 0;    // with !ok or stale: the job whose build failed
   std::string diagnostics;  // errors and warnings, formatted
-  mesh::TriangleMesh mesh;
+  mesh::TriangleMesh mesh;  // moved into the drawn scene when shown
+  size_t triangles = 0;
   mesh::Palette palette;
-  mesh::Box bounds;       // the whole plant's (ground and shadows are fitted to it)
-  render::Camera camera;  // the view it was tessellated for
-  Vec3 lo{0, 0, 0}, hi{1, 1, 1};
+  render::Camera camera;          // the view it was tessellated for
+  Vec3 lo{0, 0, 0}, hi{1, 1, 1};  // the whole plant's box (ground and shadows fit it)
   uint64_t modules = 0;
   int derivationLength = 0;
   std::vector<std::pair<std::string, double>> constants;  // file order not kept: sorted
+  std::set<std::string> overridden;  // the constants the job set (the others are the file's)
+  // A 2D figure (plant::IsLineFigure): drawn as these lines, orthographic,
+  // with no ground and no shadow.
+  std::optional<draw::Lines> lines;
   double deriveMs = 0, turtleMs = 0, tessellateMs = 0;
 };
 
@@ -93,6 +105,7 @@ struct WorkerState {
   std::optional<plant::Plant> plant;
   plant::PlantSpec spec;
   mesh::Box bounds;
+  bool lines = false;  // a 2D figure (plant::IsLineFigure): drawn as lines, never tessellated
   std::string diagnostics;
   std::optional<Job> failed;
   std::string failedDiagnostics;
@@ -109,12 +122,19 @@ Result RunJob(const Job& job, WorkerState& st) {
     spec.defines = job.overrides;
     spec.seed = job.seed;
     if (job.steps >= 0) spec.steps = job.steps;
+    spec.threads = job.threads;
+    // cpfg's NAME.v (and .map, .mat) beside the grammar, read again on each reload.
+    AttachViewFile(LoadViewFiles(job.path, ""), spec);
     spec.until = plant::Stage::kGeometry;
     plant::PlantResult built = plant::BuildPlant(spec);
     std::string diagnostics = built.diagnostics.FormatAll();
     std::optional<mesh::Box> bounds;
+    bool lines = false;
     if (built.plant && job.strict && !built.diagnostics.items.empty()) {
       diagnostics += "sylva: error: --strict: warnings are treated as errors\n";
+    } else if (built.plant && plant::IsLineFigure(built.plant->geometry)) {
+      lines = true;
+      bounds = mesh::Box{built.plant->geometry.boundsMin, built.plant->geometry.boundsMax};
     } else if (built.plant) {
       auto b = plant::MeshBounds(*built.plant, spec);
       if (b) bounds = *b;
@@ -131,6 +151,7 @@ Result RunJob(const Job& job, WorkerState& st) {
     st.history = {};
     st.diagnostics = diagnostics;
     st.bounds = *bounds;
+    st.lines = lines;
     st.plant = std::move(built.plant);
     st.spec = spec;
     st.built = job;
@@ -144,36 +165,47 @@ Result RunJob(const Job& job, WorkerState& st) {
   r.stale = failedBefore;
   r.diagnostics = failedBefore ? st.failedDiagnostics : st.diagnostics;
   plant::Plant& p = *st.plant;
-  plant::PlantSpec spec = st.spec;
-  spec.detail.sides = job.sides;
   const bool empty = !(st.bounds.lo.array() <= st.bounds.hi.array()).all();
   const Vec3 lo = empty ? Vec3::Zero() : st.bounds.lo, hi = empty ? Vec3::Ones() : st.bounds.hi;
-  r.camera = job.camera
-                 ? *job.camera
-                 : render::Camera::Frame(lo, hi, double(job.width) / job.height, 30, 12, false);
-  if (job.lod) {
-    spec.view = ViewOf(r.camera, job.width, job.height, 0.5);
-    spec.view->shadowFrom = render::KeyLightDirection();
-    spec.view->shadowPlaneY = lo.y();
-    spec.view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(st.bounds);
-    spec.view->coverage = true;
-    spec.history = &st.history;
+  const double aspect = double(job.width) / job.height;
+  r.camera = job.camera ? *job.camera
+                        : (st.lines ? render::Camera::Frame(lo, hi, aspect, 0, 0, true)
+                                    : render::Camera::Frame(lo, hi, aspect, 30, 12, false));
+  if (st.lines) {
+    r.lines = LinesOf(p);
   } else {
-    st.history = {};  // levels of another detail mean nothing to the next view
-  }
-  DiagnosticList warnings;
-  if (Status s = plant::Tessellate(p, spec, warnings); !s.ok()) {
-    r.diagnostics += s.error().message + "\n";
-    return r;
+    plant::PlantSpec spec = st.spec;
+    spec.detail.sides = job.sides;
+    if (job.lod) {
+      spec.view = ViewOf(r.camera, job.width, job.height, 0.5);
+      // Shadows of what lies outside the view may fall inside it; the
+      // viewer's shadow map is smaller than `sylva render`'s.
+      spec.view->shadowFrom = render::KeyLightDirection();
+      spec.view->shadowPlaneY = lo.y();
+      spec.view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(st.bounds) *
+                                       kViewerShadowMapSize /
+                                       render::Renderer::kDefaultShadowMapSize;
+      // Twigs under a pixel fade as coverage lines (the renderer blends them).
+      spec.view->coverage = true;
+      spec.history = &st.history;
+    } else {
+      st.history = {};  // levels of another detail mean nothing to the next view
+    }
+    DiagnosticList warnings;
+    if (Status s = plant::Tessellate(p, spec, warnings); !s.ok()) {
+      r.diagnostics += s.error().message + "\n";
+      return r;
+    }
+    r.mesh = std::move(p.mesh);
+    p.mesh = mesh::TriangleMesh();
   }
   r.derivationLength = p.grammar.derivationLength;
   for (const auto& [k, v] : p.grammar.constants) r.constants.emplace_back(k, v);
   std::sort(r.constants.begin(), r.constants.end());
-  r.mesh = std::move(p.mesh);
-  p.mesh = mesh::TriangleMesh();
+  for (const auto& [k, v] : st.built->overrides) r.overridden.insert(k);
   r.palette = p.palette;
   r.modules = p.DrawnWord().size();
-  r.bounds = st.bounds;
+  r.triangles = r.mesh.triangleCount();
   r.lo = lo;
   r.hi = hi;
   r.deriveMs = p.time.parse + p.time.derive + p.time.interpret;
@@ -225,25 +257,68 @@ std::string DefaultGrammar() {
 // What the panel shows of the newest results.
 struct Shown {
   std::optional<Result> plant;  // the last good plant
+  uint64_t id = 0;              // the job it came from
   std::string diagnostics;
   bool lastFailed = false;
   std::vector<std::pair<std::string, double>> constants;
+  // Each #define's slider range, fixed: set from the file's value (not from
+  // a value the slider set, or the range would follow the slider away).
+  std::map<std::string, std::pair<float, float>> ranges;
   int derivationLength = 0;
+  bool playing = false;  // stepping the derivation 0, 1, 2 ... by itself
+  Clock::time_point lastPlayed;
 };
 
-// The control panel: step, seed, sides and a slider per #define; true when
-// the job changed.
-bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double frameMs, Job& job) {
+// The slider range of a #define whose file value is v.
+std::pair<float, float> RangeFor(double v) {
+  if (v > 0) return {0.0f, float(2 * v)};
+  if (v < 0) return {float(2 * v), 0.0f};
+  return {-1.0f, 1.0f};
+}
+
+// What the panel asked for beyond a new job.
+struct PanelActions {
+  bool changed = false;   // post the job
+  bool frameAll = false;  // frame the plant again
+};
+
+// The control panel: step (with play, step and reset), seed, sides, frame
+// all, and a slider per #define.
+PanelActions DrawPanel(const std::string& path, Shown& shown, bool busy, double frameMs, Job& job) {
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(340, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("Sylva", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
   ImGui::TextWrapped("%s", fs::path(path).filename().string().c_str());
-  bool changed = false;
+  PanelActions act;
+  bool& changed = act.changed;
   int steps = job.steps < 0 ? shown.derivationLength : job.steps;
   if (ImGui::SliderInt("step", &steps, 0, std::max(shown.derivationLength, 1))) {
     job.steps = steps;
+    shown.playing = false;
     changed = true;
   }
+  if (ImGui::Button(shown.playing ? "pause" : "play")) {
+    shown.playing = !shown.playing;
+    if (shown.playing && steps >= shown.derivationLength) {  // play from the axiom
+      job.steps = 0;
+      changed = true;
+    }
+    shown.lastPlayed = Clock::now();
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("step") && steps < shown.derivationLength) {
+    job.steps = steps + 1;
+    shown.playing = false;
+    changed = true;
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("reset")) {
+    job.steps = 0;
+    shown.playing = false;
+    changed = true;
+  }
+  ImGui::SameLine();
+  if (ImGui::Button("frame all")) act.frameAll = true;
   int seed = int(job.seed.value_or(1));
   if (ImGui::InputInt("seed", &seed)) {
     job.seed = uint64_t(std::max(seed, 0));
@@ -255,20 +330,22 @@ bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double fr
       ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
     for (const auto& [name, value] : shown.constants) {
       float v = float(job.overrides.count(name) ? job.overrides[name] : value);
-      const float lo = value > 0 ? 0.0f : float(value) - 10.0f;
-      const float hi = value > 0 ? float(value) * 2.0f : float(value) + 10.0f;
-      if (ImGui::SliderFloat(name.c_str(), &v, lo, hi)) {
+      const auto range = shown.ranges.count(name) ? shown.ranges[name] : RangeFor(value);
+      if (ImGui::SliderFloat(name.c_str(), &v, range.first, range.second)) {
         job.overrides[name] = v;
         changed = true;
       }
+    }
+    if (!job.overrides.empty() && ImGui::Button("file values")) {
+      job.overrides.clear();
+      changed = true;
     }
   }
   if (busy) ImGui::ProgressBar(-1.0f * float(ImGui::GetTime()), ImVec2(-1, 0), "deriving...");
   ImGui::Separator();
   if (shown.plant) {
     ImGui::Text("modules %llu, triangles %zu",
-                static_cast<unsigned long long>(shown.plant->modules),
-                shown.plant->mesh.triangleCount());
+                static_cast<unsigned long long>(shown.plant->modules), shown.plant->triangles);
     ImGui::Text("derive %.1f ms, turtle %.1f ms, mesh %.1f ms", shown.plant->deriveMs,
                 shown.plant->turtleMs, shown.plant->tessellateMs);
   }
@@ -280,7 +357,29 @@ bool DrawPanel(const std::string& path, const Shown& shown, bool busy, double fr
     ImGui::TextWrapped("%s", shown.diagnostics.c_str());
   }
   ImGui::End();
-  return changed;
+  return act;
+}
+
+// The drawn scene of a result: a 2D figure's lines on white, or the
+// plant's default scene.
+draw::DrawList SceneOf(Result& r) {
+  if (r.lines) {
+    draw::DrawList list;
+    list.background = mesh::Vec3f(1, 1, 1);
+    list.lines.push_back(std::move(*r.lines));
+    r.lines.reset();
+    return list;
+  }
+  return scene::DefaultScene(std::make_shared<const mesh::TriangleMesh>(std::move(r.mesh)),
+                             r.palette, r.lo, r.hi);
+}
+
+// A camera that frames the result: the 2D figure from +Z, orthographic;
+// a plant from `azimuth`, `elevation`.
+render::Camera FrameOf(const Result& r, double aspect, bool lines, double azimuth,
+                       double elevation) {
+  return lines ? render::Camera::Frame(r.lo, r.hi, aspect, 0, 0, true)
+               : render::Camera::Frame(r.lo, r.hi, aspect, azimuth, elevation, false);
 }
 
 }  // namespace
@@ -308,27 +407,37 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   if (IsSceneFile(path)) {
+    if (cmd.steps || cmd.seed) {
+      err << "sylva: error: -n and --seed are for grammars; a scene sets them on <plant> and "
+             "<forest>\n";
+      return kExitBadInput;
+    }
     ViewCommand scene = cmd;
     scene.file = path;  // the bundled scene when no file was given
     return RunViewScene(scene, width, height, out, err);
   }
-  if (cmd.time || !cmd.defines.empty() || cmd.threads) {
-    err << "sylva: error: --time, -D and --threads are for scenes (.xml); a grammar's #defines "
-           "have sliders in the viewer\n";
+  if (cmd.time) {
+    err << "sylva: error: --time is for scenes (.xml); a grammar has its derivation step (-n)\n";
     return kExitBadInput;
   }
+  Job job;
+  if (!ParseDefines(cmd.defines, &job.overrides, err)) return kExitBadInput;
+  if (cmd.steps) job.steps = *cmd.steps;
+  job.seed = cmd.seed;
+  job.threads = cmd.threads;
   Window window;
   if (int code = OpenWindow(width, height, "Sylva - " + path, cmd.frames == 0, window, err))
     return code;
   // Declared after the window: its GL objects are destroyed before the context.
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer) return Report(renderer.error(), err);
-  (*renderer)->SetGround(true);
+  (*renderer)->SetShadowMapSize(kViewerShadowMapSize);  // interactive: cheaper shadow samples
+  // The default scene of the plant shown (a ground plane, the default lights).
+  draw::DrawList drawn;
 
   int exitCode = kExitOk;
   WorkerState state;  // the worker's alone; outlives it
   Worker<Job, Result> worker([&state](const Job& j) { return RunJobSafely(j, state); });
-  Job job;
   job.path = path;
   job.strict = cmd.strict;
   job.width = width;
@@ -343,6 +452,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   int retessellations = 0;
   uint64_t reportedFailure = 0;  // the job id of the last failed build reported
   double slowestFrameMs = 0, slowestSwapMs = 0;
+  std::optional<double> plainDrawMs;  // the last Draw of a frame without a new mesh
   auto post = [&] {
     job.id = nextId++;
     job.camera = framed ? std::optional<render::Camera>(camera) : std::nullopt;
@@ -355,6 +465,8 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   double frameMs = 0;
   int frame = 0;
   int shots = 0;
+  bool screenshotKeyDown = false;  // one picture per press of P, however long it is held
+  bool lines = false;              // the plant shown is a 2D figure
   MouseCamera mouse;
 
   while (!glfwWindowShouldClose(window.handle)) {
@@ -370,6 +482,10 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
         post();
       }
     }
+    // The time a new mesh costs this thread (set when one came): building its
+    // scene, and its upload in the next Draw.
+    std::optional<double> swapMs;
+    bool newScene = false;  // also the first mesh, which replaces none (not timed)
     if (auto r = worker.Take()) {
       shown.diagnostics = r->diagnostics;
       // Report each failed build once, also when a newer view of the last
@@ -381,17 +497,29 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       }
       if (r->ok) {
         shown.constants = r->constants;
+        for (const auto& [name, value] : r->constants)
+          if (!r->overridden.count(name) || !shown.ranges.count(name))
+            shown.ranges[name] = RangeFor(value);
         shown.derivationLength = r->derivationLength;
-        // The only work a new tessellation costs this thread: the upload.
+        shown.id = r->id;
+        const bool wasLines = lines;
+        lines = r->lines.has_value();
+        // The only work a new tessellation costs this thread: the upload
+        // (in the next Draw).
         const auto swapStart = Clock::now();
-        (*renderer)->SetMesh(r->mesh, r->palette, &r->bounds);
-        slowestSwapMs =
-            std::max(slowestSwapMs,
-                     std::chrono::duration<double, std::milli>(Clock::now() - swapStart).count());
+        drawn = SceneOf(*r);
+        if (shown.plant)
+          swapMs = std::chrono::duration<double, std::milli>(Clock::now() - swapStart).count();
+        newScene = true;
         if (!framed) {
+          // The view the mesh was tessellated for: `sylva render`'s framing.
           camera = r->camera;
           posted = camera;
           framed = true;
+        } else if (lines != wasLines) {
+          // A plant became a 2D figure or back: framed again (a plant's mesh,
+          // made for the last view, is re-tessellated for this one).
+          camera = FrameOf(*r, double(width) / height, lines, 30, 12);
         }
         shown.lastFailed = r->stale;  // a view of the last good plant keeps the errors shown
         shown.plant = std::move(r);
@@ -410,34 +538,69 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     if (fbw > 0 && fbh > 0 && (fbw != (*renderer)->width() || fbh != (*renderer)->height())) {
       (void)(*renderer)->Resize(fbw, fbh);
     }
-    mouse.Update(window.handle, camera);
-    if (framed) camera.azimuth += cmd.orbit;
-    if (fbw > 0 && fbh > 0 && (fbw != job.width || fbh != job.height)) {
-      job.width = fbw;
-      job.height = fbh;
-      if (framed && job.lod) post();
-    }
-    // Re-tessellate in the background once the camera has moved far
-    // enough, one job at a time; the shown mesh is drawn meanwhile.
-    if (framed && job.lod && !worker.Busy() && MovedFarEnough(camera, posted)) {
-      post();
-      ++retessellations;
-    }
-
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
-    if (DrawPanel(path, shown, worker.Busy(), frameMs, job)) post();
+    // After NewFrame: ImGui knows whether this frame's click is on the panel.
+    mouse.Update(window.handle, camera);
+    if (framed) camera.azimuth += cmd.orbit;
+    // Re-tessellation applies to meshes only: a 2D figure is drawn as lines.
+    const bool retessellate = framed && job.lod && !lines;
+    if (fbw > 0 && fbh > 0 && (fbw != job.width || fbh != job.height)) {
+      job.width = fbw;
+      job.height = fbh;
+      if (retessellate) post();
+    }
+    const PanelActions act = DrawPanel(path, shown, worker.Busy(), frameMs, job);
+    // Playing: the next step once the last one is shown (at most 4 a second).
+    if (shown.playing && !worker.Busy() && shown.id + 1 == nextId &&
+        Clock::now() - shown.lastPlayed > std::chrono::milliseconds(250)) {
+      const int at = job.steps < 0 ? shown.derivationLength : job.steps;
+      if (at < shown.derivationLength) {
+        job.steps = at + 1;
+        shown.lastPlayed = Clock::now();
+        post();
+      } else {
+        shown.playing = false;
+      }
+    }
+    if (act.changed) post();
+    const bool frameKey =
+        glfwGetKey(window.handle, GLFW_KEY_F) == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard;
+    if ((act.frameAll || frameKey) && shown.plant)
+      camera = FrameOf(*shown.plant, double(fbw) / std::max(fbh, 1), lines, camera.azimuth,
+                       camera.elevation);
+    // Re-tessellate in the background once the camera has moved far
+    // enough, one job at a time; the shown mesh is drawn meanwhile.
+    if (retessellate && !worker.Busy() && MovedFarEnough(camera, posted)) {
+      post();
+      ++retessellations;
+    }
     ImGui::Render();
 
-    (*renderer)->Draw(camera);
+    const auto drawStart = Clock::now();
+    if (Status s = (*renderer)->Draw(drawn, camera); !s.ok()) {
+      exitCode = Report(s.error(), err);
+      break;
+    }
+    const double drawMs =
+        std::chrono::duration<double, std::milli>(Clock::now() - drawStart).count();
+    // The upload is what the frame with a new mesh draws longer than the
+    // last frame without one (the first mesh has none to compare with).
+    if (!newScene) {
+      plainDrawMs = drawMs;
+    } else if (swapMs && plainDrawMs) {
+      slowestSwapMs = std::max(slowestSwapMs, *swapMs + std::max(0.0, drawMs - *plainDrawMs));
+    }
     (*renderer)->PresentToWindow(fbw, fbh);
     glViewport(0, 0, fbw, fbh);
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
     ++frame;
-    const bool key =
+    const bool keyDown =
         glfwGetKey(window.handle, GLFW_KEY_P) == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard;
+    const bool key = keyDown && !screenshotKeyDown;
+    screenshotKeyDown = keyDown;
     const bool done = cmd.frames > 0 && frame >= cmd.frames && shown.plant.has_value();
     if (key || done) {
       std::string file =

@@ -27,13 +27,16 @@ struct ViewCommand {
   int frames = 0;
   std::string size = "1280x720";
   bool strict = false;  // --strict: a plant with warnings is not shown (they are errors)
+  std::vector<std::string> defines;  // -D NAME=VALUE: a grammar's #defines, a scene's <default>s
+  int threads = 0;                   // --threads: derivation, build and simulation (0: all cores)
+  // Grammars (.lsys) only: the step and seed the viewer starts at.
+  std::optional<int> steps;
+  std::optional<uint64_t> seed;
   // --orbit: degrees of azimuth the camera turns each frame (tests, demos);
   // with --frames, the frame and re-tessellation figures go to stdout.
   double orbit = 0;
   // Scenes (.xml) only:
-  std::optional<double> time;        // --time: start paused at this time (seconds)
-  std::vector<std::string> defines;  // -D NAME=VALUE: the scene's <default>s
-  int threads = 0;                   // --threads: build and simulation (0: all cores)
+  std::optional<double> time;  // --time: start paused at this time (seconds)
 };
 
 int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err);

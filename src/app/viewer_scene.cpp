@@ -183,6 +183,7 @@ int RunViewScene(const ViewCommand& cmd, int width, int height, std::ostream& ou
   // Declared after the window: its GL objects are destroyed before the context.
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer) return Report(renderer.error(), err);
+  (*renderer)->SetShadowMapSize(2048);  // interactive: cheaper shadow samples
 
   int exitCode = kExitOk;
   Worker<SceneJob, SceneResult> worker(RunSceneJob);
@@ -285,11 +286,10 @@ int RunViewScene(const ViewCommand& cmd, int width, int height, std::ostream& ou
     if (fbw > 0 && fbh > 0 && (fbw != (*renderer)->width() || fbh != (*renderer)->height())) {
       (void)(*renderer)->Resize(fbw, fbh);
     }
-    mouse.Update(window.handle, camera);
-
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
+    mouse.Update(window.handle, camera);  // after NewFrame: is the click on the panel?
     DrawScenePanel(path, player.get(), shown, worker.Busy(), frameMs);
     ImGui::Render();
 

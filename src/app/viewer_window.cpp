@@ -63,19 +63,26 @@ void MouseCamera::Update(GLFWwindow* window, render::Camera& camera) {
   const ImGuiIO& io = ImGui::GetIO();
   double mx, my;
   glfwGetCursorPos(window, &mx, &my);
-  if (!io.WantCaptureMouse) {
-    if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS) {
-      camera.azimuth -= (mx - lastX) * 0.4;
-      camera.elevation = std::clamp(camera.elevation + (my - lastY) * 0.4, -85.0, 85.0);
-    }
-    if (glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) {
-      const Mat4 v = camera.View();
-      const Vec3 right(v(0, 0), v(0, 1), v(0, 2)), up(v(1, 0), v(1, 1), v(1, 2));
-      const double k = camera.distance * 0.0015;
-      camera.target += (-right * (mx - lastX) + up * (my - lastY)) * k;
-    }
-    if (io.MouseWheel != 0) camera.distance *= std::pow(0.9, io.MouseWheel);
+  // A drag belongs to the camera only if its button went down off the
+  // panel: a click or drag that starts on the panel (a slider moved past
+  // the panel's edge) never also turns the view.
+  const bool left = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+  const bool right = glfwGetMouseButton(window, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
+  if (left && !leftDown) leftOrbits = !io.WantCaptureMouse;
+  if (right && !rightDown) rightPans = !io.WantCaptureMouse;
+  leftDown = left;
+  rightDown = right;
+  if (left && leftOrbits) {
+    camera.azimuth -= (mx - lastX) * 0.4;
+    camera.elevation = std::clamp(camera.elevation + (my - lastY) * 0.4, -85.0, 85.0);
   }
+  if (right && rightPans) {
+    const Mat4 v = camera.View();
+    const Vec3 r(v(0, 0), v(0, 1), v(0, 2)), up(v(1, 0), v(1, 1), v(1, 2));
+    const double k = camera.distance * 0.0015;
+    camera.target += (-r * (mx - lastX) + up * (my - lastY)) * k;
+  }
+  if (!io.WantCaptureMouse && io.MouseWheel != 0) camera.distance *= std::pow(0.9, io.MouseWheel);
   lastX = mx;
   lastY = my;
 }

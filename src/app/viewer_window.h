@@ -30,10 +30,13 @@ struct Window {
 int OpenWindow(int width, int height, const std::string& title, bool vsync, Window& w,
                std::ostream& err);
 
-// Left drag orbits, right drag pans, the wheel zooms (when ImGui does not
-// want the mouse).
+// Left drag orbits, right drag pans, the wheel zooms: a drag only when its
+// button went down off the panel, the wheel only off the panel. Call it
+// after ImGui::NewFrame (which decides what the panel wants this frame).
 struct MouseCamera {
   double lastX = 0, lastY = 0;
+  bool leftDown = false, rightDown = false;    // the buttons at the last update
+  bool leftOrbits = false, rightPans = false;  // the drag began off the panel
   void Update(GLFWwindow* window, render::Camera& camera);
 };
 

@@ -52,7 +52,16 @@ Light Light::Point(const Vec3f& position, const Vec3f& color, float intensity) {
   return l;
 }
 
+std::vector<Light> DefaultLights() {
+  return {Light::Sun({0.5f, -0.8f, -0.6f}, {1.0f, 0.95f, 0.85f}, 0.9f),
+          Light::Sun({-0.7f, -0.2f, 0.4f}, {0.55f, 0.62f, 0.75f}, 0.35f),
+          Light::Ambient({0.35f, 0.36f, 0.38f}, 1.0f)};
+}
+
 Status DrawList::Check() const {
+  if (shadowBounds && (!Finite(shadowBounds->first) || !Finite(shadowBounds->second) ||
+                       !(shadowBounds->first.array() <= shadowBounds->second.array()).all()))
+    return Bad("the shadow bounds are not a box of finite numbers (lo <= hi)");
   if (lights.size() > kMaxLights)
     return Bad(std::to_string(lights.size()) + " lights; the renderer takes at most " +
                std::to_string(kMaxLights));

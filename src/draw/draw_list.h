@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/math.h"
@@ -84,6 +85,11 @@ struct Lines {
   std::string name;           // as MeshDraw::name
 };
 
+// The default light rig: a warm key from the upper left (the shadow
+// caster), a cool fill from the right and a hemisphere ambient. A list
+// without lights is lit by it; a grammar's default scene uses it.
+std::vector<Light> DefaultLights();
+
 struct DrawList {
   std::vector<MeshDraw> meshes;
   std::vector<Sprites> sprites;
@@ -91,6 +97,12 @@ struct DrawList {
   std::vector<Light> lights;  // none: the renderer's default key, fill and ambient
   std::optional<Sky> sky;     // none: the flat background
   Vec3f background{0.87f, 0.89f, 0.91f};
+  // The box the first sun's shadow map covers; none: the bounds of the
+  // meshes that cast shadows. Set it to the whole plant's box when culling
+  // (screen-space detail) drops parts whose shadows still fall in view, so
+  // every view gets the same shadow map.
+  std::optional<std::pair<Vec3, Vec3>> shadowBounds;
+  bool wireframe = false;  // triangle edges drawn over the shaded meshes
 
   // Every array length agrees, at most kMaxLights lights, every number
   // finite (each component of every position, matrix and colour). An

@@ -72,6 +72,24 @@ struct Section {
   bool empty() const { return productions.empty(); }
 };
 
+// `environment: KIND ITEM ...` (docs/grammar.md, "Environment"): which
+// environment answers the grammar's ?E queries. The parser reads only its
+// form (a kind word, then `key=value`, `name(v, ...)` or bare words, the
+// values constant expressions); the plant library gives it meaning and
+// reports an unknown kind or key at its location.
+struct EnvironmentStatement {
+  struct Item {
+    std::string name;            // the key, the function name or the bare word
+    std::vector<double> values;  // one for key=value, the arguments of name(...)
+    bool call = false;           // name(...)
+    bool keyValue = false;       // key=value
+    SourceLoc loc;               // of the name
+  };
+  std::string kind;
+  SourceLoc loc;  // of the kind word
+  std::vector<Item> items;
+};
+
 struct Tropism {
   double x = 0, y = -1, z = 0, susceptibility = 0;
 };
@@ -87,6 +105,12 @@ struct Grammar {
   double widthIncrement = 0;  // `width increment:` (cpfg): ! and # subtract/add it; 0: factor
   double widthScale = 1;      // drawing: diameter = width x widthScale (cpfg's pixel widths)
   std::optional<Tropism> tropism;
+  std::optional<EnvironmentStatement> environment;  // `environment:`
+  // From a cpfg view file (app/view_file.h): the colour index the turtle
+  // starts with, the step of `;` and `,`, and of @Ti/@Td.
+  int initialColor = 0;
+  int colorIncrement = 1;
+  double elasticityIncrement = 0;
   uint64_t seed = 1;
   // `palette: #rrggbb ...`: material colour of each colour index (sRGB as
   // written, 0..1); empty: the exporters' default palette.

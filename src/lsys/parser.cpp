@@ -69,8 +69,8 @@ bool IsIdentChar(char c) {
 constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_;,#";
 
 // cpfg's @ commands, longest first where they share a prefix.
-constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS",
-                                            "@PD", "@Ts", "@Sx", "@O",  "@o",  "@c",  "@v",
+constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS", "@PD",
+                                            "@Ts", "@Ti", "@Td", "@Sx", "@O",  "@o",  "@c",  "@v",
                                             "@M",  "@m",  "@R",  "@D",  "@i",  "@L",  "@b"};
 
 std::string Lower(std::string_view s) {
@@ -100,7 +100,8 @@ constexpr const char* kKeywords[] = {
     "derivation length", "width factor",   "width increment", "width scale", "maximum depth",
     "lsystem",           "axiom",          "angle",           "step",        "width",
     "tropism",           "seed",           "ignore",          "consider",    "module",
-    "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette"};
+    "decomposition",     "interpretation", "homomorphism",    "endlsystem",  "palette",
+    "environment"};
 
 // The keyword that starts `t` at `pos` ("keyword:", or a bare section
 // keyword alone on its line), case-insensitive; *after is just past it.
@@ -171,6 +172,7 @@ class GrammarParser {
   void ParseAxiom(const Line& l, int col, size_t after, size_t end);
   void ParseContextNames(const Line& l, size_t after, size_t end, bool ignore);
   void ParsePalette(const Line& l, int col, size_t after, size_t end);
+  void ParseEnvironment(const Line& l, int col, size_t after, size_t end);
   void ParseTropism(const Line& l, size_t after, size_t end);
   void ParseNumberStatement(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseDefine(const Line& l, size_t pos);
@@ -787,9 +789,10 @@ void GrammarParser::ParseContextNames(const Line& l, size_t after, size_t end, b
     std::string name;
     if (!LexName(l, p, end, &name)) return;
     if (name == "[" || name == "]") {
-      Error(l, c,
-            "brackets cannot be " + std::string(ignore ? "ignored" : "considered") +
-                ": they give the branching structure");
+      // cpfg files list the brackets in `consider:` so that context
+      // matching sees the branching; Sylva's matcher always does.
+      if (!ignore) continue;
+      Error(l, c, "brackets cannot be ignored: they give the branching structure");
       return;
     }
     (ignore ? ignoreNames_ : considerNames_).insert(name);
@@ -853,6 +856,87 @@ void GrammarParser::ParseTropism(const Line& l, size_t after, size_t end) {
   }
   g_.tropism = Tropism{v[0], v[1], v[2], v[3]};
   return;
+}
+
+// `environment: KIND ITEM ...`, each item `key=EXPR`, `name(EXPR, ...)` or
+// a bare word; the meaning is the plant library's (plant/environment.h).
+void GrammarParser::ParseEnvironment(const Line& l, int col, size_t after, size_t end) {
+  const std::string& t = l.text;
+  if (g_.environment) {
+    Error(l, col,
+          "a second 'environment:' (the first is at line " +
+              std::to_string(g_.environment->loc.line) + "); a grammar has one environment",
+          11);
+    return;
+  }
+  EnvironmentStatement env;
+  auto word = [&](size_t& p) {
+    const size_t s = p;
+    while (p < end && IsIdentChar(t[p])) ++p;
+    return t.substr(s, p - s);
+  };
+  size_t p = after;
+  if (p >= end || !IsIdentStart(t[p])) {
+    Error(l, int(p) + 1, "expected the kind of environment (shape, light) after 'environment:'");
+    return;
+  }
+  env.loc = Loc(l, int(p) + 1);
+  env.kind = word(p);
+  ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+  const std::string_view view(t.data(), end);
+  auto constant = [&](size_t& q, double* out) {
+    Expr e;
+    ExprParseError err;
+    if (!ParseExpr(view, &q, scope, &e, &err)) {
+      Error(l, err.column, err.message, err.length);
+      return false;
+    }
+    if (!e.IsConstant()) {
+      Error(l, int(q) + 1, "expected a constant expression here (no random functions)");
+      return false;
+    }
+    *out = e.constant();
+    return true;
+  };
+  while (true) {
+    while (p < end && (IsSpace(t[p]) || t[p] == ',')) ++p;
+    if (p >= end) break;
+    if (!IsIdentStart(t[p])) {
+      Error(l, int(p) + 1,
+            "unexpected character '" + Printable(t[p]) +
+                "' in 'environment:'; expected key=value, name(values) or a word");
+      return;
+    }
+    EnvironmentStatement::Item item;
+    item.loc = Loc(l, int(p) + 1);
+    item.name = word(p);
+    if (p < end && t[p] == '=') {
+      ++p;
+      item.keyValue = true;
+      item.values.emplace_back();
+      if (!constant(p, &item.values.back())) return;
+    } else if (p < end && t[p] == '(') {
+      item.call = true;
+      ++p;
+      while (true) {
+        item.values.emplace_back();
+        if (!constant(p, &item.values.back())) return;
+        while (p < end && IsSpace(t[p])) ++p;
+        if (p < end && t[p] == ',') {
+          ++p;
+          continue;
+        }
+        if (p < end && t[p] == ')') {
+          ++p;
+          break;
+        }
+        Error(l, int(p) + 1, "expected ',' or ')' in '" + item.name + "(...)'");
+        return;
+      }
+    }
+    env.items.push_back(std::move(item));
+  }
+  g_.environment = std::move(env);
 }
 
 void GrammarParser::ParseNumberStatement(const Line& l, const std::string& k, size_t after,
@@ -968,6 +1052,10 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
   }
   if (k == "tropism") {
     ParseTropism(l, after, end);
+    return true;
+  }
+  if (k == "environment") {
+    ParseEnvironment(l, col, after, end);
     return true;
   }
   ParseNumberStatement(l, k, after, end);
@@ -1387,6 +1475,20 @@ void GrammarParser::Finish() {
   }
   if (diags_.HasErrors()) return;
   WarnUnmatchable();
+  // ?E is answered by the environment that `environment:` names; without
+  // one its parameters keep the values written in the grammar.
+  if (!g_.environment && !opt_.environmentGiven) {
+    for (size_t s = 0; s < g_.symbols.size(); ++s) {
+      if (g_.symbols.name(SymbolId(s)) != "?E") continue;
+      auto it = g_.symbolLoc.find("?E");
+      const SourceLoc loc = it != g_.symbolLoc.end() ? it->second.loc : SourceLoc{files_[0], 0, 0};
+      Warn(loc, g_.SourceLine(loc),
+           "query module '?E' is not answered: the grammar has no 'environment:' statement, so "
+           "its parameters keep the values written in the grammar",
+           2);
+      break;
+    }
+  }
 
   const size_t nsym = g_.symbols.size();
   for (auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation}) {

@@ -43,6 +43,9 @@ struct ParseOptions {
   // that one is (`~lF` with l.obj and no lF.obj), else whole (and later
   // reported as an unknown surface). Empty: always whole.
   std::function<bool(const std::string& name)> isSurface;
+  // The caller answers ?E itself (plant::PlantSpec::environment): no
+  // warning that a grammar without `environment:` leaves ?E unanswered.
+  bool environmentGiven = false;
   // What may be read: per file, and all files of the grammar together.
   size_t maxFileBytes = kMaxGrammarFileBytes;
   size_t maxTotalBytes = kMaxGrammarBytes;

@@ -11,19 +11,11 @@ struct Command {
 
 // cpfg's @ commands that Sylva lexes but does not draw.
 constexpr Command kUndrawn[] = {
-    {"@Gs", "start of a generalized cylinder"},
-    {"@Ge", "end of a generalized cylinder"},
-    {"@Gc", "generalized cylinder control point"},
     {"@Gr", "generalized cylinder radius"},
     {"@Gt", "generalized cylinder tangent"},
-    {"@Tf", "tropism change"},
-    {"@Ts", "tropism strength"},
     {"@PS", "bicubic patch"},
     {"@PD", "bicubic patch"},
     {"@Sx", "surface command"},
-    {"@o", "disc"},
-    {"@c", "circle"},
-    {"@v", "roll to vertical"},
     {"@m", "move-to with drawing"},
     {"@R", "set heading and up"},
     {"@D", "scale factor"},
@@ -46,6 +38,30 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
       return "'@O' (sphere) uses 1 parameter, the diameter; the other " +
              std::to_string(arity - 1) + " are ignored";
     }
+    // Implemented, with the parameters they use (docs/turtle.md).
+    struct Used {
+      std::string_view name, what, params;
+      int most;
+    };
+    static constexpr Used kUsed[] = {
+        {"@o", "disc", "the diameter", 1},
+        {"@c", "circle", "the diameter", 1},
+        {"@v", "roll to vertical", "none", 0},
+        {"@Gs", "start of a generalized cylinder", "none", 0},
+        {"@Gc", "generalized cylinder point", "the number of segments", 1},
+        {"@Ge", "end of a generalized cylinder", "the number of segments", 1},
+        {"@Ts", "set tropism elasticity", "the tropism and the elasticity", 2},
+        {"@Ti", "raise tropism elasticity", "the tropism and the step", 2},
+        {"@Td", "lower tropism elasticity", "the tropism and the step", 2},
+        {"@Tf", "keep the twist", "none", 0},
+    };
+    for (const Used& u : kUsed) {
+      if (name != u.name) continue;
+      if (arity <= u.most) return std::nullopt;
+      return "'" + std::string(name) + "' (" + std::string(u.what) + ") uses " +
+             (u.most == 0 ? std::string("no parameters") : std::string(u.params)) + "; the other " +
+             std::to_string(arity - u.most) + " are ignored";
+    }
     if (name == "@M") {
       if (arity == 3) return std::nullopt;
       return "'@M' (move to) needs 3 parameters (x, y, z); with " + Params(arity) +
@@ -60,8 +76,23 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
     return "'" + std::string(name) + "' is not a command Sylva knows: it does nothing";
   }
   if (name[0] == '?') {
+    // ?P ?H ?L ?U are answered after each step (plant::Grower): 2 parameters
+    // take x, y and 3 take x, y, z. ?E is answered by the grammar's
+    // `environment:` (the parser warns when there is none).
+    if (name == "?P" || name == "?H" || name == "?L" || name == "?U") {
+      if (arity == 2 || arity == 3) return std::nullopt;
+      return "query module '" + std::string(name) +
+             "' takes 2 parameters (x, y) or 3 (x, y, z); with " + Params(arity) +
+             " it is not answered: its parameters keep the values written in the grammar";
+    }
+    if (name == "?E") {
+      if (arity >= 1) return std::nullopt;
+      return "query module '?E' needs at least 1 parameter for the environment to fill; with "
+             "none it is not answered";
+    }
     return "query module '" + std::string(name) +
-           "' is not answered yet: its parameters keep the values written in the grammar";
+           "' is not answered (Sylva answers ?P ?H ?L ?U and ?E): its parameters keep the "
+           "values written in the grammar";
   }
   if (name[0] == '~') {
     if (arity <= 1 || arity == 3) return std::nullopt;

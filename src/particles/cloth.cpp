@@ -4,7 +4,9 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
+#include "particles/cloth_collision.h"
 #include "particles/def_check.h"
 
 namespace sylva::particles {
@@ -54,11 +56,15 @@ Status Validate(const ClothDef& d) {
   for (size_t k = 0; k < d.pinned.size(); ++k) {
     SYLVA_CHECK_OK(Range("ClothDef.pinned[" + std::to_string(k) + "]", d.pinned[k], 0, n - 1));
   }
+  SYLVA_CHECK_OK(Range("ClothDef.thickness", d.thickness, 0, 1e12, "m"));
+  SYLVA_CHECK_OK(Range("ClothDef.selfFriction", d.selfFriction, 0, 1e3));
   SYLVA_CHECK_OK(Range("ClothDef.threads", d.threads, 0, 256));
   SYLVA_CHECK_OK(Range("ClothDef.implicitStiffness", d.implicitStiffness, 1e-12, 1e12, "N/m"));
   SYLVA_CHECK_OK(Range("ClothDef.implicitDamping", d.implicitDamping, 0, 1e12, "N s/m"));
   SYLVA_CHECK_OK(Range("ClothDef.implicitSubsteps", d.implicitSubsteps, 1, 10000));
   SYLVA_CHECK_OK(Range("ClothDef.cgIterations", d.cgIterations, 1, 100000));
+  SYLVA_CHECK_OK(Range("ClothDef.implicitStrainLimit", d.implicitStrainLimit, 0, 1e6));
+  SYLVA_CHECK_OK(Range("ClothDef.implicitStrainIterations", d.implicitStrainIterations, 1, 100000));
   return {};
 }
 
@@ -145,6 +151,8 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
       }
     }
   }
+  if (def_.thickness > 0)
+    self_ = std::make_unique<clothcontact::SelfCollision>(x_, def_.thickness, def_.selfFriction);
   if (def_.pool && def_.solver == ClothSolver::kXPBD) {
     pool_ = def_.pool->threads() > 1 ? def_.pool : nullptr;
   } else if (def_.threads != 1 && def_.solver == ClothSolver::kXPBD) {  // implicit: its own
@@ -173,9 +181,30 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
   }
 }
 
+Cloth::~Cloth() = default;
+
+Status Cloth::AddCollider(Collider c) {
+  SYLVA_CHECK_OK(Validate(c));
+  if (c.response == Response::kKill)
+    return check::Error(
+        "Cloth.AddCollider: a kKill collider cannot take cloth (a cloth particle "
+        "cannot die); use kBounce or kStick");
+  if (implicit_) SYLVA_CHECK_OK(implicit_->AddCollider(c));
+  colliders_.push_back(std::move(c));
+  return {};
+}
+
 void Cloth::AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& wind, Vec3* f) {
+  if (externalForce_) {
+    const size_t n = x_.size();
+    ForRanges(pool, n, BalancedGrain(pool, n, 512, 4096), [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        if (w_[i] > 0) f[i] += externalForce_(i, x[i], v[i]);
+    });
+  }
   const double cd = def_.windDrag, cl = def_.windLift, cf = def_.windFriction;
   if (cd == 0 && cl == 0 && cf == 0) return;
+  const WindField* field = windField_;
   // Each triangle's force, then each particle gathers from the (up to six)
   // triangles around it in a fixed order: parallel, and the same sums for
   // any thread count.
@@ -186,8 +215,13 @@ void Cloth::AddWind(ThreadPool* pool, const Vec3* x, const Vec3* v, const Vec3& 
       const auto& t = tris_[k];
       const Vec3 cr = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
       const double area2 = cr.norm();
-      const Vec3 u = wind - (v[t[0]] + v[t[1]] + v[t[2]]) / 3;
+      const Vec3 air = field ? (*field)((x[t[0]] + x[t[1]] + x[t[2]]) / 3) : wind;
+      const Vec3 u = air - (v[t[0]] + v[t[1]] + v[t[2]]) / 3;
       const double uu = u.squaredNorm();
+      if (!std::isfinite(uu)) {  // a non-finite wind: the corners report it as theirs
+        triForce_[k] = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+        continue;
+      }
       if (!(area2 > 0) || !(uu > 0)) {
         triForce_[k] = Vec3::Zero();
         continue;
@@ -258,6 +292,7 @@ Status Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
   implicit_->state.velocity = v_;
   const int subs = def_.implicitSubsteps;
   for (int s = 0; s < subs; ++s) {
+    if (self_) selfPrev_ = implicit_->state.position;
     if (Status st = implicit_->Step(dt / subs, Integrator::kImplicitEuler); !st.ok()) {
       Diagnostic d = st.error();
       d.message = "cloth: frame " + std::to_string(frames_) + ", implicit substep " +
@@ -265,6 +300,27 @@ Status Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
       fault_ = d;
       return d;
     }
+    // A kStick collider makes the particles it holds immovable in the
+    // particle system: so in the cloth too (self-collision, strain limits).
+    for (size_t i = 0; i < w_.size(); ++i) {
+      if (w_[i] > 0 && implicit_->state.invMass[i] == 0) {
+        w_[i] = 0;
+        strainLinks_.clear();  // rebuilt with the new shares
+      }
+    }
+    if (self_) {  // after the step: the correction's velocity is dx / h
+      ParticleState& ps = implicit_->state;
+      const size_t moved =
+          self_->Pass(def_.pool, selfPrev_.data(), ps.position.data(), w_.data(), selfDx_);
+      lastContacts_ += moved;
+      const double invH = subs / dt;
+      for (size_t i = 0; i < ps.size(); ++i) {
+        ps.position[i] += selfDx_[i];
+        ps.velocity[i] += invH * selfDx_[i];
+      }
+    }
+    if (def_.implicitStrainLimit > 0)
+      LimitStrain(implicit_->state.position, implicit_->state.velocity, dt / subs);
   }
   x_ = implicit_->state.position;
   v_ = implicit_->state.velocity;
@@ -272,12 +328,24 @@ Status Cloth::StepImplicit(double dt, const Vec3& gravity, const Vec3& wind) {
 }
 
 Status Cloth::Step(double dt, const Vec3& gravity, const Vec3& wind) {
+  return StepAny(dt, gravity, wind, nullptr);
+}
+
+Status Cloth::StepInWindField(double dt, const Vec3& gravity, const WindField& wind) {
+  if (!wind) return Step(dt, gravity, Vec3::Zero());
+  return StepAny(dt, gravity, Vec3::Zero(), &wind);
+}
+
+Status Cloth::StepAny(double dt, const Vec3& gravity, const Vec3& wind, const WindField* field) {
   if (fault_) return *fault_;
   if (!(dt > 0 && dt <= 1e6))
     return check::Error("Cloth.Step dt " + check::Num(dt) + " is outside (0, 1e+06] s");
   SYLVA_CHECK_OK(check::Finite("Cloth.Step gravity", gravity, 1e12, "m/s^2"));
   SYLVA_CHECK_OK(check::Finite("Cloth.Step wind", wind, 1e12, "m/s"));
+  windField_ = field;
+  lastContacts_ = 0;
   Status st = implicit_ ? StepImplicit(dt, gravity, wind) : StepXpbd(dt, gravity, wind);
+  windField_ = nullptr;
   ++frames_;
   return st;
 }
@@ -290,17 +358,8 @@ Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
   // Wind once a frame (it changes slowly next to the substeps).
   fext_.assign(n, Vec3::Zero());
   AddWind(pool, x_.data(), v_.data(), wind, fext_.data());
-  const size_t m = constraints_.size();
-  const bool reuse = projH_ == h && proj_.size() == m;  // the masses never change; the substep may
-  projH_ = h;
-  proj_.resize(m);
-  for (size_t k = 0; k < m && !reuse; ++k) {
-    const Constraint& c = constraints_[k];
-    const double alphaT = c.compliance / (h * h);
-    const double denom = w_[c.a] + w_[c.b] + alphaT;
-    const double scale = denom > 0 ? 1 / denom : 0;  // 0: both ends pinned, nothing moves
-    proj_[k] = {c.a, c.b, c.rest, scale, w_[c.a] * scale, w_[c.b] * scale, alphaT};
-  }
+  // The masses change only when a particle sticks (which resets projH_).
+  if (!(projH_ == h && proj_.size() == constraints_.size())) BuildProjections(h);
   const double invH = 1 / h;
   const bool keepLambda = def_.iterations > 1;
   // The substeps run on padded positions, velocities and forces (see
@@ -355,6 +414,10 @@ Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
         });
       }
     }
+    if (self_ || !colliders_.empty()) {
+      ContactsXpbd(pool);
+      if (projH_ == 0) BuildProjections(h);  // a particle stuck: it is a pin now
+    }
     // This substep's attachments and velocities, fused with the next one's
     // prediction (or the store back).
     const bool last = s + 1 == subs;
@@ -371,6 +434,121 @@ Status Cloth::StepXpbd(double dt, const Vec3& gravity, const Vec3& wind) {
     });
   }
   return bad.load() ? FindNonFinite("after") : Status{};
+}
+
+void Cloth::BuildProjections(double h) {
+  const size_t m = constraints_.size();
+  projH_ = h;
+  proj_.resize(m);
+  for (size_t k = 0; k < m; ++k) {
+    const Constraint& c = constraints_[k];
+    const double alphaT = c.compliance / (h * h);
+    const double denom = w_[c.a] + w_[c.b] + alphaT;
+    const double scale = denom > 0 ? 1 / denom : 0;  // 0: both ends pinned, nothing moves
+    proj_[k] = {c.a, c.b, c.rest, scale, w_[c.a] * scale, w_[c.b] * scale, alphaT};
+  }
+}
+
+void Cloth::ContactsXpbd(ThreadPool* pool) {
+  const size_t n = x_.size();
+  const size_t grain = BalancedGrain(pool, n, 512, 4096);
+  auto get = [](const xpbd::Point4& p) { return Vec3(p.p[0], p.p[1], p.p[2]); };
+  auto put = [](xpbd::Point4& p, const Vec3& v) {
+    p.p[0] = v.x();
+    p.p[1] = v.y();
+    p.p[2] = v.z();
+  };
+  if (self_) {
+    selfX_.resize(n);
+    selfPrev_.resize(n);
+    ForRanges(pool, n, grain, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i) {
+        selfX_[i] = get(x4_[i]);
+        selfPrev_[i] = get(prev4_[i]);
+      }
+    });
+    lastContacts_ += self_->Pass(pool, selfPrev_.data(), selfX_.data(), w_.data(), selfDx_);
+    ForRanges(pool, n, grain, [&](size_t b, size_t e) {
+      for (size_t i = b; i < e; ++i)
+        if (selfDx_[i] != Vec3::Zero()) put(x4_[i], selfX_[i] + selfDx_[i]);
+    });
+  }
+  if (colliders_.empty()) return;
+  std::atomic<size_t> touched{0};
+  std::atomic<bool> stuck{false};
+  ForRanges(pool, n, grain, [&](size_t b, size_t e) {
+    size_t count = 0;
+    for (size_t i = b; i < e; ++i) {
+      if (w_[i] == 0) continue;
+      Vec3 x = get(x4_[i]);
+      bool any = false;
+      for (const Collider& c : colliders_) any = any || c.MayHit(get(prev4_[i]), x);
+      if (!any) continue;
+      const Collider* hit = clothcontact::Collide(colliders_, get(prev4_[i]), x);
+      if (!hit) continue;
+      put(x4_[i], x);
+      ++count;
+      if (hit->response == Response::kStick) {  // immovable from now on, as a pin
+        w_[i] = 0;
+        v4_[i] = xpbd::Point4{{0, 0, 0, 0}};
+        prev4_[i] = x4_[i];
+        stuck.store(true, std::memory_order_relaxed);
+      }
+    }
+    touched.fetch_add(count, std::memory_order_relaxed);
+  });
+  lastContacts_ += touched.load();
+  if (stuck.load()) projH_ = 0;  // the projections' shares change: rebuilt below
+}
+
+void Cloth::LimitStrain(std::vector<Vec3>& x, std::vector<Vec3>& v, double h) {
+  // A stretched constraint goes back to 98 % of the limit: a neighbour's
+  // later correction then rarely pushes it over again (Gauss-Seidel passes
+  // approach the limit from above only geometrically otherwise).
+  const double limit = 1 + def_.implicitStrainLimit;
+  const double target = 1 + 0.98 * def_.implicitStrainLimit;
+  if (strainLinks_.empty()) {  // the structural constraints (MaxStretch's), in colour order
+    for (const Constraint& c : constraints_) {
+      const double wa = w_[c.a], wb = w_[c.b];
+      if (c.compliance != def_.stretchCompliance || wa + wb == 0) continue;
+      const double max = limit * c.rest;
+      strainLinks_.push_back(
+          {c.a, c.b, max * max, target * c.rest, wa / (wa + wb), wb / (wa + wb)});
+    }
+  }
+  strainX0_ = x;
+  const size_t n = x.size();
+  for (int it = 0; it < def_.implicitStrainIterations; ++it) {
+    bool any = false;
+    for (const StrainLink& l : strainLinks_) {
+      const Vec3 d = x[l.b] - x[l.a];
+      const double len2 = d.squaredNorm();
+      if (!(len2 > l.max2)) continue;
+      const double len = std::sqrt(len2);
+      const Vec3 corr = d * ((len - l.target) / len);
+      x[l.a] += l.shareA * corr;
+      x[l.b] -= l.shareB * corr;
+      any = true;
+    }
+    // Tethers: no farther from a pin than the limit allows.
+    if (!tethers_.empty()) {
+      for (size_t i = 0; i < n; ++i) {
+        if (w_[i] == 0) continue;
+        for (int k = 0; k < xpbd::kTethers; ++k) {
+          const xpbd::Tether& t = tethers_[i * xpbd::kTethers + size_t(k)];
+          if (t.pin == UINT32_MAX) continue;
+          const Vec3 d = x[i] - x[t.pin];
+          const double len2 = d.squaredNorm(), max = limit * t.rest;
+          if (!(len2 > max * max)) continue;
+          x[i] = x[t.pin] + d * (target * t.rest / std::sqrt(len2));
+          any = true;
+        }
+      }
+    }
+    if (!any) break;
+  }
+  const double invH = 1 / h;
+  for (size_t i = 0; i < n; ++i) v[i] += invH * (x[i] - strainX0_[i]);
 }
 
 }  // namespace sylva::particles

@@ -88,6 +88,16 @@ Status Springs::Add(uint32_t a, uint32_t b, double rest, double ks, double kd) {
   return {};
 }
 
+void Springs::Clear() {
+  springs_.clear();
+  maxIndex_ = 0;
+  linear_.clear();
+  length_.clear();
+  preparedX_ = nullptr;
+  accumulateCached_ = false;
+  colouredSprings_ = SIZE_MAX;  // colour again, even for as many springs
+}
+
 Status Springs::Check(const ParticleState& s) const {
   if (springs_.empty() || maxIndex_ < s.size()) return {};
   return check::Error("Springs: a spring joins particle " + std::to_string(maxIndex_) +

@@ -157,6 +157,9 @@ class Springs : public Force {
   // a Diagnostic and adds nothing. The indices are checked against the
   // state by Check, on every System::Step.
   [[nodiscard]] Status Add(uint32_t a, uint32_t b, double rest, double ks, double kd);
+  // Removes every spring, for a caller that renumbers the particles
+  // (RemoveDead) and adds the springs again at their new indices.
+  void Clear();
   Status Check(const ParticleState& s) const override;
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
   // Baraff & Witkin's spring Jacobian, with the transverse term clamped at

@@ -177,6 +177,7 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
   lsys::ParseOptions popt;
   popt.overrides = spec.defines;
   popt.readFile = spec.readFile;
+  popt.environmentGiven = spec.environment != nullptr;
   // `~lF`: cpfg's one-letter surface `l` then `F` when l.obj exists and lF.obj does not.
   const SurfaceLibrary surfaces(spec.path, spec.surfacePath, spec.readFile);
   popt.isSurface = [&surfaces](const std::string& name) { return surfaces.Has(name); };
@@ -189,8 +190,35 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
   g.spec_ = spec;
   g.grammar_ = std::make_unique<lsys::Grammar>(std::move(*parsed.grammar));
   g.diagnostics_ = std::move(parsed.diagnostics);
+  if (spec.amendGrammar) {
+    DiagnosticList amended;
+    spec.amendGrammar(*g.grammar_, amended);
+    for (const Diagnostic& d : amended.items) {
+      diagnostics.Add(d);
+      g.diagnostics_.Add(d);
+    }
+    if (amended.HasErrors()) return std::nullopt;
+  }
   g.time_.parse = MsSince(t0);
   g.steps_ = spec.steps.value_or(g.grammar_->derivationLength);
+  const lsys::Grammar& grammar = *g.grammar_;
+  g.queries_ = QueryTableOf(grammar.symbols);
+  if (g.queries_.any) {
+    if (Status s = CheckQueriesSurviveInterpretation(grammar, g.queries_); !s.ok()) {
+      diagnostics.Add(s.error());
+      return std::nullopt;
+    }
+  }
+  if (grammar.environment) {
+    auto env =
+        MakeEnvironment(*grammar.environment, grammar, spec.ground ? &*spec.ground : nullptr);
+    if (!env) {
+      diagnostics.Add(env.error());
+      return std::nullopt;
+    }
+    g.ownEnvironment_ = std::move(*env);
+  }
+  g.environment_ = spec.environment ? spec.environment : g.ownEnvironment_.get();
   if (spec.until == Stage::kGrammar) return g;
   const auto t1 = Clock::now();
   auto derivation = lsys::Derivation::Start(*g.grammar_, DeriveOptionsOf(spec));
@@ -199,6 +227,12 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
     return std::nullopt;
   }
   g.derivation_ = std::move(*derivation);
+  if (Status s = g.AnswerQueries(); !s.ok()) {
+    Diagnostic d = s.error();
+    if (d.loc.file.empty()) d.loc.file = grammar.path;
+    diagnostics.Add(std::move(d));
+    return std::nullopt;
+  }
   g.time_.derive = MsSince(t1);
   return g;
 }
@@ -218,10 +252,31 @@ lsys::Word& Grower::MutableWord() {
   return derivation_->MutableWord();
 }
 
+// cpfg: after each step the word is drawn (interpretation rules first) and
+// each query module takes the turtle's state at it (plant/queries.h).
+Status Grower::AnswerQueries() {
+  if (!queries_.any) return {};
+  const lsys::Grammar& g = *grammar_;
+  std::optional<lsys::Word> interpreted;
+  if (!g.interpretation.empty()) {
+    auto w = derivation_->Interpreted();
+    if (!w) return w.error();
+    interpreted = std::move(*w);
+  }
+  turtle::DrawOptions options = DrawOptionsOf(spec_);
+  options.recordModules = true;
+  lsys::Word& word = derivation_->MutableWord();
+  const lsys::Word& drawn = interpreted ? *interpreted : word;
+  auto geometry = turtle::Interpret(drawn, g.symbols, turtle::TurtleDefFrom(g), options);
+  if (!geometry) return geometry.error();
+  return plant::AnswerQueries(queries_, word, drawn, *geometry, environment_);
+}
+
 Status Grower::Step() {
   SYLVA_ASSERT(derivation_.has_value());
   const auto t0 = Clock::now();
   Status s = derivation_->Step();
+  if (s.ok()) s = AnswerQueries();
   time_.derive += MsSince(t0);
   if (s.ok() && spec_.progress) spec_.progress(step(), steps_, word().size());
   return s;

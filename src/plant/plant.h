@@ -37,6 +37,9 @@
 #include "mesh/plant_geometry.h"
 #include "mesh/tessellator.h"
 #include "mesh/triangle_mesh.h"
+#include "plant/environment.h"
+#include "plant/ground_environment.h"
+#include "plant/queries.h"
 #include "turtle/interpreter.h"
 
 namespace sylva::plant {
@@ -90,6 +93,16 @@ struct PlantSpec {
   mesh::DetailHistory* history = nullptr;
   Stage until = Stage::kMesh;
   FileReader readFile;  // empty: the file system
+  // Answers ?E instead of the environment the grammar's `environment:`
+  // names (not owned; outlives the growth). Null: the grammar's, if any.
+  Environment* environment = nullptr;
+  // The ground `environment: terrain` answers from, in the plant's own
+  // coordinates (a scene's terrain under the plant). Unset: the plane y = 0.
+  std::optional<Ground> ground;
+  // Called once the grammar is parsed, before derivation: a front end's
+  // settings from outside the grammar (a cpfg view file, app/view_file.h)
+  // go in here. Its diagnostics join the plant's; an error stops the build.
+  std::function<void(lsys::Grammar& grammar, DiagnosticList& diagnostics)> amendGrammar;
   // Called after each derivation step, from the calling thread.
   std::function<void(int step, int steps, uint64_t modules)> progress;
 };
@@ -148,7 +161,10 @@ bool IsLineFigure(const mesh::PlantGeometry& geometry);
 // exporters' default one.
 mesh::Palette PaletteOf(const lsys::Grammar& g);
 
-// A plant grown one derivation step at a time:
+// A plant grown one derivation step at a time. When the grammar has query
+// modules (?P ?H ?L ?U ?E, plant/queries.h) Start() answers those of the
+// axiom and every Step() those of the new word (drawing it with the turtle),
+// so each step's productions read where the previous word put them.
 //
 //   DiagnosticList diags;
 //   auto grower = Grower::Start(spec, diags);
@@ -192,6 +208,10 @@ class Grower {
   int steps_ = 0;
   DiagnosticList diagnostics_;  // those Start reported, handed on by Finish
   Timings time_;
+  Status AnswerQueries();
+  QueryTable queries_;
+  std::unique_ptr<Environment> ownEnvironment_;  // the grammar's `environment:`
+  Environment* environment_ = nullptr;
 };
 
 }  // namespace sylva::plant

@@ -45,9 +45,6 @@ struct Renderer::Gl {
   static constexpr int kShadowSize = kShadowMapSize;
   Eigen::Matrix4f lightViewProj = Eigen::Matrix4f::Identity();
   bool haveShadow = false;
-  // Ground disc: its own small vertex array, drawn with the mesh program.
-  GLuint groundVao = 0, groundBuffers[3] = {0, 0, 0};
-  GLsizei groundCount = 0;
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};  // mesh bounds
   GLuint meshVao = 0, meshBuffers[3] = {0, 0, 0}, meshIndex = 0, meshCoverage = 0;
   GLsizei meshIndexCount = 0;
@@ -214,8 +211,6 @@ Expected<std::unique_ptr<Renderer>> Renderer::Create(const std::string& shaderDi
   glDrawBuffer(GL_NONE);
   glReadBuffer(GL_NONE);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glGenVertexArrays(1, &g.groundVao);
-  glGenBuffers(3, g.groundBuffers);
   g.lineViewProj = glGetUniformLocation(g.lineProgram, "uViewProj");
   auto point = CompileProgram(shaderDir, "point");
   if (!point) return point.error();
@@ -242,8 +237,6 @@ Renderer::~Renderer() {
   glDeleteProgram(g.shadowProgram);
   glDeleteFramebuffers(1, &g.shadowFbo);
   glDeleteTextures(1, &g.shadowDepth);
-  glDeleteBuffers(3, g.groundBuffers);
-  glDeleteVertexArrays(1, &g.groundVao);
   glDeleteProgram(g.lineProgram);
   glDeleteBuffers(3, g.meshBuffers);
   glDeleteBuffers(1, &g.meshIndex);
@@ -328,37 +321,13 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
     g.lo = bounds->lo;
     g.hi = bounds->hi;
   }
-  // Ground: a disc of 48 sectors under the mesh, 1.1 times its radius.
-  {
-    const Vec3 c((g.lo.x() + g.hi.x()) / 2, g.lo.y(), (g.lo.z() + g.hi.z()) / 2);
-    const double r = std::max(0.55 * (g.hi - g.lo).norm(), 1e-3);
-    std::vector<mesh::Vec3f> pos, nor, col;
-    for (int k = 0; k < 48; ++k) {
-      const double a0 = 6.283185307 * k / 48, a1 = 6.283185307 * (k + 1) / 48;
-      for (const Vec3& p : {c, Vec3(c + r * Vec3(std::cos(a1), 0, std::sin(a1))),
-                            Vec3(c + r * Vec3(std::cos(a0), 0, std::sin(a0)))}) {
-        pos.push_back(p.cast<float>());
-        nor.push_back(mesh::Vec3f(0, 1, 0));
-        col.push_back(mesh::Srgb(0.86f, 0.84f, 0.80f));
-      }
-    }
-    glBindVertexArray(g.groundVao);
-    const void* ground[3] = {pos.data(), nor.data(), col.data()};
-    for (int k = 0; k < 3; ++k) {
-      glBindBuffer(GL_ARRAY_BUFFER, g.groundBuffers[k]);
-      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(pos.size() * 12), ground[k], GL_STATIC_DRAW);
-      glEnableVertexAttribArray(GLuint(k));
-      glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
-    }
-    g.groundCount = GLsizei(pos.size());
-    glBindVertexArray(0);
-  }
   RenderShadowMap();
 }
 
 // The key light is fixed in world space; its orthographic view covers the
 // mesh's bounding sphere, so the map is made once per mesh.
-static const Vec3 kKeyDir = Vec3(-0.5, 0.8, 0.6).normalized();
+// The same key as draw::DefaultLights (the scene pass's default rig).
+static const Vec3 kKeyDir = -draw::DefaultLights()[0].direction.cast<double>().normalized();
 
 Vec3 KeyLightDirection() {
   return kKeyDir;
@@ -366,11 +335,7 @@ Vec3 KeyLightDirection() {
 
 // The radius of the sphere the light's orthographic view covers.
 static double ShadowRadius(const Vec3& lo, const Vec3& hi) {
-  return std::max((hi - lo).norm() / 2, 1e-3) * 1.2;  // ground included
-}
-
-double ShadowTexelsPerUnit(const mesh::Box& bounds) {
-  return kShadowMapSize / (2 * ShadowRadius(bounds.lo, bounds.hi));
+  return std::max((hi - lo).norm() / 2, 1e-3) * 1.2;
 }
 
 void Renderer::RenderShadowMap() {
@@ -491,10 +456,6 @@ void Renderer::Draw(const Camera& camera) {
       glUniform1i(g.meshWire, 0);
       glDisable(GL_POLYGON_OFFSET_LINE);
       glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-    }
-    if (ground_) {
-      glBindVertexArray(g.groundVao);
-      glDrawArrays(GL_TRIANGLES, 0, g.groundCount);
     }
     if (g.opaqueIndexCount < g.meshIndexCount) {
       // Coverage in alpha, blended over everything opaque in the encoded

@@ -10,6 +10,7 @@
 // the compiler's message.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -56,8 +57,13 @@ std::string FindShaderDir();
 // world space).
 Vec3 KeyLightDirection();
 
-// Texels per world unit of the shadow map when the mesh's bounds (or the
-// bounds given to SetMesh) are `bounds`.
+// The first sun's shadow map in Draw(DrawList): an orthographic view of
+// the sphere of this radius about the centre of lo..hi (the list's
+// shadowBounds, else what casts shadows).
+double SunShadowRadius(const Vec3& lo, const Vec3& hi);
+// Texels per world unit of that shadow map (at the default size) when it
+// is fitted to `bounds` (screen-space detail keeps what casts a shadow of a
+// texel or more).
 double ShadowTexelsPerUnit(const mesh::Box& bounds);
 
 class Renderer {
@@ -75,15 +81,17 @@ class Renderer {
 
   // Replaces the mesh (uploaded once; drawing it again uploads nothing) and
   // renders its shadow map from the key light once.
-  // `bounds`, when given, replaces the mesh's own box as the box the ground
-  // disc and the shadow map are fitted to: a mesh tessellated for one view
-  // (culled, screen-space detail) then gets the ground and shadows of the
-  // whole plant.
+  // `bounds`, when given, replaces the mesh's own box as the box the shadow
+  // map is fitted to. No ground is drawn: a plant's ground is a scene
+  // element (scene/default_scene.h, drawn through Draw(DrawList)).
   void SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette,
                const mesh::Box* bounds = nullptr);
-  // A ground disc under the mesh that receives its shadow (off by default).
-  void SetGround(bool on) { ground_ = on; }
   void SetShadows(bool on) { shadows_ = on; }
+  // Texels on a side of Draw(DrawList)'s shadow map (256..8192). The
+  // default suits a still picture; the viewer takes 2048, whose samples
+  // cost llvmpipe a third of the frame time of 4096.
+  static constexpr int kDefaultShadowMapSize = 4096;
+  void SetShadowMapSize(int texels) { shadowMapSize_ = std::clamp(texels, 256, 8192); }
   // Draws the mesh's triangle edges over it (docs/lod.md's pictures).
   void SetWireframe(bool on) { wireframe_ = on; }
   // Replaces the lines. colors must have one entry per point (else a
@@ -117,7 +125,8 @@ class Renderer {
   std::unique_ptr<Gl> gl_;
   int width_ = 0, height_ = 0;
   mesh::Vec3f background_ = mesh::Srgb(0.94f, 0.95f, 0.96f);  // linear
-  bool ground_ = false, shadows_ = true, wireframe_ = false;
+  bool shadows_ = true, wireframe_ = false;
+  int shadowMapSize_ = kDefaultShadowMapSize;
   void RenderShadowMap();
   unsigned MultisampleFramebuffer() const;
   unsigned ResolveFramebuffer() const;

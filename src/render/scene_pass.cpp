@@ -44,17 +44,27 @@ struct GpuInstance {
 };
 static_assert(sizeof(GpuInstance) == 76, "instance layout");
 
+// FNV-1a over bytes, continuing from `h`.
+constexpr uint64_t kFnvBasis = 1469598103934665603ull;
+uint64_t Fnv(uint64_t h, const void* data, size_t n) {
+  const auto* b = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+  return h;
+}
+
 }  // namespace
 
 struct Renderer::ScenePass {
   GLuint meshProgram = 0, shadowProgram = 0, skyProgram = 0, spriteProgram = 0, lineProgram = 0;
   GLint viewProj = -1, eye = -1, lightCount = -1, lightType = -1, lightVector = -1, lightColor = -1,
-        shadowLight = -1, lightViewProj = -1, shadowMap = -1;
+        shadowLight = -1, lightViewProj = -1, shadowMap = -1, wire = -1;
   GLint shadowViewProj = -1;
   GLint skyInverse = -1, skyTop = -1, skyHorizon = -1;
   GLint spriteViewProj = -1, spriteScale = -1, lineViewProj = -1;
   GLuint shadowFbo = 0, shadowDepth = 0, emptyVao = 0;
-  static constexpr int kShadowSize = 4096;
+  int shadowSize = 0;      // texels on a side of the depth texture allocated
+  uint64_t shadowKey = 0;  // what the shadow map shows (see Draw)
+  bool shadowValid = false;
   std::unordered_map<const mesh::TriangleMesh*, GpuMesh> meshes;
   GLuint spriteVao = 0, spriteBuffers[4] = {0, 0, 0, 0};
   GLuint lineVao = 0, lineBuffers[2] = {0, 0};
@@ -93,6 +103,7 @@ struct Renderer::ScenePass {
     shadowLight = glGetUniformLocation(meshProgram, "uShadowLight");
     lightViewProj = glGetUniformLocation(meshProgram, "uLightViewProj");
     shadowMap = glGetUniformLocation(meshProgram, "uShadow");
+    wire = glGetUniformLocation(meshProgram, "uWire");
     shadowViewProj = glGetUniformLocation(shadowProgram, "uLightViewProj");
     skyInverse = glGetUniformLocation(skyProgram, "uInverseViewProj");
     skyTop = glGetUniformLocation(skyProgram, "uTop");
@@ -102,8 +113,6 @@ struct Renderer::ScenePass {
     lineViewProj = glGetUniformLocation(lineProgram, "uViewProj");
     glGenTextures(1, &shadowDepth);
     glBindTexture(GL_TEXTURE_2D, shadowDepth);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, kShadowSize, kShadowSize, 0,
-                 GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -122,6 +131,16 @@ struct Renderer::ScenePass {
     glGenVertexArrays(1, &lineVao);
     glGenBuffers(2, lineBuffers);
     return {};
+  }
+
+  // (Re)allocates the shadow map at `size` texels a side.
+  void SizeShadowMap(int size) {
+    if (size == shadowSize) return;
+    glBindTexture(GL_TEXTURE_2D, shadowDepth);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, size, size, 0, GL_DEPTH_COMPONENT,
+                 GL_FLOAT, nullptr);
+    shadowSize = size;
+    shadowValid = false;
   }
 
   GpuMesh& Upload(const draw::MeshDraw& d) {
@@ -176,7 +195,7 @@ struct Renderer::ScenePass {
     Camera light;
     light.orthographic = true;
     light.target = (lo + hi) / 2;
-    const double r = std::max((hi - lo).norm() / 2, 1e-3) * 1.05;
+    const double r = SunShadowRadius(lo, hi);
     light.distance = 3 * r;
     light.elevation = std::asin(std::clamp(toLight.y(), -1.0, 1.0)) * kRadToDeg;
     light.azimuth = std::atan2(toLight.x(), toLight.z()) * kRadToDeg;
@@ -184,6 +203,14 @@ struct Renderer::ScenePass {
     return light.ViewProjection(1.0).cast<float>();
   }
 };
+
+double SunShadowRadius(const Vec3& lo, const Vec3& hi) {
+  return std::max((hi - lo).norm() / 2, 1e-3) * 1.05;
+}
+
+double ShadowTexelsPerUnit(const mesh::Box& bounds) {
+  return Renderer::kDefaultShadowMapSize / (2 * SunShadowRadius(bounds.lo, bounds.hi));
+}
 
 void Renderer::DestroyScenePass(ScenePass* pass) {
   delete pass;
@@ -200,6 +227,7 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     scene_ = pass;
   }
   ScenePass& p = *scene_;
+  p.SizeShadowMap(shadowMapSize_);
   for (auto& [k, m] : p.meshes) m.used = false;
   std::vector<GpuMesh*> gpu;
   for (const draw::MeshDraw& d : list.meshes) {
@@ -226,14 +254,38 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
   draw::DrawList casters;
   for (const draw::MeshDraw& d : list.meshes)
     if (d.castsShadow) casters.meshes.push_back(d);
-  const bool any = casters.Bounds(lo, hi);
+  bool any = casters.Bounds(lo, hi);
+  if (list.shadowBounds) {
+    lo = list.shadowBounds->first;
+    hi = list.shadowBounds->second;
+    any = true;
+  }
   for (size_t i = 0; i < list.lights.size() && shadowLight < 0; ++i)
     if (list.lights[i].type == draw::Light::Type::kSun) shadowLight = int(i);
+  // The map is drawn again only when what it shows changed: the light's
+  // view, the casting meshes or their instances (a still plant in the
+  // viewer costs one shadow pass, not one per frame).
+  uint64_t shadowKey = 0;
   if (shadowLight >= 0 && any) {
     const Vec3 toLight = -list.lights[size_t(shadowLight)].direction.cast<double>().normalized();
     lightViewProj = p.SunViewProj(toLight, lo, hi);
+    shadowKey = Fnv(kFnvBasis, lightViewProj.data(), sizeof(float) * 16);
+    for (size_t i = 0; i < list.meshes.size(); ++i) {
+      const draw::MeshDraw& d = list.meshes[i];
+      if (!d.castsShadow || d.instances.empty()) continue;
+      const uintptr_t key[2] = {uintptr_t(d.mesh.get()), uintptr_t(d.mesh->indices.size())};
+      shadowKey = Fnv(shadowKey, key, sizeof key);
+      for (const draw::Instance& inst : d.instances)
+        shadowKey = Fnv(shadowKey, inst.transform.data(), sizeof(float) * 16);
+    }
+  }
+  if (shadowLight >= 0 && any && p.shadowValid && shadowKey == p.shadowKey) {
+    // The map drawn for an earlier frame still holds.
+  } else if (shadowLight >= 0 && any) {
+    p.shadowKey = shadowKey;
+    p.shadowValid = true;
     glBindFramebuffer(GL_FRAMEBUFFER, p.shadowFbo);
-    glViewport(0, 0, ScenePass::kShadowSize, ScenePass::kShadowSize);
+    glViewport(0, 0, p.shadowSize, p.shadowSize);
     glClear(GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glEnable(GL_POLYGON_OFFSET_FILL);
@@ -277,12 +329,8 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
 
   if (!list.meshes.empty()) {
     // No lights: a default key, fill and ambient, as the single-mesh path.
-    std::vector<draw::Light> lights = list.lights;
-    if (lights.empty()) {
-      lights.push_back(draw::Light::Sun({0.5f, -0.8f, -0.6f}, {1.0f, 0.95f, 0.85f}, 0.9f));
-      lights.push_back(draw::Light::Sun({-0.7f, -0.2f, 0.4f}, {0.55f, 0.62f, 0.75f}, 0.35f));
-      lights.push_back(draw::Light::Ambient({0.35f, 0.36f, 0.38f}, 1.0f));
-    }
+    const std::vector<draw::Light> lights =
+        list.lights.empty() ? draw::DefaultLights() : list.lights;
     int types[draw::kMaxLights];
     float vectors[3 * draw::kMaxLights], colors[3 * draw::kMaxLights];
     for (size_t i = 0; i < lights.size(); ++i) {
@@ -312,6 +360,7 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     glBindTexture(GL_TEXTURE_2D, p.shadowDepth);
     glUniform1i(p.shadowMap, 0);
     glVertexAttrib1f(kCoverageLocation, 1.0f);  // meshes without coverage
+    glUniform1i(p.wire, 0);
     for (size_t i = 0; i < list.meshes.size(); ++i) {
       if (list.meshes[i].instances.empty()) continue;
       glBindVertexArray(gpu[i]->vao);
@@ -333,6 +382,22 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     }
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
+    if (list.wireframe) {
+      // The triangles' edges over the shaded meshes, pulled toward the eye.
+      glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+      glEnable(GL_POLYGON_OFFSET_LINE);
+      glPolygonOffset(-1.0f, -1.0f);
+      glUniform1i(p.wire, 1);
+      for (size_t i = 0; i < list.meshes.size(); ++i) {
+        if (list.meshes[i].instances.empty() || !list.meshes[i].castsShadow) continue;
+        glBindVertexArray(gpu[i]->vao);
+        glDrawElementsInstanced(GL_TRIANGLES, gpu[i]->indexCount, GL_UNSIGNED_INT, nullptr,
+                                GLsizei(list.meshes[i].instances.size()));
+      }
+      glUniform1i(p.wire, 0);
+      glDisable(GL_POLYGON_OFFSET_LINE);
+      glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    }
   }
 
   for (const draw::Lines& l : list.lines) {

@@ -5,6 +5,8 @@
 #include <unordered_map>
 
 #include "core/rng.h"
+#include "plant/grow_together.h"
+#include "plant/surface_library.h"
 #include "scene/plants.h"
 
 namespace sylva::scene {
@@ -17,15 +19,18 @@ Diagnostic AtElement(const SourceLoc& loc, std::string message,
   return d;
 }
 
-// A plant's mesh, or its diagnostics with a note at the scene element.
-std::optional<plant::Plant> Grow(plant::PlantSpec spec, const BuildOptions& options,
-                                 const SourceLoc& where, const char* element,
-                                 DiagnosticList& diags) {
+// The spec as the scene grows it: its threads, detail, to the mesh.
+plant::PlantSpec ForScene(plant::PlantSpec spec, const BuildOptions& options) {
   spec.threads = options.threads;
   spec.pool = options.pool;
   spec.detail.sides = options.sides;
   spec.until = plant::Stage::kMesh;
-  plant::PlantResult r = plant::BuildPlant(spec);
+  return spec;
+}
+
+// A grown plant, or its diagnostics with a note at the scene element.
+std::optional<plant::Plant> Take(plant::PlantResult r, const SourceLoc& where, const char* element,
+                                 DiagnosticList& diags) {
   for (Diagnostic& d : r.diagnostics.items) diags.Add(std::move(d));
   if (!r.plant || !r.diagnostics.items.empty()) {
     Diagnostic note = MakeError(where, std::string("in the grammar of this <") + element + ">");
@@ -33,6 +38,113 @@ std::optional<plant::Plant> Grow(plant::PlantSpec spec, const BuildOptions& opti
     diags.Add(std::move(note));
   }
   return std::move(r.plant);
+}
+
+std::optional<plant::Plant> Grow(const plant::PlantSpec& spec, const BuildOptions& options,
+                                 const SourceLoc& where, const char* element,
+                                 DiagnosticList& diags) {
+  return Take(plant::BuildPlant(ForScene(spec, options)), where, element, diags);
+}
+
+// Where a <plant> stands: on the ground at x, z unless its y is given.
+Vec3 PlacedAt(const PlantDef& p, const BuiltScene& built) {
+  Vec3 at = p.position;
+  if (!p.positionHasY) at.y() = built.GroundHeight(at.x(), at.z());
+  return at;
+}
+
+// A plant's grammar, parsed alone (nullopt on an error: it is reported
+// when the plant grows).
+std::optional<lsys::Grammar> ParsedGrammar(const plant::PlantSpec& spec) {
+  plant::PlantSpec s = spec;
+  s.until = plant::Stage::kGrammar;
+  plant::PlantResult r = plant::BuildPlant(s);
+  if (!r.plant) return std::nullopt;
+  return std::move(r.plant->grammar);
+}
+
+bool SameStatement(const lsys::EnvironmentStatement& a, const lsys::EnvironmentStatement& b) {
+  if (a.kind != b.kind || a.items.size() != b.items.size()) return false;
+  for (size_t i = 0; i < a.items.size(); ++i) {
+    const auto &x = a.items[i], &y = b.items[i];
+    if (x.name != y.name || x.values != y.values || x.call != y.call || x.keyValue != y.keyValue)
+      return false;
+  }
+  return true;
+}
+
+// The <plant>s whose grammars say `environment: light` grow together in one
+// light grid, in world coordinates (metres), so that they compete for
+// light (plant/grow_together.h). The grid is the first such plant's
+// statement (its boxes read in world coordinates); a plant whose statement
+// differs is warned about. Results by plant index; the others are unset.
+std::vector<std::optional<plant::PlantResult>> GrowInSharedLight(const Scene& scene,
+                                                                 const BuiltScene& built,
+                                                                 const BuildOptions& options,
+                                                                 DiagnosticList& diags) {
+  std::vector<std::optional<plant::PlantResult>> out(scene.plants.size());
+  std::vector<size_t> which;
+  std::vector<plant::PlantSpec> specs;
+  std::vector<plant::Placement> placements;
+  std::unique_ptr<plant::Environment> shared;
+  lsys::EnvironmentStatement first;
+  for (size_t i = 0; i < scene.plants.size(); ++i) {
+    const PlantDef& p = scene.plants[i];
+    const plant::PlantSpec spec = SpecFor(p);
+    const std::optional<lsys::Grammar> g = ParsedGrammar(spec);
+    if (!g || !g->environment || g->environment->kind != "light") continue;
+    const lsys::EnvironmentStatement& st = *g->environment;
+    if (!shared) {
+      auto env = plant::MakeEnvironment(st, *g);
+      if (!env) continue;  // reported when the plant grows alone
+      shared = std::move(*env);
+      first = st;
+    } else if (!SameStatement(st, first)) {
+      diags.Add(AtElement(
+          p.loc,
+          "this plant's 'environment: light' (" + st.loc.file + ":" + std::to_string(st.loc.line) +
+              ") differs from the first light plant's (" + first.loc.file + ":" +
+              std::to_string(first.loc.line) + "): the scene's plants share that one's light grid",
+          Severity::kWarning));
+    }
+    which.push_back(i);
+    specs.push_back(ForScene(spec, options));
+    placements.push_back(plant::Placement{PlacedAt(p, built), p.rotateDegrees, p.scale});
+  }
+  if (which.empty()) return out;
+  std::vector<plant::PlantResult> grown = plant::GrowTogether(specs, placements, *shared);
+  for (size_t k = 0; k < which.size(); ++k) out[which[k]] = std::move(grown[k]);
+  return out;
+}
+
+// The ground under a plant at `at`, turned by `yawDegrees` about Y and
+// scaled by `scale` (draw::Transform), in the plant's own coordinates.
+// Points into `built`: use it while the plants grow.
+plant::Ground GroundUnder(const BuiltScene& built, const Vec3& at, double yawDegrees,
+                          double scale) {
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(yawDegrees * 3.14159265358979323846 / 180, Vec3::UnitY())
+          .toRotationMatrix();
+  auto world = [r, at, scale](double x, double z) {
+    return Vec3(at + r * (scale * Vec3(x, 0, z)));
+  };
+  plant::Ground g;
+  g.height = [&built, world, at, scale](double x, double z) {
+    const Vec3 w = world(x, z);
+    return (built.GroundHeight(w.x(), w.z()) - at.y()) / scale;
+  };
+  g.normal = [&built, world, r](double x, double z) {
+    const Vec3 w = world(x, z);
+    for (const terrain::HeightField& t : built.terrains)
+      if (t.Contains(w.x(), w.z())) return Vec3(r.transpose() * t.Normal(w.x(), w.z()));
+    return Vec3(0, 1, 0);
+  };
+  return g;
+}
+
+// The grammar's environment reads the plant's placement (terrain, light).
+bool ReadsPlacement(const lsys::Grammar& g) {
+  return g.environment && (g.environment->kind == "terrain" || g.environment->kind == "light");
 }
 
 // Box of a mesh through a transform.
@@ -78,8 +190,21 @@ double HeightScale(const mesh::TriangleMesh& m, double height, const SourceLoc& 
   return height / double(hi - lo);
 }
 
-// Tips, segment points and leaves of `g` through the transform `t`.
-void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t, PlantPoints& out) {
+// The surface meshes `g` places (`~leaf`), found as the plant's
+// tessellation found them; empty when it places none.
+std::unordered_map<std::string, mesh::TriangleMesh> SurfacesOf(const plant::Plant& p,
+                                                               const plant::PlantSpec& spec) {
+  if (p.geometry.surfaces.empty()) return {};
+  plant::SurfaceLibrary library(p.grammar.path, spec.surfacePath, spec.readFile);
+  if (!library.LoadFor(p.geometry, p.grammar).ok()) return {};  // the mesh was built: never
+  return library.meshes();
+}
+
+// Tips, segment points and leaves of `g` through the transform `t`; the
+// surfaces it places (`surfaces`, by name) collide as their triangles.
+void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t,
+               const std::unordered_map<std::string, mesh::TriangleMesh>& surfaces,
+               PlantPoints& out) {
   const Eigen::Matrix4d m = t.cast<double>();
   auto world = [&](const Vec3& p) { return Vec3((m * p.homogeneous()).head<3>()); };
   struct Hash {
@@ -107,7 +232,23 @@ void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t, PlantPoints& 
       out.leafTriangles.push_back(
           {world(p.vertices[0]), world(p.vertices[k]), world(p.vertices[k + 1])});
   }
-  for (const mesh::SurfaceInstance& s : g.surfaces) out.leaves.push_back(world(s.position));
+  for (const mesh::SurfaceInstance& s : g.surfaces) {
+    out.leaves.push_back(world(s.position));
+    const auto found = surfaces.find(s.name);
+    if (found == surfaces.end()) continue;
+    // Placed as the tessellator places it: scaled along its own axes, then
+    // in the turtle's frame (left, heading, up) at its position.
+    const mesh::TriangleMesh& sm = found->second;
+    auto place = [&](const mesh::Vec3f& p) {
+      const Vec3 q = p.cast<double>().cwiseProduct(s.scale);
+      return world(s.position + q.x() * s.frame.left + q.y() * s.frame.heading +
+                   q.z() * s.frame.up);
+    };
+    for (size_t k = 0; k + 2 < sm.indices.size(); k += 3)
+      out.leafTriangles.push_back({place(sm.positions[sm.indices[k]]),
+                                   place(sm.positions[sm.indices[k + 1]]),
+                                   place(sm.positions[sm.indices[k + 2]])});
+  }
 }
 
 }  // namespace
@@ -220,16 +361,32 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
   // terrain error left the command failing without a word.
   if (diags.HasErrors()) return result;
 
-  for (const PlantDef& p : scene.plants) {
-    const plant::PlantSpec spec = SpecFor(p);
-    std::optional<plant::Plant> grown = Grow(spec, options, p.grammarLoc, "plant", diags);
+  std::vector<std::optional<plant::PlantResult>> inLight =
+      GrowInSharedLight(scene, built, options, diags);
+  for (size_t pi = 0; pi < scene.plants.size(); ++pi) {
+    const PlantDef& p = scene.plants[pi];
+    plant::PlantSpec spec = SpecFor(p);
+    const Vec3 at = PlacedAt(p, built);
+    // `environment: terrain` reads the terrain under the plant, in the
+    // plant's coordinates (at its `scale`: `height` rescales after growth).
+    spec.ground = GroundUnder(built, at, p.rotateDegrees, p.scale);
+    std::optional<plant::Plant> grown =
+        inLight[pi] ? Take(std::move(*inLight[pi]), p.grammarLoc, "plant", diags)
+                    : Grow(spec, options, p.grammarLoc, "plant", diags);
     if (!grown) continue;
+    spec.ground.reset();  // it points into `built`; the kept spec is for tessellation
+    if (p.height && ReadsPlacement(grown->grammar)) {
+      diags.Add(AtElement(p.loc,
+                          "'height' rescales this plant after it grew: its grammar's "
+                          "'environment: " +
+                              grown->grammar.environment->kind + "' read the scene at scale " +
+                              std::to_string(p.scale) + ", not at the height's",
+                          Severity::kWarning));
+    }
     BuiltMesh m;
     m.mesh = std::make_shared<mesh::TriangleMesh>(std::move(grown->mesh));
     m.palette = grown->palette;
     m.spec = spec;
-    Vec3 at = p.position;
-    if (!p.positionHasY) at.y() = built.GroundHeight(at.x(), at.z());
     const double unit = p.height ? HeightScale(*m.mesh, *p.height, p.loc, diags) : 1;
     m.instances.push_back({draw::Transform(at, p.rotateDegrees, p.scale * unit), {1, 1, 1}});
     m.loc = p.loc;
@@ -240,7 +397,8 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
     built.trianglesDrawn += m.mesh->triangleCount();
     if (!p.id.empty()) {
-      AddPoints(grown->geometry, m.instances[0].transform, built.points[p.id]);
+      AddPoints(grown->geometry, m.instances[0].transform, SurfacesOf(*grown, spec),
+                built.points[p.id]);
       built.meshesOf[p.id].push_back(built.meshes.size());
     }
     m.plant = std::make_shared<plant::Plant>(std::move(*grown));
@@ -264,10 +422,20 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     const size_t first = built.meshes.size();
     std::vector<double> unit;
     std::vector<mesh::PlantGeometry> geometry;
+    std::vector<std::unordered_map<std::string, mesh::TriangleMesh>> surfaces;
     for (int v = 0; v < variants; ++v) {
       const plant::PlantSpec spec = SpecFor(f, forestSeed, v);
       std::optional<plant::Plant> grown = Grow(spec, options, f.grammarLoc, "forest", diags);
       if (!grown) break;
+      if (v == 0 && ReadsPlacement(grown->grammar)) {
+        diags.Add(AtElement(f.loc,
+                            "a forest grows each variant once, alone, and places it many times: "
+                            "its grammar's 'environment: " +
+                                grown->grammar.environment->kind +
+                                "' read flat ground at y = 0 and the variant's own light, not "
+                                "what is around each tree",
+                            Severity::kWarning));
+      }
       BuiltMesh m;
       m.mesh = std::make_shared<mesh::TriangleMesh>(std::move(grown->mesh));
       m.palette = grown->palette;
@@ -276,6 +444,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       unit.push_back(f.height ? HeightScale(*m.mesh, *f.height, f.loc, diags) : 1);
       if (!f.id.empty()) {
         geometry.push_back(grown->geometry);
+        surfaces.push_back(SurfacesOf(*grown, spec));
         built.meshesOf[f.id].push_back(built.meshes.size());
       }
       m.plant = std::make_shared<plant::Plant>(std::move(*grown));
@@ -300,7 +469,8 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       GrowBounds(*m.mesh, m.instances.back().transform, built.lo, built.hi, any);
       built.trianglesDrawn += m.mesh->triangleCount();
       if (!f.id.empty())
-        AddPoints(geometry[size_t(v)], m.instances.back().transform, built.points[f.id]);
+        AddPoints(geometry[size_t(v)], m.instances.back().transform, surfaces[size_t(v)],
+                  built.points[f.id]);
     }
   }
 

@@ -25,8 +25,10 @@
 
 #include "core/atomic_file.h"
 #include "core/spelling.h"
+#include "scene/build.h"
 #include "scene/values.h"
 #include "scene/xml_source.h"
+#include "terrain/height_field.h"
 
 namespace sylva::scene {
 
@@ -822,15 +824,16 @@ TerrainDef Reader::ReadTerrain(const Elem& e) {
   TerrainDef t;
   t.loc = a.Loc();
   if (const pugi::xml_attribute id = e.node.attribute("id")) t.id = id.value();
+  const size_t errorsBefore = diags.ErrorCount();
   std::vector<double> size;
   if (a.Numbers("size", size, 2)) {
-    if (size[0] > 0 && size[1] > 0)
+    if (size[0] >= 1e-3 && size[1] >= 1e-3 && size[0] <= 1e6 && size[1] <= 1e6)
       t.size = Vec2(size[0], size[1]);
     else
-      a.Error("size", "'size' is 'x z' in metres, both above 0");
+      a.Error("size", "'size' is 'x z' in metres, each from 0.001 to 1e6");
   }
   a.Count("resolution", t.resolution, 2, 8193);
-  a.Number("height", t.height, kNonNegative);
+  a.Number("height", t.height, Range{0, 1e5});
   a.Enum("noise", t.noise,
          {{"fbm", NoiseKind::kFbm},
           {"ridged", NoiseKind::kRidged},
@@ -846,6 +849,16 @@ TerrainDef Reader::ReadTerrain(const Elem& e) {
     a.Error("resolution",
             "diamond-square needs a resolution of 2^k + 1 (129, 257, 513 ...), found " +
                 std::to_string(t.resolution));
+  // What the terrain library checks beyond each attribute's range (the
+  // finest octave's lattice within float precision), here rather than
+  // when the scene is built.
+  if (diags.ErrorCount() == errorsBefore) {
+    if (Status st = terrain::Validate(TerrainDefOf(t, 0)); !st.ok()) {
+      std::string message = st.error().message;
+      if (message.rfind("TerrainDef: ", 0) == 0) message = "<terrain>: " + message.substr(12);
+      Add(e.file->AtElement(e.node, message + "; lower 'octaves' or 'lacunarity'"));
+    }
+  }
   AddSize(e, "resolution", uint64_t(t.resolution) * uint64_t(t.resolution) * 128,
           "<terrain resolution>");
   NoChildren(e);

@@ -11,10 +11,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <unordered_map>
 
+#include "core/assert.h"
 #include "core/rng.h"
 #include "mesh/obj_reader.h"
 #include "particles/cloth.h"
@@ -73,6 +76,22 @@ struct WindGrid {
       lo = lo.cwiseMin(s.position[i]);
       hi = hi.cwiseMax(s.position[i]);
     }
+    PrepareBox(lo, hi, t, eddy);
+  }
+
+  // Over points x (a cloth's vertices).
+  void Prepare(const std::vector<Vec3>& x, double t, double eddy) {
+    valid = false;
+    if (!wind || !wind->gusts || x.empty()) return;
+    Vec3 lo = Vec3::Constant(HUGE_VAL), hi = Vec3::Constant(-HUGE_VAL);
+    for (const Vec3& p : x) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    PrepareBox(lo, hi, t, eddy);
+  }
+
+  void PrepareBox(Vec3 lo, Vec3 hi, double t, double eddy) {
     if (!lo.allFinite() || !hi.allFinite() || !(lo.array() <= hi.array()).all()) return;
     spacing = eddy / 4;
     lo.array() -= 2 * spacing;  // room for a step's motion
@@ -286,10 +305,78 @@ struct ParticleSystem {
   std::unique_ptr<LeafStates> leaves;
   double plateK = 0;  // drag along the normal, N s/m
   uint64_t leafSeed = 0;
+  // <springs>: joined by particle id, so a spring survives the renumbering
+  // of RemoveDead; `springs` holds them at the current indices.
+  struct Joint {
+    uint32_t a, b;
+    double rest;
+  };
+  const SpringsDef* springsDef = nullptr;
+  std::shared_ptr<particles::Springs> springs;
+  std::vector<Joint> joints;
+  std::optional<uint32_t> lastBorn;  // chain: the id of the latest birth
+  // Joins particle i, just born, as `between` says.
+  Status Join(size_t i);
+  // After RemoveDead: the springs of living particles at their new indices.
+  Status Renumber();
   // Turns each leaf by the flow's torque and its spin; new ones get a
   // random orientation and spin, dead ones are forgotten.
   void TurnLeaves(double h, const Wind* wind, double time);
 };
+
+Status ParticleSystem::Join(size_t i) {
+  const ParticleState& st = system->state;
+  const SpringsDef& d = *springsDef;
+  auto join = [&](size_t j) -> Status {
+    const double rest = d.rest.value_or((st.position[i] - st.position[j]).norm());
+    joints.push_back({st.id[j], st.id[i], rest});
+    return springs->Add(uint32_t(j), uint32_t(i), rest, d.k, d.damping);
+  };
+  if (d.between == SpringTopology::kChain) {
+    // The latest birth is the last particle before i, if it still lives
+    // (births are appended; RemoveDead keeps the order).
+    const bool chained = lastBorn && i > 0 && st.id[i - 1] == *lastBorn;
+    lastBorn = st.id[i];
+    return chained ? join(i - 1) : Status{};
+  }
+  // Nearest (and for `grid` every particle within 1.5 times the nearest
+  // distance, at most 6): a linear scan, bounded by `max` (Create).
+  double best = HUGE_VAL;
+  size_t nearest = i;
+  for (size_t j = 0; j < i; ++j) {
+    const double d2 = (st.position[j] - st.position[i]).squaredNorm();
+    if (d2 < best) best = d2, nearest = j;
+  }
+  if (nearest == i) return {};
+  if (d.between == SpringTopology::kNearest) return join(nearest);
+  const double reach = 2.25 * best;  // (1.5 x)^2
+  int joined = 0;
+  for (size_t j = 0; j < i && joined < 6; ++j) {
+    if ((st.position[j] - st.position[i]).squaredNorm() > reach) continue;
+    if (Status s = join(j); !s.ok()) return s;
+    ++joined;
+  }
+  return {};
+}
+
+Status ParticleSystem::Renumber() {
+  const ParticleState& st = system->state;
+  std::unordered_map<uint32_t, uint32_t> index;
+  index.reserve(st.size());
+  for (size_t i = 0; i < st.size(); ++i) index.emplace(st.id[i], uint32_t(i));
+  springs->Clear();
+  size_t kept = 0;
+  for (const Joint& j : joints) {
+    const auto a = index.find(j.a), b = index.find(j.b);
+    if (a == index.end() || b == index.end()) continue;  // an end died: the spring goes
+    joints[kept++] = j;
+    if (Status s = springs->Add(a->second, b->second, j.rest, springsDef->k, springsDef->damping);
+        !s.ok())
+      return s;
+  }
+  joints.resize(kept);
+  return {};
+}
 
 void ParticleSystem::TurnLeaves(double h, const Wind* wind, double time) {
   const ParticleState& st = system->state;
@@ -327,6 +414,7 @@ void ParticleSystem::TurnLeaves(double h, const Wind* wind, double time) {
 struct ClothSheet {
   const ClothDef* def = nullptr;
   std::unique_ptr<particles::Cloth> cloth;
+  std::unique_ptr<WindGrid> windGrid = std::make_unique<WindGrid>();  // the gusts over it
   Vec3 gravity = Vec3::Zero();
 };
 
@@ -358,6 +446,15 @@ std::shared_ptr<mesh::TriangleMesh> DartMesh() {
 
 }  // namespace
 
+// An attractor's centre at another element (`of`): fixed for a plant,
+// forest or emitter; the centroid of a flock or cloth at each step.
+struct Centre {
+  std::shared_ptr<Vec3> at;  // read by the attractor's force
+  std::string of;
+  SourceLoc loc;
+  std::function<Vec3()> follow;  // set for what moves
+};
+
 struct Simulation::Impl {
   const Scene* scene = nullptr;
   const BuiltScene* built = nullptr;
@@ -369,6 +466,8 @@ struct Simulation::Impl {
   std::vector<std::unique_ptr<ParticleSystem>> systems;
   std::vector<ClothSheet> cloths;
   std::vector<Flock> flocks;
+  std::vector<Centre> centres;
+  Status PlaceCentres();
   std::map<std::string, std::shared_ptr<const particles::TriangleBvh>> bvhs, leafBvhs;
   std::map<std::string, std::shared_ptr<const particles::CapsuleBvh>> capsuleBvhs;
   std::shared_ptr<const particles::CapsuleBvh> CapsulesOf(const std::string& id) {
@@ -390,6 +489,11 @@ struct Simulation::Impl {
     return slot;
   }
 
+  // The colliders of `collides`, validated; a cloth named in `with` is
+  // skipped silently when it is `selfId` (the cloth's own self-collision)
+  // and with a warning otherwise.
+  Status CollidersOf(const std::vector<CollideDef>& collides, const std::string& selfId,
+                     DiagnosticList& diags, std::vector<particles::Collider>& out);
   Status AddColliders(particles::System& system, const std::vector<CollideDef>& collides,
                       DiagnosticList& diags);
   std::shared_ptr<const particles::TriangleBvh> BvhOf(const std::string& id);
@@ -423,51 +527,58 @@ std::shared_ptr<const particles::TriangleBvh> Simulation::Impl::BvhOf(const std:
   return bvh;
 }
 
-Status Simulation::Impl::AddColliders(particles::System& system,
-                                      const std::vector<CollideDef>& collides,
-                                      DiagnosticList& diags) {
+Status Simulation::Impl::CollidersOf(const std::vector<CollideDef>& collides,
+                                     const std::string& selfId, DiagnosticList& diags,
+                                     std::vector<particles::Collider>& out) {
   for (const CollideDef& c : collides) {
     const particles::Response response =
         c.stick ? particles::Response::kStick : particles::Response::kBounce;
     for (const std::string& id : c.with) {
-      particles::Collider collider;
+      std::vector<particles::Collider> parts;
       if (id == "ground") {
-        collider = particles::Collider::Plane(Vec3::Zero(), Vec3::UnitY());
+        parts.push_back(particles::Collider::Plane(Vec3::Zero(), Vec3::UnitY()));
       } else {
         bool isCloth = false;
         for (const ClothDef& cl : scene->cloths) isCloth = isCloth || cl.id == id;
         if (isCloth) {
-          diags.Add(
-              Warn(c.withLoc, "collisions with a cloth ('" + id + "') are not simulated yet"));
+          if (id != selfId)  // a cloth with itself: its self-collision (the caller)
+            diags.Add(
+                Warn(c.withLoc, "collisions with a cloth ('" + id + "') are not simulated yet"));
           continue;
         }
         const auto pts = built->points.find(id);
         if (pts != built->points.end()) {
           // A plant or forest: capsules for the branches, triangles for the
           // leaves.
-          std::vector<particles::Collider> parts;
           parts.push_back(particles::Collider::Capsules(CapsulesOf(id)));
           if (!pts->second.leafTriangles.empty())
             parts.push_back(particles::Collider::Mesh(LeavesOf(id)));
-          for (particles::Collider& part : parts) {
-            part.Restitution(c.restitution).Friction(std::min(c.friction, 1e3)).Respond(response);
-            if (Status s = system.AddCollider(part); !s.ok()) {
-              Diagnostic d = s.error();
-              d.loc = c.loc;
-              return d;
-            }
-          }
-          continue;
+        } else {
+          parts.push_back(particles::Collider::Mesh(BvhOf(id)));
         }
-        collider = particles::Collider::Mesh(BvhOf(id));
       }
-      collider.Restitution(c.restitution).Friction(std::min(c.friction, 1e3)).Respond(response);
-      if (Status s = system.AddCollider(collider); !s.ok()) {
-        Diagnostic d = s.error();
-        d.loc = c.loc;
-        return d;
+      for (particles::Collider& part : parts) {
+        part.Restitution(c.restitution).Friction(std::min(c.friction, 1e3)).Respond(response);
+        if (Status s = particles::Validate(part); !s.ok()) {
+          Diagnostic d = s.error();
+          d.loc = c.loc;
+          return d;
+        }
+        out.push_back(std::move(part));
       }
     }
+  }
+  return {};
+}
+
+Status Simulation::Impl::AddColliders(particles::System& system,
+                                      const std::vector<CollideDef>& collides,
+                                      DiagnosticList& diags) {
+  std::vector<particles::Collider> colliders;
+  if (Status s = CollidersOf(collides, "", diags, colliders); !s.ok()) return s;
+  for (particles::Collider& c : colliders) {
+    const Status s = system.AddCollider(std::move(c));
+    SYLVA_ASSERT(s.ok());  // validated above
   }
   return {};
 }
@@ -502,12 +613,61 @@ Status Simulation::Impl::Emit(ParticleSystem& ps, double step) {
         if (at != b.x && c.Intersect(b.x, at, &contact)) at = b.x;
       st.Add(at, b.v, b.mass, b.lifetime);
       st.age.back() = remaining;
+      if (ps.springs) {
+        if (Status s = ps.Join(st.size() - 1); !s.ok()) {
+          Diagnostic d = s.error();
+          d.loc = ps.springsDef->loc;
+          return d;
+        }
+      }
     }
   }
   return {};
 }
 
+Status Simulation::Impl::PlaceCentres() {
+  auto mean = [](const std::vector<Vec3>& points) {
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& p : points) c += p;
+    return points.empty() ? c : Vec3(c / double(points.size()));
+  };
+  for (Centre& c : centres) {
+    const auto points = built->points.find(c.of);
+    if (points != built->points.end()) {  // a plant or forest
+      *c.at = mean(points->second.segmentPoints);
+      continue;
+    }
+    bool found = false;
+    for (size_t k = 0; k < cloths.size() && !found; ++k) {
+      if (cloths[k].def->id != c.of) continue;
+      const particles::Cloth* cloth = cloths[k].cloth.get();
+      c.follow = [cloth, mean] { return mean(cloth->positions()); };
+      found = true;
+    }
+    for (size_t k = 0; k < flocks.size() && !found; ++k) {
+      if (flocks[k].def->id != c.of) continue;
+      const ParticleState* boids = &flocks[k].system->state;
+      c.follow = [boids, mean] { return mean(boids->position); };
+      found = true;
+    }
+    for (const ParticlesDef& p : scene->particles) {
+      for (const EmitterDef& e : p.emitters) {
+        if (found || e.id != c.of) continue;
+        found = true;
+        const auto target = built->points.find(e.of);  // an emitter on a plant's parts
+        *c.at = target != built->points.end() ? mean(target->second.segmentPoints) : e.at;
+      }
+    }
+    if (!found)  // the reader checks the kind of every `of`: this is a bug
+      return Fail(c.loc, "'of=\"" + c.of + "\"' names nothing an attractor can follow");
+    if (c.follow) *c.at = c.follow();
+  }
+  return {};
+}
+
 Status Simulation::Impl::Step() {
+  for (Centre& c : centres)
+    if (c.follow) *c.at = c.follow();
   for (auto& ps : systems) {
     const int sub = ps->def->substeps;
     for (int k = 0; k < sub; ++k) {
@@ -548,16 +708,28 @@ Status Simulation::Impl::Step() {
         }
       }
     }
+    const size_t before = st.size();
     particles::RemoveDead(st);
+    if (ps->springs && st.size() != before) {
+      if (Status s = ps->Renumber(); !s.ok()) {
+        Diagnostic d = s.error();
+        d.loc = ps->springsDef->loc;
+        return d;
+      }
+    }
   }
   for (ClothSheet& c : cloths) {
-    Vec3 w = Vec3::Zero();
-    if (hasWind && c.def->wind) {
-      Vec3 centre = Vec3::Zero();
-      for (const Vec3& p : c.cloth->positions()) centre += p;
-      w = wind.At(centre / double(c.cloth->positions().size()), time);
-    }
-    if (Status s = c.cloth->Step(h, c.gravity, w); !s.ok()) {
+    // The wind at each triangle (gusts smaller than the sheet bend it),
+    // from the gusts sampled on a grid over the sheet.
+    const double t = time;
+    const bool gusts = hasWind && c.def->wind && wind.gusts;
+    if (gusts) c.windGrid->Prepare(c.cloth->positions(), t, scene->wind->scale);
+    const WindGrid* air = c.windGrid.get();
+    Status s = gusts
+                   ? c.cloth->StepInWindField(h, c.gravity,
+                                              [air, t](const Vec3& x) { return air->At(x, t); })
+                   : c.cloth->Step(h, c.gravity, hasWind && c.def->wind ? wind.mean : Vec3::Zero());
+    if (!s.ok()) {
       Diagnostic d = s.error();
       d.loc = c.def->loc;
       d.message = "<cloth> at t = " + std::to_string(time) + " s: " + d.message;
@@ -656,6 +828,54 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
         std::make_shared<mesh::TriangleMesh>(std::move(*obj)));
   };
 
+  // The acceleration field (m/s^2 at x, t) of an attractor, vortex or noise
+  // force.
+  auto accelerationOf = [&](const ForceDef& f) -> Expected<AccelerationField::Fn> {
+    switch (f.kind) {
+      case ForceKind::kAttractor: {
+        // The centre: its position, or the element `of` names (a flock or
+        // cloth moves: its centroid is taken at the start of every step).
+        auto centre = std::make_shared<Vec3>(f.position.value_or(Vec3::Zero()));
+        if (!f.of.empty()) m.centres.push_back({centre, f.of, f.loc, {}});
+        const double strength = f.strength, soft = std::max(f.radius, 1e-3);
+        const bool inverseSquare = f.falloff == Falloff::kInverseSquare;
+        return AccelerationField::Fn([=](const Vec3& x, double) {
+          const Vec3 d = *centre - x;
+          const double r = std::max(d.norm(), soft);
+          return Vec3(d / r * strength / (inverseSquare ? r * r : r));
+        });
+      }
+      case ForceKind::kVortex: {
+        const Vec3 c = f.position.value_or(Vec3::Zero()), a = f.axis.normalized();
+        const double strength = f.strength;
+        return AccelerationField::Fn([=](const Vec3& x, double) {
+          const Vec3 r = x - c;
+          const Vec3 radial = r - a * a.dot(r);
+          const double n = radial.norm();
+          return n < 1e-9 ? Vec3(Vec3::Zero()) : Vec3(strength * a.cross(radial) / n);
+        });
+      }
+      case ForceKind::kNoise: {
+        particles::NoiseWindDef w;
+        w.speed = 1;
+        w.scale = f.scale;
+        w.frequency = 2 * kPi * f.frequency;
+        w.seed = ElementSeed(scene.seed, f.id, "noise-force", size_t(f.loc.line));
+        auto field = particles::NoiseWind::Create(w);
+        if (!field) return Fail(f.loc, field.error().message, ErrorKind::kInput);
+        std::shared_ptr<particles::NoiseWind> n = *field;
+        const double strength = f.strength;
+        return AccelerationField::Fn(
+            [=](const Vec3& x, double t) { return Vec3(strength * n->Velocity(x, t)); });
+      }
+      case ForceKind::kGravity:
+      case ForceKind::kDrag:
+        break;
+    }
+    SYLVA_ASSERT(false);  // gravity and drag are not fields
+    return AccelerationField::Fn();
+  };
+
   auto addForces = [&](particles::System& system, const std::vector<ForceDef>& forces, bool windOn,
                        const SourceLoc& loc, const WindGrid* windGrid) -> Status {
     bool drag = false;
@@ -669,52 +889,12 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
           system.AddForce(std::make_shared<WindDrag>(f.quadratic ? 0 : f.k, f.quadratic ? f.k : 0,
                                                      windOn && wind ? windGrid : nullptr));
           break;
-        case ForceKind::kAttractor: {
-          Vec3 c = f.position.value_or(Vec3::Zero());
-          if (!f.of.empty()) {
-            const auto it = built.points.find(f.of);
-            if (it != built.points.end() && !it->second.segmentPoints.empty()) {
-              c = Vec3::Zero();
-              for (const Vec3& p : it->second.segmentPoints) c += p;
-              c /= double(it->second.segmentPoints.size());
-            } else {
-              diags.Add(Warn(f.loc, "'of=\"" + f.of +
-                                        "\"': only a plant or forest gives an "
-                                        "attractor its position yet; the origin is used"));
-            }
-          }
-          const double strength = f.strength, soft = std::max(f.radius, 1e-3);
-          const bool inverseSquare = f.falloff == Falloff::kInverseSquare;
-          system.AddForce(std::make_shared<AccelerationField>([=](const Vec3& x, double) {
-            const Vec3 d = c - x;
-            const double r = std::max(d.norm(), soft);
-            return Vec3(d / r * strength / (inverseSquare ? r * r : r));
-          }));
-          break;
-        }
-        case ForceKind::kVortex: {
-          const Vec3 c = f.position.value_or(Vec3::Zero()), a = f.axis.normalized();
-          const double strength = f.strength;
-          system.AddForce(std::make_shared<AccelerationField>([=](const Vec3& x, double) {
-            const Vec3 r = x - c;
-            const Vec3 radial = r - a * a.dot(r);
-            const double n = radial.norm();
-            return n < 1e-9 ? Vec3(Vec3::Zero()) : Vec3(strength * a.cross(radial) / n);
-          }));
-          break;
-        }
+        case ForceKind::kAttractor:
+        case ForceKind::kVortex:
         case ForceKind::kNoise: {
-          particles::NoiseWindDef w;
-          w.speed = 1;
-          w.scale = f.scale;
-          w.frequency = 2 * kPi * f.frequency;
-          w.seed = ElementSeed(scene.seed, f.id, "noise-force", size_t(f.loc.line));
-          auto field = particles::NoiseWind::Create(w);
-          if (!field) return Fail(f.loc, field.error().message, ErrorKind::kInput);
-          std::shared_ptr<particles::NoiseWind> n = *field;
-          const double strength = f.strength;
-          system.AddForce(std::make_shared<AccelerationField>(
-              [=](const Vec3& x, double t) { return Vec3(strength * n->Velocity(x, t)); }));
+          auto field = accelerationOf(f);
+          if (!field) return field.error();
+          system.AddForce(std::make_shared<AccelerationField>(std::move(*field)));
           break;
         }
       }
@@ -763,8 +943,21 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
           !s.ok())
         return Fail(p.loc, s.error().message, ErrorKind::kInput);
     }
-    for (const SpringsDef& sp : p.springs)
-      diags.Add(Warn(sp.loc, "<springs> in a scene are not simulated yet"));
+    if (p.springs.size() > 1)
+      return Fail(p.springs[1].loc, "one <springs> per <particles>", ErrorKind::kInput);
+    if (!p.springs.empty()) {
+      const SpringsDef& sp = p.springs[0];
+      // Nearest and grid scan every living particle at each birth.
+      if (sp.between != SpringTopology::kChain && p.max > 20000)
+        return Fail(sp.loc,
+                    "springs between nearest particles scan them all at each birth: at most "
+                    "20000 particles (the <particles> max is " +
+                        std::to_string(p.max) + ")",
+                    ErrorKind::kInput);
+      ps->springsDef = &sp;
+      ps->springs = std::make_shared<particles::Springs>();
+      ps->system->AddForce(ps->springs);
+    }
     for (size_t k = 0; k < p.emitters.size(); ++k) {
       const EmitterDef& e = p.emitters[k];
       Source src;
@@ -855,21 +1048,58 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
         break;
     }
     if (!c.wind || !scene.wind) d.windDrag = d.windLift = 0;
+    // Colliders; `with` naming the cloth itself turns on its self-collision,
+    // at a thickness of 0.75 of its larger cell side (at least the cell's
+    // half diagonal, so a layer cannot slip between two particles of
+    // another), with that <collide>'s friction.
+    std::vector<particles::Collider> colliders;
+    if (Status s = m.CollidersOf(c.collides, c.id, diags, colliders); !s.ok()) return s.error();
+    for (const CollideDef& col : c.collides) {
+      if (c.id.empty() || std::find(col.with.begin(), col.with.end(), c.id) == col.with.end())
+        continue;
+      d.thickness = 0.75 * std::max(c.size.x() / (c.columns - 1), c.size.y() / (c.rows - 1));
+      d.selfFriction = std::min(col.friction, 1e3);
+    }
     auto cloth = particles::Cloth::Create(d);
     if (!cloth) return Fail(c.loc, cloth.error().message, ErrorKind::kInput);
     ClothSheet sheet;
     sheet.def = &c;
     sheet.cloth = std::move(*cloth);
-    for (const ForceDef& f : c.forces) {
-      if (f.kind == ForceKind::kGravity)
-        sheet.gravity += f.g;
-      else
-        diags.Add(Warn(f.loc,
-                       "cloth feels gravity and the wind; this force is not simulated on "
-                       "cloth yet"));
+    sheet.windGrid->wind = wind;
+    for (particles::Collider& col : colliders) {
+      const Status s = sheet.cloth->AddCollider(std::move(col));
+      SYLVA_ASSERT(s.ok());  // validated, and never kKill
     }
-    for (const CollideDef& col : c.collides)
-      diags.Add(Warn(col.loc, "cloth collisions are not simulated yet (the cloth passes through)"));
+    // Forces: gravity as the cloth's own, the others through one field of
+    // forces on each vertex (drag -k (v - wind) per vertex, as on particles;
+    // attractor, vortex and noise as accelerations of the vertex's mass).
+    std::vector<AccelerationField::Fn> fields;
+    std::vector<std::pair<double, bool>> drags;  // k, quadratic
+    for (const ForceDef& f : c.forces) {
+      if (f.kind == ForceKind::kGravity) {
+        sheet.gravity += f.g;
+      } else if (f.kind == ForceKind::kDrag) {
+        drags.emplace_back(f.k, f.quadratic);
+      } else {
+        auto field = accelerationOf(f);
+        if (!field) return field.error();
+        fields.push_back(std::move(*field));
+      }
+    }
+    if (!fields.empty() || !drags.empty()) {
+      const double mass = sheet.cloth->particleMass();
+      const double* time = &m.time;
+      const Wind* air = c.wind ? wind : nullptr;
+      sheet.cloth->SetExternalForce([=](size_t, const Vec3& x, const Vec3& v) {
+        Vec3 f = Vec3::Zero();
+        for (const AccelerationField::Fn& a : fields) f += mass * a(x, *time);
+        if (!drags.empty()) {
+          const Vec3 u = air ? Vec3(v - air->At(x, *time)) : v;
+          for (const auto& [k, quadratic] : drags) f -= (quadratic ? k * u.norm() : k) * u;
+        }
+        return f;
+      });
+    }
     m.cloths.push_back(std::move(sheet));
   }
 
@@ -958,6 +1188,7 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
     }
     m.flocks.push_back(std::move(flock));
   }
+  if (Status s = m.PlaceCentres(); !s.ok()) return s.error();
   return sim;
 }
 

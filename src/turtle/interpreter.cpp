@@ -4,12 +4,16 @@
 
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 #include "core/assert.h"
 #include "core/memory.h"
 
 namespace sylva::turtle {
 namespace {
+
+constexpr int kDiscSides = 24;     // polygon vertices of a @o or @c disc
+constexpr int kCylinderRings = 8;  // segments per @Gc/@Ge piece without a parameter
 
 enum class Op : uint8_t {
   kNone,
@@ -37,6 +41,15 @@ enum class Op : uint8_t {
   kSurface,
   kSphere,
   kMoveTo,
+  kDisc,         // @o
+  kCircle,       // @c
+  kGcStart,      // @Gs
+  kGcPoint,      // @Gc
+  kGcEnd,        // @Ge
+  kTropismSet,   // @Ts
+  kTropismUp,    // @Ti
+  kTropismDown,  // @Td
+  kTwistForce,   // @Tf
 };
 
 Op OpFor(const std::string& name) {
@@ -92,9 +105,20 @@ Op OpFor(const std::string& name) {
   if (name[0] == '~') return Op::kSurface;
   if (name == "@O") return Op::kSphere;
   if (name == "@M") return Op::kMoveTo;
+  if (name == "@v") return Op::kLevel;  // cpfg's roll to vertical is `$`
+  if (name == "@o") return Op::kDisc;
+  if (name == "@c") return Op::kCircle;
+  if (name == "@Gs") return Op::kGcStart;
+  if (name == "@Gc") return Op::kGcPoint;
+  if (name == "@Ge") return Op::kGcEnd;
+  if (name == "@Ts") return Op::kTropismSet;
+  if (name == "@Ti") return Op::kTropismUp;
+  if (name == "@Td") return Op::kTropismDown;
+  if (name == "@Tf") return Op::kTwistForce;
   return Op::kNone;
 }
 
+// What `[` saves and `]` restores. 112 bytes: copied at every bracket.
 struct State {
   Vec3 pos{0, 0, 0};
   Frame frame;
@@ -102,6 +126,29 @@ struct State {
   uint32_t branch = 0;
   uint16_t depth = 0;
   uint16_t color = 0;
+};
+
+// The part of the state only cpfg's @T and @G commands change, saved on its
+// own stack only when the word's symbols include them, so that State stays
+// small for every other word.
+struct CpfgState {
+  double elasticity = 0;  // tropism susceptibility (cpfg: elasticity), @Ts @Ti @Td change it
+  int32_t cylinder = -1;  // the open generalized cylinder (@Gs), or -1
+};
+
+// A control point of a generalized cylinder: where the turtle was at @Gs,
+// @Gc or @Ge.
+struct ControlPoint {
+  Vec3 pos, heading, left;
+  double width = 0;
+  uint16_t color = 0;
+};
+
+// An open generalized cylinder: its last control point and the branch id
+// its tube segments carry.
+struct Cylinder {
+  ControlPoint last;
+  uint32_t branch = 0;
 };
 
 // X' = X cos a + Y sin a, Y' = Y cos a - X sin a: X turns toward Y.
@@ -200,6 +247,9 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
     d.tropism = Vec3(g.tropism->x, g.tropism->y, g.tropism->z);
     d.susceptibility = g.tropism->susceptibility;
   }
+  d.initialColor = g.initialColor;
+  d.colorIncrement = g.colorIncrement;
+  d.elasticityIncrement = g.elasticityIncrement;
   return d;
 }
 
@@ -211,16 +261,100 @@ Expected<PlantGeometry> Interpret(const lsys::Word& word, const lsys::SymbolTabl
 }
 
 // Module i as written: its name and parameters (%g), for error messages.
-static std::string ModuleText(const lsys::Word& word, const lsys::SymbolTable& symbols, size_t i) {
+[[gnu::noinline]] static std::string ModuleText(const lsys::Word& word,
+                                                const lsys::SymbolTable& symbols, size_t i) {
   std::string text = symbols.name(word.symbols[i]);
   const auto params = word.ParamsOf(i);
   for (size_t k = 0; k < params.size(); ++k) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g", params[k]);
-    text += (k ? "," : "(") + std::string(buf);
+    text += k ? ',' : '(';
+    text += buf;
   }
   if (!params.empty()) text += ")";
   return text;
+}
+
+// ABOP eq. 2.3: after a move, the frame turns about H x T by e |H x T|
+// (Rodrigues' rotation). True when it turned.
+static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
+  if (e == 0) return false;
+  const Vec3 axis = f.heading.cross(tropismVector);
+  const double norm = axis.norm();
+  if (!(norm > 1e-12)) return false;
+  // v' = v cos a + (k x v) sin a + k (k.v)(1 - cos a).
+  const double a = e * norm;
+  const Vec3 k = axis / norm;
+  double sa, ca;
+  SinCosSmall(a, &sa, &ca);
+  auto turn = [&](Vec3& v) { v = v * ca + k.cross(v) * sa + k * (k.dot(v) * (1 - ca)); };
+  turn(f.heading);
+  turn(f.left);
+  turn(f.up);
+  return true;
+}
+
+// @o and @c: a disc of diameter `diameter` centred at `centre` in the plane
+// of the unit vectors a and b, as a polygon of kDiscSides vertices running
+// from a toward b (its normal is a x b).
+[[gnu::noinline]] static void AddDisc(const Vec3& centre, const Vec3& a, const Vec3& b,
+                                      double diameter, uint16_t color, uint32_t module,
+                                      PlantGeometry& g) {
+  Polygon poly;
+  poly.vertices.reserve(kDiscSides);
+  const double r = diameter * 0.5;
+  for (int k = 0; k < kDiscSides; ++k) {
+    double s, c;
+    SinCosRadians(2 * kPi * k / kDiscSides, &s, &c);
+    poly.vertices.push_back(centre + (a * c + b * s) * r);
+  }
+  poly.color = color;
+  poly.module = module;
+  g.polygons.push_back(std::move(poly));
+}
+
+// One piece of a generalized cylinder (@Gc, @Ge): the cubic Hermite curve
+// from control point a to b with tangents H_a |b - a| and H_b |b - a|,
+// cut into `rings` segments of one branch whose width runs linearly from
+// a's to b's.
+[[gnu::noinline]] static void AddCylinderPiece(const ControlPoint& a, const ControlPoint& b,
+                                               int rings, double widthScale, uint32_t branch,
+                                               uint32_t parent, uint16_t depth, uint32_t module,
+                                               PlantGeometry& g) {
+  const double chord = (b.pos - a.pos).norm();
+  const Vec3 m0 = a.heading * chord, m1 = b.heading * chord;
+  Vec3 prev = a.pos;
+  double prevWidth = a.width;
+  for (int k = 1; k <= rings; ++k) {
+    const double t = double(k) / rings, t2 = t * t, t3 = t2 * t;
+    const Vec3 p = k == rings ? b.pos
+                              : a.pos * (2 * t3 - 3 * t2 + 1) + m0 * (t3 - 2 * t2 + t) +
+                                    b.pos * (3 * t2 - 2 * t3) + m1 * (t3 - t2);
+    const double w = a.width + (b.width - a.width) * t;
+    Segment sg;
+    sg.start = prev;
+    sg.end = p;
+    sg.left = a.left;
+    sg.radiusStart = float(prevWidth * widthScale * 0.5);
+    sg.radiusEnd = float(w * widthScale * 0.5);
+    sg.branch = branch;
+    sg.parent = parent;
+    sg.depth = depth;
+    sg.color = a.color;
+    sg.module = module;
+    g.segments.push_back(sg);
+    prev = p;
+    prevWidth = w;
+  }
+}
+
+// The rings of a @Gc(n) or @Ge(n) piece: n (at least 1), kCylinderRings
+// without a parameter. A double: the caller compares it with its limit
+// before converting.
+static double CylinderRings(const double* p, uint32_t np) {
+  if (!np) return kCylinderRings;
+  if (!(p[0] >= 1)) return 1;  // NaN and below 1 (cpfg: at least 1)
+  return std::floor(p[0]);
 }
 
 // Every number the tessellator and the exporters will see must be finite
@@ -270,13 +404,49 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   g.warnings.clear();
   g.modulePosition.clear();
   g.moduleFrame.clear();
+  // How often each symbol occurs (one increment a module), then what each draws.
+  std::vector<size_t> count(ops.size(), 0);
+  for (size_t i = 0; i < word.size(); ++i) ++count[word.symbols[i]];
   size_t draws = 0, spheres = 0, surfaces = 0;
-  for (size_t i = 0; i < word.size(); ++i) {
-    const Op op = ops[word.symbols[i]];
-    draws += op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex;
-    spheres += op == Op::kSphere;
-    surfaces += op == Op::kSurface;
+  bool cylinders = false;
+  for (size_t sym = 0; sym < ops.size(); ++sym) {
+    switch (ops[sym]) {
+      case Op::kForwardDraw:
+      case Op::kForwardDrawNoVertex:
+        draws += count[sym];
+        break;
+      case Op::kSphere:
+        spheres += count[sym];
+        break;
+      case Op::kSurface:
+        surfaces += count[sym];
+        break;
+      case Op::kDisc:
+      case Op::kCircle:
+        draws += count[sym] * kDiscSides;
+        break;
+      case Op::kGcPoint:
+      case Op::kGcEnd:
+        cylinders |= count[sym] > 0;
+        break;
+      default:
+        break;
+    }
   }
+  double cylinderRings = 0;  // a double: a @Gc(1e300) must not overflow the count
+  if (cylinders) {
+    const bool hasParams = word.HasParams();
+    for (size_t i = 0; i < word.size(); ++i) {
+      const Op op = ops[word.symbols[i]];
+      if (op != Op::kGcPoint && op != Op::kGcEnd) continue;
+      const uint32_t np = hasParams ? word.paramStart[i + 1] - word.paramStart[i] : 0;
+      cylinderRings +=
+          CylinderRings(hasParams ? word.params.data() + word.paramStart[i] : nullptr, np);
+    }
+  }
+  if (cylinderRings > double(options.maxPrimitives))
+    cylinderRings = double(options.maxPrimitives) + 1;
+  draws += size_t(cylinderRings);
   if (draws + spheres + surfaces > options.maxPrimitives) {
     Diagnostic d;
     d.kind = ErrorKind::kRuntime;
@@ -295,24 +465,6 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   g.spheres.reserve(spheres);
   g.surfaces.reserve(surfaces);
   return {};
-}
-
-// ABOP eq. 2.3: after a move, the frame turns about H x T by e |H x T|
-// (Rodrigues' rotation). True when it turned.
-static inline bool ApplyTropism(const TurtleDef& def, Frame& f) {
-  const Vec3 axis = f.heading.cross(def.tropism);
-  const double norm = axis.norm();
-  if (!(norm > 1e-12)) return false;
-  // v' = v cos a + (k x v) sin a + k (k.v)(1 - cos a).
-  const double a = def.susceptibility * norm;
-  const Vec3 k = axis / norm;
-  double sa, ca;
-  SinCosSmall(a, &sa, &ca);
-  auto turn = [&](Vec3& v) { v = v * ca + k.cross(v) * sa + k * (k.dot(v) * (1 - ca)); };
-  turn(f.heading);
-  turn(f.left);
-  turn(f.up);
-  return true;
 }
 
 // `}`: closes the innermost open polygon into g.polygons, dropping a closing
@@ -344,12 +496,24 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   std::vector<uint32_t> branchParent{0};
   std::vector<State> stack;
   std::vector<Polygon> openPolygons;
+  std::vector<Cylinder> cylinders;
   State t;
   t.width = def.width;
+  CpfgState x;
+  x.elasticity = def.susceptibility;
+  std::vector<CpfgState> xstack;
+  t.color = uint16_t(std::clamp(def.initialColor, 0, 65535));
+  const int colorStep = def.colorIncrement;
   SinCos sincos;
   double defSin, defCos;
   sincos.Get(def.angle, &defSin, &defCos);
-  const bool tropism = def.susceptibility != 0;
+  bool changesTropism = false, drawsCylinders = false;
+  for (Op op : ops) {
+    changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp || op == Op::kTropismDown;
+    drawsCylinders |= op == Op::kGcStart || op == Op::kGcPoint || op == Op::kGcEnd;
+  }
+  const bool cpfgState = changesTropism || drawsCylinders;
+  const bool tropism = def.susceptibility != 0 || changesTropism;
   Vec3 lo = t.pos, hi = t.pos;
   bool planar = true;
   const size_t n = word.size();
@@ -365,188 +529,271 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   };
   uint32_t turnsSinceOrtho = 0;
 
-  for (size_t i = 0; i < n; ++i) {
-    const lsys::SymbolId sym = word.symbols[i];
-    const Op op = ops[sym];
-    if (op == Op::kNone) {
+  // The loop, compiled twice: words with cpfg's @T and @G commands keep a
+  // second stack of state (CpfgState); every other word runs without it.
+  auto run = [&](auto cpfgTag) -> Status {
+    constexpr bool kCpfg = decltype(cpfgTag)::value;
+    for (size_t i = 0; i < n; ++i) {
+      const lsys::SymbolId sym = word.symbols[i];
+      const Op op = ops[sym];
+      if (op == Op::kNone) {
+        if (options.recordModules) {
+          g.modulePosition[i] = t.pos;
+          g.moduleFrame[i] = t.frame;
+        }
+        continue;
+      }
+      const double* p = nullptr;
+      uint32_t np = 0;
+      if (hasParams) {
+        p = word.params.data() + word.paramStart[i];
+        np = word.paramStart[i + 1] - word.paramStart[i];
+      }
+      double s = defSin, c = defCos;
+      auto angle = [&] {
+        if (np) sincos.Get(p[0], &s, &c);
+        ++turnsSinceOrtho;
+      };
+      switch (op) {
+        case Op::kForwardDraw:
+        case Op::kForwardMove:
+        case Op::kForwardDrawNoVertex:
+        case Op::kForwardMoveNoVertex: {
+          const double len = np ? p[0] : def.step;
+          const Vec3 start = t.pos;
+          t.pos += t.frame.heading * len;
+          visit(t.pos);
+          const bool inPolygon = !openPolygons.empty();
+          if (inPolygon) {
+            if (op == Op::kForwardDraw || op == Op::kForwardMove)
+              openPolygons.back().vertices.push_back(t.pos);
+          } else if (kCpfg && x.cylinder >= 0) {
+            // Inside a generalized cylinder F draws nothing: the tube through
+            // the control points is the drawing (cpfg).
+          } else if (op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex) {
+            Segment sg;
+            sg.start = start;
+            sg.end = t.pos;
+            sg.left = t.frame.left;
+            sg.radiusStart = sg.radiusEnd = float(t.width * def.widthScale * 0.5);
+            sg.branch = t.branch;
+            sg.parent = branchParent[t.branch];
+            sg.depth = t.depth;
+            sg.color = t.color;
+            sg.module = uint32_t(i);
+            g.segments.push_back(sg);
+          }
+          if (tropism && ApplyTropism(def.tropism, x.elasticity, t.frame)) ++turnsSinceOrtho;
+          break;
+        }
+        case Op::kTurnLeft:
+          angle();
+          Rotate(t.frame.heading, t.frame.left, c, s);
+          break;
+        case Op::kTurnRight:
+          angle();
+          Rotate(t.frame.heading, t.frame.left, c, -s);
+          break;
+        case Op::kPitchDown:
+          angle();
+          Rotate(t.frame.heading, t.frame.up, c, s);
+          break;
+        case Op::kPitchUp:
+          angle();
+          Rotate(t.frame.heading, t.frame.up, c, -s);
+          break;
+        case Op::kRollRight:
+          angle();
+          Rotate(t.frame.left, t.frame.up, c, s);
+          break;
+        case Op::kRollLeft:
+          angle();
+          Rotate(t.frame.left, t.frame.up, c, -s);
+          break;
+        case Op::kTurnAround:
+          t.frame.heading = -t.frame.heading;
+          t.frame.left = -t.frame.left;
+          break;
+        case Op::kLevel: {
+          const Vec3 v = Vec3::UnitY().cross(t.frame.heading);
+          const double norm = v.norm();
+          if (norm > 1e-9) {
+            t.frame.left = v / norm;
+            t.frame.up = t.frame.left.cross(t.frame.heading);
+          }
+          break;
+        }
+        case Op::kPush:
+          stack.push_back(t);
+          branchParent.push_back(t.branch);
+          t.branch = uint32_t(branchParent.size() - 1);
+          t.depth = uint16_t(std::min<int>(t.depth + 1, 65535));
+          if constexpr (kCpfg) {
+            xstack.push_back(x);
+            x.cylinder = -1;  // a branch draws its own segments; `]` resumes the cylinder
+          }
+          break;
+        case Op::kPop:
+          if (stack.empty()) {
+            g = PlantGeometry();
+            return MakeError({},
+                             "unmatched ']' at module " + std::to_string(i + 1) + " of the word");
+          }
+          t = stack.back();
+          stack.pop_back();
+          if constexpr (kCpfg) {
+            x = xstack.back();
+            xstack.pop_back();
+          }
+          break;
+        case Op::kWidth:
+          if (np) {
+            t.width = p[0];
+          } else if (def.widthIncrement > 0) {
+            t.width = std::max(t.width - def.widthIncrement, 0.0);
+          } else {
+            t.width *= def.widthFactor;
+          }
+          break;
+        case Op::kWidthUp:
+          if (np) {
+            t.width = p[0];
+          } else if (def.widthIncrement > 0) {
+            t.width += def.widthIncrement;
+          } else if (def.widthFactor != 0) {
+            t.width /= def.widthFactor;
+          }
+          break;
+        case Op::kColor:
+          t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0)
+                                : std::clamp(t.color + colorStep, 0, 65535));
+          break;
+        case Op::kColorDown:
+          t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0)
+                                : std::clamp(t.color - colorStep, 0, 65535));
+          break;
+        case Op::kPolygonBegin: {
+          Polygon poly;
+          poly.color = t.color;
+          poly.module = uint32_t(i);
+          openPolygons.push_back(std::move(poly));
+          break;
+        }
+        case Op::kVertex:
+          if (!openPolygons.empty()) openPolygons.back().vertices.push_back(t.pos);
+          break;
+        case Op::kPolygonEnd:
+          ClosePolygon(openPolygons, i, g);
+          break;
+        case Op::kSurface: {
+          SurfaceInstance si;
+          si.name = symbols.name(sym).substr(1);
+          si.position = t.pos;
+          si.frame = t.frame;
+          // ~name(s): uniform; ~name(sx, sy, sz): along L, H, U (cpfg).
+          if (np >= 3) {
+            si.scale = Vec3(p[0], p[1], p[2]);
+          } else if (np) {
+            si.scale = Vec3(p[0], p[0], p[0]);
+          }
+          si.color = t.color;
+          si.module = uint32_t(i);
+          g.surfaces.push_back(std::move(si));
+          break;
+        }
+        case Op::kSphere: {
+          Sphere sp;
+          sp.center = t.pos;
+          sp.radius = (np ? p[0] : t.width * def.widthScale) * 0.5;
+          sp.color = t.color;
+          sp.module = uint32_t(i);
+          g.spheres.push_back(sp);
+          break;
+        }
+        case Op::kMoveTo:
+          // @M(x,y,z): cpfg's move-to, drawing nothing. Other arities are
+          // warned about by the parser and do nothing.
+          if (np >= 3) {
+            t.pos = Vec3(p[0], p[1], p[2]);
+            visit(t.pos);
+          }
+          break;
+        case Op::kDisc:
+        case Op::kCircle: {
+          // @o(d): in the plane of H and L, facing -U (the viewer of a 2D
+          // figure, which cpfg draws facing the screen); @c(d): across the
+          // heading, facing H. d defaults to the width.
+          const double d = (np ? p[0] : t.width) * def.widthScale;
+          if (op == Op::kDisc) {
+            AddDisc(t.pos, t.frame.heading, t.frame.left, d, t.color, uint32_t(i), g);
+          } else {
+            AddDisc(t.pos, t.frame.up, t.frame.left, d, t.color, uint32_t(i), g);
+          }
+          break;
+        }
+        case Op::kGcStart:
+        case Op::kGcPoint:
+        case Op::kGcEnd: {
+          const ControlPoint here{t.pos, t.frame.heading, t.frame.left, t.width, t.color};
+          if (x.cylinder < 0) {
+            if (op == Op::kGcEnd) break;  // nothing open: nothing to end
+            branchParent.push_back(t.branch);
+            x.cylinder = int32_t(cylinders.size());
+            cylinders.push_back({here, uint32_t(branchParent.size() - 1)});
+            if (op == Op::kGcStart) break;
+          }
+          Cylinder& cyl = cylinders[size_t(x.cylinder)];
+          if (op == Op::kGcStart) {  // @Gs inside an open cylinder restarts it here
+            cyl.last = here;
+            break;
+          }
+          AddCylinderPiece(cyl.last, here, int(CylinderRings(p, np)), def.widthScale, cyl.branch,
+                           t.branch, t.depth, uint32_t(i), g);
+          cyl.last = here;
+          if (op == Op::kGcEnd) x.cylinder = -1;
+          break;
+        }
+        case Op::kTropismSet:
+        case Op::kTropismUp:
+        case Op::kTropismDown: {
+          // @Ts(i, e) sets the elasticity of tropism i to e (0 without e);
+          // @Ti(i, d) and @Td(i, d) add and subtract d (default: the
+          // elasticity increment). Sylva has one tropism, i = 1.
+          if (np >= 1 && p[0] != 1) {
+            g.warnings.push_back("module " + std::to_string(i + 1) + " (" +
+                                 ModuleText(word, symbols, i) +
+                                 ") names a tropism other than 1; Sylva has one tropism: ignored");
+            break;
+          }
+          const double v = np >= 2 ? p[1] : (op == Op::kTropismSet ? 0 : def.elasticityIncrement);
+          if (op == Op::kTropismSet) x.elasticity = v;
+          if (op == Op::kTropismUp) x.elasticity += v;
+          if (op == Op::kTropismDown) x.elasticity -= v;
+          break;
+        }
+        case Op::kTwistForce:
+          // @Tf: cpfg records the frame so its next cylinder does not twist;
+          // Sylva's tubes follow rotation-minimizing frames and never twist.
+          break;
+        case Op::kNone:
+          break;
+      }
+      if (turnsSinceOrtho >= 64) {
+        Orthonormalise(t.frame);
+        turnsSinceOrtho = 0;
+      }
       if (options.recordModules) {
         g.modulePosition[i] = t.pos;
         g.moduleFrame[i] = t.frame;
       }
-      continue;
     }
-    const double* p = nullptr;
-    uint32_t np = 0;
-    if (hasParams) {
-      p = word.params.data() + word.paramStart[i];
-      np = word.paramStart[i + 1] - word.paramStart[i];
-    }
-    double s = defSin, c = defCos;
-    auto angle = [&] {
-      if (np) sincos.Get(p[0], &s, &c);
-      ++turnsSinceOrtho;
-    };
-    switch (op) {
-      case Op::kForwardDraw:
-      case Op::kForwardMove:
-      case Op::kForwardDrawNoVertex:
-      case Op::kForwardMoveNoVertex: {
-        const double len = np ? p[0] : def.step;
-        const Vec3 start = t.pos;
-        t.pos += t.frame.heading * len;
-        visit(t.pos);
-        const bool inPolygon = !openPolygons.empty();
-        if (inPolygon) {
-          if (op == Op::kForwardDraw || op == Op::kForwardMove)
-            openPolygons.back().vertices.push_back(t.pos);
-        } else if (op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex) {
-          Segment sg;
-          sg.start = start;
-          sg.end = t.pos;
-          sg.left = t.frame.left;
-          sg.radiusStart = sg.radiusEnd = float(t.width * def.widthScale * 0.5);
-          sg.branch = t.branch;
-          sg.parent = branchParent[t.branch];
-          sg.depth = t.depth;
-          sg.color = t.color;
-          sg.module = uint32_t(i);
-          g.segments.push_back(sg);
-        }
-        if (tropism && ApplyTropism(def, t.frame)) ++turnsSinceOrtho;
-        break;
-      }
-      case Op::kTurnLeft:
-        angle();
-        Rotate(t.frame.heading, t.frame.left, c, s);
-        break;
-      case Op::kTurnRight:
-        angle();
-        Rotate(t.frame.heading, t.frame.left, c, -s);
-        break;
-      case Op::kPitchDown:
-        angle();
-        Rotate(t.frame.heading, t.frame.up, c, s);
-        break;
-      case Op::kPitchUp:
-        angle();
-        Rotate(t.frame.heading, t.frame.up, c, -s);
-        break;
-      case Op::kRollRight:
-        angle();
-        Rotate(t.frame.left, t.frame.up, c, s);
-        break;
-      case Op::kRollLeft:
-        angle();
-        Rotate(t.frame.left, t.frame.up, c, -s);
-        break;
-      case Op::kTurnAround:
-        t.frame.heading = -t.frame.heading;
-        t.frame.left = -t.frame.left;
-        break;
-      case Op::kLevel: {
-        const Vec3 v = Vec3::UnitY().cross(t.frame.heading);
-        const double norm = v.norm();
-        if (norm > 1e-9) {
-          t.frame.left = v / norm;
-          t.frame.up = t.frame.left.cross(t.frame.heading);
-        }
-        break;
-      }
-      case Op::kPush:
-        stack.push_back(t);
-        branchParent.push_back(t.branch);
-        t.branch = uint32_t(branchParent.size() - 1);
-        t.depth = uint16_t(std::min<int>(t.depth + 1, 65535));
-        break;
-      case Op::kPop:
-        if (stack.empty()) {
-          g = PlantGeometry();
-          return MakeError({}, "unmatched ']' at module " + std::to_string(i + 1) + " of the word");
-        }
-        t = stack.back();
-        stack.pop_back();
-        break;
-      case Op::kWidth:
-        if (np) {
-          t.width = p[0];
-        } else if (def.widthIncrement > 0) {
-          t.width = std::max(t.width - def.widthIncrement, 0.0);
-        } else {
-          t.width *= def.widthFactor;
-        }
-        break;
-      case Op::kWidthUp:
-        if (np) {
-          t.width = p[0];
-        } else if (def.widthIncrement > 0) {
-          t.width += def.widthIncrement;
-        } else if (def.widthFactor != 0) {
-          t.width /= def.widthFactor;
-        }
-        break;
-      case Op::kColor:
-        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : std::min(t.color + 1, 65535));
-        break;
-      case Op::kColorDown:
-        t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0) : std::max(t.color - 1, 0));
-        break;
-      case Op::kPolygonBegin: {
-        Polygon poly;
-        poly.color = t.color;
-        poly.module = uint32_t(i);
-        openPolygons.push_back(std::move(poly));
-        break;
-      }
-      case Op::kVertex:
-        if (!openPolygons.empty()) openPolygons.back().vertices.push_back(t.pos);
-        break;
-      case Op::kPolygonEnd:
-        ClosePolygon(openPolygons, i, g);
-        break;
-      case Op::kSurface: {
-        SurfaceInstance si;
-        si.name = symbols.name(sym).substr(1);
-        si.position = t.pos;
-        si.frame = t.frame;
-        // ~name(s): uniform; ~name(sx, sy, sz): along L, H, U (cpfg).
-        if (np >= 3) {
-          si.scale = Vec3(p[0], p[1], p[2]);
-        } else if (np) {
-          si.scale = Vec3(p[0], p[0], p[0]);
-        }
-        si.color = t.color;
-        si.module = uint32_t(i);
-        g.surfaces.push_back(std::move(si));
-        break;
-      }
-      case Op::kSphere: {
-        Sphere sp;
-        sp.center = t.pos;
-        sp.radius = (np ? p[0] : t.width * def.widthScale) * 0.5;
-        sp.color = t.color;
-        sp.module = uint32_t(i);
-        g.spheres.push_back(sp);
-        break;
-      }
-      case Op::kMoveTo:
-        // @M(x,y,z): cpfg's move-to, drawing nothing. Other arities are
-        // warned about by the parser and do nothing.
-        if (np >= 3) {
-          t.pos = Vec3(p[0], p[1], p[2]);
-          visit(t.pos);
-        }
-        break;
-      case Op::kNone:
-        break;
-    }
-    if (turnsSinceOrtho >= 64) {
-      Orthonormalise(t.frame);
-      turnsSinceOrtho = 0;
-    }
-    if (options.recordModules) {
-      g.modulePosition[i] = t.pos;
-      g.moduleFrame[i] = t.frame;
-    }
+    return {};
+  };
+  if (Status st = cpfgState ? run(std::true_type{}) : run(std::false_type{}); !st.ok()) return st;
+  if (x.cylinder >= 0) {
+    g.warnings.push_back(
+        "generalized cylinder (@Gs) is never ended with @Ge; drawn up to its last "
+        "control point");
   }
   for (const Polygon& poly : openPolygons) {
     g.warnings.push_back("polygon opened at module " + std::to_string(poly.module + 1) +

@@ -19,6 +19,22 @@
 // by s (default 1), ~name(sx,sy,sz) scaled along L, H, U; @O(d) a sphere of diameter d (default:
 // the width); @M(x,y,z) moves to (x,y,z) drawing nothing. Tropism (ABOP eq. 2.3): after every F and
 // f, the frame turns about H x T by e |H x T|.
+//
+// cpfg's commands (its manual, and vlab's blackbox.c):
+//   @o(d)  a disc of diameter d (default: the width) in the plane of H and L,
+//          facing -U: a polygon of 24 vertices
+//   @c(d)  the same across the heading (the plane of L and U), facing H
+//   @v     roll to vertical: the same as $
+//   @Gs @Gc(n) @Ge(n)  a generalized cylinder: a tube along the cubic
+//          Hermite curve through the turtle's positions at @Gs, each @Gc and
+//          @Ge (tangents: the headings there times the distance between the
+//          points), n segments per piece (default 8), the width running
+//          linearly between the points; F inside draws nothing; a branch
+//          `[` draws on its own and `]` resumes the cylinder
+//   @Ts(i, e) @Ti(i, d) @Td(i, d)  set, raise and lower the tropism
+//          susceptibility e (cpfg's elasticity) of the turtle (kept by [ ]);
+//          i must be 1
+//   @Tf    accepted, nothing to do: Sylva's tubes never twist
 #pragma once
 
 #include <optional>
@@ -48,7 +64,10 @@ struct TurtleDef {
   double widthIncrement = 0;  // > 0: ! and # subtract and add it (cpfg); 0: the factor
   double widthScale = 1;      // drawn diameter = width x widthScale
   Vec3 tropism{0, -1, 0};
-  double susceptibility = 0;  // 0: no tropism
+  double susceptibility = 0;       // 0: no tropism (until @Ts, @Ti or @Td changes it)
+  double elasticityIncrement = 0;  // @Ti and @Td without a value add and subtract it
+  int initialColor = 0;            // colour index the turtle starts with
+  int colorIncrement = 1;          // ; and , without a parameter add and subtract it
 };
 
 TurtleDef TurtleDefFrom(const lsys::Grammar& g);

@@ -171,4 +171,32 @@ sys.stdout.write('<scene version=\"1\">\n<!--' + ' ' * 60000000 + '-->\n<sky/>\n
 run check sixty.xml
 [[ $code == 0 ]] || fail "a 60 MB scene: exit $code: $err"
 echo "ok: a 60 MB scene loads with $kb KiB resident"
+# --strict: a warning of the simulation (here a wind that cannot act on
+# particles without <drag>) fails render, mesh and simulate alike, at its
+# line, before anything is written; without --strict it is a warning and
+# exit 0.
+cat > warned.xml <<'EOF'
+<scene version="1">
+  <wind velocity="2 0 0"/>
+  <particles id="rain" max="10">
+    <emitter shape="point" at="0 1 0" rate="10"/>
+  </particles>
+</scene>
+EOF
+for cmd in "simulate --duration 0.1" "mesh -o strict.glb"; do
+  run $cmd warned.xml --strict
+  [[ $code == 2 ]] || fail "$cmd --strict with a warning exited $code: $err"
+  grep -qF "warned.xml:3:" err.txt || fail "$cmd --strict: expected the warning's line: $err"
+  [[ ! -e strict.glb ]] || fail "$cmd --strict wrote its output"
+  run $cmd warned.xml
+  [[ $code == 0 ]] || fail "$cmd without --strict exited $code: $err"
+  rm -f strict.glb
+done
+if [[ $graphics == graphics ]]; then
+  run render warned.xml -o strict.png --size 64x48 --strict
+  [[ $code == 2 ]] || fail "render --strict with a warning exited $code: $err"
+  grep -qF "warned.xml:3:" err.txt || fail "render --strict: expected the warning's line: $err"
+  [[ ! -e strict.png ]] || fail "render --strict wrote its output"
+fi
+echo "ok: --strict turns a simulation warning into exit 2 for simulate, mesh and render"
 echo "ok: all bad scenes are exit 2 at their line and column"

@@ -16,36 +16,43 @@ trap cleanup EXIT
 export DISPLAY="$display"
 for _ in $(seq 50); do [[ -e "/tmp/.X11-unix/X${display#:}" ]] && break; sleep 0.1; done
 
+# A PNG reader for the checks below (RGBA rows, PNG filters undone).
+cat > "$work/png.py" <<'PY'
+import struct, zlib
+def read(path):
+    data = open(path, 'rb').read()
+    assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
+    w, h = struct.unpack('>II', data[16:24])
+    idat = b''; i = 8
+    while i < len(data):
+        n, kind = struct.unpack('>I4s', data[i:i + 8]); body = data[i + 8:i + 8 + n]
+        if kind == b'IDAT': idat += body
+        i += 12 + n
+    raw = zlib.decompress(idat); stride = 4 * w + 1
+    prev = bytearray(4 * w); rows = []
+    for y in range(h):
+        f = raw[y * stride]; row = bytearray(raw[y * stride + 1:(y + 1) * stride])
+        for x in range(4 * w):
+            a = row[x - 4] if x >= 4 else 0; b = prev[x]; c = prev[x - 4] if x >= 4 else 0
+            if f == 1: row[x] = (row[x] + a) & 255
+            elif f == 2: row[x] = (row[x] + b) & 255
+            elif f == 3: row[x] = (row[x] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                row[x] = (row[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(row); prev = row
+    return w, h, rows
+PY
+
 cp "$src/grammars/abop/fig2_06a_monopodial.lsys" "$work/tree.lsys"
 "$sylva" view "$work/tree.lsys" --screenshot "$work/shot.png" --frames 5 --size 640x360
-python3 - "$work/shot.png" <<'PY'
-import struct, sys, zlib
-data = open(sys.argv[1], 'rb').read()
-assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
-w, h = struct.unpack('>II', data[16:24])
-idat = b''; i = 8
-while i < len(data):
-    n, kind = struct.unpack('>I4s', data[i:i + 8]); body = data[i + 8:i + 8 + n]
-    if kind == b'IDAT': idat += body
-    i += 12 + n
-raw = zlib.decompress(idat); stride = 4 * w + 1
+python3 - "$work" <<'PY'
+import sys; sys.path.insert(0, sys.argv[1]); import png
+w, h, rows = png.read(sys.argv[1] + '/shot.png')
 assert w == 640 and h == 360, (w, h)
-# Count brownish bark pixels (the plant), undoing PNG row filters.
-prev = bytearray(4 * w); bark = 0
-for y in range(h):
-    f = raw[y * stride]; row = bytearray(raw[y * stride + 1:(y + 1) * stride])
-    for x in range(4 * w):
-        a = row[x - 4] if x >= 4 else 0; b = prev[x]; c = prev[x - 4] if x >= 4 else 0
-        if f == 1: row[x] = (row[x] + a) & 255
-        elif f == 2: row[x] = (row[x] + b) & 255
-        elif f == 3: row[x] = (row[x] + (a + b) // 2) & 255
-        elif f == 4:
-            p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-            row[x] = (row[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-    for x in range(w):
-        r, g, bl = row[4 * x:4 * x + 3]
-        if r > g > bl and r - bl > 25: bark += 1
-    prev = row
+# Count brownish bark pixels (the plant).
+bark = sum(1 for row in rows for x in range(w)
+           if row[4 * x] > row[4 * x + 1] > row[4 * x + 2] and row[4 * x] - row[4 * x + 2] > 25)
 print(f'screenshot {w}x{h}: {bark} bark-coloured pixels')
 assert bark > 300, 'the plant is not in the picture'
 PY
@@ -69,6 +76,36 @@ assert redone >= 3, f'{redone} re-tessellations in {frames} frames of orbiting'
 print(f'{redone} re-tessellations in {frames} frames; slowest swap {swap_ms} ms, '
       f'slowest frame {frame_ms} ms')
 PY
+
+# -n, --seed and -D as the other commands take them (a younger tree: fewer
+# bark pixels), and a 2D figure drawn as lines on white: no ground, no
+# shadow (the bottom rows, below the figure, are white).
+"$sylva" view "$work/tree.lsys" -n 3 --seed 2 -D r1=0.8 --screenshot "$work/young.png" --frames 5 --size 640x360
+cp "$src/grammars/abop/fig1_06_koch_island.lsys" "$work/koch.lsys"
+"$sylva" view "$work/koch.lsys" --screenshot "$work/koch.png" --frames 5 --size 640x360
+python3 - "$work" <<'PY'
+import sys; sys.path.insert(0, sys.argv[1]); import png
+def bark(rows, w):
+    return sum(1 for row in rows for x in range(w)
+               if row[4 * x] > row[4 * x + 1] > row[4 * x + 2] and row[4 * x] - row[4 * x + 2] > 25)
+w, h, old = png.read(sys.argv[1] + '/shot.png')
+_, _, young = png.read(sys.argv[1] + '/young.png')
+print(f'-n 3: {bark(young, w)} bark pixels against {bark(old, w)} at the full length')
+assert 0 < bark(young, w) < bark(old, w), 'view -n 3 did not show a younger tree'
+w, h, rows = png.read(sys.argv[1] + '/koch.png')
+# Right of the panel (x >= 330): lines on white; the bottom 8 rows all white.
+dark = sum(1 for row in rows for x in range(330, w) if sum(row[4 * x:4 * x + 3]) < 300)
+bottom = [row[4 * x:4 * x + 3] for row in rows[h - 8:] for x in range(330, w)]
+white = sum(1 for p in bottom if min(p) >= 250)
+print(f'2D figure: {dark} dark line pixels; {white} of {len(bottom)} bottom pixels white')
+assert dark > 500, 'the Koch island lines are not in the picture'
+assert white == len(bottom), 'a 2D figure got a ground or a shadow'
+PY
+if "$sylva" view "$src/examples/scenes/flag.xml" -n 3 --screenshot "$work/s.png" --frames 2 2>"$work/n.err"; then
+  echo "view SCENE -n 3 should be exit 2"; exit 1
+fi
+grep -q "are for grammars" "$work/n.err"
+echo "view takes -n, --seed and -D; 2D figures are lines on white"
 
 # A running viewer, then a bad edit.
 # It orbits, so it keeps re-tessellating: after the bad edit it must go on

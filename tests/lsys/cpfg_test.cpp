@@ -36,28 +36,93 @@ std::string Joined(const std::vector<std::string>& v) {
 TEST(Cpfg, UnimplementedCommandsWarnOncePerSymbolAtTheirFirstUse) {
   auto w = Warnings(
       "axiom: A\n"
-      "A --> F@Gs F@Gc(1)@Gc(2)@Ge A\n"
-      "F --> @Gs F @Tf(1) @Ts(2) @o(1) @c(1) @v @M(1,2) @O(2)\n");
+      "A --> F@Gr(1) F@Gt(1)@Gt(2)@PS(1) A\n"
+      "F --> @Gs F @Tf @Ts(1,2) @o(1) @c(1) @v @M(1,2) @O(2) @Ge\n");
   const std::string all = Joined(w);
-  ASSERT_EQ(w.size(), 9u) << all;
-  EXPECT_EQ(w[0].rfind("2:8 '@Gs' (cpfg: start of a generalized cylinder) is not implemented", 0),
-            0u)
+  ASSERT_EQ(w.size(), 4u) << all;
+  EXPECT_EQ(w[0].rfind("2:8 '@Gr' (cpfg: generalized cylinder radius) is not implemented", 0), 0u)
       << all;
-  EXPECT_EQ(w[1].rfind("2:13 '@Gc'", 0), 0u) << all;  // once for @Gc(1) and @Gc(2)
-  EXPECT_EQ(w[2].rfind("2:25 '@Ge'", 0), 0u) << all;
-  EXPECT_EQ(w[3].rfind("3:13 '@Tf'", 0), 0u) << all;
-  EXPECT_EQ(w[4].rfind("3:20 '@Ts'", 0), 0u) << all;
-  EXPECT_EQ(w[5].rfind("3:27 '@o'", 0), 0u) << all;
-  EXPECT_EQ(w[6].rfind("3:33 '@c'", 0), 0u) << all;
-  EXPECT_EQ(w[7].rfind("3:39 '@v'", 0), 0u) << all;
-  EXPECT_EQ(w[8].rfind("3:42 '@M' (move to) needs 3 parameters", 0), 0u) << all;
+  EXPECT_EQ(w[1].rfind("2:16 '@Gt'", 0), 0u) << all;  // once for @Gt(1) and @Gt(2)
+  EXPECT_EQ(w[2].rfind("2:28 '@PS'", 0), 0u) << all;
+  EXPECT_EQ(w[3].rfind("3:41 '@M' (move to) needs 3 parameters", 0), 0u) << all;
 }
 
-TEST(Cpfg, QueryModulesWarnThatTheyAreNotAnswered) {
-  auto w = Warnings("axiom: A ?P(0,0,0)\nA --> F ?H(0,0,0) ?P(1,1,1)\n");
-  ASSERT_EQ(w.size(), 2u) << Joined(w);
-  EXPECT_EQ(w[0].rfind("1:10 query module '?P' is not answered yet", 0), 0u) << w[0];
-  EXPECT_EQ(w[1].rfind("2:9 query module '?H' is not answered yet", 0), 0u) << w[1];
+TEST(Cpfg, ImplementedCommandsWarnAboutParametersTheyDoNotUse) {
+  auto w = Warnings("axiom: @o(1,2) @c(1) @Gs(3) @Gc(2) @Ge(1,1) @Ts(1,2,3) @Ti(1) @Td @v\n");
+  const std::string all = Joined(w);
+  ASSERT_EQ(w.size(), 4u) << all;
+  EXPECT_EQ(w[0].rfind("1:8 '@o' (disc) uses the diameter; the other 1 are ignored", 0), 0u) << all;
+  EXPECT_EQ(w[1].rfind("1:22 '@Gs' (start of a generalized cylinder) uses no parameters", 0), 0u)
+      << all;
+  EXPECT_EQ(w[2].rfind("1:36 '@Ge'", 0), 0u) << all;
+  EXPECT_EQ(w[3].rfind("1:45 '@Ts'", 0), 0u) << all;
+}
+
+TEST(Cpfg, BracketsInConsiderAreAcceptedAndKeepTheBranching) {
+  // B and the branch [C] are skipped: A sees A as its left context.
+  EXPECT_EQ(DeriveText("consider: [ ] A\naxiom: A B [C] A\nA < A --> D\n", 1), "AB[C]D");
+  // Without the consider: list B stands between them.
+  EXPECT_EQ(DeriveText("axiom: A B [C] A\nA < A --> D\n", 1), "AB[C]A");
+  ParseResult r = ParseGrammarText("ignore: [ +\naxiom: A\n", "c.l", {});
+  EXPECT_FALSE(r.grammar);
+  EXPECT_NE(r.diagnostics.FormatAll().find("c.l:1:9: error: brackets cannot be ignored"),
+            std::string::npos)
+      << r.diagnostics.FormatAll();
+}
+
+TEST(Cpfg, QueryModulesWarnOnlyWhereTheyAreNotAnswered) {
+  // ?P ?H ?L ?U with 2 or 3 parameters are answered (plant/queries.h).
+  auto none = Warnings("axiom: A ?P(0,0,0)\nA --> F ?H(0,0) ?L(0,0,0) ?U(1,1) ?P(1,1,1)\n");
+  EXPECT_TRUE(none.empty()) << Joined(none);
+  auto w = Warnings("axiom: A ?P(0)\nA --> F ?H(0,0,0,0) ?E(1) ?X(1)\n");
+  ASSERT_EQ(w.size(), 4u) << Joined(w);
+  EXPECT_EQ(w[0].rfind("1:10 query module '?P' takes 2 parameters (x, y) or 3", 0), 0u) << w[0];
+  EXPECT_EQ(w[1].rfind("2:9 query module '?H' takes 2 parameters", 0), 0u) << w[1];
+  EXPECT_EQ(w[2].rfind("2:27 query module '?X' is not answered", 0), 0u) << w[2];
+  // ?E without an `environment:` statement, at its first use.
+  EXPECT_EQ(
+      w[3].rfind("2:21 query module '?E' is not answered: the grammar has no 'environment:'", 0),
+      0u)
+      << w[3];
+}
+
+TEST(Cpfg, EnvironmentStatementIsReadAsKindAndItems) {
+  auto r = lsys::ParseGrammarText(
+      "#define h 2\nenvironment: light cell=0.25 depth=h+1 box(0,0,0, 1,h,3)\naxiom: A ?E(1)\n",
+      "env.lsys");
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  ASSERT_TRUE(r.grammar->environment.has_value());
+  const auto& e = *r.grammar->environment;
+  EXPECT_EQ(e.kind, "light");
+  EXPECT_EQ(e.loc.line, 2);
+  EXPECT_EQ(e.loc.column, 14);
+  ASSERT_EQ(e.items.size(), 3u);
+  EXPECT_TRUE(e.items[0].keyValue);
+  EXPECT_EQ(e.items[0].name, "cell");
+  EXPECT_EQ(e.items[0].values, std::vector<double>{0.25});
+  EXPECT_EQ(e.items[1].values, std::vector<double>{3});
+  EXPECT_TRUE(e.items[2].call);
+  EXPECT_EQ(e.items[2].name, "box");
+  EXPECT_EQ(e.items[2].values, (std::vector<double>{0, 0, 0, 1, 2, 3}));
+  EXPECT_EQ(e.items[2].loc.column, 40);
+}
+
+TEST(Cpfg, EnvironmentStatementErrorsHaveAPosition) {
+  auto two = lsys::ParseGrammarText(
+      "environment: shape sphere(0,0,0,1)\nenvironment: light\naxiom: A\n", "e.lsys");
+  ASSERT_FALSE(two.grammar);
+  EXPECT_NE(two.diagnostics.FormatAll().find("e.lsys:2:1: error: a second 'environment:'"),
+            std::string::npos)
+      << two.diagnostics.FormatAll();
+  auto bad = lsys::ParseGrammarText("environment: shape box(0,0,0 1)\naxiom: A\n", "e.lsys");
+  ASSERT_FALSE(bad.grammar);
+  EXPECT_NE(bad.diagnostics.FormatAll().find("e.lsys:1:30: error: expected ',' or ')'"),
+            std::string::npos)
+      << bad.diagnostics.FormatAll();
+  auto random = lsys::ParseGrammarText("environment: light cell=ran(1)\naxiom: A\n", "e.lsys");
+  ASSERT_FALSE(random.grammar);
+  EXPECT_NE(random.diagnostics.FormatAll().find("constant expression"), std::string::npos)
+      << random.diagnostics.FormatAll();
 }
 
 TEST(Cpfg, SurfaceWithTwoScalesWarns) {

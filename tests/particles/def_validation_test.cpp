@@ -88,6 +88,11 @@ TEST(ClothDef, RejectsEveryOutOfRangeField) {
   bad([](ClothDef& d) { d.threads = -1; }, "ClothDef.threads", "-1");
   bad([](ClothDef& d) { d.implicitStiffness = 0; }, "ClothDef.implicitStiffness", "0");
   bad([](ClothDef& d) { d.cgIterations = 0; }, "ClothDef.cgIterations", "0");  // was clamped to 1
+  bad([](ClothDef& d) { d.thickness = kNaN; }, "ClothDef.thickness", "nan");
+  bad([](ClothDef& d) { d.selfFriction = -1; }, "ClothDef.selfFriction", "-1");
+  bad([](ClothDef& d) { d.implicitStrainLimit = kInf; }, "ClothDef.implicitStrainLimit", "inf");
+  bad([](ClothDef& d) { d.implicitStrainIterations = 0; }, "ClothDef.implicitStrainIterations",
+      "0");
 }
 
 TEST(FlockingDef, RejectsEveryOutOfRangeField) {

@@ -19,6 +19,7 @@
 #include "render/camera.h"
 #include "render/render_fixture.h"
 #include "render/renderer.h"
+#include "scene/default_scene.h"
 
 namespace sylva::render {
 namespace {
@@ -26,8 +27,10 @@ namespace {
 class ScreenDetailRender : public testing::RenderFixture {};
 
 // A close-up inside the crown (most of the tree is outside the frustum),
-// without and with the ground, its shadows and coverage lines (a branch outside the view
-// may cast a shadow into it, so culling keeps it then).
+// without and with the default scene's ground, its shadows and coverage
+// lines (a branch outside the view may cast a shadow into it, so culling
+// keeps it then), drawn as `sylva render` draws a grammar: through the
+// DrawList.
 TEST_F(ScreenDetailRender, CullingNeverRemovesAVisiblePixel) {
   auto p =
       sylva::testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 11, plant::Stage::kGeometry);
@@ -67,10 +70,13 @@ TEST_F(ScreenDetailRender, CullingNeverRemovesAVisiblePixel) {
           EXPECT_GT(lines, 0u) << "azimuth " << az << ": no coverage line to test";
         }
         ASSERT_TRUE(renderer_->Resize(W, H).ok());
-        renderer_->SetGround(shadows);
-        renderer_->SetShadows(shadows);
-        renderer_->SetMesh(m, mesh::DefaultPalette(), &box);
-        renderer_->Draw(cam);
+        auto shared = std::make_shared<const mesh::TriangleMesh>(std::move(m));
+        draw::DrawList list = scene::DefaultScene(shared, mesh::DefaultPalette(), box.lo, box.hi);
+        if (!shadows) {  // the plant alone, lit by an ambient light: no shadow map
+          list.meshes.resize(1);
+          list.lights = {draw::Light::Ambient({1, 1, 1}, 0.8f)};
+        }
+        ASSERT_TRUE(renderer_->Draw(list, cam).ok());
         images[cull] = renderer_->ReadPixels();
       }
       // Without shadows most of the tree is culled; with them, what shades the view stays.
@@ -200,7 +206,6 @@ TEST_F(ScreenDetailRender, SubPixelTwigsKeepTheirCoverage) {
     mesh::TriangleMesh m;
     EXPECT_TRUE(mesh::Tessellate(g, opt, m).ok());
     EXPECT_TRUE(renderer_->Resize(W * scale, H * scale).ok());
-    renderer_->SetGround(false);
     renderer_->SetShadows(false);
     renderer_->SetMesh(m, mesh::DefaultPalette());
     renderer_->Draw(cam);
@@ -252,7 +257,6 @@ TEST_F(ScreenDetailRender, SubPixelLinesKeepTheAnalyticCoverage) {
     EXPECT_TRUE(mesh::Tessellate(grid.geometry, opt, m).ok());
     EXPECT_EQ(mesh::Validate(m), "");
     EXPECT_TRUE(renderer_->Resize(W, H).ok());
-    renderer_->SetGround(false);
     renderer_->SetShadows(false);
     renderer_->SetMesh(m, mesh::DefaultPalette());
     renderer_->Draw(cam);
@@ -350,7 +354,6 @@ TEST_F(ScreenDetailRender, DrawListBlendsCoverageLinesToo) {
   auto opaque = std::make_shared<mesh::TriangleMesh>(*m);
   opaque->coverage.clear();
   const double solid = Darkness(drawList(opaque), bg);
-  renderer_->SetGround(false);
   renderer_->SetShadows(false);
   renderer_->SetMesh(*m, mesh::DefaultPalette());
   renderer_->Draw(cam);
@@ -385,6 +388,14 @@ TEST_F(ScreenDetailRender, SlowDollyDoesNotFlipDetailBackAndForth) {
     distances.push_back(d);
     d *= k % 4 == 3 ? 1 / 0.97 : 0.97;
   }
+  // Drawn as `sylva render` draws a grammar: in the default scene (its
+  // ground and shadows), through the DrawList.
+  auto drawScene = [&](mesh::TriangleMesh m) {
+    auto shared = std::make_shared<const mesh::TriangleMesh>(std::move(m));
+    const draw::DrawList list = scene::DefaultScene(shared, mesh::DefaultPalette(), box.lo, box.hi);
+    EXPECT_TRUE(renderer_->Draw(list, cam).ok());
+    return renderer_->ReadPixels();
+  };
   auto run = [&](bool hysteresis, bool render, std::vector<Image>* frames) {
     mesh::DetailHistory history;
     std::vector<std::vector<int16_t>> levels;
@@ -400,11 +411,7 @@ TEST_F(ScreenDetailRender, SlowDollyDoesNotFlipDetailBackAndForth) {
       levels.push_back(history.level);
       if (!render) continue;
       EXPECT_TRUE(renderer_->Resize(W, H).ok());
-      renderer_->SetGround(true);
-      renderer_->SetShadows(true);
-      renderer_->SetMesh(m, mesh::DefaultPalette(), &box);
-      renderer_->Draw(cam);
-      frames->push_back(renderer_->ReadPixels());
+      frames->push_back(drawScene(std::move(m)));
     }
     // Reversals: a chain whose level changes against its previous change.
     size_t reversals = 0, changes = 0;
@@ -434,9 +441,7 @@ TEST_F(ScreenDetailRender, SlowDollyDoesNotFlipDetailBackAndForth) {
     opt.detail.sides = 16;
     mesh::TriangleMesh m;
     ASSERT_TRUE(mesh::Tessellate(p->geometry, opt, m).ok());
-    renderer_->SetMesh(m, mesh::DefaultPalette(), &box);
-    renderer_->Draw(cam);
-    uniformFrames.push_back(renderer_->ReadPixels());
+    uniformFrames.push_back(drawScene(std::move(m)));
   }
   auto change = [](const Image& a, const Image& b) {
     double sum = 0;

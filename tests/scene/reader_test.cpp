@@ -62,6 +62,12 @@ std::vector<BadCase> BadCases() {
       {"wrong_type", "<terrain height=\"tall\"/>\n", "2:18",
        "expected a decimal number, found 'tall'"},
       {"out_of_range", "<terrain gain=\"1.5\"/>\n", "2:16", "'gain': must be between 0 and 1"},
+      // The terrain library's own ranges, so `check` refuses what `render` would.
+      {"terrain_too_wide", "<terrain size=\"1e7 10\"/>\n", "2:10", "each from 0.001 to 1e6"},
+      {"terrain_too_high", "<terrain height=\"1e6\"/>\n", "2:18",
+       "'height': must be between 0 and 100000"},
+      {"terrain_past_float", "<terrain size=\"1e6 1e6\" octaves=\"16\" lacunarity=\"8\"/>\n", "2:1",
+       "<terrain>: 16 octaves of lacunarity 8"},
       {"negative", "<wind gust=\"-1\"/>\n", "2:13", "'gust': must be 0 or more"},
       {"not_whole", "<particles max=\"1.5\"><emitter/></particles>\n", "2:17",
        "expected a whole number"},

@@ -28,7 +28,9 @@ struct Run {
 };
 
 // Reads, builds and creates the simulation of `text`, or fails the test.
-std::unique_ptr<Run> Start(const std::string& text, int threads = 1) {
+// Warnings of Simulation::Create go to *warningsOut when given.
+std::unique_ptr<Run> Start(const std::string& text, int threads = 1,
+                           DiagnosticList* warningsOut = nullptr) {
   const auto dir = sylva::testing::ScratchDir("sylva_scene_sim_");
   const std::string path = (dir / "s.xml").string();
   std::ofstream(path) << text;
@@ -48,6 +50,7 @@ std::unique_ptr<Run> Start(const std::string& text, int threads = 1) {
   EXPECT_TRUE(sim.ok()) << (sim.ok() ? "" : sim.error().message);
   if (!sim.ok()) return nullptr;
   run->sim = std::move(*sim);
+  if (warningsOut) *warningsOut = std::move(warnings);
   return run;
 }
 
@@ -123,6 +126,98 @@ TEST(SceneSimulation, SnowThatLandsOnABranchStaysThere) {
         break;
       }
   EXPECT_EQ(kept, rest.size()) << "resting flakes that moved: " << rest.size() - kept;
+}
+
+TEST(SceneSimulation, SnowRestsOnTheSurfacesAPlantPlaces) {
+  // A stem whose leaves and flower are the bundled surfaces ~leaf and
+  // ~flower (no polygons): snow lands on them, away from the stem's axis.
+  // Surfaces did not collide before: flakes passed through every leaf.
+  auto run = Start(R"(<scene version="1">
+    <plant id="stem" grammar=")" +
+                   Grammar("plants/leafy_stem.lsys") +
+                   R"(" steps="6" height="3"/>
+    <particles id="snow" max="20000">
+      <emitter shape="box" at="0 4 0" size="3 0.2 3" rate="20000" direction="0 -1 0"
+               speed="1" lifetime="100"/>
+      <gravity/>
+      <collide with="stem ground" stick="true"/>
+    </particles>
+    <simulation fps="30" substeps="2"/>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(2).ok());
+  size_t onLeaves = 0, below = 0, n = 0;
+  for (const Row& r : Rows(*run->sim)) {
+    ++n;
+    if (r.x.y() < -1e-9) ++below;
+    const double fromAxis = std::hypot(r.x.x(), r.x.z());
+    if (r.v.norm() == 0 && r.x.y() > 0.05 && fromAxis > 0.2) ++onLeaves;
+  }
+  EXPECT_EQ(below, 0u) << "flakes below the ground";
+  EXPECT_GT(onLeaves, 100u) << "flakes resting on leaves (above the ground, 0.2 m or more from "
+                               "the stem) of "
+                            << n;
+}
+
+TEST(SceneSimulation, ChainSpringsHoldParticlesBornTogether) {
+  // 20 particles burst in random directions at 1 m/s: alone they fly
+  // apart; joined in a chain (each to the one born before it) they stay
+  // near the distances they were born at. Dying ends take their springs
+  // with them (the second system dies early; no step fails).
+  const std::string body = R"(
+      <emitter shape="box" at="0 5 0" size="1 1 1" burst="20" speed="1" spread="180"
+               lifetime="100 100"/>)";
+  auto run = Start(R"(<scene version="1">
+    <particles id="rope" max="20">)" +
+                   body + R"(
+      <springs between="chain" k="2000" damping="4"/>
+    </particles>
+    <particles id="free" max="20">)" +
+                   body + R"(
+    </particles>
+    <particles id="short" max="200">
+      <emitter shape="point" at="0 1 0" rate="100" speed="0.5" spread="180" lifetime="0.2 0.6"/>
+      <springs between="grid" k="50" damping="1"/>
+    </particles>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(3).ok());
+  const std::vector<Row> rows = Rows(*run->sim);
+  double ropeStretch = 0, freeStretch = 0;
+  for (const char* system : {"rope", "free"}) {
+    std::vector<Vec3> now;
+    for (const Row& r : rows)
+      if (r.system == system) now.push_back(r.x);
+    ASSERT_EQ(now.size(), 20u) << system;
+    double sum = 0;
+    for (size_t i = 1; i < now.size(); ++i) sum += (now[i] - now[i - 1]).norm();
+    (std::string(system) == "rope" ? ropeStretch : freeStretch) = sum / 19;
+  }
+  // Born within a 1 m box: consecutive distances about 0.66 m. After 3 s
+  // the free ones are metres apart; the rope's stay under 1.5 m.
+  EXPECT_LT(ropeStretch, 1.5) << "mean distance of consecutive rope particles after 3 s";
+  EXPECT_GT(freeStretch, 2.0) << "mean distance of consecutive free particles after 3 s";
+}
+
+TEST(SceneSimulation, NearestSpringsAreBoundedByTheSystemSize) {
+  const auto dir = sylva::testing::ScratchDir("sylva_scene_sim_");
+  const std::string path = (dir / "s.xml").string();
+  std::ofstream(path) << R"(<scene version="1">
+    <particles id="web" max="100000">
+      <emitter rate="10"/>
+      <springs between="nearest"/>
+    </particles>
+  </scene>)";
+  ReadResult r = ReadScene(path);
+  ASSERT_TRUE(r.scene) << r.diagnostics.FormatAll();
+  BuildResult b = Build(*r.scene, {});
+  ASSERT_TRUE(b.scene);
+  DiagnosticList warnings;
+  auto sim = Simulation::Create(*r.scene, *b.scene, {}, warnings);
+  ASSERT_FALSE(sim.ok()) << "a nearest-springs system of 100,000 must be refused";
+  EXPECT_NE(sim.error().message.find("at most 20000 particles"), std::string::npos)
+      << sim.error().message;
+  EXPECT_EQ(sim.error().loc.line, 4) << sim.error().Format();
 }
 
 TEST(SceneSimulation, FastParticlesBornOverATerrainDoNotPassThroughIt) {
@@ -257,6 +352,57 @@ TEST(SceneSimulation, ClothHangsFromItsPinsAndFlagsInTheWind) {
   EXPECT_GT(meanX, 1.0) << "free edge's mean x; the wind blows along +x";
 }
 
+// A sheet dropped flat from 3.5 m: on the ground it rests on it; over a
+// flagpole it hangs on the pole's tip (a capsule); its <drag> and <vortex> act (no
+// warnings), and `with` naming the cloth itself is its self-collision.
+TEST(SceneSimulation, ClothCollidesWithTheGroundAndPlantsAndFeelsItsForces) {
+  auto scene = [](const std::string& with, const std::string& forces) {
+    return R"(<scene version="1">
+      <plant id="pole" grammar=")" +
+           Grammar("plants/flagpole.lsys") +
+           R"("/>
+      <cloth id="sheet" size="3 3" resolution="25 25" position="-1.5 3.5 -1.5" rotate="-90 0 0"
+             pin="none">
+        <gravity/>)" +
+           forces + (with.empty() ? "" : R"(<collide with=")" + with + R"(" friction="0.5"/>)") +
+           R"(
+      </cloth>
+      <simulation fps="30" substeps="2"/>
+    </scene>)";
+  };
+  struct Result {
+    double lowest = HUGE_VAL, highest = -HUGE_VAL;
+    size_t warnings = 0;
+  };
+  auto run = [&](const std::string& with, const std::string& forces, double t) {
+    DiagnosticList warnings;
+    auto r = Start(scene(with, forces), 1, &warnings);
+    Result out;
+    if (!r) return out;
+    EXPECT_TRUE(r->sim->AdvanceTo(t).ok());
+    for (const Row& row : Rows(*r->sim)) {
+      out.lowest = std::min(out.lowest, row.x.y());
+      out.highest = std::max(out.highest, row.x.y());
+    }
+    out.warnings = warnings.items.size();
+    if (out.warnings) ADD_FAILURE() << warnings.FormatAll();
+    return out;
+  };
+  const Result ground = run("ground", "", 3);
+  EXPECT_GE(ground.lowest, -1e-9) << "a vertex under the ground";
+  // Caught on the tip at 0.8 s (it slides off the rounded end later: one
+  // point of contact is an unstable balance).
+  const Result pole = run("pole ground sheet", "", 0.8);
+  EXPECT_GE(pole.lowest, 1.0) << "the sheet hangs on the pole";
+  EXPECT_GT(pole.highest, 3.3) << "the sheet hangs on the pole's tip (3.3 m + its radius)";
+  EXPECT_LT(pole.highest, 3.34) << "the sheet hangs on the pole's tip (3.3 m + its radius)";
+  EXPECT_LT(ground.highest, 0.1) << "without the pole the sheet lies on the ground";
+  const Result none = run("", "", 0.5);
+  const Result drag = run("", R"(<drag k="0.01"/><vortex strength="0.1"/>)", 0.5);
+  EXPECT_GT(drag.lowest, none.lowest + 0.1) << "the sheet with a drag falls slower: lowest "
+                                            << drag.lowest << " m against " << none.lowest << " m";
+}
+
 }  // namespace
 }  // namespace sylva::scene
 
@@ -310,6 +456,40 @@ TEST(SceneSimulation, AnEndlessRunIsAnErrorBeforeAnyStep) {
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().message.find("more than the limit"), std::string::npos) << s.error().message;
   EXPECT_EQ(run->sim->time(), 0) << "no step was taken";
+}
+
+TEST(SceneSimulation, AnAttractorFollowsTheFlockOrClothItIsOf) {
+  // Moths drawn to a flock that cruises in a box around x = 25, and dust
+  // drawn to a cloth hanging around x = -20: each system's centroid moves
+  // toward the element its attractor is `of` (before, both used the origin).
+  auto run = Start(R"(<scene version="1">
+    <flock id="birds" count="50" bounds="20 4 -5 30 8 5" speed="2"/>
+    <cloth id="sheet" position="-21 6 -1" size="2 2" resolution="6 6" pin="top"/>
+    <particles id="moths" max="20">
+      <emitter shape="point" at="0 5 0" burst="20" lifetime="100 100"/>
+      <attractor of="birds" strength="400" falloff="linear"/>
+    </particles>
+    <particles id="dust" max="20">
+      <emitter shape="point" at="0 5 0" burst="20" lifetime="100 100"/>
+      <attractor of="sheet" strength="400" falloff="linear"/>
+    </particles>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(1.0).ok());
+  Vec3 moths = Vec3::Zero(), dust = Vec3::Zero();
+  int nm = 0, nd = 0;
+  for (const Row& r : Rows(*run->sim)) {
+    if (r.system == "moths") moths += r.x, ++nm;
+    if (r.system == "dust") dust += r.x, ++nd;
+  }
+  ASSERT_EQ(nm, 20);
+  ASSERT_EQ(nd, 20);
+  moths /= nm;
+  dust /= nd;
+  // Linear falloff: 400 / 25 = 16 m/s^2 at the start, 1 s from rest.
+  EXPECT_GT(moths.x(), 5) << "moths' centroid " << moths.transpose();
+  EXPECT_LT(dust.x(), -5) << "dust's centroid " << dust.transpose();
+  EXPECT_NEAR(moths.z(), 0, 1) << "moths' centroid " << moths.transpose();
 }
 
 }  // namespace

@@ -359,5 +359,127 @@ TEST(Turtle, WidthDownAndUpByTheIncrementAsCpfg) {
     EXPECT_NEAR(d.geometry.segments[i].radiusStart, want[i] / 2, 1e-6) << "segment " << i;
 }
 
+// Newell's normal of a polygon, unit length.
+Vec3 NewellNormal(const std::vector<Vec3>& v) {
+  Vec3 n(0, 0, 0);
+  for (size_t i = 0; i < v.size(); ++i) n += v[i].cross(v[(i + 1) % v.size()]);
+  return n.normalized();
+}
+
+TEST(Turtle, DiscLiesInTheHeadingLeftPlaneFacingMinusUp) {
+  Drawn d = Draw("axiom: F @o(2)\n");
+  ASSERT_EQ(d.geometry.polygons.size(), 1u);
+  const auto& v = d.geometry.polygons[0].vertices;
+  ASSERT_EQ(v.size(), 24u);
+  for (const Vec3& p : v) {
+    EXPECT_NEAR((p - Vec3(0, 1, 0)).norm(), 1.0, 1e-12) << Str(p);
+    EXPECT_NEAR(p.z(), 0.0, 1e-12) << Str(p);  // the plane of H and L
+  }
+  EXPECT_VEC_NEAR(NewellNormal(v), Vec3(0, 0, 1), 1e-12);  // -U
+  EXPECT_TRUE(d.geometry.segments.size() == 1u);
+}
+
+TEST(Turtle, CircleLiesAcrossTheHeadingWithTheWidthAsDefaultDiameter) {
+  Drawn d = Draw("width: 0.4\naxiom: F &(90) @c\n");
+  ASSERT_EQ(d.geometry.polygons.size(), 1u);
+  const auto& v = d.geometry.polygons[0].vertices;
+  ASSERT_EQ(v.size(), 24u);
+  // After &(90) H = (0,0,-1): the disc lies in the plane z = 0 through (0,1,0).
+  for (const Vec3& p : v) {
+    EXPECT_NEAR((p - Vec3(0, 1, 0)).norm(), 0.2, 1e-12) << Str(p);
+    EXPECT_NEAR(p.z(), 0.0, 1e-12) << Str(p);
+  }
+  EXPECT_VEC_NEAR(NewellNormal(v), Vec3(0, 0, -1), 1e-12);  // H
+}
+
+TEST(Turtle, RollToVerticalIsDollar) {
+  const Frame a = FinalFrame("&(30)/(40)+(20)@v");
+  const Frame b = FinalFrame("&(30)/(40)+(20)$");
+  EXPECT_VEC_NEAR(a.heading, b.heading, 1e-15);
+  EXPECT_VEC_NEAR(a.left, b.left, 1e-15);
+  EXPECT_VEC_NEAR(a.up, b.up, 1e-15);
+  EXPECT_NEAR(a.left.y(), 0.0, 1e-15);  // L horizontal
+  EXPECT_NEAR(a.left.dot(a.heading), 0.0, 1e-15);
+}
+
+TEST(Turtle, GeneralizedCylinderAlongALineIsEvenlyCutAndTapers) {
+  Drawn d = Draw("axiom: !(1) @Gs F(3) !(2) @Ge(6)\n");
+  ASSERT_EQ(d.geometry.segments.size(), 6u);  // F inside draws nothing
+  for (size_t k = 0; k < 6; ++k) {
+    const Segment& s = d.geometry.segments[k];
+    EXPECT_VEC_NEAR(s.end, Vec3(0, 0.5 * double(k + 1), 0), 1e-12);
+    EXPECT_NEAR(s.radiusEnd, (1 + double(k + 1) / 6) / 2, 1e-6) << "segment " << k;
+    EXPECT_EQ(s.branch, d.geometry.segments[0].branch);
+  }
+}
+
+TEST(Turtle, GeneralizedCylinderFollowsTheHermiteCurveOfTheHeadings) {
+  // From (0,0,0) heading +y to (1,1,0) heading +x: at t = 1/2 the cubic
+  // Hermite curve with tangents H |p1 - p0| is
+  // (p0 + p1)/2 + |p1 - p0| (H0 - H1)/8.
+  Drawn d = Draw("axiom: @Gs F -(90) F @Gc(2) F @Ge\n");
+  ASSERT_EQ(d.geometry.segments.size(), 2u + 8u);
+  const double c = std::sqrt(2.0) / 8;
+  EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(0.5 - c, 0.5 + c, 0), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.segments[1].end, Vec3(1, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.segments[9].end, Vec3(2, 1, 0), 1e-12);  // default: 8 pieces
+}
+
+TEST(Turtle, GeneralizedCylinderIsOneTubeAndBranchesDrawOnTheirOwn) {
+  Drawn d = Draw("axiom: @Gs F [+F] F @Ge(4)\n");
+  ASSERT_EQ(d.geometry.segments.size(), 5u);
+  EXPECT_VEC_NEAR(d.geometry.segments[0].start, Vec3(0, 1, 0), 1e-12);  // the branch
+  EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(-1, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.segments[4].end, Vec3(0, 2, 0), 1e-12);
+  // Tessellated as one tube: the same triangles as four steps of F.
+  auto tube = testing::PlantFromText("axiom: @Gs F(2) @Ge(4)\n", -1, plant::Stage::kMesh);
+  auto steps = testing::PlantFromText("axiom: F(.5)F(.5)F(.5)F(.5)\n", -1, plant::Stage::kMesh);
+  ASSERT_TRUE(tube && steps);
+  EXPECT_EQ(tube->mesh.triangleCount(), steps->mesh.triangleCount());
+}
+
+TEST(Turtle, GeneralizedCylinderLeftOpenWarnsAndHugeRingCountsStopEarly) {
+  Drawn d = Draw("axiom: @Gs F @Gc(2) F\n");
+  EXPECT_EQ(d.geometry.segments.size(), 2u);
+  ASSERT_EQ(d.geometry.warnings.size(), 1u);
+  EXPECT_NE(d.geometry.warnings[0].find("never ended"), std::string::npos)
+      << d.geometry.warnings[0];
+  plant::PlantSpec spec;
+  spec.path = "t.lsys";
+  spec.text = "axiom: @Gs F @Ge(1e300)\n";
+  spec.until = plant::Stage::kGeometry;
+  plant::PlantResult r = plant::BuildPlant(spec);
+  EXPECT_FALSE(r.plant.has_value());
+  EXPECT_NE(r.diagnostics.FormatAll().find("more than the limit"), std::string::npos)
+      << r.diagnostics.FormatAll();
+}
+
+TEST(Turtle, TropismElasticitySetRaisedAndLoweredPerBranch) {
+  DrawOptions opt;
+  opt.recordModules = true;
+  auto end = [&](const std::string& text) {
+    Drawn d = Draw(text, 0, opt);
+    return d.geometry.modulePosition.empty() ? Vec3(1e9, 0, 0) : d.geometry.modulePosition.back();
+  };
+  const Vec3 want = end("tropism: 0 -1 0 0.2\naxiom: +(60) F F F\n");
+  EXPECT_VEC_NEAR(end("tropism: 0 -1 0 0\naxiom: @Ts(1,0.2) +(60) F F F\n"), want, 1e-12);
+  EXPECT_VEC_NEAR(end("tropism: 0 -1 0 0\naxiom: @Ti(1,0.1) @Ti(1,0.15) @Td(1,0.05) +(60) F F F\n"),
+                  want, 1e-12);
+  // The branch's change ends at its `]`.
+  EXPECT_VEC_NEAR(end("tropism: 0 -1 0 0.2\naxiom: [@Ts(1)] +(60) F F F\n"), want, 1e-12);
+  const Vec3 straight = end("axiom: +(60) F F F\n");
+  EXPECT_VEC_NEAR(end("tropism: 0 -1 0 0.2\naxiom: @Ts(1) +(60) F F F\n"), straight, 1e-12);
+  Drawn other = Draw("axiom: @Ts(2,1) F\n");
+  ASSERT_EQ(other.geometry.warnings.size(), 1u);
+  EXPECT_NE(other.geometry.warnings[0].find("tropism other than 1"), std::string::npos);
+}
+
+TEST(Turtle, TwistForceChangesNothing) {
+  const Frame a = FinalFrame("&(30)/(40)F@Tf F");
+  const Frame b = FinalFrame("&(30)/(40)F F");
+  EXPECT_VEC_NEAR(a.heading, b.heading, 1e-300);
+  EXPECT_VEC_NEAR(a.up, b.up, 1e-300);
+}
+
 }  // namespace
 }  // namespace sylva::turtle

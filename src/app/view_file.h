@@ -1,0 +1,93 @@
+// cpfg's view file (`.v`), colour map (`.map`) and material (`.mat`) files.
+//
+// cpfg takes from them what a Sylva grammar writes in its header: the angle
+// increment, the initial line width and its increment, the initial colour
+// index and its increment, the tropism, and the colours. `sylva render
+// plant.l` (mesh, check, derive, view) reads `plant.v` beside the grammar,
+// or the file `--view FILE` names, and `plant.map` / `plant.mat` beside the
+// grammar or the view file (the .mat wins when both exist).
+//
+// The reference is vlab's cpfg (src/cpfg/interpret.c, ReadViewData; irisGL.c,
+// load_in_colormaps and load_in_materials):
+//   .v    one setting a line, `label: values`; labels as in cpfg's manual.
+//   .map  256 colours of 3 bytes (r, g, b), 768 bytes, colour index i is
+//         entry i.
+//   .mat  records of 15 bytes: the colour index, then transparency,
+//         ambient rgb, diffuse rgb, emissive rgb, specular rgb, shininess;
+//         Sylva takes the diffuse colour.
+//
+// Nothing is silently ignored: every line Sylva does not act on is a warning
+// at its file:line:col (`--strict` makes it an error); a value that cannot be
+// read, and a file that is not a readable regular file of a sane size
+// (truncated, huge, a directory, a device), is an error.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/diagnostic.h"
+#include "core/math.h"
+#include "lsys/grammar.h"
+#include "plant/plant.h"
+
+namespace sylva::app {
+
+// What a view file (and its colour files) says that Sylva acts on; unset:
+// the file does not say it.
+struct ViewFile {
+  std::string path;                           // the view file read; empty when there was none
+  std::optional<double> angle;                // `angle increment:` or 360 / `angle factor:`
+  std::optional<double> width;                // `initial line width:`
+  std::optional<double> widthIncrement;       // `line width increment:`
+  std::optional<int> initialColor;            // `initial color:`
+  std::optional<int> colorIncrement;          // `color increment:`
+  std::optional<Vec3> tropism;                // unit: `tropism direction:` or `tropism: T`
+  std::optional<double> elasticity;           // `initial elasticity:` or `tropism: E`
+  std::optional<double> elasticityIncrement;  // `elasticity increment:` or `tropism: S`
+  std::optional<Vec3> viewpoint;              // `viewpoint:` (the eye)
+  std::optional<Vec3> target;                 // `view reference point:`
+  std::optional<double> scale;                // `scale factor:` (> 0)
+  std::string colorsPath;                     // the .map or .mat read
+  std::vector<std::array<float, 3>> palette;  // sRGB 0..1 of each colour index
+  DiagnosticList diagnostics;                 // warnings, and errors that stop the build
+};
+
+// Reads the text of a view file; `path` names it in diagnostics.
+ViewFile ParseViewFile(const std::string& text, const std::string& path);
+
+// 768 bytes of a .map: 256 sRGB colours. An error when shorter; a warning
+// (in `warnings`) when longer: only the first 768 bytes are colours.
+Expected<std::vector<std::array<float, 3>>> ParseColormap(const std::string& bytes,
+                                                          const std::string& path,
+                                                          DiagnosticList& warnings);
+
+// Records of a .mat: 256 colours, the diffuse colour of each material
+// (indices without a material: light grey, cpfg's default). An error when
+// the size is not a whole number of records.
+Expected<std::vector<std::array<float, 3>>> ParseMaterials(const std::string& bytes,
+                                                           const std::string& path);
+
+// The view file and colours of the grammar at `grammarPath`: `explicitView`
+// when not empty (an error when it cannot be read), else NAME.v beside the
+// grammar if it exists; NAME.mat or NAME.map beside the grammar or the view
+// file. nullptr when there is none of them.
+std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
+                                              const std::string& explicitView);
+
+// Puts what the view file says into the grammar (its header values, read
+// as the turtle's defaults).
+void ApplyViewFile(const ViewFile& view, lsys::Grammar& grammar);
+
+// Sets spec.amendGrammar: the view applied and its diagnostics added to the
+// plant's (so --strict counts them).
+void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec);
+
+// Azimuth and elevation in degrees (render::Camera's) of the direction from
+// the view reference point to the viewpoint; nullopt when the file sets
+// neither or they coincide. Elevation within -89..89.
+std::optional<std::array<double, 2>> ViewDirection(const ViewFile& view);
+
+}  // namespace sylva::app
