@@ -122,6 +122,37 @@ void BM_TessellateScreenSpace(benchmark::State& state) {
 }
 BENCHMARK(BM_TessellateScreenSpace)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// The same with coverage lines (`sylva render`'s default: twigs under a
+// pixel as 1 px ribbons with their coverage), one thread.
+void BM_TessellateScreenSpaceCoverage(benchmark::State& state) {
+  plant::PlantSpec spec;
+  spec.path = std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys";
+  spec.steps = 20;
+  spec.until = plant::Stage::kGeometry;
+  static const mesh::PlantGeometry geometry = std::move(plant::BuildPlant(spec).plant->geometry);
+  const mesh::Box box = mesh::TessellatedBounds(geometry, nullptr);
+  const render::Camera cam = render::Camera::Frame(box.lo, box.hi, 1920.0 / 1080, 30, 12, false);
+  mesh::TessellateOptions opt;
+  opt.view = mesh::ScreenView{cam.ViewProjection(1920.0 / 1080), 1920, 1080, 0.5};
+  opt.view->coverage = state.range(0) != 0;
+  mesh::TriangleMesh m;
+  for (auto _ : state) {
+    m.Clear();
+    (void)mesh::Tessellate(geometry, opt, m);
+    benchmark::DoNotOptimize(m.indices.data());
+  }
+  size_t lines = 0;
+  for (float c : m.coverage) lines += c < 1;
+  state.SetItemsProcessed(int64_t(m.triangleCount()) * state.iterations());
+  state.counters["triangles"] = double(m.triangleCount());
+  state.counters["coverageVertices"] = double(lines);
+}
+BENCHMARK(BM_TessellateScreenSpaceCoverage)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
 }  // namespace
 
 BENCHMARK_MAIN();

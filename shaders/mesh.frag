@@ -6,6 +6,7 @@
 in vec3 vPosition;
 in vec3 vNormal;
 in vec3 vColor;
+in float vCoverage;  // alpha: the fraction of a coverage line or point that is covered
 uniform vec3 uEye;
 uniform vec3 uKeyDir;             // toward the key light
 uniform mat4 uLightViewProj;
@@ -51,5 +52,5 @@ void main() {
   vec3 h = normalize(keyDir + toEye);
   float spec = pow(max(dot(n, h), 0.0), 32.0) * 0.08;
   vec3 c = albedo * (ambient + key * vec3(1.0, 0.95, 0.85) * 0.9 + fill * vec3(0.55, 0.62, 0.75) * 0.35) + spec;
-  fragColor = vec4(EncodeSrgb(c), 1.0);
+  fragColor = vec4(EncodeSrgb(c), vCoverage);
 }

@@ -6,6 +6,7 @@
 in vec3 vPosition;
 in vec3 vNormal;
 in vec3 vColor;
+in float vCoverage;  // alpha: the covered fraction of a coverage line or point
 uniform vec3 uEye;
 uniform int uLightCount;
 uniform int uLightType[8];        // 0 sun, 1 ambient, 2 point
@@ -64,5 +65,5 @@ void main() {
     light += c * diffuse;
     spec += pow(max(dot(n, normalize(l + toEye)), 0.0), 32.0) * 0.04 * diffuse * length(c);
   }
-  fragColor = vec4(EncodeSrgb(vColor * light + spec), 1.0);
+  fragColor = vec4(EncodeSrgb(vColor * light + spec), vCoverage);
 }

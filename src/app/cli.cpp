@@ -186,6 +186,8 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   vi->add_option("--frames", view.frames, "frames to draw before the screenshot")
       ->check(CLI::Range(1, 1000000));
   vi->add_option("--size", view.size, "window size WxH (default 1280x720)");
+  vi->add_option("--orbit", view.orbit,
+                 "turn the camera by this many degrees a frame (grammars; tests and demos)");
   AddStrictFlag(vi, view.strict);
   vi->add_option("--time", view.time, "scenes: start paused at this time in seconds")
       ->check(CLI::Range(0.0, 1e6));

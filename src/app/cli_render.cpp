@@ -218,6 +218,8 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
       spec->view->shadowFrom = render::KeyLightDirection();
       spec->view->shadowPlaneY = bounds.lo.y();
       spec->view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(bounds);
+      // Twigs under a pixel fade as coverage lines (the renderer blends them).
+      spec->view->coverage = true;
     }
     DiagnosticList warnings;
     Status s = plant::Tessellate(*plant, *spec, warnings);

@@ -1,7 +1,10 @@
 // The viewer. Threads: the UI thread owns the window, ImGui and every GL
 // call; one worker derives, draws and tessellates jobs posted by the UI and
 // hands back meshes. Only the newest job matters: a job that is overtaken
-// is dropped when it finishes.
+// is dropped when it finishes. Every job carries the whole request (file,
+// defines, seed, step, detail, view); the worker keeps the last plant and
+// only re-tessellates it when a job differs from it in the view or the
+// detail alone (a camera move).
 #include "app/viewer.h"
 
 #include <GL/glew.h>
@@ -10,9 +13,12 @@
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -27,34 +33,58 @@
 #include "app/viewer_window.h"
 #include "plant/plant.h"
 #include "plant/surface_library.h"
+#include "render/camera.h"
 #include "render/renderer.h"
 #include "scene/default_scene.h"
 
 namespace sylva::app {
+
+// cli_render.cpp: the screen-space view of a camera.
+mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps);
+
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+// The viewer's shadow map (Renderer::SetShadowMapSize): smaller than
+// `sylva render`'s, for cheaper shadow samples.
+constexpr int kViewerShadowMapSize = 2048;
+
 struct Job {
   uint64_t id = 0;
   std::string path;
+  uint64_t reload = 0;  // bumped when the file changes: the plant is rebuilt
   std::map<std::string, double> overrides;
   std::optional<uint64_t> seed;
   int steps = -1;
-  int sides = 8;
+  int sides = 8;    // uniform detail, when lod is off
+  bool lod = true;  // screen-space detail for the camera (docs/lod.md)
   int threads = 0;
   bool strict = false;  // warnings are errors
+  // The view to tessellate for (with lod); empty: the framing of `sylva render`.
+  std::optional<render::Camera> camera;
+  int width = 1280, height = 720;
 };
+
+// Jobs that differ only in the view (or the detail) reuse the plant.
+bool SamePlant(const Job& a, const Job& b) {
+  return a.path == b.path && a.reload == b.reload && a.overrides == b.overrides &&
+         a.seed == b.seed && a.steps == b.steps && a.threads == b.threads && a.strict == b.strict;
+}
 
 struct Result {
   uint64_t id = 0;
   bool ok = false;
+  bool rebuilt = false;     // a new plant, not only a new tessellation
+  bool stale = false;       // the last good plant: the request's own failed to build
+  uint64_t failedId = 0;    // with !ok or stale: the job whose build failed
   std::string diagnostics;  // errors and warnings, formatted
   mesh::TriangleMesh mesh;  // moved into the drawn scene when shown
   size_t triangles = 0;
   mesh::Palette palette;
-  Vec3 lo{0, 0, 0}, hi{1, 1, 1};
+  render::Camera camera;          // the view it was tessellated for
+  Vec3 lo{0, 0, 0}, hi{1, 1, 1};  // the whole plant's box (ground and shadows fit it)
   uint64_t modules = 0;
   int derivationLength = 0;
   std::vector<std::pair<std::string, double>> constants;  // file order not kept: sorted
@@ -65,46 +95,119 @@ struct Result {
   double deriveMs = 0, turtleMs = 0, tessellateMs = 0;
 };
 
-Result RunJob(const Job& job) {
+// What the worker keeps between jobs: the last plant (geometry, before
+// tessellation) and the detail history of its chains, so a camera move
+// only re-tessellates, with hysteresis.
+// A request whose plant failed to build is not built again for a camera
+// move: the last good plant is re-tessellated, marked stale.
+struct WorkerState {
+  std::optional<Job> built;
+  std::optional<plant::Plant> plant;
+  plant::PlantSpec spec;
+  mesh::Box bounds;
+  bool lines = false;  // a 2D figure (plant::IsLineFigure): drawn as lines, never tessellated
+  std::string diagnostics;
+  std::optional<Job> failed;
+  std::string failedDiagnostics;
+  mesh::DetailHistory history;
+};
+
+Result RunJob(const Job& job, WorkerState& st) {
   Result r;
   r.id = job.id;
-  plant::PlantSpec spec;
-  spec.path = job.path;
-  spec.defines = job.overrides;
-  spec.seed = job.seed;
-  if (job.steps >= 0) spec.steps = job.steps;
-  spec.detail.sides = job.sides;
-  spec.threads = job.threads;
-  // cpfg's NAME.v (and .map, .mat) beside the grammar, read again on each reload.
-  AttachViewFile(LoadViewFiles(job.path, ""), spec);
-  plant::PlantResult built = plant::BuildPlant(spec);
-  r.diagnostics = built.diagnostics.FormatAll();
-  if (!built.plant) return r;
-  if (job.strict && !built.diagnostics.items.empty()) {
-    r.diagnostics += "sylva: error: --strict: warnings are treated as errors\n";
+  const bool failedBefore = st.failed && SamePlant(*st.failed, job);
+  if (!failedBefore && (!st.plant || !st.built || !SamePlant(*st.built, job))) {
+    plant::PlantSpec spec;
+    spec.path = job.path;
+    spec.defines = job.overrides;
+    spec.seed = job.seed;
+    if (job.steps >= 0) spec.steps = job.steps;
+    spec.threads = job.threads;
+    // cpfg's NAME.v (and .map, .mat) beside the grammar, read again on each reload.
+    AttachViewFile(LoadViewFiles(job.path, ""), spec);
+    spec.until = plant::Stage::kGeometry;
+    plant::PlantResult built = plant::BuildPlant(spec);
+    std::string diagnostics = built.diagnostics.FormatAll();
+    std::optional<mesh::Box> bounds;
+    bool lines = false;
+    if (built.plant && job.strict && !built.diagnostics.items.empty()) {
+      diagnostics += "sylva: error: --strict: warnings are treated as errors\n";
+    } else if (built.plant && plant::IsLineFigure(built.plant->geometry)) {
+      lines = true;
+      bounds = mesh::Box{built.plant->geometry.boundsMin, built.plant->geometry.boundsMax};
+    } else if (built.plant) {
+      auto b = plant::MeshBounds(*built.plant, spec);
+      if (b) bounds = *b;
+      if (!b) diagnostics += b.error().message + "\n";
+    }
+    if (!bounds) {
+      st.failed = job;
+      st.failedDiagnostics = diagnostics;
+      r.diagnostics = diagnostics;
+      r.failedId = job.id;
+      return r;
+    }
+    st.failed.reset();
+    st.history = {};
+    st.diagnostics = diagnostics;
+    st.bounds = *bounds;
+    st.lines = lines;
+    st.plant = std::move(built.plant);
+    st.spec = spec;
+    st.built = job;
+    r.rebuilt = true;
+  }
+  if (failedBefore) r.failedId = st.failed->id;
+  if (!st.plant) {
+    r.diagnostics = st.failedDiagnostics;
     return r;
   }
-  plant::Plant& p = *built.plant;
+  r.stale = failedBefore;
+  r.diagnostics = failedBefore ? st.failedDiagnostics : st.diagnostics;
+  plant::Plant& p = *st.plant;
+  const bool empty = !(st.bounds.lo.array() <= st.bounds.hi.array()).all();
+  const Vec3 lo = empty ? Vec3::Zero() : st.bounds.lo, hi = empty ? Vec3::Ones() : st.bounds.hi;
+  const double aspect = double(job.width) / job.height;
+  r.camera = job.camera ? *job.camera
+                        : (st.lines ? render::Camera::Frame(lo, hi, aspect, 0, 0, true)
+                                    : render::Camera::Frame(lo, hi, aspect, 30, 12, false));
+  if (st.lines) {
+    r.lines = LinesOf(p);
+  } else {
+    plant::PlantSpec spec = st.spec;
+    spec.detail.sides = job.sides;
+    if (job.lod) {
+      spec.view = ViewOf(r.camera, job.width, job.height, 0.5);
+      // Shadows of what lies outside the view may fall inside it; the
+      // viewer's shadow map is smaller than `sylva render`'s.
+      spec.view->shadowFrom = render::KeyLightDirection();
+      spec.view->shadowPlaneY = lo.y();
+      spec.view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(st.bounds) *
+                                       kViewerShadowMapSize /
+                                       render::Renderer::kDefaultShadowMapSize;
+      // Twigs under a pixel fade as coverage lines (the renderer blends them).
+      spec.view->coverage = true;
+      spec.history = &st.history;
+    } else {
+      st.history = {};  // levels of another detail mean nothing to the next view
+    }
+    DiagnosticList warnings;
+    if (Status s = plant::Tessellate(p, spec, warnings); !s.ok()) {
+      r.diagnostics += s.error().message + "\n";
+      return r;
+    }
+    r.mesh = std::move(p.mesh);
+    p.mesh = mesh::TriangleMesh();
+  }
   r.derivationLength = p.grammar.derivationLength;
   for (const auto& [k, v] : p.grammar.constants) r.constants.emplace_back(k, v);
   std::sort(r.constants.begin(), r.constants.end());
-  for (const auto& [k, v] : job.overrides) r.overridden.insert(k);
-  if (plant::IsLineFigure(p.geometry)) {
-    r.lines = LinesOf(p);
-    r.lo = p.geometry.boundsMin;
-    r.hi = p.geometry.boundsMax;
-  }
-  r.mesh = std::move(p.mesh);
+  for (const auto& [k, v] : st.built->overrides) r.overridden.insert(k);
   r.palette = p.palette;
   r.modules = p.DrawnWord().size();
   r.triangles = r.mesh.triangleCount();
-  if (!r.lines && r.mesh.vertexCount()) {
-    r.lo = r.hi = r.mesh.positions[0].cast<double>();
-    for (const auto& q : r.mesh.positions) {
-      r.lo = r.lo.cwiseMin(q.cast<double>());
-      r.hi = r.hi.cwiseMax(q.cast<double>());
-    }
-  }
+  r.lo = lo;
+  r.hi = hi;
   r.deriveMs = p.time.parse + p.time.derive + p.time.interpret;
   r.turtleMs = p.time.turtle;
   r.tessellateMs = p.time.tessellate;
@@ -112,11 +215,20 @@ Result RunJob(const Job& job) {
   return r;
 }
 
+// The camera has moved far enough from the one the shown mesh was
+// tessellated for to re-tessellate: 5 % nearer or farther, 2 degrees
+// around, or the target 2 % of the distance away.
+bool MovedFarEnough(const render::Camera& a, const render::Camera& b) {
+  return std::abs(std::log(a.distance / b.distance)) > 0.05 ||
+         std::abs(a.azimuth - b.azimuth) > 2 || std::abs(a.elevation - b.elevation) > 2 ||
+         (a.target - b.target).norm() > 0.02 * a.distance || a.fovY != b.fovY;
+}
+
 // A live edit can ask for anything (a word or mesh larger than memory): the
 // worker reports it as a failed job and the viewer keeps the last plant.
-Result RunJobSafely(const Job& job) {
+Result RunJobSafely(const Job& job, WorkerState& state) {
   try {
-    return RunJob(job);
+    return RunJob(job, state);
   } catch (const std::bad_alloc&) {
     Result r;
     r.id = job.id;
@@ -212,7 +324,8 @@ PanelActions DrawPanel(const std::string& path, Shown& shown, bool busy, double 
     job.seed = uint64_t(std::max(seed, 0));
     changed = true;
   }
-  if (ImGui::SliderInt("sides", &job.sides, 3, 32)) changed = true;
+  if (ImGui::Checkbox("screen-space detail", &job.lod)) changed = true;
+  if (!job.lod && ImGui::SliderInt("sides", &job.sides, 3, 32)) changed = true;
   if (!shown.constants.empty() &&
       ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
     for (const auto& [name, value] : shown.constants) {
@@ -318,23 +431,35 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   // Declared after the window: its GL objects are destroyed before the context.
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer) return Report(renderer.error(), err);
-  (*renderer)->SetShadowMapSize(2048);  // interactive: cheaper shadow samples
+  (*renderer)->SetShadowMapSize(kViewerShadowMapSize);  // interactive: cheaper shadow samples
   // The default scene of the plant shown (a ground plane, the default lights).
   draw::DrawList drawn;
 
   int exitCode = kExitOk;
-  Worker<Job, Result> worker(RunJobSafely);
+  WorkerState state;  // the worker's alone; outlives it
+  Worker<Job, Result> worker([&state](const Job& j) { return RunJobSafely(j, state); });
   job.path = path;
   job.strict = cmd.strict;
+  job.width = width;
+  job.height = height;
   uint64_t nextId = 1;
-  auto post = [&] {
-    job.id = nextId++;
-    worker.Post(job);
-  };
-  post();
   Shown shown;
   render::Camera camera;
   bool framed = false;
+  // The view of the last job posted: the camera moving far from it posts
+  // a re-tessellation; meanwhile the shown mesh stays on screen.
+  render::Camera posted;
+  int retessellations = 0;
+  uint64_t reportedFailure = 0;  // the job id of the last failed build reported
+  double slowestFrameMs = 0, slowestSwapMs = 0;
+  std::optional<double> plainDrawMs;  // the last Draw of a frame without a new mesh
+  auto post = [&] {
+    job.id = nextId++;
+    job.camera = framed ? std::optional<render::Camera>(camera) : std::nullopt;
+    posted = camera;
+    worker.Post(job);
+  };
+  post();
   fs::file_time_type mtime = fs::last_write_time(path, ec);
   auto lastPoll = Clock::now();
   double frameMs = 0;
@@ -353,11 +478,23 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       auto t = fs::last_write_time(path, ec);
       if (!ec && t != mtime) {
         mtime = t;
+        ++job.reload;
         post();
       }
     }
+    // The time a new mesh costs this thread (set when one came): building its
+    // scene, and its upload in the next Draw.
+    std::optional<double> swapMs;
+    bool newScene = false;  // also the first mesh, which replaces none (not timed)
     if (auto r = worker.Take()) {
       shown.diagnostics = r->diagnostics;
+      // Report each failed build once, also when a newer view of the last
+      // good plant (stale) overtook the failure itself.
+      if ((!r->ok || r->stale) && r->failedId != reportedFailure) {
+        reportedFailure = r->failedId;
+        err << "sylva view: the grammar has errors; keeping the last good plant\n"
+            << shown.diagnostics;
+      }
       if (r->ok) {
         shown.constants = r->constants;
         for (const auto& [name, value] : r->constants)
@@ -367,17 +504,27 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
         shown.id = r->id;
         const bool wasLines = lines;
         lines = r->lines.has_value();
+        // The only work a new tessellation costs this thread: the upload
+        // (in the next Draw).
+        const auto swapStart = Clock::now();
         drawn = SceneOf(*r);
-        if (!framed || lines != wasLines) {
-          camera = FrameOf(*r, double(width) / height, lines, 30, 12);
+        if (shown.plant)
+          swapMs = std::chrono::duration<double, std::milli>(Clock::now() - swapStart).count();
+        newScene = true;
+        if (!framed) {
+          // The view the mesh was tessellated for: `sylva render`'s framing.
+          camera = r->camera;
+          posted = camera;
           framed = true;
+        } else if (lines != wasLines) {
+          // A plant became a 2D figure or back: framed again (a plant's mesh,
+          // made for the last view, is re-tessellated for this one).
+          camera = FrameOf(*r, double(width) / height, lines, 30, 12);
         }
+        shown.lastFailed = r->stale;  // a view of the last good plant keeps the errors shown
         shown.plant = std::move(r);
-        shown.lastFailed = false;
       } else {
-        // Keep the last good plant; report what went wrong.
-        err << "sylva view: the grammar has errors; keeping the last good plant\n"
-            << shown.diagnostics;
+        // Keep the last good plant (what went wrong is reported above).
         shown.lastFailed = true;
         // A screenshot of a plant that cannot be built: nothing will come.
         if (cmd.frames > 0 && !shown.plant) {
@@ -396,6 +543,14 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     ImGui::NewFrame();
     // After NewFrame: ImGui knows whether this frame's click is on the panel.
     mouse.Update(window.handle, camera);
+    if (framed) camera.azimuth += cmd.orbit;
+    // Re-tessellation applies to meshes only: a 2D figure is drawn as lines.
+    const bool retessellate = framed && job.lod && !lines;
+    if (fbw > 0 && fbh > 0 && (fbw != job.width || fbh != job.height)) {
+      job.width = fbw;
+      job.height = fbh;
+      if (retessellate) post();
+    }
     const PanelActions act = DrawPanel(path, shown, worker.Busy(), frameMs, job);
     // Playing: the next step once the last one is shown (at most 4 a second).
     if (shown.playing && !worker.Busy() && shown.id + 1 == nextId &&
@@ -415,11 +570,27 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     if ((act.frameAll || frameKey) && shown.plant)
       camera = FrameOf(*shown.plant, double(fbw) / std::max(fbh, 1), lines, camera.azimuth,
                        camera.elevation);
+    // Re-tessellate in the background once the camera has moved far
+    // enough, one job at a time; the shown mesh is drawn meanwhile.
+    if (retessellate && !worker.Busy() && MovedFarEnough(camera, posted)) {
+      post();
+      ++retessellations;
+    }
     ImGui::Render();
 
+    const auto drawStart = Clock::now();
     if (Status s = (*renderer)->Draw(drawn, camera); !s.ok()) {
       exitCode = Report(s.error(), err);
       break;
+    }
+    const double drawMs =
+        std::chrono::duration<double, std::milli>(Clock::now() - drawStart).count();
+    // The upload is what the frame with a new mesh draws longer than the
+    // last frame without one (the first mesh has none to compare with).
+    if (!newScene) {
+      plainDrawMs = drawMs;
+    } else if (swapMs && plainDrawMs) {
+      slowestSwapMs = std::max(slowestSwapMs, *swapMs + std::max(0.0, drawMs - *plainDrawMs));
     }
     (*renderer)->PresentToWindow(fbw, fbh);
     glViewport(0, 0, fbw, fbh);
@@ -444,6 +615,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     }
     glfwSwapBuffers(window.handle);
     frameMs = std::chrono::duration<double, std::milli>(Clock::now() - frameStart).count();
+    if (frame > 1) slowestFrameMs = std::max(slowestFrameMs, frameMs);  // past the first upload
     if (done) break;
     // Wait for the first plant no longer than a minute when taking a screenshot.
     if (cmd.frames > 0 && frame > cmd.frames + 6000) {
@@ -451,6 +623,14 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       exitCode = kExitRuntime;
       break;
     }
+  }
+  if (cmd.frames > 0) {
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "frames: %d, re-tessellations: %d, slowest frame: %.1f ms, slowest mesh swap: "
+                  "%.1f ms\n",
+                  frame, retessellations, slowestFrameMs, slowestSwapMs);
+    out << line;
   }
   return exitCode;
 }

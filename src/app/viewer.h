@@ -7,7 +7,10 @@
 // viewer reloads it when the file changes; a bad edit lists its
 // diagnostics in a panel and keeps the last good plant on screen. Sliders
 // set every #define, the seed, the derivation step and the detail; changes
-// are derived on a worker thread, so the window never freezes. In both,
+// are derived on a worker thread, so the window never freezes. With
+// screen-space detail (the default) the worker keeps the plant and
+// re-tessellates it for the camera once the camera has moved far enough,
+// while the window keeps drawing the previous mesh. In both,
 // left drag orbits, right drag pans, wheel zooms; P saves a screenshot.
 #pragma once
 
@@ -29,6 +32,9 @@ struct ViewCommand {
   // Grammars (.lsys) only: the step and seed the viewer starts at.
   std::optional<int> steps;
   std::optional<uint64_t> seed;
+  // --orbit: degrees of azimuth the camera turns each frame (tests, demos);
+  // with --frames, the frame and re-tessellation figures go to stdout.
+  double orbit = 0;
   // Scenes (.xml) only:
   std::optional<double> time;  // --time: start paused at this time (seconds)
 };

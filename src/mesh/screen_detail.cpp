@@ -18,6 +18,19 @@ int SidesForPixelRadius(double radiusPx, double eps) {
   return int(std::clamp(c, 3.0, 256.0));
 }
 
+int ChainLevel(double radiusPx, double eps, bool coverage) {
+  if (coverage && radiusPx < kLinePixels / 2) return 0;
+  if (radiusPx < 3 * eps) return 1;
+  return SidesForPixelRadius(radiusPx, eps);
+}
+
+int ChainLevelAfter(int last, double radiusPx, double eps, bool coverage) {
+  const int lo = ChainLevel(radiusPx, eps, coverage);
+  if (last < 0) return lo;
+  const int hi = ChainLevel(radiusPx * (1 + kHysteresis), eps, coverage);
+  return std::clamp(last, lo, hi);
+}
+
 double PixelsPerUnit(const ScreenView& view, const Vec3& p) {
   const Mat4& m = view.viewProjection;
   const Vec4 c = m * Vec4(p.x(), p.y(), p.z(), 1);
@@ -32,6 +45,16 @@ double PixelsPerUnit(const ScreenView& view, const Vec3& p) {
   const double a = jx.dot(jx), b = jx.dot(jy), d = jy.dot(jy);
   const double h = (a - d) / 2;
   return std::sqrt((a + d) / 2 + std::sqrt(h * h + b * b));
+}
+
+Vec2 PixelOffset(const ScreenView& view, const Vec3& p, const Vec3& d) {
+  const Mat4& m = view.viewProjection;
+  const Vec4 c = m * Vec4(p.x(), p.y(), p.z(), 1);
+  if (!(c.w() > 1e-12)) return Vec2::Constant(std::numeric_limits<double>::infinity());
+  const double x = c.x() / c.w(), y = c.y() / c.w();
+  const Vec3 r3 = m.block<1, 3>(3, 0).transpose();
+  return Vec2((m.block<1, 3>(0, 0).transpose() - x * r3).dot(d) * (0.5 * view.width / c.w()),
+              (m.block<1, 3>(1, 0).transpose() - y * r3).dot(d) * (0.5 * view.height / c.w()));
 }
 
 Vec3 TowardEye(const ScreenView& view, const Vec3& p) {

@@ -46,6 +46,39 @@ struct ScreenView {
   Vec3 shadowFrom = Vec3::Zero();
   double shadowPlaneY = 0;
   double shadowTexelsPerUnit = 0;
+  // Sub-pixel coverage, for a renderer that blends (never for export):
+  // a tube under kLinePixels wide on screen is drawn as a ribbon
+  // kLinePixels wide whose TriangleMesh::coverage is its true width over
+  // that, so a twig fades instead of vanishing or aliasing; a polygon or
+  // surface under a pixel across becomes a one-pixel camera-facing quad (a
+  // point) whose coverage is its projected area.
+  bool coverage = false;
+};
+
+// The width, in pixels, of a coverage line (ScreenView::coverage): tubes
+// thinner than this are drawn this wide with their coverage in alpha.
+inline constexpr double kLinePixels = 1.0;
+
+// A tube's representation as one ordered number, coarse to fine: 0 a
+// coverage line (only with ScreenView::coverage), 1 a camera-facing
+// ribbon, n >= 3 a tube of n sides. Monotone in the projected radius r:
+// a line under kLinePixels / 2, a ribbon under 3 eps, else
+// SidesForPixelRadius(r, eps).
+int ChainLevel(double radiusPx, double eps, bool coverage);
+
+// Hysteresis (docs/lod.md, "Without popping"): the level a chain drawn
+// at `last` last frame (-1: none) takes now. It is never coarser than
+// ChainLevel(r) (the error stays within eps), and it drops to a coarser
+// level only once r is kHysteresis below that level's threshold, so a
+// camera wobbling about a threshold does not flip the choice back and forth.
+inline constexpr double kHysteresis = 0.15;
+int ChainLevelAfter(int last, double radiusPx, double eps, bool coverage);
+
+// The level each chain of one geometry had in the last frame, for
+// TessellateOptions::history: index c is the c-th chain in Tessellate's
+// order (a different geometry resets it). -1: not drawn yet.
+struct DetailHistory {
+  std::vector<int16_t> level;
 };
 
 // The fewest sides (3..256) whose chord error r (1 - cos(pi/n)) is at most
@@ -55,6 +88,11 @@ int SidesForPixelRadius(double radiusPx, double eps);
 // Pixels per world unit at p: how far, at most, the image of p moves when p
 // moves by one unit in any direction. +inf at or behind the eye's plane.
 double PixelsPerUnit(const ScreenView& view, const Vec3& p);
+
+// How far, in pixels (x right, y up), the image of p moves when p moves by
+// one world unit along d (the Jacobian of world -> pixels at p times d).
+// Non-finite at or behind the eye's plane.
+Vec2 PixelOffset(const ScreenView& view, const Vec3& p, const Vec3& d);
 
 // The unit direction from p toward the eye (for an orthographic view, the
 // reverse of the view direction): the direction in which moving p does not

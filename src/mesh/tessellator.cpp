@@ -128,6 +128,7 @@ struct ChainPlan {
   int sides = 0;  // 0: not drawn (zero width, or culled)
   bool caps = true;
   bool ribbon = false;  // a camera-facing strip: 2 vertices a ring, no caps
+  bool line = false;    // a ribbon kLinePixels wide with its coverage per vertex
   std::vector<uint32_t> joints;
   size_t rings(size_t segments) const { return joints.empty() ? segments + 1 : joints.size(); }
   size_t vertices(size_t segments) const {
@@ -140,19 +141,16 @@ struct ChainPlan {
   }
 };
 
-// Tubes thinner than this many eps in radius (1.5 px at eps 0.5) are drawn
-// as camera-facing ribbons: their silhouette is the tube's, and a 3-sided
-// prism would cost three times the triangles for no visible difference.
-constexpr double kRibbonPixels = 3;
-
-// Screen-space plan of a chain (docs/lod.md): the sides from the largest
-// projected radius (in shadow-map texels for a chain outside the view that
-// may shade it); a joint is dropped when the tube straight from the last
-// kept joint to a later one passes within eps/2 pixels of it (axis and
-// radius) and the colour does not change there; caps only on tubes at
-// least a pixel wide.
+// Screen-space plan of a chain (docs/lod.md): its level (ChainLevel: a
+// coverage line, a ribbon or the sides) from the largest projected radius,
+// with hysteresis against `last` when there is a history (in shadow-map
+// texels and without history for a chain outside the view that may shade
+// it: a tube then); a joint is dropped when the tube straight from the
+// last kept joint to a later one passes within eps/2 pixels of it (axis
+// and radius) and the colour does not change there; caps only on tubes
+// at least a pixel wide.
 void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
-               const ScreenView& view, bool shadowOnly, ChainPlan& plan) {
+               const ScreenView& view, bool shadowOnly, int16_t* last, ChainPlan& plan) {
   const size_t m = chain.size();
   std::vector<double> ppu(m + 1);
   double rPx = 0;
@@ -160,10 +158,19 @@ void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const
     ppu[k] = shadowOnly ? view.shadowTexelsPerUnit : PixelsPerUnit(view, f.P[k]);
     rPx = std::max(rPx, f.R[k] * ppu[k]);
   }
-  plan.sides = SidesForPixelRadius(rPx, view.eps);
+  int level;
+  if (shadowOnly) {
+    // A ribbon faces the camera, not the light: never for a shadow caster.
+    level = SidesForPixelRadius(rPx, view.eps);
+  } else {
+    level = last ? ChainLevelAfter(*last, rPx, view.eps, view.coverage)
+                 : ChainLevel(rPx, view.eps, view.coverage);
+    if (last) *last = int16_t(level);
+  }
+  plan.sides = std::max(level, 3);
   plan.caps = !(rPx < 1);
-  // A ribbon faces the camera, not the light: never for a shadow caster.
-  plan.ribbon = !shadowOnly && rPx < kRibbonPixels * view.eps;
+  plan.ribbon = level < 3;
+  plan.line = level == 0;
   plan.joints.clear();
   if (m < 2) return;
   const double budget = view.eps / 2;
@@ -196,7 +203,8 @@ void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const
 // from triangle tbase on; the arrays are already sized.
 // A ribbon: at every kept joint two vertices, the axis point moved by the
 // radius either way along the direction perpendicular to both the axis and
-// the line of sight, with the normal turned toward the eye.
+// the line of sight, with the normal turned toward the eye. A line is
+// at least kLinePixels wide, its coverage the true width over the drawn one.
 void EmitRibbon(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
                 const ChainPlan& plan, const ScreenView& view, size_t vbase, size_t tbase,
                 TriangleMesh& out) {
@@ -214,8 +222,23 @@ void EmitRibbon(const PlantGeometry& g, const std::vector<uint32_t>& chain, cons
     Vec3 normal = toEye - f.T[k] * f.T[k].dot(toEye);
     normal = normal.norm() > 1e-9 ? Vec3(normal.normalized()) : f.T[k].cross(side);
     const float v = float(f.V[k]);
+    double half = f.R[k];
+    if (plan.line) {
+      // Pixels per unit across the line's image: the side's image less its
+      // part along the axis's image (PixelsPerUnit, the largest stretch,
+      // overstates the width off the image centre).
+      const Vec2 s = PixelOffset(view, f.P[k], side), t = PixelOffset(view, f.P[k], f.T[k]);
+      const double tn = t.norm();
+      const double ppu = tn > 1e-12 ? std::abs(s.x() * t.y() - s.y() * t.x()) / tn : s.norm();
+      // Non-finite or zero (at the eye's plane, end-on): the tube's own width.
+      const double drawn =
+          ppu > 0 && std::isfinite(ppu) ? std::max(half, kLinePixels / 2 / ppu) : half;
+      out.coverage[vbase + 2 * r] = out.coverage[vbase + 2 * r + 1] =
+          float(std::clamp(half / drawn, 1e-3, 1.0));
+      half = drawn;
+    }
     for (int e = 0; e < 2; ++e) {
-      *pos++ = F(f.P[k] + side * (e ? f.R[k] : -f.R[k]));
+      *pos++ = F(f.P[k] + side * (e ? half : -half));
       *nor++ = F(normal);
       *uv++ = Vec2f(float(e), v);
     }
@@ -313,6 +336,93 @@ void EmitChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const
     cap(0, false);
     cap(m, true);
   }
+}
+
+// A polygon or surface under a pixel across, drawn as a point: a square
+// kLinePixels on a side facing the eye, whose coverage is the projected
+// area of what it stands for (a fraction of the square; 0: not a point).
+struct SubPixelPoint {
+  Vec3 center = Vec3::Zero(), normal = Vec3::Zero(), toEye = Vec3::Zero();
+  double halfSide = 0;  // world units
+  float coverage = 0;
+};
+
+// Areas are |a . toEye| ppu^2 for each triangle's area vector a (the
+// perspective at the centre, which is exact to first order for something
+// under a pixel). Both faces of a closed surface count, so its coverage
+// is up to twice its silhouette's.
+SubPixelPoint PointOf(const Box& box, const Vec3& areaNormal, double areaPx2Sum,
+                      const ScreenView& view) {
+  SubPixelPoint p;
+  if (!(box.lo.array() <= box.hi.array()).all()) return p;
+  const Vec3 c = (box.lo + box.hi) / 2;
+  const double ppu = PixelsPerUnit(view, c);
+  if (!std::isfinite(ppu) || !((box.hi - box.lo).norm() * ppu < 1)) return p;
+  p.center = c;
+  p.toEye = TowardEye(view, c);
+  if (!(p.toEye.norm() > 0.5)) return p;
+  p.normal = areaNormal.norm() > 1e-30 ? Vec3(areaNormal.normalized()) : p.toEye;
+  p.halfSide = kLinePixels / 2 / ppu;
+  const double side2 = kLinePixels * kLinePixels;
+  p.coverage = float(std::clamp(areaPx2Sum / side2, 1e-3, 1.0));
+  return p;
+}
+
+SubPixelPoint PointOfPolygon(const Polygon& poly, const ScreenView& view) {
+  if (poly.vertices.size() < 3) return {};
+  Box box;
+  Vec3 area = Vec3::Zero();  // Newell: twice the area vector
+  for (size_t i = 0; i < poly.vertices.size(); ++i) {
+    box.Add(poly.vertices[i]);
+    area += poly.vertices[i].cross(poly.vertices[(i + 1) % poly.vertices.size()]);
+  }
+  area /= 2;
+  const Vec3 c = (box.lo + box.hi) / 2;
+  const double ppu = PixelsPerUnit(view, c);
+  return PointOf(box, area, std::abs(area.dot(TowardEye(view, c))) * ppu * ppu, view);
+}
+
+SubPixelPoint PointOfSurface(const SurfaceInstance& si, const TriangleMesh& m,
+                             const ScreenView& view) {
+  Box box;
+  std::vector<Vec3> placed(m.positions.size());
+  for (size_t i = 0; i < placed.size(); ++i) {
+    placed[i] = SurfacePoint(si, m.positions[i]);
+    box.Add(placed[i]);
+  }
+  if (!(box.lo.array() <= box.hi.array()).all()) return {};
+  const Vec3 c = (box.lo + box.hi) / 2;
+  const double ppu = PixelsPerUnit(view, c);
+  if (!std::isfinite(ppu) || !((box.hi - box.lo).norm() * ppu < 1)) return {};
+  const Vec3 d = TowardEye(view, c);
+  Vec3 sum = Vec3::Zero();
+  double projected = 0;
+  for (size_t t = 0; t < m.triangleCount(); ++t) {
+    const Vec3& a = placed[m.indices[3 * t]];
+    const Vec3& b = placed[m.indices[3 * t + 1]];
+    const Vec3& e = placed[m.indices[3 * t + 2]];
+    const Vec3 n = (b - a).cross(e - a) / 2;
+    sum += n.dot(d) >= 0 ? n : Vec3(-n);
+    projected += std::abs(n.dot(d));
+  }
+  return PointOf(box, sum, projected * ppu * ppu, view);
+}
+
+void EmitPoint(const SubPixelPoint& p, uint16_t color, TriangleMesh& out) {
+  const Vec3 u = AnyPerpendicular(p.toEye) * p.halfSide;
+  const Vec3 v = p.toEye.normalized().cross(u);
+  out.coverage.resize(out.positions.size(), 1.0f);
+  const uint32_t base = uint32_t(out.positions.size());
+  const Vec3 corners[4] = {p.center - u - v, p.center + u - v, p.center + u + v, p.center - u + v};
+  for (int k = 0; k < 4; ++k) {
+    out.positions.push_back(F(corners[k]));
+    out.normals.push_back(F(p.normal));
+    out.uvs.push_back(Vec2f(float(k == 1 || k == 2), float(k >= 2)));
+    out.coverage.push_back(p.coverage);
+  }
+  out.indices.insert(out.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+  out.material.push_back(color);
+  out.material.push_back(color);
 }
 
 void TessellateSphere(const Sphere& s, int sides, TriangleMesh& out) {
@@ -446,6 +556,8 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   auto shadowOnly = [&](size_t item) { return view && !inShadow.empty() && !inView[item]; };
   // Choose every chain's detail first, so the arrays are sized exactly once.
   std::vector<ChainPlan> plans(nc);
+  DetailHistory* history = view ? options.history : nullptr;
+  if (history && history->level.size() != nc) history->level.assign(nc, -1);
   auto plan = [&](size_t c, ChainFrames& frames) {
     const auto& chain = chains[c];
     double rmax = 0;
@@ -453,7 +565,8 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     if (!(rmax > 0) || !shown(c)) return;  // zero width, or culled: nothing to draw
     if (view) {
       BuildFrames(g, chain, frames, FramePart::kAxis);
-      PlanChain(g, chain, frames, *view, shadowOnly(c), plans[c]);
+      PlanChain(g, chain, frames, *view, shadowOnly(c), history ? &history->level[c] : nullptr,
+                plans[c]);
       return;
     }
     Vec3 lo = g.segments[chain[0]].start, hi = lo;
@@ -492,12 +605,35 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     const uint64_t S = uint64_t(sphereSides[i]), R = std::max<uint64_t>(2, S / 2);
     total += S * (2 * R - 2);
   }
+  // Polygons and surfaces under a pixel across, with coverage: points.
+  std::vector<SubPixelPoint> points(np + nf);
+  if (view && view->coverage) {
+    ForRanges(options.pool, np + nf, BalancedGrain(options.pool, np + nf, 256),
+              [&](size_t begin, size_t end) {
+                for (size_t i = begin; i < end; ++i) {
+                  if (!shown(nc + ns + i) || shadowOnly(nc + ns + i)) continue;
+                  if (i < np) {
+                    points[i] = PointOfPolygon(g.polygons[i], *view);
+                  } else {
+                    const SurfaceInstance& si = g.surfaces[i - np];
+                    points[i] = PointOfSurface(si, options.surfaces->at(si.name), *view);
+                  }
+                }
+              });
+  }
   for (size_t i = 0; i < np; ++i) {
     const Polygon& poly = g.polygons[i];
-    if (shown(nc + ns + i)) total += poly.vertices.size() >= 3 ? poly.vertices.size() - 2 : 0;
+    if (!shown(nc + ns + i)) continue;
+    if (points[i].coverage > 0) {
+      total += 2;
+    } else {
+      total += poly.vertices.size() >= 3 ? poly.vertices.size() - 2 : 0;
+    }
   }
   for (size_t i = 0; i < nf; ++i) {
-    if (shown(nc + ns + np + i)) total += options.surfaces->at(g.surfaces[i].name).triangleCount();
+    if (!shown(nc + ns + np + i)) continue;
+    total +=
+        points[np + i].coverage > 0 ? 2 : options.surfaces->at(g.surfaces[i].name).triangleCount();
   }
   const uint64_t limit = std::min<uint64_t>(options.maxTriangles, kMaxIndexedTriangles);
   if (out.triangleCount() + total > limit) {
@@ -530,6 +666,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   out.uvs.resize(vbase + verts);
   out.indices.resize(3 * (tbase + tris));
   out.material.resize(tbase + tris);
+  if (view && view->coverage) out.coverage.resize(vbase + verts, 1.0f);
   ForRanges(options.pool, nc, BalancedGrain(options.pool, nc, 256), [&](size_t begin, size_t end) {
     ChainFrames frames;
     for (size_t c = begin; c < end; ++c) {
@@ -549,6 +686,10 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   for (size_t i = 0; i < np; ++i) {
     const Polygon& poly = g.polygons[i];
     if (!shown(nc + ns + i)) continue;
+    if (points[i].coverage > 0) {
+      EmitPoint(points[i], poly.color, out);
+      continue;
+    }
     Vec3 normal;
     std::vector<uint32_t> polyTris = TriangulatePolygon(poly.vertices, &normal);
     if (polyTris.empty()) {
@@ -584,6 +725,10 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   for (size_t f = 0; f < nf; ++f) {
     if (!shown(nc + ns + np + f)) continue;
     const SurfaceInstance& si = g.surfaces[f];
+    if (points[np + f].coverage > 0) {
+      EmitPoint(points[np + f], si.color, out);
+      continue;
+    }
     const TriangleMesh& s = options.surfaces->at(si.name);
     const uint32_t base = uint32_t(out.positions.size());
     // ~name(s) scales all axes alike (the common case, computed as it
@@ -606,6 +751,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     for (uint32_t i : s.indices) out.indices.push_back(base + i);
     for (size_t t = 0; t < s.triangleCount(); ++t) out.material.push_back(si.color);
   }
+  if (!out.coverage.empty()) out.coverage.resize(out.positions.size(), 1.0f);
   if (stats) {
     stats->chains += chains.size();
     for (size_t i = 0; i < inView.size(); ++i) stats->culled += shown(i) ? 0 : 1;

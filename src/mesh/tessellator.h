@@ -70,12 +70,20 @@ struct TessellateOptions {
   // triangles a span) and tubes under a pixel get no caps. Spheres get the
   // sides of their projected radius at their centre. With view.shadowFrom
   // set, what lies outside the view but may shade it gets the detail of
-  // the shadow map (view.shadowTexelsPerUnit) instead.
+  // the shadow map (view.shadowTexelsPerUnit) instead. With view.coverage,
+  // tubes under kLinePixels wide become coverage lines and polygons and
+  // surfaces under a pixel points, and out.coverage is filled (one value a
+  // vertex, 1 for everything else).
   std::optional<ScreenView> view;
   // With a view: drop primitives whose box lies outside the view frustum
   // and, with view.shadowFrom, whose shadow cannot fall in it either (a box
   // straddling the frustum is kept).
   bool cull = true;
+  // With a view: the level each chain had last frame, read and updated, so
+  // a moving camera changes a chain's representation only past a margin
+  // (ChainLevelAfter in mesh/screen_detail.h). Reset when its size is not
+  // this geometry's chain count. Null: no hysteresis.
+  DetailHistory* history = nullptr;
   // Threads for planning and writing chains; null: the calling thread.
   // The mesh is the same for any pool (offsets are fixed before writing).
   // A detailFn is always called from the calling thread.

@@ -10,10 +10,19 @@ void TriangleMesh::Clear() {
   uvs.clear();
   indices.clear();
   material.clear();
+  coverage.clear();
 }
 
 void TriangleMesh::Append(const TriangleMesh& o) {
   const uint32_t base = uint32_t(positions.size());
+  if (!coverage.empty() || !o.coverage.empty()) {
+    coverage.resize(positions.size(), 1.0f);
+    if (o.coverage.empty()) {
+      coverage.resize(positions.size() + o.positions.size(), 1.0f);
+    } else {
+      coverage.insert(coverage.end(), o.coverage.begin(), o.coverage.end());
+    }
+  }
   positions.insert(positions.end(), o.positions.begin(), o.positions.end());
   normals.insert(normals.end(), o.normals.begin(), o.normals.end());
   uvs.insert(uvs.end(), o.uvs.begin(), o.uvs.end());
@@ -33,6 +42,10 @@ std::string FindNonFinite(const TriangleMesh& m) {
   };
   if (std::string s = bad(m.positions, "the position"); !s.empty()) return s;
   if (std::string s = bad(m.normals, "the normal"); !s.empty()) return s;
+  for (size_t i = 0; i < m.coverage.size(); ++i) {
+    if (!std::isfinite(m.coverage[i]))
+      return "the coverage of vertex " + std::to_string(i) + " is not finite";
+  }
   return bad(m.uvs, "the texture coordinate");
 }
 
@@ -41,6 +54,12 @@ std::string Validate(const TriangleMesh& m, float areaEpsilon) {
   if (m.normals.size() != n || m.uvs.size() != n) return "attribute arrays differ in size";
   if (m.indices.size() % 3) return "index count is not a multiple of 3";
   if (m.material.size() != m.triangleCount()) return "one material per triangle expected";
+  if (!m.coverage.empty() && m.coverage.size() != n) return "coverage array differs in size";
+  for (size_t i = 0; i < m.coverage.size(); ++i) {
+    if (!(m.coverage[i] > 0 && m.coverage[i] <= 1))
+      return "coverage " + std::to_string(i) + " is " + std::to_string(m.coverage[i]) +
+             ", outside (0, 1]";
+  }
   for (size_t i = 0; i < n; ++i) {
     if (!m.positions[i].allFinite() || !m.normals[i].allFinite() || !m.uvs[i].allFinite())
       return "vertex " + std::to_string(i) + " is not finite";

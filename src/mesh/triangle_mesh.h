@@ -21,6 +21,11 @@ struct TriangleMesh {
   std::vector<Vec2f> uvs;          // one per vertex
   std::vector<uint32_t> indices;   // 3 per triangle, counter-clockwise seen from outside
   std::vector<uint16_t> material;  // one per triangle
+  // Sub-pixel coverage (docs/lod.md): empty (every vertex opaque), or one
+  // value in (0, 1] per vertex, the fraction of the drawn width (or area)
+  // the true geometry covers. Only screen-space tessellation for a renderer
+  // that blends fills it (ScreenView::coverage); exporters ignore it.
+  std::vector<float> coverage;
 
   size_t vertexCount() const { return positions.size(); }
   size_t triangleCount() const { return indices.size() / 3; }
@@ -34,7 +39,8 @@ struct TriangleMesh {
 std::string FindNonFinite(const TriangleMesh& m);
 
 // Checks the invariants every mesh Sylva makes must hold: indices in range,
-// finite values, unit normals, no zero-area triangle, array sizes agree.
+// finite values, unit normals, no zero-area triangle, array sizes agree,
+// coverage (when present) in (0, 1].
 // Returns a description of the first violation, or an empty string.
 std::string Validate(const TriangleMesh& m, float areaEpsilon = 1e-12f);
 

@@ -138,6 +138,7 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
   options.detail = spec.detail;
   options.view = spec.view;
   options.cull = spec.cull;
+  options.history = spec.history;
   ThreadPool ownPool(spec.pool ? 1 : spec.threads);
   options.pool = spec.pool ? spec.pool : &ownPool;
   options.surfaces = &surfaces.meshes();

@@ -88,6 +88,9 @@ struct PlantSpec {
   // set. eps > 0 pixels, viewport 1..16384 pixels.
   std::optional<mesh::ScreenView> view;
   bool cull = true;  // with a view: drop what lies outside its frustum
+  // With a view: each chain's level in the last frame, read and updated
+  // (hysteresis: mesh::TessellateOptions::history); not owned. Null: none.
+  mesh::DetailHistory* history = nullptr;
   Stage until = Stage::kMesh;
   FileReader readFile;  // empty: the file system
   // Answers ?E instead of the environment the grammar's `environment:`

@@ -27,4 +27,14 @@ std::vector<mesh::Vec3f> VertexColors(const mesh::TriangleMesh& m, const mesh::P
 void UploadVertexAttributes(const unsigned buffers[3], const mesh::TriangleMesh& m,
                             const std::vector<mesh::Vec3f>& colors);
 
+// Sub-pixel coverage (TriangleMesh::coverage, docs/lod.md): when some
+// vertex has coverage < 1, fills the bound element buffer with the opaque
+// triangles first and those with partial coverage after them, uploads the
+// coverage into `coverageBuffer` as attribute `location` of the bound
+// vertex array, and returns how many indices are opaque; otherwise fills
+// the element buffer as it is, disables the attribute (its generic value,
+// 1, is set before drawing) and returns the index count.
+size_t UploadIndicesOpaqueFirst(const mesh::TriangleMesh& m, unsigned coverageBuffer,
+                                unsigned location);
+
 }  // namespace sylva::render

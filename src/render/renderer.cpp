@@ -4,6 +4,7 @@
 #include <stb_image_write.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -45,8 +46,11 @@ struct Renderer::Gl {
   Eigen::Matrix4f lightViewProj = Eigen::Matrix4f::Identity();
   bool haveShadow = false;
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};  // mesh bounds
-  GLuint meshVao = 0, meshBuffers[3] = {0, 0, 0}, meshIndex = 0;
+  GLuint meshVao = 0, meshBuffers[3] = {0, 0, 0}, meshIndex = 0, meshCoverage = 0;
   GLsizei meshIndexCount = 0;
+  // Indices [0, opaqueIndexCount) are opaque; the rest have coverage < 1
+  // somewhere and are blended after everything opaque, without depth writes.
+  GLsizei opaqueIndexCount = 0;
   GLuint lineVao = 0, lineBuffers[2] = {0, 0};
   GLsizei lineVertexCount = 0;
   GLuint pointProgram = 0, pointVao = 0, pointBuffers[3] = {0, 0, 0};
@@ -86,6 +90,42 @@ void UploadVertexAttributes(const unsigned buffers[3], const mesh::TriangleMesh&
     glEnableVertexAttribArray(GLuint(k));
     glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
   }
+}
+
+size_t UploadIndicesOpaqueFirst(const mesh::TriangleMesh& m, unsigned coverageBuffer,
+                                unsigned location) {
+  const bool partial =
+      m.coverage.size() == m.vertexCount() &&
+      std::any_of(m.coverage.begin(), m.coverage.end(), [](float c) { return c < 1; });
+  if (!partial) {
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
+                 GL_STATIC_DRAW);
+    glDisableVertexAttribArray(location);
+    return m.indices.size();
+  }
+  // Opaque triangles first, then those with partial coverage (in order).
+  std::vector<uint32_t> sorted;
+  sorted.reserve(m.indices.size());
+  auto translucent = [&](size_t t) {
+    return m.coverage[m.indices[3 * t]] < 1 || m.coverage[m.indices[3 * t + 1]] < 1 ||
+           m.coverage[m.indices[3 * t + 2]] < 1;
+  };
+  size_t opaque = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    for (size_t t = 0; t < m.triangleCount(); ++t) {
+      if (translucent(t) != (pass == 1)) continue;
+      sorted.insert(sorted.end(), &m.indices[3 * t], &m.indices[3 * t] + 3);
+    }
+    if (pass == 0) opaque = sorted.size();
+  }
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(sorted.size() * 4), sorted.data(),
+               GL_STATIC_DRAW);
+  glBindBuffer(GL_ARRAY_BUFFER, coverageBuffer);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.coverage.size() * 4), m.coverage.data(),
+               GL_STATIC_DRAW);
+  glEnableVertexAttribArray(location);
+  glVertexAttribPointer(location, 1, GL_FLOAT, GL_FALSE, 4, nullptr);
+  return opaque;
 }
 
 Expected<unsigned> CompileProgram(const std::string& dir, const std::string& name) {
@@ -183,6 +223,7 @@ Expected<std::unique_ptr<Renderer>> Renderer::Create(const std::string& shaderDi
   glGenVertexArrays(1, &g.meshVao);
   glGenBuffers(3, g.meshBuffers);
   glGenBuffers(1, &g.meshIndex);
+  glGenBuffers(1, &g.meshCoverage);
   glGenVertexArrays(1, &g.lineVao);
   glGenBuffers(2, g.lineBuffers);
   return r;
@@ -199,6 +240,7 @@ Renderer::~Renderer() {
   glDeleteProgram(g.lineProgram);
   glDeleteBuffers(3, g.meshBuffers);
   glDeleteBuffers(1, &g.meshIndex);
+  glDeleteBuffers(1, &g.meshCoverage);
   glDeleteBuffers(2, g.lineBuffers);
   glDeleteVertexArrays(1, &g.meshVao);
   glDeleteVertexArrays(1, &g.lineVao);
@@ -264,9 +306,8 @@ void Renderer::SetMesh(const mesh::TriangleMesh& m, const mesh::Palette& palette
   glBindVertexArray(g.meshVao);
   UploadVertexAttributes(g.meshBuffers, m, color);
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.meshIndex);
-  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
-               GL_STATIC_DRAW);
   g.meshIndexCount = GLsizei(m.indices.size());
+  g.opaqueIndexCount = GLsizei(UploadIndicesOpaqueFirst(m, g.meshCoverage, 3));
   glBindVertexArray(0);
   g.lo = g.hi = Vec3::Zero();
   if (m.vertexCount()) {
@@ -319,6 +360,9 @@ void Renderer::RenderShadowMap() {
   glUseProgram(g.shadowProgram);
   glUniformMatrix4fv(g.shadowLightViewProj, 1, GL_FALSE, g.lightViewProj.data());
   glBindVertexArray(g.meshVao);
+  // Coverage lines and points, drawn wider than they are, cast a
+  // screen-door shadow (shadow.frag) of their mean darkness.
+  glVertexAttrib1f(3, 1.0f);  // coverage of a mesh without any
   glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
   glBindVertexArray(0);
   glDisable(GL_POLYGON_OFFSET_FILL);
@@ -400,7 +444,8 @@ void Renderer::Draw(const Camera& camera) {
     glUniform1i(g.meshShadow, 0);
     glBindVertexArray(g.meshVao);
     glUniform1i(g.meshWire, 0);
-    glDrawElements(GL_TRIANGLES, g.meshIndexCount, GL_UNSIGNED_INT, nullptr);
+    glVertexAttrib1f(3, 1.0f);  // coverage of a mesh without any
+    glDrawElements(GL_TRIANGLES, g.opaqueIndexCount, GL_UNSIGNED_INT, nullptr);
     if (wireframe_) {
       // The triangles' edges over the shaded mesh, pulled toward the eye.
       glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
@@ -411,6 +456,19 @@ void Renderer::Draw(const Camera& camera) {
       glUniform1i(g.meshWire, 0);
       glDisable(GL_POLYGON_OFFSET_LINE);
       glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    }
+    if (g.opaqueIndexCount < g.meshIndexCount) {
+      // Coverage in alpha, blended over everything opaque in the encoded
+      // (sRGB) values the target holds, as the multisample resolve averages
+      // them; depth tested but not written, so overlapping twigs add up.
+      glBindVertexArray(g.meshVao);
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+      glDepthMask(GL_FALSE);
+      glDrawElements(GL_TRIANGLES, g.meshIndexCount - g.opaqueIndexCount, GL_UNSIGNED_INT,
+                     reinterpret_cast<const void*>(size_t(g.opaqueIndexCount) * 4));
+      glDepthMask(GL_TRUE);
+      glDisable(GL_BLEND);
     }
   }
   if (g.pointCount) {

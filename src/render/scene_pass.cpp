@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <unordered_map>
+#include <utility>
 
 #include "render/gl_program.h"
 #include "render/renderer.h"
@@ -15,11 +16,16 @@ namespace sylva::render {
 
 namespace {
 
+// The vertex attribute of sub-pixel coverage (scene.vert, scene_shadow.vert;
+// 3..7 hold the instance's model matrix and tint).
+constexpr GLuint kCoverageLocation = 8;
+
 struct GpuMesh {
   std::shared_ptr<const mesh::TriangleMesh> mesh;  // keeps the key alive
   mesh::Palette palette;
-  GLuint vao = 0, buffers[3] = {0, 0, 0}, index = 0, instances = 0;
+  GLuint vao = 0, buffers[3] = {0, 0, 0}, index = 0, instances = 0, coverage = 0;
   GLsizei indexCount = 0;
+  GLsizei opaqueCount = 0;  // indices [opaqueCount, indexCount): partial coverage, blended last
   bool used = false;
 };
 
@@ -27,6 +33,7 @@ void DeleteMesh(GpuMesh& m) {
   glDeleteBuffers(3, m.buffers);
   glDeleteBuffers(1, &m.index);
   glDeleteBuffers(1, &m.instances);
+  glDeleteBuffers(1, &m.coverage);
   glDeleteVertexArrays(1, &m.vao);
 }
 
@@ -165,8 +172,8 @@ struct Renderer::ScenePass {
                           reinterpret_cast<const void*>(size_t(64)));
     glVertexAttribDivisor(7, 1);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
-                 GL_STATIC_DRAW);
+    glGenBuffers(1, &g.coverage);
+    g.opaqueCount = GLsizei(UploadIndicesOpaqueFirst(m, g.coverage, kCoverageLocation));
     g.indexCount = GLsizei(m.indices.size());
     glBindVertexArray(0);
     return g;
@@ -285,6 +292,8 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     glPolygonOffset(2.0f, 4.0f);
     glUseProgram(p.shadowProgram);
     glUniformMatrix4fv(p.shadowViewProj, 1, GL_FALSE, lightViewProj.data());
+    glVertexAttrib1f(kCoverageLocation, 1.0f);  // meshes without coverage
+    // Coverage lines cast a screen-door shadow (shadow.frag).
     for (size_t i = 0; i < list.meshes.size(); ++i) {
       if (!list.meshes[i].castsShadow || list.meshes[i].instances.empty()) continue;
       glBindVertexArray(gpu[i]->vao);
@@ -350,13 +359,29 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, p.shadowDepth);
     glUniform1i(p.shadowMap, 0);
+    glVertexAttrib1f(kCoverageLocation, 1.0f);  // meshes without coverage
     glUniform1i(p.wire, 0);
     for (size_t i = 0; i < list.meshes.size(); ++i) {
       if (list.meshes[i].instances.empty()) continue;
       glBindVertexArray(gpu[i]->vao);
-      glDrawElementsInstanced(GL_TRIANGLES, gpu[i]->indexCount, GL_UNSIGNED_INT, nullptr,
+      glDrawElementsInstanced(GL_TRIANGLES, gpu[i]->opaqueCount, GL_UNSIGNED_INT, nullptr,
                               GLsizei(list.meshes[i].instances.size()));
     }
+    // Partial coverage (coverage lines and points) blended over everything
+    // opaque, depth tested but not written, as in the single-mesh path.
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    glDepthMask(GL_FALSE);
+    for (size_t i = 0; i < list.meshes.size(); ++i) {
+      const std::pair<GLsizei, GLsizei> range{gpu[i]->opaqueCount, gpu[i]->indexCount};
+      if (list.meshes[i].instances.empty() || range.first == range.second) continue;
+      glBindVertexArray(gpu[i]->vao);
+      glDrawElementsInstanced(GL_TRIANGLES, range.second - range.first, GL_UNSIGNED_INT,
+                              reinterpret_cast<const void*>(size_t(range.first) * 4),
+                              GLsizei(list.meshes[i].instances.size()));
+    }
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
     if (list.wireframe) {
       // The triangles' edges over the shaded meshes, pulled toward the eye.
       glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);

@@ -80,7 +80,7 @@ set +e
 "$sylva" view "$src/grammars/abop/fig2_06a_monopodial.lsys" --time 2 2>"$work/grammar.err"
 code=$?
 set -e
-[[ $code -eq 2 ]] && grep -q "are for scenes" "$work/grammar.err"
+[[ $code -eq 2 ]] && grep -q "is for scenes" "$work/grammar.err"
 
 # Live reload of the scene and of a grammar it names.
 cp "$src/grammars/abop/fig2_07a_sympodial.lsys" "$work/tree.lsys"

@@ -214,25 +214,150 @@ TEST(ScreenDetail, SameTrianglesForAnyThreadCount) {
     mix(m.uvs.data(), m.uvs.size() * sizeof(Vec2f));
     mix(m.indices.data(), m.indices.size() * 4);
     mix(m.material.data(), m.material.size() * 2);
+    mix(m.coverage.data(), m.coverage.size() * 4);
     return h;
   };
-  uint64_t first = 0;
-  size_t triangles = 0;
-  for (int threads : {1, 2, 3, 8}) {
-    ThreadPool pool(threads);
-    TessellateOptions opt;
-    opt.view = view;
-    opt.pool = threads > 1 ? &pool : nullptr;
-    TriangleMesh m;
-    ASSERT_TRUE(Tessellate(p->geometry, opt, m).ok());
-    if (threads == 1) {
-      first = hash(m);
-      triangles = m.triangleCount();
+  // Plain, and with coverage lines and a history carried from a farther frame.
+  for (bool coverage : {false, true}) {
+    uint64_t first = 0;
+    size_t triangles = 0;
+    for (int threads : {1, 2, 3, 8}) {
+      ThreadPool pool(threads);
+      TessellateOptions opt;
+      opt.view = view;
+      opt.view->coverage = coverage;
+      opt.pool = threads > 1 ? &pool : nullptr;
+      DetailHistory history;
+      TriangleMesh m;
+      if (coverage) {
+        opt.history = &history;
+        opt.view->viewProjection =
+            LookAtPerspective(Vec3(2.2, 3, 4.4), Vec3(0, 2.5, 0), 35, 960.0 / 540);
+        ASSERT_TRUE(Tessellate(p->geometry, opt, m).ok());
+        m.Clear();
+        opt.view->viewProjection = view.viewProjection;
+      }
+      ASSERT_TRUE(Tessellate(p->geometry, opt, m).ok());
+      if (threads == 1) {
+        first = hash(m);
+        triangles = m.triangleCount();
+        EXPECT_EQ(m.coverage.size(), coverage ? m.vertexCount() : 0u);
+        EXPECT_EQ(Validate(m), "");
+      }
+      EXPECT_EQ(hash(m), first) << threads << " threads, coverage " << coverage;
+      EXPECT_EQ(m.triangleCount(), triangles) << threads << " threads";
     }
-    EXPECT_EQ(hash(m), first) << threads << " threads";
-    EXPECT_EQ(m.triangleCount(), triangles) << threads << " threads";
+    EXPECT_GT(triangles, 1000u);
   }
-  EXPECT_GT(triangles, 1000u);
+}
+
+// The levels are ordered as the projected radius: a coverage line under
+// half a pixel (only with coverage), a ribbon under 3 eps, then the sides.
+// With hysteresis a level is never coarser than the radius needs, and a
+// finer one is kept until the radius is kHysteresis below its threshold.
+TEST(ScreenDetail, LevelsAndHysteresis) {
+  EXPECT_EQ(ChainLevel(0.3, 0.5, true), 0);
+  EXPECT_EQ(ChainLevel(0.3, 0.5, false), 1);
+  EXPECT_EQ(ChainLevel(1.4, 0.5, true), 1);
+  EXPECT_EQ(ChainLevel(1.6, 0.5, true), SidesForPixelRadius(1.6, 0.5));
+  EXPECT_EQ(ChainLevel(std::nan(""), 0.5, true), 256);
+  int prev = 0;
+  for (double r = 0.01; r < 300; r *= 1.01) {
+    const int l = ChainLevel(r, 0.5, true);
+    ASSERT_GE(l, prev) << "the level should grow with the radius, at r = " << r;
+    prev = l;
+    const int fine = ChainLevel(r * 1.3, 0.5, true);
+    // From a finer level: kept within the margin, never coarser than needed.
+    const int kept = ChainLevelAfter(fine, r, 0.5, true);
+    EXPECT_GE(kept, l) << "r = " << r;
+    EXPECT_LE(kept, std::max(l, ChainLevel(r * (1 + kHysteresis), 0.5, true))) << "r = " << r;
+    // From a coarser level: raised to what the radius needs at once.
+    EXPECT_EQ(ChainLevelAfter(0, r, 0.5, true), l) << "r = " << r;
+    EXPECT_EQ(ChainLevelAfter(-1, r, 0.5, true), l) << "r = " << r;
+  }
+  // Just under the ribbon threshold (1.5 px) a tube stays a tube, and a
+  // line stays a line just over half a pixel.
+  EXPECT_EQ(ChainLevelAfter(3, 1.45, 0.5, true), 3);
+  EXPECT_EQ(ChainLevelAfter(3, 1.2, 0.5, true), 1);
+  EXPECT_EQ(ChainLevelAfter(0, 0.52, 0.5, true), 1) << "a coarser level is never kept";
+  EXPECT_EQ(ChainLevelAfter(1, 0.45, 0.5, true), 1);
+  EXPECT_EQ(ChainLevelAfter(1, 0.4, 0.5, true), 0);
+}
+
+// With coverage, a leaf (polygon) under a pixel becomes a one-pixel quad
+// whose coverage is its projected area in square pixels; a larger one
+// stays a polygon. A twig under a pixel becomes a line kLinePixels wide.
+TEST(ScreenDetail, SubPixelLeavesBecomePointsAndTwigsLines) {
+  ScreenView view;
+  view.width = 960;
+  view.height = 540;
+  view.viewProjection = LookAtPerspective(Vec3(0, 0, 10), Vec3(0, 0, 0), 35, 960.0 / 540);
+  view.coverage = true;
+  const double ppu = PixelsPerUnit(view, Vec3::Zero());
+  PlantGeometry g;
+  for (double side : {0.5, 4.0}) {  // pixels
+    Polygon poly;
+    const double h = side / ppu / 2;
+    poly.vertices = {Vec3(-h, -h, 0), Vec3(h, -h, 0), Vec3(h, h, 0), Vec3(-h, h, 0)};
+    poly.color = 3;
+    g.polygons.push_back(poly);
+  }
+  Segment s;
+  s.start = Vec3(1, -1, 0);
+  s.end = Vec3(1, 1, 0);
+  s.radiusStart = s.radiusEnd = float(0.1 / ppu);  // 0.2 px wide
+  s.left = Vec3(1, 0, 0);
+  g.segments.push_back(s);
+  g.branchCount = 1;
+  TessellateOptions opt;
+  opt.view = view;
+  TriangleMesh m;
+  ASSERT_TRUE(Tessellate(g, opt, m).ok());
+  EXPECT_EQ(Validate(m), "");
+  ASSERT_EQ(m.coverage.size(), m.vertexCount());
+  // The twig: 4 vertices (a line), then the point (4), then the 4 px square (4).
+  ASSERT_EQ(m.vertexCount(), 12u);
+  EXPECT_EQ(m.triangleCount(), 6u);
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(m.coverage[i], 0.2, 0.01) << "twig vertex " << i;
+  const double width = (m.positions[1] - m.positions[0]).norm() * ppu;
+  EXPECT_NEAR(width, kLinePixels, 0.02) << "the line's drawn width in pixels";
+  for (int i = 4; i < 8; ++i) {
+    EXPECT_NEAR(m.coverage[i], 0.25, 0.01) << "a 0.5 px square covers a quarter of a pixel";
+  }
+  EXPECT_NEAR((m.positions[6] - m.positions[4]).norm() * ppu, std::sqrt(2.0) * kLinePixels, 0.02)
+      << "the point's diagonal in pixels";
+  for (int i = 8; i < 12; ++i) EXPECT_EQ(m.coverage[i], 1.0f) << "the 4 px square is opaque";
+  EXPECT_EQ(m.material[2], 3) << "the point keeps the leaf's colour";
+  // Without coverage (export): the leaf stays a polygon and the twig a ribbon, opaque.
+  opt.view->coverage = false;
+  TriangleMesh plain;
+  ASSERT_TRUE(Tessellate(g, opt, plain).ok());
+  EXPECT_TRUE(plain.coverage.empty());
+  EXPECT_NEAR((plain.positions[1] - plain.positions[0]).norm() * ppu, 0.2, 0.01);
+}
+
+TEST(TriangleMesh, CoverageIsValidatedAndAppended) {
+  TriangleMesh a;
+  a.positions = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
+  a.normals.assign(3, Vec3f(0, 0, 1));
+  a.uvs.assign(3, Vec2f(0, 0));
+  a.indices = {0, 1, 2};
+  a.material = {0};
+  TriangleMesh b = a;
+  b.coverage = {0.5f, 0.5f, 0.5f};
+  TriangleMesh c = a;
+  c.Append(b);
+  ASSERT_EQ(c.coverage.size(), 6u);
+  EXPECT_EQ(c.coverage[0], 1.0f);
+  EXPECT_EQ(c.coverage[5], 0.5f);
+  EXPECT_EQ(Validate(c), "");
+  c.coverage[4] = std::nanf("");
+  EXPECT_NE(Validate(c).find("coverage 4"), std::string::npos) << Validate(c);
+  EXPECT_NE(FindNonFinite(c), "");
+  c.coverage[4] = 0;
+  EXPECT_NE(Validate(c).find("outside (0, 1]"), std::string::npos) << Validate(c);
+  c.coverage.pop_back();
+  EXPECT_NE(Validate(c), "");
 }
 
 TEST(ScreenDetail, FewerTrianglesThanUniformSixteenSidesAtOnePixelTwigs) {
