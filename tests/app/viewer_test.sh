@@ -16,38 +16,10 @@ trap cleanup EXIT
 export DISPLAY="$display"
 for _ in $(seq 50); do [[ -e "/tmp/.X11-unix/X${display#:}" ]] && break; sleep 0.1; done
 
-# A PNG reader for the checks below (RGBA rows, PNG filters undone).
-cat > "$work/png.py" <<'PY'
-import struct, zlib
-def read(path):
-    data = open(path, 'rb').read()
-    assert data[:8] == b'\x89PNG\r\n\x1a\n', 'not a PNG'
-    w, h = struct.unpack('>II', data[16:24])
-    idat = b''; i = 8
-    while i < len(data):
-        n, kind = struct.unpack('>I4s', data[i:i + 8]); body = data[i + 8:i + 8 + n]
-        if kind == b'IDAT': idat += body
-        i += 12 + n
-    raw = zlib.decompress(idat); stride = 4 * w + 1
-    prev = bytearray(4 * w); rows = []
-    for y in range(h):
-        f = raw[y * stride]; row = bytearray(raw[y * stride + 1:(y + 1) * stride])
-        for x in range(4 * w):
-            a = row[x - 4] if x >= 4 else 0; b = prev[x]; c = prev[x - 4] if x >= 4 else 0
-            if f == 1: row[x] = (row[x] + a) & 255
-            elif f == 2: row[x] = (row[x] + b) & 255
-            elif f == 3: row[x] = (row[x] + (a + b) // 2) & 255
-            elif f == 4:
-                p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                row[x] = (row[x] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        rows.append(row); prev = row
-    return w, h, rows
-PY
-
 cp "$src/grammars/abop/fig2_06a_monopodial.lsys" "$work/tree.lsys"
 "$sylva" view "$work/tree.lsys" --screenshot "$work/shot.png" --frames 5 --size 640x360
-python3 - "$work" <<'PY'
-import sys; sys.path.insert(0, sys.argv[1]); import png
+python3 - "$work" "$src/tests/app" <<'PY'
+import sys; sys.dont_write_bytecode = True; sys.path.insert(0, sys.argv[2]); import png_rows as png
 w, h, rows = png.read(sys.argv[1] + '/shot.png')
 assert w == 640 and h == 360, (w, h)
 # Count brownish bark pixels (the plant).
@@ -83,8 +55,8 @@ PY
 "$sylva" view "$work/tree.lsys" -n 3 --seed 2 -D r1=0.8 --screenshot "$work/young.png" --frames 5 --size 640x360
 cp "$src/grammars/abop/fig1_06_koch_island.lsys" "$work/koch.lsys"
 "$sylva" view "$work/koch.lsys" --screenshot "$work/koch.png" --frames 5 --size 640x360
-python3 - "$work" <<'PY'
-import sys; sys.path.insert(0, sys.argv[1]); import png
+python3 - "$work" "$src/tests/app" <<'PY'
+import sys; sys.dont_write_bytecode = True; sys.path.insert(0, sys.argv[2]); import png_rows as png
 def bark(rows, w):
     return sum(1 for row in rows for x in range(w)
                if row[4 * x] > row[4 * x + 1] > row[4 * x + 2] and row[4 * x] - row[4 * x + 2] > 25)
