@@ -183,14 +183,28 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
 
 Cloth::~Cloth() = default;
 
-Status Cloth::AddCollider(Collider c) {
+Status Cloth::AddCollider(Collider c, double thickness) {
   SYLVA_CHECK_OK(Validate(c));
+  SYLVA_CHECK_OK(check::Range("Cloth.AddCollider thickness", thickness, 0, 1e3, "m"));
   if (c.response == Response::kKill)
     return check::Error(
         "Cloth.AddCollider: a kKill collider cannot take cloth (a cloth particle "
         "cannot die); use kBounce or kStick");
   if (implicit_) SYLVA_CHECK_OK(implicit_->AddCollider(c));
   colliders_.push_back(std::move(c));
+  colliderThickness_.push_back(thickness);
+  return {};
+}
+
+Status Cloth::SetCollider(size_t index, Collider c) {
+  if (index >= colliders_.size())
+    return check::Error("Cloth.SetCollider: collider " + std::to_string(index) + " of " +
+                        std::to_string(colliders_.size()));
+  SYLVA_CHECK_OK(Validate(c));
+  if (c.response == Response::kKill)
+    return check::Error("Cloth.SetCollider: a kKill collider cannot take cloth");
+  if (implicit_) SYLVA_CHECK_OK(implicit_->SetCollider(index, c));
+  colliders_[index] = std::move(c);
   return {};
 }
 
@@ -482,9 +496,11 @@ void Cloth::ContactsXpbd(ThreadPool* pool) {
       if (w_[i] == 0) continue;
       Vec3 x = get(x4_[i]);
       bool any = false;
-      for (const Collider& c : colliders_) any = any || c.MayHit(get(prev4_[i]), x);
+      for (size_t k = 0; k < colliders_.size() && !any; ++k)
+        any = colliders_[k].MayHit(get(prev4_[i]), x, colliderThickness_[k]);
       if (!any) continue;
-      const Collider* hit = clothcontact::Collide(colliders_, get(prev4_[i]), x);
+      const Collider* hit =
+          clothcontact::Collide(colliders_, colliderThickness_, get(prev4_[i]), x);
       if (!hit) continue;
       put(x4_[i], x);
       ++count;

@@ -150,7 +150,13 @@ class Cloth {
   // with the collider's friction; a particle that touches a kStick collider
   // becomes immovable, as a pin; kKill is an error (a cloth particle cannot
   // die).
-  Status AddCollider(Collider c);
+  // `thickness` (m, 0..1e3): how far the cloth's particles keep from it
+  // (the XPBD solver; the implicit one keeps none). A sheet met from
+  // either side, such as another cloth, needs some.
+  Status AddCollider(Collider c, double thickness = 0);
+  // Replaces collider `index` (another cloth, rebuilt each step), keeping
+  // its thickness; the same checks as AddCollider.
+  Status SetCollider(size_t index, Collider c);
   const std::vector<Collider>& colliders() const { return colliders_; }
   // An extra force on each free particle, N: f(i, x, v) for particle i at
   // x with velocity v (drag, attractors, noise). Evaluated with the wind
@@ -213,6 +219,7 @@ class Cloth {
   const WindField* windField_ = nullptr;  // during a Step with a field
   ForceField externalForce_;
   std::vector<Collider> colliders_;
+  std::vector<double> colliderThickness_;  // one per collider
   std::unique_ptr<clothcontact::SelfCollision> self_;
   std::vector<Vec3> selfX_, selfPrev_, selfDx_;
   size_t lastContacts_ = 0;

@@ -18,18 +18,19 @@ Vec3 FrictionTaken(const Vec3& t, double mu, double depth) {
 
 }  // namespace
 
-const Collider* Collide(const std::vector<Collider>& colliders, const Vec3& p, Vec3& x) {
+const Collider* Collide(const std::vector<Collider>& colliders, const std::vector<double>& radii,
+                        const Vec3& p, Vec3& x) {
   const Collider* touched = nullptr;
   Vec3 a = p;
   for (int k = 0; k < 4; ++k) {
     Contact best;
     best.s = 2;
     const Collider* hit = nullptr;
-    for (const Collider& c : colliders) {
+    for (size_t k = 0; k < colliders.size(); ++k) {
       Contact ct;
-      if (c.Intersect(a, x, &ct) && ct.s < best.s) {
+      if (colliders[k].Intersect(a, x, &ct, radii[k]) && ct.s < best.s) {
         best = ct;
-        hit = &c;
+        hit = &colliders[k];
       }
     }
     if (!hit) break;
@@ -45,9 +46,9 @@ const Collider* Collide(const std::vector<Collider>& colliders, const Vec3& p, V
     a = best.point;
   }
   if (!touched) return nullptr;
-  for (const Collider& c : colliders) {  // never left inside a solid
+  for (size_t k = 0; k < colliders.size(); ++k) {  // never left inside a solid
     Vec3 sp, sn;
-    if (c.Project(x, &sp, &sn)) x = sp;
+    if (colliders[k].Project(x, &sp, &sn, radii[k])) x = sp;
   }
   return touched;
 }

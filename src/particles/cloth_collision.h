@@ -41,7 +41,11 @@ namespace sylva::particles::clothcontact {
 // friction; returns the last collider it touched (null: none). A kStick
 // collider takes the particle's tangential motion entirely (the caller
 // then makes it immovable).
-const Collider* Collide(const std::vector<Collider>& colliders, const Vec3& p, Vec3& x);
+// radii[k]: the thickness kept from collider k (0: the surface itself; a
+// sheet met from either side, such as another cloth, needs one, or a
+// particle resting on it starts its next path on the surface and passes).
+const Collider* Collide(const std::vector<Collider>& colliders, const std::vector<double>& radii,
+                        const Vec3& p, Vec3& x);
 
 class SelfCollision {
  public:

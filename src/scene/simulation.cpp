@@ -421,6 +421,13 @@ void ParticleSystem::TurnLeaves(double h, const Wind* wind, double time) {
 struct ClothSheet {
   const ClothDef* def = nullptr;
   std::unique_ptr<particles::Cloth> cloth;
+  // Other cloths it collides with: (index into Impl::cloths, its collider
+  // index, the <collide>), rebuilt from the other sheet before each step.
+  struct Other {
+    size_t cloth, collider;
+    const CollideDef* def;
+  };
+  std::vector<Other> others;
   std::unique_ptr<WindGrid> windGrid = std::make_unique<WindGrid>();  // the gusts over it
   Vec3 gravity = Vec3::Zero();
 };
@@ -552,11 +559,9 @@ Status Simulation::Impl::CollidersOf(const std::vector<CollideDef>& collides,
         bool isCloth = false;
         for (const ClothDef& cl : scene->cloths) isCloth = isCloth || cl.id == id;
         if (isCloth) {
-          // A cloth with itself: its self-collision (the caller). Particles
-          // with a cloth: ClothCollidersOf, once the cloths exist.
-          if (id != selfId && !selfId.empty())
-            diags.Add(Warn(c.withLoc, "collisions of a cloth with another cloth ('" + id +
-                                          "') are not simulated yet"));
+          // A cloth with itself: its self-collision (the caller). With
+          // another cloth or particles: once the cloths exist (the end of
+          // Create).
           continue;
         }
         const auto pts = built->points.find(id);
@@ -596,17 +601,19 @@ Status Simulation::Impl::AddColliders(particles::System& system,
   return {};
 }
 
+// A cloth where it is now, as the triangle collider `def` describes.
+static particles::Collider ClothAsCollider(const particles::Cloth& cloth, const CollideDef& def) {
+  auto bvh = std::make_shared<const particles::TriangleBvh>(cloth.positions(), cloth.triangles());
+  particles::Collider c = particles::Collider::Mesh(std::move(bvh));
+  c.Restitution(def.restitution)
+      .Friction(std::min(def.friction, 1e3))
+      .Respond(def.stick ? particles::Response::kStick : particles::Response::kBounce);
+  return c;
+}
+
 Status Simulation::Impl::RefreshClothColliders(ParticleSystem& ps) {
   for (const ParticleSystem::ClothCollider& cc : ps.clothColliders) {
-    const particles::Cloth& cloth = *cloths[cc.cloth].cloth;
-    std::vector<std::array<uint32_t, 3>> triangles(cloth.triangles().begin(),
-                                                   cloth.triangles().end());
-    auto bvh =
-        std::make_shared<const particles::TriangleBvh>(cloth.positions(), std::move(triangles));
-    particles::Collider c = particles::Collider::Mesh(std::move(bvh));
-    c.Restitution(cc.def->restitution)
-        .Friction(std::min(cc.def->friction, 1e3))
-        .Respond(cc.def->stick ? particles::Response::kStick : particles::Response::kBounce);
+    particles::Collider c = ClothAsCollider(*cloths[cc.cloth].cloth, *cc.def);
     if (Status s = ps.system->SetCollider(cc.collider, std::move(c)); !s.ok()) {
       Diagnostic d = s.error();
       d.loc = cc.def->loc;
@@ -774,6 +781,14 @@ Status Simulation::Impl::Step() {
     }
   }
   for (ClothSheet& c : cloths) {
+    for (const ClothSheet::Other& o : c.others) {
+      particles::Collider other = ClothAsCollider(*cloths[o.cloth].cloth, *o.def);
+      if (Status s = c.cloth->SetCollider(o.collider, std::move(other)); !s.ok()) {
+        Diagnostic d = s.error();
+        d.loc = o.def->loc;
+        return d;
+      }
+    }
     // The wind at each triangle (gusts smaller than the sheet bend it),
     // from the gusts sampled on a grid over the sheet.
     const double t = time;
@@ -1246,6 +1261,30 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
   if (Status s = m.PlaceCentres(); !s.ok()) return s.error();
   for (auto& ps : m.systems)
     if (Status s = m.AddClothColliders(*ps); !s.ok()) return s.error();
+  // A cloth colliding with another cloth: the other sheet's triangles, now
+  // and before each step, kept a quarter of this sheet's cell away (a sheet
+  // has two sides: a vertex resting on the surface itself would pass).
+  for (ClothSheet& sheet : m.cloths) {
+    const ClothDef& d = *sheet.def;
+    const double cell =
+        std::max(d.size.x() / std::max(d.columns - 1, 1), d.size.y() / std::max(d.rows - 1, 1));
+    const double thickness = std::max(0.25 * cell, 1e-3);
+    for (const CollideDef& c : d.collides) {
+      for (const std::string& id : c.with) {
+        for (size_t k = 0; k < m.cloths.size(); ++k) {
+          if (m.cloths[k].def->id != id || &m.cloths[k] == &sheet) continue;
+          sheet.others.push_back({k, sheet.cloth->colliders().size(), &c});
+          if (Status s = sheet.cloth->AddCollider(ClothAsCollider(*m.cloths[k].cloth, c),
+                                                  std::min(thickness, 1e3));
+              !s.ok()) {
+            Diagnostic diag = s.error();
+            diag.loc = c.loc;
+            return diag;
+          }
+        }
+      }
+    }
+  }
   return sim;
 }
 

@@ -248,6 +248,35 @@ TEST(SceneSimulation, ParticlesCollideWithACloth) {
   EXPECT_EQ(through, 0u) << "particles through the cloth of " << n;
 }
 
+TEST(SceneSimulation, AClothLandsOnAnotherCloth) {
+  // A hammock (a sheet turned 90 degrees about x, so it lies flat and
+  // extends toward -z from its position; pinned at its four corners at
+  // y = 1) and a towel dropped onto it from y = 2: the towel rests in the
+  // hammock (it fell through, with a warning, before).
+  auto run = Start(R"(<scene version="1">
+    <cloth id="hammock" size="3 3" resolution="16 16" position="-1.5 1 1.5" rotate="90 0 0"
+           pin-ids="0 15 240 255">
+      <gravity/>
+    </cloth>
+    <cloth id="towel" size="1 1" resolution="8 8" position="-0.5 2 0.5" rotate="90 0 0"
+           pin="none">
+      <gravity/>
+      <collide with="hammock" friction="0.5"/>
+    </cloth>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(2.0).ok());
+  double hammockLow = HUGE_VAL, towelLow = HUGE_VAL;
+  size_t towel = 0;
+  for (const Row& r : Rows(*run->sim)) {
+    if (r.system == "hammock") hammockLow = std::min(hammockLow, r.x.y());
+    if (r.system == "towel") towelLow = std::min(towelLow, r.x.y()), ++towel;
+  }
+  ASSERT_EQ(towel, 64u);
+  EXPECT_GT(towelLow, hammockLow - 0.02)
+      << "the towel's lowest vertex against the hammock's lowest (it fell through)";
+}
+
 TEST(SceneSimulation, FastParticlesBornOverATerrainDoNotPassThroughIt) {
   // A birth is advanced into its step (no bands in a stream): at 100 m/s
   // that advance carried 270 of 300 particles through a terrain 0.5 m below.
