@@ -206,7 +206,7 @@ TEST(ClothWind, FlagFluttersInUniformWindWhereParticleDragGoesStill) {
     if (!perTriangle) {
       const double k = 0.02;  // N s/m a particle: the flag's weight at 3 m/s
       cloth->SetExternalForce(
-          [&](size_t, const Vec3&, const Vec3& v) { return Vec3(k * (wind - v)); });
+          [k, wind](size_t, const Vec3&, const Vec3& v) { return Vec3(k * (wind - v)); });
     }
     double sum = 0, sum2 = 0;
     int samples = 0;
