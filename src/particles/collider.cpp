@@ -133,6 +133,26 @@ bool IntersectGrown(const Vec3* poly, size_t count, const Vec3& n, const Vec3& a
   return true;
 }
 
+// The sphere's radius R and the box L..H of `c` grown by a particle's
+// radius r (inside kinds: the room shrunk by r, never below a point).
+void Grown(const Collider& c, double r, double* R, Vec3* L, Vec3* H) {
+  *R = c.inside ? std::max(c.radius - r, 0.0) : c.radius + r;
+  *L = c.lo;
+  *H = c.hi;
+  if (!(r > 0)) return;
+  for (int k = 0; k < 3; ++k) {
+    if (!c.inside) {
+      (*L)[k] -= r;
+      (*H)[k] += r;
+    } else if (c.hi[k] - c.lo[k] > 2 * r) {
+      (*L)[k] += r;
+      (*H)[k] -= r;
+    } else {
+      (*L)[k] = (*H)[k] = 0.5 * (c.lo[k] + c.hi[k]);
+    }
+  }
+}
+
 }  // namespace
 
 bool Collider::IntersectGrownPolygon(const Vec3& a, const Vec3& b, double r, Contact* c) const {
@@ -436,22 +456,9 @@ Collider Collider::Capsules(std::shared_ptr<const CapsuleBvh> bvh) {
 
 bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r) const {
   const Vec3 d = b - a;
-  // The solid grown by r (inside kinds: the room shrunk by r).
-  const double R = inside ? std::max(radius - r, 0.0) : radius + r;
-  Vec3 L = lo, H = hi;
-  if (r > 0) {
-    for (int k = 0; k < 3; ++k) {
-      if (!inside) {
-        L[k] -= r;
-        H[k] += r;
-      } else if (hi[k] - lo[k] > 2 * r) {
-        L[k] += r;
-        H[k] -= r;
-      } else {
-        L[k] = H[k] = 0.5 * (lo[k] + hi[k]);
-      }
-    }
-  }
+  double R;
+  Vec3 L, H;
+  Grown(*this, r, &R, &L, &H);
   switch (kind) {
     case Kind::kPlane:
       return Intersect(a, b, c, r);  // inline in the header
@@ -563,21 +570,9 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r) 
 }
 
 bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n, double r) const {
-  const double R = inside ? std::max(radius - r, 0.0) : radius + r;
-  Vec3 L = lo, H = hi;
-  if (r > 0) {
-    for (int k = 0; k < 3; ++k) {
-      if (!inside) {
-        L[k] -= r;
-        H[k] += r;
-      } else if (hi[k] - lo[k] > 2 * r) {
-        L[k] += r;
-        H[k] -= r;
-      } else {
-        L[k] = H[k] = 0.5 * (lo[k] + hi[k]);
-      }
-    }
-  }
+  double R;
+  Vec3 L, H;
+  Grown(*this, r, &R, &L, &H);
   switch (kind) {
     case Kind::kPlane:
       return Project(x, surface, n, r);  // inline in the header
