@@ -35,7 +35,8 @@ struct Ignored {
 constexpr std::string_view kLighting =
     "lighting and shading: Sylva's renderer lights every plant with its own key and fill lights";
 constexpr std::string_view kSurfaces =
-    "Sylva places NAME.obj surfaces, not cpfg's .s, line or triangle surfaces (docs/turtle.md)";
+    "Sylva reads cpfg's .s surfaces from 'surface:', not line or triangle surfaces "
+    "(docs/cpfg.md)";
 constexpr std::string_view kNotActed = "Sylva does not act on it";
 
 constexpr Ignored kIgnored[] = {
@@ -51,7 +52,6 @@ constexpr Ignored kIgnored[] = {
     {"render mode:", kLighting},
     {"shadow map:", kLighting},
     {"line:", kSurfaces},
-    {"surface:", kSurfaces},
     {"tsurface:", kSurfaces},
     {"box:", "a fixed bounding box: Sylva frames the plant"},
     {"background color:", kNotActed},
@@ -193,6 +193,7 @@ class Reader {
                                      (used == 1 ? " value" : " values") + "; the rest is ignored");
   }
   void Tropism();
+  void Surface();
 
   ViewFile& v_;
   std::string path_;
@@ -323,6 +324,8 @@ void Reader::Read(const app::Line& line) {
     ExtraValues(1);
   } else if (L == "tropism:") {
     Tropism();
+  } else if (L == "surface:") {
+    Surface();
   } else {
     for (const Ignored& ig : kIgnored) {
       if (L == ig.label) {
@@ -379,6 +382,55 @@ void Reader::Tropism() {
   }
   v_.tropism = dir->normalized();
   v_.elasticity = elasticity * intensity;
+}
+
+// `surface: l leaf.s size [s-precision t-precision]` (cpfg's
+// ReadViewData): the surface `~l` is the patches of leaf.s, its file beside
+// the view file.
+void Reader::Surface() {
+  if (tokens_.size() < 2) {
+    Error(int(current_.size()) + 1, "expected 'surface: LETTER FILE.s size [s t]'");
+    return;
+  }
+  plant::CpfgSurfaceDef def;
+  def.name = tokens_[0].text;
+  if (def.name.size() != 1 || !std::isalnum(static_cast<unsigned char>(def.name[0]))) {
+    Error(tokens_[0].column, "a cpfg surface is named by one letter, not '" + def.name + "'");
+    return;
+  }
+  const fs::path file(tokens_[1].text);
+  def.file = file.is_absolute()
+                 ? file.string()
+                 : (fs::path(path_).parent_path() / file).lexically_normal().string();
+  if (tokens_.size() > 2) {
+    auto size = Number(2, "a size");
+    if (!size) return;
+    if (*size <= 0) {
+      Error(tokens_[2].column, "a surface's size must be positive");
+      return;
+    }
+    def.size = *size;
+  }
+  for (size_t k = 3; k < 5 && k < tokens_.size(); ++k) {
+    auto n = Number(k, "a precision (subdivisions of a patch side)");
+    if (!n) return;
+    if (*n < 1 || *n > 64 || *n != std::floor(*n)) {
+      Error(tokens_[k].column, "a precision is a whole number from 1 to 64");
+      return;
+    }
+    (k == 3 ? def.sPrecision : def.tPrecision) = int(*n);
+  }
+  ExtraValues(5);
+  def.viewFile = path_;
+  def.line = line_;
+  for (auto& old : v_.surfaces) {
+    if (old.name == def.name) {
+      Warn(tokens_[0].column, "surface '" + def.name + "' is named again: this line wins");
+      old = def;
+      return;
+    }
+  }
+  v_.surfaces.push_back(std::move(def));
 }
 
 Expected<std::string> ReadRegular(const std::string& path, size_t maxBytes) {
@@ -545,6 +597,7 @@ void ApplyViewFile(const ViewFile& v, lsys::Grammar& g) {
 
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec) {
   if (!view) return;
+  spec.cpfgSurfaces = view->surfaces;
   spec.amendGrammar = [view](lsys::Grammar& g, DiagnosticList& diagnostics) {
     for (const Diagnostic& d : view->diagnostics.items) diagnostics.Add(d);
     if (!view->diagnostics.HasErrors()) ApplyViewFile(*view, g);

@@ -57,8 +57,8 @@ TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
   ViewFile v = ParseViewFile(
       "twist: 0\nz buffer: on\nprojection: perspective\n"  // as Sylva draws: silent
       "light direction: 1,1,1\n"
-      "  surface: l leaf.s 1\n"
-      "surface: k flower.s 1\n"
+      "  tsurface: l leaf.s 1\n"
+      "tsurface: k flower.s 1\n"
       "#include \"more.v\"\n"
       "blorp: 2\n"
       "initial color: 1 5\n",
@@ -69,13 +69,42 @@ TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
   EXPECT_EQ(v.diagnostics.items[0].loc.line, 4) << all;
   EXPECT_NE(all.find("4:1 warning: 'light direction:' is read but not acted on"), std::string::npos)
       << all;
-  EXPECT_NE(all.find("5:3 warning: 'surface:' is read but not acted on"), std::string::npos) << all;
+  EXPECT_NE(all.find("5:3 warning: 'tsurface:' is read but not acted on"), std::string::npos)
+      << all;
   EXPECT_EQ(all.find("6:1"), std::string::npos) << all;  // once per label
   EXPECT_NE(all.find("7:1 warning: preprocessor lines"), std::string::npos) << all;
   EXPECT_NE(all.find("8:1 warning: 'blorp:' is not a cpfg view file setting"), std::string::npos)
       << all;
   EXPECT_NE(all.find("9:18 warning: 'initial color:': the back-side colour"), std::string::npos)
       << all;
+}
+
+TEST(ViewFile, SurfaceLinesNameCpfgSurfacesBesideTheViewFile) {
+  ViewFile v = ParseViewFile("surface: l leaf.s 800 3 5\nsurface: b sub/bud.s 2\n", "/x/y/p.v");
+  ASSERT_EQ(v.diagnostics.items.size(), 0u) << Messages(v.diagnostics);
+  ASSERT_EQ(v.surfaces.size(), 2u);
+  EXPECT_EQ(v.surfaces[0].name, "l");
+  EXPECT_EQ(v.surfaces[0].file, "/x/y/leaf.s");
+  EXPECT_EQ(v.surfaces[0].size, 800);
+  EXPECT_EQ(v.surfaces[0].sPrecision, 3);
+  EXPECT_EQ(v.surfaces[0].tPrecision, 5);
+  EXPECT_EQ(v.surfaces[0].line, 1);
+  EXPECT_EQ(v.surfaces[1].file, "/x/y/sub/bud.s");
+  EXPECT_EQ(v.surfaces[1].size, 2);
+  EXPECT_EQ(v.surfaces[1].sPrecision, 0);
+
+  ViewFile bad = ParseViewFile(
+      "surface: lf leaf.s 1\nsurface: l leaf.s -2\nsurface: l leaf.s 1 0\nsurface: l\n", "p.v");
+  const std::string all = Messages(bad.diagnostics);
+  EXPECT_NE(all.find("1:10 error: a cpfg surface is named by one letter, not 'lf'"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("2:19 error: a surface's size must be positive"), std::string::npos) << all;
+  EXPECT_NE(all.find("3:21 error: a precision is a whole number from 1 to 64"), std::string::npos)
+      << all;
+  EXPECT_NE(all.find("4:11 error: expected 'surface: LETTER FILE.s size [s t]'"), std::string::npos)
+      << all;
+  EXPECT_TRUE(bad.surfaces.empty());
 }
 
 TEST(ViewFile, BadValuesAreErrorsAtTheirColumn) {
