@@ -310,10 +310,9 @@ void Reader::Read(const app::Line& line) {
       NotActed("Sylva draws 3D plants in perspective (2D figures in parallel projection)");
   } else if (L == "tropism direction:") {
     if (auto p = Vector(0, "x,y,z")) {
-      if (p->norm() == 0)
-        Error(tokens_[0].column, "the tropism direction must not be 0,0,0");
-      else
-        v_.tropism = p->normalized();
+      // 0,0,0: no direction, so no bending (as in cpfg, whose tropism is
+      // the cross product with it).
+      if (p->norm() > 0) v_.tropism = p->normalized();
     }
     ExtraValues(3);
   } else if (L == "initial elasticity:") {
@@ -346,6 +345,19 @@ void Reader::Tropism() {
     return;
   }
   tropismSeen_ = true;
+  // cpfg writes the letters bare (`T 0,1,0 E 0.2`) or with a colon, the
+  // value apart or attached (`T: 0 1 0  A:90`).
+  std::vector<Token> split;
+  for (const Token& t : tokens_) {
+    if (t.text.size() >= 2 && t.text[1] == ':' &&
+        std::isalpha(static_cast<unsigned char>(t.text[0]))) {
+      split.push_back({t.text.substr(0, 1), t.column});
+      if (t.text.size() > 2) split.push_back({t.text.substr(2), t.column + 2});
+    } else {
+      split.push_back(t);
+    }
+  }
+  tokens_ = std::move(split);
   std::optional<Vec3> dir;
   double elasticity = 0, intensity = 1;
   for (size_t k = 0; k < tokens_.size();) {

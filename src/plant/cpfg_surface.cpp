@@ -98,9 +98,9 @@ Expected<mesh::TriangleMesh> ParseCpfgSurface(const std::string& text, const std
   heading.normalize();
   Vec3 left = heading.cross(up);
   if (left.norm() < 1e-6) {
-    return SurfaceError(path, number,
-                        "the up vector is parallel to the heading (line " +
-                            std::to_string(headingLine) + ")");
+    return SurfaceError(
+        path, number,
+        "the up vector is parallel to the heading (line " + std::to_string(headingLine) + ")");
   }
   left.normalize();
   up = left.cross(heading);
@@ -133,9 +133,9 @@ Expected<mesh::TriangleMesh> ParseCpfgSurface(const std::string& text, const std
     while (read < 16) {
       const std::string* row = lines.Next(&number);
       if (!row) {
-        return SurfaceError(path, nameLine,
-                            "patch '" + *l + "' has " + std::to_string(read) +
-                                " control points, not 16");
+        return SurfaceError(
+            path, nameLine,
+            "patch '" + *l + "' has " + std::to_string(read) + " control points, not 16");
       }
       std::istringstream in(*row);
       std::string word;

@@ -41,10 +41,10 @@ inline constexpr int kMinPatchDivisions = 8;
 
 // What the view file's `surface:` line says (and where, for diagnostics).
 struct CpfgSurfaceDef {
-  std::string name;     // the one letter of `~l`
-  std::string file;     // the .s file, resolved against the view file's folder
-  double size = 1;      // the largest dimension of the surface, before ~l(s)
-  int sPrecision = 0;   // subdivisions a patch side; 0: the file's or the minimum
+  std::string name;    // the one letter of `~l`
+  std::string file;    // the .s file, resolved against the view file's folder
+  double size = 1;     // the largest dimension of the surface, before ~l(s)
+  int sPrecision = 0;  // subdivisions a patch side; 0: the file's or the minimum
   int tPrecision = 0;
   std::string viewFile;  // where the line is, for diagnostics
   int line = 0;
@@ -54,7 +54,6 @@ struct CpfgSurfaceDef {
 // missing or unreadable header line, a heading of zero length, a patch with
 // fewer than 16 points, a non-finite number) carry `path` and the line.
 Expected<mesh::TriangleMesh> ParseCpfgSurface(const std::string& text, const std::string& path,
-                                              double size, int sPrecision = 0,
-                                              int tPrecision = 0);
+                                              double size, int sPrecision = 0, int tPrecision = 0);
 
 }  // namespace sylva::plant

@@ -53,6 +53,23 @@ TEST(ViewFile, ReadsWhatTheTurtleUses) {
   EXPECT_EQ(ParseViewFile("angle factor: 16\n", "p.v").angle.value_or(-1), 22.5);
 }
 
+TEST(ViewFile, TropismLettersMayCarryAColonAndAnAttachedValue) {
+  // As vlab's published view files write them.
+  ViewFile v = ParseViewFile("tropism: T: 0.0 -1.0 0.0  A:0 E: 0.3\n", "p.v");
+  EXPECT_TRUE(v.diagnostics.items.empty()) << Messages(v.diagnostics);
+  ASSERT_TRUE(v.tropism.has_value());
+  EXPECT_LT((*v.tropism - Vec3(0, -1, 0)).norm(), 1e-15) << v.tropism->transpose();
+  EXPECT_EQ(v.elasticity.value_or(-1), 0.3);
+  ViewFile angled = ParseViewFile("tropism: T: 0 1 0  A:90\n", "p.v");
+  EXPECT_NE(Messages(angled.diagnostics).find("1:22 warning: a tropism at an angle"),
+            std::string::npos)
+      << Messages(angled.diagnostics);
+  // A zero tropism direction bends nothing, as in cpfg: no tropism, no error.
+  ViewFile none = ParseViewFile("tropism direction: 0.0,0.0,0.0\ninitial elasticity: 0.2\n", "p.v");
+  EXPECT_TRUE(none.diagnostics.items.empty()) << Messages(none.diagnostics);
+  EXPECT_FALSE(none.tropism.has_value());
+}
+
 TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
   ViewFile v = ParseViewFile(
       "twist: 0\nz buffer: on\nprojection: perspective\n"  // as Sylva draws: silent

@@ -14,7 +14,8 @@ namespace {
 template <typename F>
 std::string SurfaceText(const std::string& frame, F point, int points = 16) {
   std::ostringstream s;
-  s << "0 1 0 1 0 1\n" << frame << "flat\nTOP COLOR: 1 DIFFUSE: 0.00 BOTTOM COLOR: 1 DIFFUSE: 0.00\n"
+  s << "0 1 0 1 0 1\n"
+    << frame << "flat\nTOP COLOR: 1 DIFFUSE: 0.00 BOTTOM COLOR: 1 DIFFUSE: 0.00\n"
     << "AL: ~ A: ~ AR: ~\nL: ~ R: ~\nBL: ~ B: ~ BR: ~\n";
   for (int k = 0; k < points; ++k) {
     const Vec3 p = point(k / 4, k % 4);
