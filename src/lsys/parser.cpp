@@ -1426,7 +1426,8 @@ static int BlockDepth(const std::string& t, int depth, std::string_view next) {
 // space), or, for a production, by indented lines that are neither
 // statements nor productions themselves (cpfg's way of writing a long
 // successor, or the `-->` of a production on the line after its
-// predecessor and condition). Lines of different files are never joined.
+// predecessor and condition), and for `axiom:` by indented lines without an
+// arrow (a long axiom). Lines of different files are never joined.
 // Joined lines keep where each piece came from (Line::more), so errors
 // point into the right line and column.
 void GrammarParser::JoinContinuations() {
@@ -1447,6 +1448,11 @@ void GrammarParser::JoinContinuations() {
     const size_t p = firstText(l.text);
     size_t after = 0;
     return p < l.text.size() && l.text[p] != '#' && !MatchKeyword(l.text, p, &after);
+  };
+  auto isAxiom = [&](const Line& l) {
+    size_t after = 0;
+    const char* kw = MatchKeyword(l.text, firstText(l.text), &after);
+    return kw && std::string_view(kw) == "axiom";
   };
   // `l` ends with `\` and `next` goes on with it (text that is not a
   // statement, directive or production of its own; otherwise the `\` is
@@ -1484,6 +1490,12 @@ void GrammarParser::JoinContinuations() {
       continue;
     }
     bool join = continued;
+    if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
+        !hasArrow(l.text) && isAxiom(out.back())) {
+      // cpfg's axiom over several lines: the indented lines after
+      // `axiom:` that are not statements or productions go on with it.
+      join = true;
+    }
     if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
         isProduction(out.back())) {
       // Without its arrow yet, the production goes on with a line that

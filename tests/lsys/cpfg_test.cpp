@@ -201,6 +201,18 @@ TEST(Cpfg, IndentedLinesContinueAProduction) {
   EXPECT_EQ(DeriveText("axiom: A\nA --> B\n    : 1\n", 1), "B");
 }
 
+TEST(Cpfg, IndentedLinesContinueTheAxiom) {
+  // As vlab's tri-bar and natica objects write a long axiom.
+  EXPECT_EQ(DeriveText("axiom: A\n\tB[C]\n\t  D(2)\nA --> E\n", 0), "AB[C]D(2)");
+  EXPECT_EQ(DeriveText("axiom: A\n\tB\nA --> E\n", 1), "EB");
+  // An indented production after the axiom stays a production.
+  EXPECT_EQ(DeriveText("axiom: A\n\tA --> E\n", 1), "E");
+  ParseResult r = ParseGrammarText("axiom: A\n\tB(1 +)\n", "c.l");
+  ASSERT_FALSE(r.grammar);
+  EXPECT_EQ(r.diagnostics.items[0].loc.line, 2) << r.diagnostics.items[0].Format();
+  EXPECT_EQ(r.diagnostics.items[0].sourceLine, "\tB(1 +)") << r.diagnostics.items[0].Format();
+}
+
 TEST(Cpfg, IndentedProductionsAndStatementsStayLinesOfTheirOwn) {
   EXPECT_EQ(DeriveText("axiom: A\n  A --> B\n  B --> C\n", 2), "C");
   Grammar g = MustParse("axiom: A\nA --> B\n  derivation length: 2\n\tdecomposition\nB --> C\n");
