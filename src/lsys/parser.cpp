@@ -69,9 +69,9 @@ bool IsIdentChar(char c) {
 constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_;,#";
 
 // cpfg's @ commands, longest first where they share a prefix.
-constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS", "@PD",
-                                            "@Ts", "@Ti", "@Td", "@Sx", "@O",  "@o",  "@c",  "@v",
-                                            "@M",  "@m",  "@R",  "@D",  "@i",  "@L",  "@b"};
+constexpr std::string_view kAtCommands[] = {
+    "@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS", "@PD", "@Ts", "@Ti", "@Td", "@Sx", "@O", "@o",
+    "@c",  "@v",  "@M",  "@m",  "@R",  "@D",  "@i",  "@L",  "@b",  "@Tx", "@#",  "@!",  "@;"};
 
 std::string Lower(std::string_view s) {
   std::string r(s);

@@ -47,6 +47,20 @@ TEST(Cpfg, UnimplementedCommandsWarnOncePerSymbolAtTheirFirstUse) {
   EXPECT_EQ(w[3].rfind("3:41 '@M' (move to) needs 3 parameters", 0), 0u) << all;
 }
 
+TEST(Cpfg, ContourTextureAndBackColourCommandsWarnAndLexAsOneModule) {
+  // vlab's lily and thatcheria: @#(contour) @!(sides) @;(back colour) @Tx(texture).
+  auto w = Warnings("axiom: @#(2)F @!(5) @;(7)F @Tx(1)F @#(3)\n");
+  const std::string all = Joined(w);
+  ASSERT_EQ(w.size(), 4u) << all;
+  EXPECT_EQ(w[0].rfind("1:8 '@#' (cpfg: generalized cylinder contour) is not implemented", 0), 0u)
+      << all;
+  EXPECT_EQ(w[1].rfind("1:15 '@!' (cpfg: number of sides of a cylinder's contour)", 0), 0u) << all;
+  EXPECT_EQ(w[2].rfind("1:21 '@;' (cpfg: back-side colour)", 0), 0u) << all;
+  EXPECT_EQ(w[3].rfind("1:28 '@Tx' (cpfg: texture)", 0), 0u) << all;
+  // One module each: no stray 'x' or '#' module in the word.
+  EXPECT_EQ(DeriveText("axiom: @Tx(1)F@#(2)@;(3)\n", 0), "@Tx(1)F@#(2)@;(3)");
+}
+
 TEST(Cpfg, ImplementedCommandsWarnAboutParametersTheyDoNotUse) {
   auto w = Warnings("axiom: @o(1,2) @c(1) @Gs(3) @Gc(2) @Ge(1,1) @Ts(1,2,3) @Ti(1) @Td @v\n");
   const std::string all = Joined(w);
