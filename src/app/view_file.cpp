@@ -75,8 +75,7 @@ constexpr Ignored kIgnored[] = {
     {"initial scale:", "@D scaling is not implemented"},
     {"scale multiplier:", "@D scaling is not implemented"},
     {"environment display:", kNotActed},
-    {"function:", "cpfg function files (.func) are not read"},
-    {"function set:", "cpfg function files (.func) are not read"},
+    {"function set:", "cpfg function sets (.fset) are not read; name .func files with 'function:'"},
     {"curve:", "cpfg curve files are not read"},
     {"antialiasing:", "use render --supersample"},
     {"min zoom:", kNotActed},
@@ -325,6 +324,25 @@ void Reader::Read(const app::Line& line) {
     Tropism();
   } else if (L == "surface:") {
     Surface();
+  } else if (L == "function:") {
+    // `function: FILE.func [samples]`: func(1, x) is the first such line.
+    // cpfg tabulates the curve at `samples` points; Sylva evaluates it
+    // (docs/cpfg.md), so the number is not needed.
+    if (tokens_.empty()) {
+      Error(int(current_.size()) + 1, "expected 'function: FILE.func [samples]'");
+      return;
+    }
+    const fs::path file(tokens_[0].text);
+    lsys::ParseOptions::FunctionFile f;
+    f.file = file.is_absolute()
+                 ? file.string()
+                 : (fs::path(path_).parent_path() / file).lexically_normal().string();
+    f.from = path_;
+    f.line = line_;
+    f.column = tokens_[0].column;
+    v_.functions.push_back(std::move(f));
+    if (tokens_.size() > 1) Number(1, "a number of samples");
+    ExtraValues(2);
   } else {
     for (const Ignored& ig : kIgnored) {
       if (L == ig.label) {
@@ -610,6 +628,7 @@ void ApplyViewFile(const ViewFile& v, lsys::Grammar& g) {
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec) {
   if (!view) return;
   spec.cpfgSurfaces = view->surfaces;
+  spec.cpfgFunctions = view->functions;
   spec.amendGrammar = [view](lsys::Grammar& g, DiagnosticList& diagnostics) {
     for (const Diagnostic& d : view->diagnostics.items) diagnostics.Add(d);
     if (!view->diagnostics.HasErrors()) ApplyViewFile(*view, g);

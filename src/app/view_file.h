@@ -31,6 +31,7 @@
 #include "core/diagnostic.h"
 #include "core/math.h"
 #include "lsys/grammar.h"
+#include "lsys/parser.h"
 #include "plant/plant.h"
 
 namespace sylva::app {
@@ -53,7 +54,9 @@ struct ViewFile {
   std::string colorsPath;                       // the .map or .mat read
   std::vector<std::array<float, 3>> palette;    // sRGB 0..1 of each colour index
   std::vector<plant::CpfgSurfaceDef> surfaces;  // `surface: l leaf.s size s t`
-  DiagnosticList diagnostics;                   // warnings, and errors that stop the build
+  // `function: FILE.func [samples]`, in order (func(1, x) the first).
+  std::vector<lsys::ParseOptions::FunctionFile> functions;
+  DiagnosticList diagnostics;  // warnings, and errors that stop the build
 };
 
 // Reads the text of a view file; `path` names it in diagnostics.
@@ -82,7 +85,8 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
 // as the turtle's defaults).
 void ApplyViewFile(const ViewFile& view, lsys::Grammar& grammar);
 
-// Sets spec.cpfgSurfaces (the view's `surface:` lines) and
+// Sets spec.cpfgSurfaces and spec.cpfgFunctions (the view's `surface:` and
+// `function:` lines) and
 // spec.amendGrammar: the view applied and its diagnostics added to the
 // plant's (so --strict counts them).
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec);

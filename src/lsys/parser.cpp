@@ -212,6 +212,7 @@ class GrammarParser {
   }
   std::optional<SymbolId> Intern(const Line& l, int col, const std::string& name, int arity);
   void JoinContinuations();
+  void LoadOptionFunctions();
   void WarnAfterEnd(const Line& l);
   void Finish();
   void WarnUnmatchable();
@@ -1156,8 +1157,37 @@ void GrammarParser::Conditionals() {
   lines_ = std::move(kept);
 }
 
+// ParseOptions::functionFiles (a view file's `function:` lines), unless
+// the grammar says `functions:` itself. Errors point at the naming line.
+void GrammarParser::LoadOptionFunctions() {
+  if (opt_.functionFiles.empty()) return;
+  for (const Line& l : lines_) {
+    size_t p = 0, after = 0;
+    while (p < l.text.size() && IsSpace(l.text[p])) ++p;
+    const char* kw = MatchKeyword(l.text, p, &after);
+    if (kw && std::string_view(kw) == "functions") return;
+  }
+  for (const ParseOptions::FunctionFile& ff : opt_.functionFiles) {
+    std::string why;
+    auto text = Read(ff.file, &why);
+    std::string problem;
+    if (!text) {
+      problem = "cannot read function file '" + ff.file + "': " + why;
+    } else if (auto f = CpfgFunction::Parse(*text, ff.file); !f) {
+      problem = "in function file " + ff.file + ":" + std::to_string(f.error().loc.line) + ": " +
+                f.error().message;
+    } else {
+      g_.functions.push_back(std::make_shared<const CpfgFunction>(std::move(f).value()));
+      continue;
+    }
+    diags_.Add(MakeError(SourceLoc{ff.from, ff.line, ff.column}, problem));
+    return;
+  }
+}
+
 // `functions: a.func b.func`: cpfg function files, func(1, x) is the first.
-// Names are relative to the grammar file.
+// Names are relative to the grammar file. They replace those a view file
+// names (ParseOptions::functionFiles).
 void GrammarParser::ParseFunctions(const Line& l, size_t after, size_t end) {
   const std::string& t = l.text;
   size_t p = after;
@@ -1959,6 +1989,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   JoinContinuations();
   Conditionals();
   CollectGlobals();
+  LoadOptionFunctions();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
   // module: declarations apply to the whole file, wherever they stand.

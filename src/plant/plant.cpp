@@ -180,6 +180,7 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
   popt.overrides = spec.defines;
   popt.readFile = spec.readFile;
   popt.environmentGiven = spec.environment != nullptr;
+  popt.functionFiles = spec.cpfgFunctions;
   // `~lF`: cpfg's one-letter surface `l` then `F` when l.obj exists and lF.obj does not.
   SurfaceLibrary surfaces(spec.path, spec.surfacePath, spec.readFile);
   surfaces.Define(spec.cpfgSurfaces);

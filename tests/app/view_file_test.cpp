@@ -226,6 +226,34 @@ TEST(ViewFile, HostileFilesAreClearErrors) {
   EXPECT_EQ(LoadViewFiles(grammar, ""), nullptr);  // nothing beside it
 }
 
+TEST(ViewFile, FunctionLinesGiveFuncItsFilesInOrder) {
+  ViewFile v = ParseViewFile("function: a.func 100\nfunction: sub/b.func\n", "/x/p.v");
+  EXPECT_TRUE(v.diagnostics.items.empty()) << Messages(v.diagnostics);
+  ASSERT_EQ(v.functions.size(), 2u);
+  EXPECT_EQ(v.functions[0].file, "/x/a.func");
+  EXPECT_EQ(v.functions[0].line, 1);
+  EXPECT_EQ(v.functions[0].column, 11);
+  EXPECT_EQ(v.functions[1].file, "/x/sub/b.func");
+  EXPECT_NE(Messages(ParseViewFile("function: a.func many\n", "p.v").diagnostics)
+                .find("1:18 error: expected a number of samples, not 'many'"),
+            std::string::npos);
+
+  // Through the plant: func(1, x) reads the view file's first function.
+  const std::string grammar = WriteFile("vf.l", "axiom: A(func(1, 0.25))\n");
+  WriteFile("vf.v", "function: vf.func 100\n");
+  WriteFile("vf.func",
+            "range: 0.0 1.0\npoints: 4\n0 0\n0.333333 0.666667\n"
+            "0.666667 1.333333\n1 2\n");
+  plant::PlantSpec spec;
+  spec.path = grammar;
+  spec.until = plant::Stage::kWord;
+  AttachViewFile(LoadViewFiles(grammar, ""), spec);
+  plant::PlantResult r = plant::BuildPlant(spec);
+  ASSERT_TRUE(r.plant.has_value()) << r.diagnostics.FormatAll();
+  ASSERT_EQ(r.plant->word.params.size(), 1u);
+  EXPECT_NEAR(r.plant->word.params[0], 0.5, 0.003) << r.plant->word.params[0];  // y = 2x
+}
+
 TEST(ViewFile, TheTurtleDrawsWithTheViewFilesSettings) {
   const std::string grammar = WriteFile("vt.l", "axiom: F + F ; F ! F\n");
   WriteFile("vt.v",
