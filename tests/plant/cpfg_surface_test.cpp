@@ -130,6 +130,16 @@ TEST(CpfgSurface, APlantPlacesTheNamedSurfaceScaledByItsParameter) {
   EXPECT_NEAR(b.hi.y() - b.lo.y(), 12, 1e-4) << b.lo.transpose() << " / " << b.hi.transpose();
   EXPECT_NEAR((b.hi - b.lo).maxCoeff(), 12, 1e-4) << b.lo.transpose() << " / " << b.hi.transpose();
 
+  // cpfg's one-letter names: `~lF` is the surface l, then F, when l is a
+  // view-file surface (and there is no lF.obj).
+  spec.text = "axiom: ~lF\n";
+  auto lf = testing::BuildOrFail(spec);
+  ASSERT_TRUE(lf);
+  EXPECT_EQ(lf->word.size(), 2u);
+  EXPECT_EQ(lf->geometry.surfaces.size(), 1u);
+  EXPECT_EQ(lf->geometry.segments.size(), 1u);
+  spec.text = "axiom: ~l(2)\n";
+
   // A surface file that cannot be read is an error at the view file's line.
   spec.cpfgSurfaces[0].file = "/g/missing.s";
   PlantResult r = BuildPlant(spec);
