@@ -141,9 +141,9 @@ Expected<mesh::TriangleMesh> ParseCpfgSurface(const std::string& text, const std
       std::string word;
       std::vector<double> values;
       while (in >> word) {
-        char* end = nullptr;
-        const double x = std::strtod(word.c_str(), &end);
-        if (end != word.c_str() + word.size()) {
+        char* stop = nullptr;
+        const double x = std::strtod(word.c_str(), &stop);
+        if (stop != word.c_str() + word.size()) {
           return SurfaceError(path, number, "expected a coordinate, not '" + word + "'");
         }
         if (!std::isfinite(x)) {
