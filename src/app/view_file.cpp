@@ -35,7 +35,8 @@ struct Ignored {
 constexpr std::string_view kLighting =
     "lighting and shading: Sylva's renderer lights every plant with its own key and fill lights";
 constexpr std::string_view kSurfaces =
-    "Sylva places NAME.obj surfaces, not cpfg's .s, line or triangle surfaces (docs/turtle.md)";
+    "Sylva reads cpfg's .s surfaces from 'surface:', not line or triangle surfaces "
+    "(docs/cpfg.md)";
 constexpr std::string_view kNotActed = "Sylva does not act on it";
 
 constexpr Ignored kIgnored[] = {
@@ -51,7 +52,6 @@ constexpr Ignored kIgnored[] = {
     {"render mode:", kLighting},
     {"shadow map:", kLighting},
     {"line:", kSurfaces},
-    {"surface:", kSurfaces},
     {"tsurface:", kSurfaces},
     {"box:", "a fixed bounding box: Sylva frames the plant"},
     {"background color:", kNotActed},
@@ -75,8 +75,7 @@ constexpr Ignored kIgnored[] = {
     {"initial scale:", "@D scaling is not implemented"},
     {"scale multiplier:", "@D scaling is not implemented"},
     {"environment display:", kNotActed},
-    {"function:", "cpfg function files (.func) are not read"},
-    {"function set:", "cpfg function files (.func) are not read"},
+    {"function set:", "cpfg function sets (.fset) are not read; name .func files with 'function:'"},
     {"curve:", "cpfg curve files are not read"},
     {"antialiasing:", "use render --supersample"},
     {"min zoom:", kNotActed},
@@ -193,6 +192,7 @@ class Reader {
                                      (used == 1 ? " value" : " values") + "; the rest is ignored");
   }
   void Tropism();
+  void Surface();
 
   ViewFile& v_;
   std::string path_;
@@ -309,10 +309,9 @@ void Reader::Read(const app::Line& line) {
       NotActed("Sylva draws 3D plants in perspective (2D figures in parallel projection)");
   } else if (L == "tropism direction:") {
     if (auto p = Vector(0, "x,y,z")) {
-      if (p->norm() == 0)
-        Error(tokens_[0].column, "the tropism direction must not be 0,0,0");
-      else
-        v_.tropism = p->normalized();
+      // 0,0,0: no direction, so no bending (as in cpfg, whose tropism is
+      // the cross product with it).
+      if (p->norm() > 0) v_.tropism = p->normalized();
     }
     ExtraValues(3);
   } else if (L == "initial elasticity:") {
@@ -323,6 +322,27 @@ void Reader::Read(const app::Line& line) {
     ExtraValues(1);
   } else if (L == "tropism:") {
     Tropism();
+  } else if (L == "surface:") {
+    Surface();
+  } else if (L == "function:") {
+    // `function: FILE.func [samples]`: func(1, x) is the first such line.
+    // cpfg tabulates the curve at `samples` points; Sylva evaluates it
+    // (docs/cpfg.md), so the number is not needed.
+    if (tokens_.empty()) {
+      Error(int(current_.size()) + 1, "expected 'function: FILE.func [samples]'");
+      return;
+    }
+    const fs::path file(tokens_[0].text);
+    lsys::ParseOptions::FunctionFile f;
+    f.file = file.is_absolute()
+                 ? file.string()
+                 : (fs::path(path_).parent_path() / file).lexically_normal().string();
+    f.from = path_;
+    f.line = line_;
+    f.column = tokens_[0].column;
+    v_.functions.push_back(std::move(f));
+    if (tokens_.size() > 1) Number(1, "a number of samples");
+    ExtraValues(2);
   } else {
     for (const Ignored& ig : kIgnored) {
       if (L == ig.label) {
@@ -343,6 +363,19 @@ void Reader::Tropism() {
     return;
   }
   tropismSeen_ = true;
+  // cpfg writes the letters bare (`T 0,1,0 E 0.2`) or with a colon, the
+  // value apart or attached (`T: 0 1 0  A:90`).
+  std::vector<Token> split;
+  for (const Token& t : tokens_) {
+    if (t.text.size() >= 2 && t.text[1] == ':' &&
+        std::isalpha(static_cast<unsigned char>(t.text[0]))) {
+      split.push_back({t.text.substr(0, 1), t.column});
+      if (t.text.size() > 2) split.push_back({t.text.substr(2), t.column + 2});
+    } else {
+      split.push_back(t);
+    }
+  }
+  tokens_ = std::move(split);
   std::optional<Vec3> dir;
   double elasticity = 0, intensity = 1;
   for (size_t k = 0; k < tokens_.size();) {
@@ -379,6 +412,55 @@ void Reader::Tropism() {
   }
   v_.tropism = dir->normalized();
   v_.elasticity = elasticity * intensity;
+}
+
+// `surface: l leaf.s size [s-precision t-precision]` (cpfg's
+// ReadViewData): the surface `~l` is the patches of leaf.s, its file beside
+// the view file.
+void Reader::Surface() {
+  if (tokens_.size() < 2) {
+    Error(int(current_.size()) + 1, "expected 'surface: LETTER FILE.s size [s t]'");
+    return;
+  }
+  plant::CpfgSurfaceDef def;
+  def.name = tokens_[0].text;
+  if (def.name.size() != 1 || !std::isalnum(static_cast<unsigned char>(def.name[0]))) {
+    Error(tokens_[0].column, "a cpfg surface is named by one letter, not '" + def.name + "'");
+    return;
+  }
+  const fs::path file(tokens_[1].text);
+  def.file = file.is_absolute()
+                 ? file.string()
+                 : (fs::path(path_).parent_path() / file).lexically_normal().string();
+  if (tokens_.size() > 2) {
+    auto size = Number(2, "a size");
+    if (!size) return;
+    if (*size <= 0) {
+      Error(tokens_[2].column, "a surface's size must be positive");
+      return;
+    }
+    def.size = *size;
+  }
+  for (size_t k = 3; k < 5 && k < tokens_.size(); ++k) {
+    auto n = Number(k, "a precision (subdivisions of a patch side)");
+    if (!n) return;
+    if (*n < 1 || *n > 64 || *n != std::floor(*n)) {
+      Error(tokens_[k].column, "a precision is a whole number from 1 to 64");
+      return;
+    }
+    (k == 3 ? def.sPrecision : def.tPrecision) = int(*n);
+  }
+  ExtraValues(5);
+  def.viewFile = path_;
+  def.line = line_;
+  for (auto& old : v_.surfaces) {
+    if (old.name == def.name) {
+      Warn(tokens_[0].column, "surface '" + def.name + "' is named again: this line wins");
+      old = def;
+      return;
+    }
+  }
+  v_.surfaces.push_back(std::move(def));
 }
 
 Expected<std::string> ReadRegular(const std::string& path, size_t maxBytes) {
@@ -545,6 +627,8 @@ void ApplyViewFile(const ViewFile& v, lsys::Grammar& g) {
 
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec) {
   if (!view) return;
+  spec.cpfgSurfaces = view->surfaces;
+  spec.cpfgFunctions = view->functions;
   spec.amendGrammar = [view](lsys::Grammar& g, DiagnosticList& diagnostics) {
     for (const Diagnostic& d : view->diagnostics.items) diagnostics.Add(d);
     if (!view->diagnostics.HasErrors()) ApplyViewFile(*view, g);

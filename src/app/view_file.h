@@ -31,6 +31,7 @@
 #include "core/diagnostic.h"
 #include "core/math.h"
 #include "lsys/grammar.h"
+#include "lsys/parser.h"
 #include "plant/plant.h"
 
 namespace sylva::app {
@@ -38,21 +39,24 @@ namespace sylva::app {
 // What a view file (and its colour files) says that Sylva acts on; unset:
 // the file does not say it.
 struct ViewFile {
-  std::string path;                           // the view file read; empty when there was none
-  std::optional<double> angle;                // `angle increment:` or 360 / `angle factor:`
-  std::optional<double> width;                // `initial line width:`
-  std::optional<double> widthIncrement;       // `line width increment:`
-  std::optional<int> initialColor;            // `initial color:`
-  std::optional<int> colorIncrement;          // `color increment:`
-  std::optional<Vec3> tropism;                // unit: `tropism direction:` or `tropism: T`
-  std::optional<double> elasticity;           // `initial elasticity:` or `tropism: E`
-  std::optional<double> elasticityIncrement;  // `elasticity increment:` or `tropism: S`
-  std::optional<Vec3> viewpoint;              // `viewpoint:` (the eye)
-  std::optional<Vec3> target;                 // `view reference point:`
-  std::optional<double> scale;                // `scale factor:` (> 0)
-  std::string colorsPath;                     // the .map or .mat read
-  std::vector<std::array<float, 3>> palette;  // sRGB 0..1 of each colour index
-  DiagnosticList diagnostics;                 // warnings, and errors that stop the build
+  std::string path;                             // the view file read; empty when there was none
+  std::optional<double> angle;                  // `angle increment:` or 360 / `angle factor:`
+  std::optional<double> width;                  // `initial line width:`
+  std::optional<double> widthIncrement;         // `line width increment:`
+  std::optional<int> initialColor;              // `initial color:`
+  std::optional<int> colorIncrement;            // `color increment:`
+  std::optional<Vec3> tropism;                  // unit: `tropism direction:` or `tropism: T`
+  std::optional<double> elasticity;             // `initial elasticity:` or `tropism: E`
+  std::optional<double> elasticityIncrement;    // `elasticity increment:` or `tropism: S`
+  std::optional<Vec3> viewpoint;                // `viewpoint:` (the eye)
+  std::optional<Vec3> target;                   // `view reference point:`
+  std::optional<double> scale;                  // `scale factor:` (> 0)
+  std::string colorsPath;                       // the .map or .mat read
+  std::vector<std::array<float, 3>> palette;    // sRGB 0..1 of each colour index
+  std::vector<plant::CpfgSurfaceDef> surfaces;  // `surface: l leaf.s size s t`
+  // `function: FILE.func [samples]`, in order (func(1, x) the first).
+  std::vector<lsys::ParseOptions::FunctionFile> functions;
+  DiagnosticList diagnostics;  // warnings, and errors that stop the build
 };
 
 // Reads the text of a view file; `path` names it in diagnostics.
@@ -81,7 +85,9 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
 // as the turtle's defaults).
 void ApplyViewFile(const ViewFile& view, lsys::Grammar& grammar);
 
-// Sets spec.amendGrammar: the view applied and its diagnostics added to the
+// Sets spec.cpfgSurfaces and spec.cpfgFunctions (the view's `surface:` and
+// `function:` lines) and
+// spec.amendGrammar: the view applied and its diagnostics added to the
 // plant's (so --strict counts them).
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec);
 

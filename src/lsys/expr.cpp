@@ -741,7 +741,8 @@ class Parser {
     if (count == 0)
       return Error(col,
                    "func(id, x) needs cpfg function files: name them with "
-                   "'functions: FILE.func ...' before the productions",
+                   "'functions: FILE.func ...' before the productions, or with "
+                   "'function: FILE.func' lines in the view file",
                    len);
     if (id->op != OpCode::kConst || id->value != std::floor(id->value) || id->value < 1 ||
         id->value > double(count)) {

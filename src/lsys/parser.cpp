@@ -69,9 +69,9 @@ bool IsIdentChar(char c) {
 constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_;,#";
 
 // cpfg's @ commands, longest first where they share a prefix.
-constexpr std::string_view kAtCommands[] = {"@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS", "@PD",
-                                            "@Ts", "@Ti", "@Td", "@Sx", "@O",  "@o",  "@c",  "@v",
-                                            "@M",  "@m",  "@R",  "@D",  "@i",  "@L",  "@b"};
+constexpr std::string_view kAtCommands[] = {
+    "@Gs", "@Ge", "@Gc", "@Gr", "@Gt", "@Tf", "@PS", "@PD", "@Ts", "@Ti", "@Td", "@Sx", "@O", "@o",
+    "@c",  "@v",  "@M",  "@m",  "@R",  "@D",  "@i",  "@L",  "@b",  "@Tx", "@#",  "@!",  "@;"};
 
 std::string Lower(std::string_view s) {
   std::string r(s);
@@ -212,6 +212,7 @@ class GrammarParser {
   }
   std::optional<SymbolId> Intern(const Line& l, int col, const std::string& name, int arity);
   void JoinContinuations();
+  void LoadOptionFunctions();
   void WarnAfterEnd(const Line& l);
   void Finish();
   void WarnUnmatchable();
@@ -1156,8 +1157,37 @@ void GrammarParser::Conditionals() {
   lines_ = std::move(kept);
 }
 
+// ParseOptions::functionFiles (a view file's `function:` lines), unless
+// the grammar says `functions:` itself. Errors point at the naming line.
+void GrammarParser::LoadOptionFunctions() {
+  if (opt_.functionFiles.empty()) return;
+  for (const Line& l : lines_) {
+    size_t p = 0, after = 0;
+    while (p < l.text.size() && IsSpace(l.text[p])) ++p;
+    const char* kw = MatchKeyword(l.text, p, &after);
+    if (kw && std::string_view(kw) == "functions") return;
+  }
+  for (const ParseOptions::FunctionFile& ff : opt_.functionFiles) {
+    std::string why;
+    auto text = Read(ff.file, &why);
+    std::string problem;
+    if (!text) {
+      problem = "cannot read function file '" + ff.file + "': " + why;
+    } else if (auto f = CpfgFunction::Parse(*text, ff.file); !f) {
+      problem = "in function file " + ff.file + ":" + std::to_string(f.error().loc.line) + ": " +
+                f.error().message;
+    } else {
+      g_.functions.push_back(std::make_shared<const CpfgFunction>(std::move(f).value()));
+      continue;
+    }
+    diags_.Add(MakeError(SourceLoc{ff.from, ff.line, ff.column}, problem));
+    return;
+  }
+}
+
 // `functions: a.func b.func`: cpfg function files, func(1, x) is the first.
-// Names are relative to the grammar file.
+// Names are relative to the grammar file. They replace those a view file
+// names (ParseOptions::functionFiles).
 void GrammarParser::ParseFunctions(const Line& l, size_t after, size_t end) {
   const std::string& t = l.text;
   size_t p = after;
@@ -1426,7 +1456,8 @@ static int BlockDepth(const std::string& t, int depth, std::string_view next) {
 // space), or, for a production, by indented lines that are neither
 // statements nor productions themselves (cpfg's way of writing a long
 // successor, or the `-->` of a production on the line after its
-// predecessor and condition). Lines of different files are never joined.
+// predecessor and condition), and for `axiom:` by indented lines without an
+// arrow (a long axiom). Lines of different files are never joined.
 // Joined lines keep where each piece came from (Line::more), so errors
 // point into the right line and column.
 void GrammarParser::JoinContinuations() {
@@ -1447,6 +1478,11 @@ void GrammarParser::JoinContinuations() {
     const size_t p = firstText(l.text);
     size_t after = 0;
     return p < l.text.size() && l.text[p] != '#' && !MatchKeyword(l.text, p, &after);
+  };
+  auto isAxiom = [&](const Line& l) {
+    size_t after = 0;
+    const char* kw = MatchKeyword(l.text, firstText(l.text), &after);
+    return kw && std::string_view(kw) == "axiom";
   };
   // `l` ends with `\` and `next` goes on with it (text that is not a
   // statement, directive or production of its own; otherwise the `\` is
@@ -1484,6 +1520,12 @@ void GrammarParser::JoinContinuations() {
       continue;
     }
     bool join = continued;
+    if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
+        !hasArrow(l.text) && isAxiom(out.back())) {
+      // cpfg's axiom over several lines: the indented lines after
+      // `axiom:` that are not statements or productions go on with it.
+      join = true;
+    }
     if (!join && !out.empty() && out.back().file == l.file && !blank && p > 0 && isProduction(l) &&
         isProduction(out.back())) {
       // Without its arrow yet, the production goes on with a line that
@@ -1947,6 +1989,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   JoinContinuations();
   Conditionals();
   CollectGlobals();
+  LoadOptionFunctions();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
   // module: declarations apply to the whole file, wherever they stand.

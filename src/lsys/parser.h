@@ -13,6 +13,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/diagnostic.h"
 #include "lsys/grammar.h"
@@ -43,6 +44,17 @@ struct ParseOptions {
   // that one is (`~lF` with l.obj and no lF.obj), else whole (and later
   // reported as an unknown surface). Empty: always whole.
   std::function<bool(const std::string& name)> isSurface;
+  // cpfg function files from outside the grammar (a view file's
+  // `function: FILE [samples]` lines), func(1, x) the first; used when the
+  // grammar has no `functions:` statement of its own (which wins). `file`
+  // is resolved; `from` and `line` locate the naming line for diagnostics.
+  struct FunctionFile {
+    std::string file;
+    std::string from;
+    int line = 0;
+    int column = 0;
+  };
+  std::vector<FunctionFile> functionFiles;
   // The caller answers ?E itself (plant::PlantSpec::environment): no
   // warning that a grammar without `environment:` leaves ?E unanswered.
   bool environmentGiven = false;

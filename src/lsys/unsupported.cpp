@@ -22,6 +22,10 @@ constexpr Command kUndrawn[] = {
     {"@i", "interpolation"},
     {"@L", "label"},
     {"@b", "bounding box"},
+    {"@Tx", "texture"},
+    {"@#", "generalized cylinder contour"},
+    {"@!", "number of sides of a cylinder's contour"},
+    {"@;", "back-side colour"},
 };
 
 std::string Params(int n) {

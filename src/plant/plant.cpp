@@ -121,6 +121,7 @@ mesh::Palette PaletteOf(const lsys::Grammar& g) {
 
 Expected<mesh::Box> MeshBounds(const Plant& plant, const PlantSpec& spec) {
   SurfaceLibrary surfaces(plant.grammar.path, spec.surfacePath, spec.readFile);
+  surfaces.Define(spec.cpfgSurfaces);
   if (Status s = surfaces.LoadFor(plant.geometry, plant.grammar); !s.ok()) return s.error();
   return mesh::TessellatedBounds(plant.geometry, &surfaces.meshes());
 }
@@ -133,6 +134,7 @@ bool IsLineFigure(const mesh::PlantGeometry& geometry) {
 Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics) {
   const auto t0 = Clock::now();
   SurfaceLibrary surfaces(plant.grammar.path, spec.surfacePath, spec.readFile);
+  surfaces.Define(spec.cpfgSurfaces);
   if (Status s = surfaces.LoadFor(plant.geometry, plant.grammar); !s.ok()) return s;
   mesh::TessellateOptions options;
   options.detail = spec.detail;
@@ -178,8 +180,10 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
   popt.overrides = spec.defines;
   popt.readFile = spec.readFile;
   popt.environmentGiven = spec.environment != nullptr;
+  popt.functionFiles = spec.cpfgFunctions;
   // `~lF`: cpfg's one-letter surface `l` then `F` when l.obj exists and lF.obj does not.
-  const SurfaceLibrary surfaces(spec.path, spec.surfacePath, spec.readFile);
+  SurfaceLibrary surfaces(spec.path, spec.surfacePath, spec.readFile);
+  surfaces.Define(spec.cpfgSurfaces);
   popt.isSurface = [&surfaces](const std::string& name) { return surfaces.Has(name); };
   lsys::ParseResult parsed = spec.text ? lsys::ParseGrammarText(*spec.text, spec.path, popt)
                                        : lsys::ParseGrammarFile(spec.path, popt);

@@ -32,11 +32,13 @@
 #include "core/status.h"
 #include "lsys/deriver.h"
 #include "lsys/grammar.h"
+#include "lsys/parser.h"
 #include "lsys/word.h"
 #include "mesh/export.h"
 #include "mesh/plant_geometry.h"
 #include "mesh/tessellator.h"
 #include "mesh/triangle_mesh.h"
+#include "plant/cpfg_surface.h"
 #include "plant/environment.h"
 #include "plant/ground_environment.h"
 #include "plant/queries.h"
@@ -76,6 +78,11 @@ struct PlantSpec {
   // Folders searched for NAME.obj before the grammar's own folder, its
   // surfaces/ folder and the bundled grammars/surfaces (SurfaceLibrary).
   std::vector<std::string> surfacePath;
+  // cpfg surfaces by letter (a view file's `surface:` lines; app/view_file.h).
+  std::vector<CpfgSurfaceDef> cpfgSurfaces;
+  // cpfg function files for func(id, x) when the grammar names none (a view
+  // file's `function:` lines; lsys::ParseOptions::functionFiles).
+  std::vector<lsys::ParseOptions::FunctionFile> cpfgFunctions;
   int threads = 0;  // derivation threads; 0: all hardware threads; at most 256
   // When set, derivation, interpretation and tessellation run on this pool
   // (the process's, core/parallel.h SharedPool; not owned) and `threads` is

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 
 #include <set>
@@ -68,8 +69,37 @@ std::string SurfaceLibrary::Locate(const std::string& name,
   return {};
 }
 
+void SurfaceLibrary::Define(const std::vector<CpfgSurfaceDef>& defs) {
+  for (const CpfgSurfaceDef& d : defs) cpfg_[d.name] = d;
+}
+
+Status SurfaceLibrary::LoadCpfg(const CpfgSurfaceDef& def) {
+  std::optional<std::string> text;
+  if (readFile_) {
+    text = readFile_(def.file);
+  } else {
+    struct stat st;
+    if (::stat(def.file.c_str(), &st) == 0 && S_ISREG(st.st_mode) && st.st_size < (64 << 20)) {
+      if (FILE* f = std::fopen(def.file.c_str(), "rb")) {
+        std::string bytes(size_t(st.st_size), '\0');
+        const size_t got = std::fread(bytes.data(), 1, bytes.size(), f);
+        std::fclose(f);
+        if (got == bytes.size()) text = std::move(bytes);
+      }
+    }
+  }
+  if (!text) {
+    return MakeError(SourceLoc{def.viewFile, def.line, 0},
+                     "cannot read the surface file " + def.file + " of surface '" + def.name + "'");
+  }
+  auto m = ParseCpfgSurface(*text, def.file, def.size, def.sPrecision, def.tPrecision);
+  if (!m) return m.error();
+  meshes_.emplace(def.name, std::move(*m));
+  return {};
+}
+
 bool SurfaceLibrary::Has(const std::string& name) const {
-  if (meshes_.count(name)) return true;
+  if (meshes_.count(name) || cpfg_.count(name)) return true;
   std::optional<std::string> text;
   return !Locate(name, &text).empty();
 }
@@ -80,6 +110,10 @@ Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::
     if (!meshes_.count(si.name)) names.insert(si.name);
   }
   for (const std::string& name : names) {
+    if (auto it = cpfg_.find(name); it != cpfg_.end()) {
+      if (Status s = LoadCpfg(it->second); !s.ok()) return s;
+      continue;
+    }
     const std::string file = name + ".obj";
     std::optional<std::string> text;
     const std::string found = Locate(name, &text);

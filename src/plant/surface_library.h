@@ -5,6 +5,8 @@
 // in: the folders the caller adds (PlantSpec::surfacePath), the grammar's
 // folder, its `surfaces/` folder, and the bundled `grammars/surfaces`.
 // The first file found wins. Meshes are loaded once per library.
+// A cpfg surface (plant/cpfg_surface.h: a view file's `surface: l leaf.s
+// ...`) defined with Define() wins over an OBJ of the same name.
 #pragma once
 
 #include <functional>
@@ -17,6 +19,7 @@
 #include "lsys/grammar.h"
 #include "mesh/plant_geometry.h"
 #include "mesh/triangle_mesh.h"
+#include "plant/cpfg_surface.h"
 
 namespace sylva::plant {
 
@@ -34,6 +37,9 @@ class SurfaceLibrary {
   // the file system (tests, fuzzers).
   SurfaceLibrary(const std::string& grammarPath, const std::vector<std::string>& extra = {},
                  FileReader readFile = {});
+
+  // Names cpfg .s surfaces (a view file's `surface:` lines).
+  void Define(const std::vector<CpfgSurfaceDef>& defs);
 
   // Loads every surface `geometry` places that is not loaded yet. An error
   // (no such surface, a bad OBJ file) points at the surface's first use in
@@ -56,6 +62,8 @@ class SurfaceLibrary {
   std::vector<std::string> searchPath_;
   FileReader readFile_;
   std::unordered_map<std::string, mesh::TriangleMesh> meshes_;
+  std::unordered_map<std::string, CpfgSurfaceDef> cpfg_;
+  Status LoadCpfg(const CpfgSurfaceDef& def);
 };
 
 }  // namespace sylva::plant

@@ -53,12 +53,29 @@ TEST(ViewFile, ReadsWhatTheTurtleUses) {
   EXPECT_EQ(ParseViewFile("angle factor: 16\n", "p.v").angle.value_or(-1), 22.5);
 }
 
+TEST(ViewFile, TropismLettersMayCarryAColonAndAnAttachedValue) {
+  // As vlab's published view files write them.
+  ViewFile v = ParseViewFile("tropism: T: 0.0 -1.0 0.0  A:0 E: 0.3\n", "p.v");
+  EXPECT_TRUE(v.diagnostics.items.empty()) << Messages(v.diagnostics);
+  ASSERT_TRUE(v.tropism.has_value());
+  EXPECT_LT((*v.tropism - Vec3(0, -1, 0)).norm(), 1e-15) << v.tropism->transpose();
+  EXPECT_EQ(v.elasticity.value_or(-1), 0.3);
+  ViewFile angled = ParseViewFile("tropism: T: 0 1 0  A:90\n", "p.v");
+  EXPECT_NE(Messages(angled.diagnostics).find("1:22 warning: a tropism at an angle"),
+            std::string::npos)
+      << Messages(angled.diagnostics);
+  // A zero tropism direction bends nothing, as in cpfg: no tropism, no error.
+  ViewFile none = ParseViewFile("tropism direction: 0.0,0.0,0.0\ninitial elasticity: 0.2\n", "p.v");
+  EXPECT_TRUE(none.diagnostics.items.empty()) << Messages(none.diagnostics);
+  EXPECT_FALSE(none.tropism.has_value());
+}
+
 TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
   ViewFile v = ParseViewFile(
       "twist: 0\nz buffer: on\nprojection: perspective\n"  // as Sylva draws: silent
       "light direction: 1,1,1\n"
-      "  surface: l leaf.s 1\n"
-      "surface: k flower.s 1\n"
+      "  tsurface: l leaf.s 1\n"
+      "tsurface: k flower.s 1\n"
       "#include \"more.v\"\n"
       "blorp: 2\n"
       "initial color: 1 5\n",
@@ -69,13 +86,42 @@ TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
   EXPECT_EQ(v.diagnostics.items[0].loc.line, 4) << all;
   EXPECT_NE(all.find("4:1 warning: 'light direction:' is read but not acted on"), std::string::npos)
       << all;
-  EXPECT_NE(all.find("5:3 warning: 'surface:' is read but not acted on"), std::string::npos) << all;
+  EXPECT_NE(all.find("5:3 warning: 'tsurface:' is read but not acted on"), std::string::npos)
+      << all;
   EXPECT_EQ(all.find("6:1"), std::string::npos) << all;  // once per label
   EXPECT_NE(all.find("7:1 warning: preprocessor lines"), std::string::npos) << all;
   EXPECT_NE(all.find("8:1 warning: 'blorp:' is not a cpfg view file setting"), std::string::npos)
       << all;
   EXPECT_NE(all.find("9:18 warning: 'initial color:': the back-side colour"), std::string::npos)
       << all;
+}
+
+TEST(ViewFile, SurfaceLinesNameCpfgSurfacesBesideTheViewFile) {
+  ViewFile v = ParseViewFile("surface: l leaf.s 800 3 5\nsurface: b sub/bud.s 2\n", "/x/y/p.v");
+  ASSERT_EQ(v.diagnostics.items.size(), 0u) << Messages(v.diagnostics);
+  ASSERT_EQ(v.surfaces.size(), 2u);
+  EXPECT_EQ(v.surfaces[0].name, "l");
+  EXPECT_EQ(v.surfaces[0].file, "/x/y/leaf.s");
+  EXPECT_EQ(v.surfaces[0].size, 800);
+  EXPECT_EQ(v.surfaces[0].sPrecision, 3);
+  EXPECT_EQ(v.surfaces[0].tPrecision, 5);
+  EXPECT_EQ(v.surfaces[0].line, 1);
+  EXPECT_EQ(v.surfaces[1].file, "/x/y/sub/bud.s");
+  EXPECT_EQ(v.surfaces[1].size, 2);
+  EXPECT_EQ(v.surfaces[1].sPrecision, 0);
+
+  ViewFile bad = ParseViewFile(
+      "surface: lf leaf.s 1\nsurface: l leaf.s -2\nsurface: l leaf.s 1 0\nsurface: l\n", "p.v");
+  const std::string all = Messages(bad.diagnostics);
+  EXPECT_NE(all.find("1:10 error: a cpfg surface is named by one letter, not 'lf'"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find("2:19 error: a surface's size must be positive"), std::string::npos) << all;
+  EXPECT_NE(all.find("3:21 error: a precision is a whole number from 1 to 64"), std::string::npos)
+      << all;
+  EXPECT_NE(all.find("4:11 error: expected 'surface: LETTER FILE.s size [s t]'"), std::string::npos)
+      << all;
+  EXPECT_TRUE(bad.surfaces.empty());
 }
 
 TEST(ViewFile, BadValuesAreErrorsAtTheirColumn) {
@@ -178,6 +224,34 @@ TEST(ViewFile, HostileFilesAreClearErrors) {
   EXPECT_NE(Messages(dir->diagnostics).find("is a directory"), std::string::npos);
   std::filesystem::remove(Scratch() / "hostile.v");
   EXPECT_EQ(LoadViewFiles(grammar, ""), nullptr);  // nothing beside it
+}
+
+TEST(ViewFile, FunctionLinesGiveFuncItsFilesInOrder) {
+  ViewFile v = ParseViewFile("function: a.func 100\nfunction: sub/b.func\n", "/x/p.v");
+  EXPECT_TRUE(v.diagnostics.items.empty()) << Messages(v.diagnostics);
+  ASSERT_EQ(v.functions.size(), 2u);
+  EXPECT_EQ(v.functions[0].file, "/x/a.func");
+  EXPECT_EQ(v.functions[0].line, 1);
+  EXPECT_EQ(v.functions[0].column, 11);
+  EXPECT_EQ(v.functions[1].file, "/x/sub/b.func");
+  EXPECT_NE(Messages(ParseViewFile("function: a.func many\n", "p.v").diagnostics)
+                .find("1:18 error: expected a number of samples, not 'many'"),
+            std::string::npos);
+
+  // Through the plant: func(1, x) reads the view file's first function.
+  const std::string grammar = WriteFile("vf.l", "axiom: A(func(1, 0.25))\n");
+  WriteFile("vf.v", "function: vf.func 100\n");
+  WriteFile("vf.func",
+            "range: 0.0 1.0\npoints: 4\n0 0\n0.333333 0.666667\n"
+            "0.666667 1.333333\n1 2\n");
+  plant::PlantSpec spec;
+  spec.path = grammar;
+  spec.until = plant::Stage::kWord;
+  AttachViewFile(LoadViewFiles(grammar, ""), spec);
+  plant::PlantResult r = plant::BuildPlant(spec);
+  ASSERT_TRUE(r.plant.has_value()) << r.diagnostics.FormatAll();
+  ASSERT_EQ(r.plant->word.params.size(), 1u);
+  EXPECT_NEAR(r.plant->word.params[0], 0.5, 0.003) << r.plant->word.params[0];  // y = 2x
 }
 
 TEST(ViewFile, TheTurtleDrawsWithTheViewFilesSettings) {

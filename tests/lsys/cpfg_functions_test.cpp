@@ -155,6 +155,31 @@ TEST(CpfgFunctions, FuncInAProductionReadsTheFilesInOrder) {
   EXPECT_NEAR(w->word.params[1], 0.25, 0.0015) << w->word.params[1];
 }
 
+TEST(CpfgFunctions, AViewFilesFunctionLinesServeAGrammarWithoutFunctions) {
+  ParseOptions opt = Files();
+  opt.functionFiles = {{"line.func", "p.v", 3, 11}, {"hump.func", "p.v", 4, 11}};
+  ParseResult r = ParseGrammarText("axiom: A(func(1, 0.25), func(2, 0.5))\n", "c.l", opt);
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  auto w = Derive(*r.grammar, DeriveOptions{});
+  ASSERT_TRUE(w);
+  EXPECT_NEAR(w->word.params[0], 0.25, 0.0015) << w->word.params[0];
+  EXPECT_DOUBLE_EQ(w->word.params[1], 0.75);
+  // The grammar's own `functions:` wins: func(1) is the hump there.
+  ParseResult own = ParseGrammarText("functions: hump.func\naxiom: A(func(1, 0.5))\n", "c.l", opt);
+  ASSERT_TRUE(own.grammar) << own.diagnostics.FormatAll();
+  ASSERT_EQ(own.grammar->functions.size(), 1u);
+  // A file the view names that cannot be read: an error at the view's line.
+  opt.functionFiles.push_back({"missing.func", "p.v", 5, 11});
+  ParseResult bad = ParseGrammarText("axiom: A\n", "c.l", opt);
+  ASSERT_FALSE(bad.grammar);
+  const Diagnostic& d = bad.diagnostics.items[0];
+  EXPECT_EQ(d.loc.file + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column),
+            "p.v:5:11")
+      << d.Format();
+  EXPECT_NE(d.message.find("cannot read function file 'missing.func'"), std::string::npos)
+      << d.Format();
+}
+
 TEST(CpfgFunctions, FuncErrorsAreLocated) {
   auto first = [](const std::string& g) {
     ParseResult r = ParseGrammarText(g, "c.l", Files());
@@ -165,7 +190,7 @@ TEST(CpfgFunctions, FuncErrorsAreLocated) {
   };
   EXPECT_EQ(first("axiom: A\nA --> B(func(1, 0.5))\n"),
             "2:9 func(id, x) needs cpfg function files: name them with 'functions: FILE.func "
-            "...' before the productions");
+            "...' before the productions, or with 'function: FILE.func' lines in the view file");
   EXPECT_EQ(first("functions: hump.func\naxiom: A\nA --> B(func(2, 0.5))\n"),
             "3:9 func(id, x): id must be a whole number from 1 to 1 (the files of 'functions:')");
   EXPECT_EQ(first("functions: hump.func missing.func\naxiom: A\n"),

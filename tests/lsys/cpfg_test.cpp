@@ -47,6 +47,20 @@ TEST(Cpfg, UnimplementedCommandsWarnOncePerSymbolAtTheirFirstUse) {
   EXPECT_EQ(w[3].rfind("3:41 '@M' (move to) needs 3 parameters", 0), 0u) << all;
 }
 
+TEST(Cpfg, ContourTextureAndBackColourCommandsWarnAndLexAsOneModule) {
+  // vlab's lily and thatcheria: @#(contour) @!(sides) @;(back colour) @Tx(texture).
+  auto w = Warnings("axiom: @#(2)F @!(5) @;(7)F @Tx(1)F @#(3)\n");
+  const std::string all = Joined(w);
+  ASSERT_EQ(w.size(), 4u) << all;
+  EXPECT_EQ(w[0].rfind("1:8 '@#' (cpfg: generalized cylinder contour) is not implemented", 0), 0u)
+      << all;
+  EXPECT_EQ(w[1].rfind("1:15 '@!' (cpfg: number of sides of a cylinder's contour)", 0), 0u) << all;
+  EXPECT_EQ(w[2].rfind("1:21 '@;' (cpfg: back-side colour)", 0), 0u) << all;
+  EXPECT_EQ(w[3].rfind("1:28 '@Tx' (cpfg: texture)", 0), 0u) << all;
+  // One module each: no stray 'x' or '#' module in the word.
+  EXPECT_EQ(DeriveText("axiom: @Tx(1)F@#(2)@;(3)\n", 0), "@Tx(1)F@#(2)@;(3)");
+}
+
 TEST(Cpfg, ImplementedCommandsWarnAboutParametersTheyDoNotUse) {
   auto w = Warnings("axiom: @o(1,2) @c(1) @Gs(3) @Gc(2) @Ge(1,1) @Ts(1,2,3) @Ti(1) @Td @v\n");
   const std::string all = Joined(w);
@@ -199,6 +213,18 @@ TEST(Cpfg, IndentedLinesContinueAProduction) {
   EXPECT_EQ(DeriveText("axiom: A(2)\nA(n) : n > 0\n\t--> B A(n-1)\n", 3), "BBA(0)");
   // A weight on its own line.
   EXPECT_EQ(DeriveText("axiom: A\nA --> B\n    : 1\n", 1), "B");
+}
+
+TEST(Cpfg, IndentedLinesContinueTheAxiom) {
+  // As vlab's tri-bar and natica objects write a long axiom.
+  EXPECT_EQ(DeriveText("axiom: A\n\tB[C]\n\t  D(2)\nA --> E\n", 0), "AB[C]D(2)");
+  EXPECT_EQ(DeriveText("axiom: A\n\tB\nA --> E\n", 1), "EB");
+  // An indented production after the axiom stays a production.
+  EXPECT_EQ(DeriveText("axiom: A\n\tA --> E\n", 1), "E");
+  ParseResult r = ParseGrammarText("axiom: A\n\tB(1 +)\n", "c.l");
+  ASSERT_FALSE(r.grammar);
+  EXPECT_EQ(r.diagnostics.items[0].loc.line, 2) << r.diagnostics.items[0].Format();
+  EXPECT_EQ(r.diagnostics.items[0].sourceLine, "\tB(1 +)") << r.diagnostics.items[0].Format();
 }
 
 TEST(Cpfg, IndentedProductionsAndStatementsStayLinesOfTheirOwn) {
