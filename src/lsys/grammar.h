@@ -51,6 +51,14 @@ inline constexpr int kMaxRightContextNesting = 64;
 struct Production {
   std::vector<FormalModule> left;  // in word order; empty = any
   FormalModule pred;
+  // cpfg's predecessor of several modules (`A B --> C`): the modules after
+  // `pred`, matched on the modules right after it in the word (no skipping);
+  // the successor replaces them all, and the right context starts after the
+  // last. Empty for the usual one-module predecessor.
+  std::vector<FormalModule> predTail;
+  // The L-system block the production belongs to (Grammar::lsystems; 0 is
+  // the main one): it rewrites only modules inside that sub-L-system.
+  uint16_t lsystem = 0;
   std::vector<FormalModule> right;  // may contain brackets; empty = any
   uint16_t formalCount = 0;
   // Local variables of the statement blocks: slots after the formals, set
@@ -78,6 +86,7 @@ struct Production {
   SourceLoc LocOf(int column) const;
 
   bool HasContext() const { return !left.empty() || !right.empty(); }
+  size_t PredLength() const { return 1 + predTail.size(); }
   bool HasBlocks() const { return preBlock || postBlock || !successor.blocks.empty(); }
 };
 
@@ -111,6 +120,22 @@ struct Tropism {
   double x = 0, y = -1, z = 0, susceptibility = 0;
 };
 
+// One `lsystem:` block of a file (cpfg's sub-L-systems): the first is the
+// main L-system, whose axiom and derivation length are used; each later
+// one has the number its `lsystem:` line gives. In a word, `?(id, scale)`
+// starts the sub-L-system numbered id and `$` ends it: the modules between
+// are rewritten by that block's productions only (decomposition and
+// interpretation too), and the turtle multiplies its step and width by
+// scale there (docs/cpfg.md, "Sub-L-systems").
+struct LsystemBlock {
+  int id = 0;        // the number of its `lsystem:` line (cpfg: atof of the label)
+  std::string name;  // the label as written
+  SourceLoc loc;     // of the `lsystem:` line
+  // Its ignore:/consider: (per symbol id, 1: skipped by context matching);
+  // empty for the main L-system, whose table is Grammar::contextSkip.
+  std::vector<uint8_t> contextSkip;
+};
+
 struct Grammar {
   std::string name;  // `lsystem:` or the file name
   std::string path;  // main file
@@ -141,8 +166,17 @@ struct Grammar {
   // Per symbol id: 1 when context matching skips it (ignore:/consider:).
   std::vector<uint8_t> contextSkip;
   std::optional<SymbolId> cutSymbol;  // the id of `%` when the grammar uses it
-  bool usesContext = false;           // some production has a context
-  bool usesRandom = false;            // weights or random functions anywhere
+  // The L-system blocks, main first (one at least).
+  std::vector<LsystemBlock> lsystems;
+  // Several blocks, or `?(id)` / `?(id, scale)` modules: the derivation
+  // then tracks which block each module belongs to (one thread, left to
+  // right, as cpfg), and `$` ends a sub-L-system instead of rolling the
+  // turtle (cpfg's `$`).
+  bool subLsystems = false;
+  // Some production has a predecessor of several modules.
+  bool multiModulePredecessors = false;
+  bool usesContext = false;  // some production has a context
+  bool usesRandom = false;   // weights or random functions anywhere
 
   std::unordered_map<std::string, double> constants;  // after -D overrides
 

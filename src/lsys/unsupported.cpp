@@ -75,6 +75,12 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
     }
     return "'" + std::string(name) + "' is not a command Sylva knows: it does nothing";
   }
+  if (name == "?") {  // ?(id, scale): the start of a sub-L-system
+    if (arity == 1 || arity == 2) return std::nullopt;
+    return "'?' (start of a sub-L-system) uses 2 parameters, the L-system's number and the "
+           "scale; the other " +
+           std::to_string(arity - 2) + " are ignored";
+  }
   if (name[0] == '?') {
     // ?P ?H ?L ?U are answered after each step (plant::Grower): 2 parameters
     // take x, y and 3 take x, y, z. ?E is answered by the grammar's

@@ -135,17 +135,15 @@ TEST(Cpfg, SurfaceWithTwoScalesWarns) {
 TEST(Cpfg, TextAfterEndlsystemWarnsWhereItStarts) {
   auto w = Warnings("axiom: F\nendlsystem\n\n  F --> FF\nG --> GG\n");
   ASSERT_EQ(w.size(), 1u) << Joined(w);
-  EXPECT_EQ(w[0], "4:3 text after 'endlsystem' is ignored (Sylva reads one L-system a file)");
+  EXPECT_EQ(w[0], "4:3 text after 'endlsystem' is ignored (it is not an 'lsystem:' block)");
   // ... and it is ignored: F is not rewritten.
   EXPECT_EQ(DeriveText("axiom: F\nendlsystem\nF --> FF\n", 1), "F");
 }
 
-TEST(Cpfg, SecondLsystemBlockWarnsThatSubLsystemsAreNotSupported) {
-  auto w = Warnings("Lsystem: 1\naxiom: F\nendlsystem\nLsystem: 2\naxiom: G\nendlsystem\n");
-  ASSERT_EQ(w.size(), 1u) << Joined(w);
-  EXPECT_EQ(w[0].rfind("4:1 a second 'lsystem:' block (a cpfg sub-L-system) is not supported", 0),
-            0u)
-      << w[0];
+TEST(Cpfg, SecondLsystemBlockIsASubLsystem) {
+  // Read, not warned about (tests/lsys/cpfg_sub_lsystem_test.cpp).
+  EXPECT_TRUE(
+      Warnings("Lsystem: 1\naxiom: F\nendlsystem\nLsystem: 2\naxiom: G\nendlsystem\n").empty());
 }
 
 TEST(Cpfg, BlankLinesAndCommentsAfterEndlsystemAreSilent) {
