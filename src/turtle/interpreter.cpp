@@ -50,6 +50,8 @@ enum class Op : uint8_t {
   kTropismUp,    // @Ti
   kTropismDown,  // @Td
   kTwistForce,   // @Tf
+  kSubStart,     // ?(id, scale): a sub-L-system starts (grammars with sub-L-systems)
+  kSubEnd,       // $ there: it ends
 };
 
 Op OpFor(const std::string& name) {
@@ -134,6 +136,7 @@ struct State {
 struct CpfgState {
   double elasticity = 0;  // tropism susceptibility (cpfg: elasticity), @Ts @Ti @Td change it
   int32_t cylinder = -1;  // the open generalized cylinder (@Gs), or -1
+  double scale = 1;       // sub-L-system scale (cpfg: scale_factor) of steps, widths, surfaces
 };
 
 // A control point of a generalized cylinder: where the turtle was at @Gs,
@@ -250,6 +253,7 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   d.initialColor = g.initialColor;
   d.colorIncrement = g.colorIncrement;
   d.elasticityIncrement = g.elasticityIncrement;
+  d.subLsystems = g.subLsystems;
   return d;
 }
 
@@ -491,6 +495,13 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
                      const DrawOptions& options, PlantGeometry& g) {
   std::vector<Op> ops(symbols.size());
   for (size_t s = 0; s < symbols.size(); ++s) ops[s] = OpFor(symbols.name(lsys::SymbolId(s)));
+  if (def.subLsystems) {  // cpfg's `?(id, scale)` and `$` (not the roll of ABOP's `$`)
+    for (size_t s = 0; s < symbols.size(); ++s) {
+      const std::string& name = symbols.name(lsys::SymbolId(s));
+      if (name == "?" && symbols.arity(lsys::SymbolId(s)) >= 1) ops[s] = Op::kSubStart;
+      if (name == "$") ops[s] = Op::kSubEnd;
+    }
+  }
 
   if (Status st = ClearAndReserve(word, ops, options, g); !st.ok()) return st;
   std::vector<uint32_t> branchParent{0};
@@ -502,6 +513,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   CpfgState x;
   x.elasticity = def.susceptibility;
   std::vector<CpfgState> xstack;
+  std::vector<double> subScales;  // the scale outside each open sub-L-system
   t.color = uint16_t(std::clamp(def.initialColor, 0, 65535));
   const int colorStep = def.colorIncrement;
   SinCos sincos;
@@ -512,7 +524,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
     changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp || op == Op::kTropismDown;
     drawsCylinders |= op == Op::kGcStart || op == Op::kGcPoint || op == Op::kGcEnd;
   }
-  const bool cpfgState = changesTropism || drawsCylinders;
+  const bool cpfgState = changesTropism || drawsCylinders || def.subLsystems;
   const bool tropism = def.susceptibility != 0 || changesTropism;
   Vec3 lo = t.pos, hi = t.pos;
   bool planar = true;
@@ -559,7 +571,8 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kForwardMove:
         case Op::kForwardDrawNoVertex:
         case Op::kForwardMoveNoVertex: {
-          const double len = np ? p[0] : def.step;
+          double len = np ? p[0] : def.step;
+          if constexpr (kCpfg) len *= x.scale;
           const Vec3 start = t.pos;
           t.pos += t.frame.heading * len;
           visit(t.pos);
@@ -649,8 +662,11 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kWidth:
           if (np) {
             t.width = p[0];
+            if constexpr (kCpfg) t.width *= x.scale;
           } else if (def.widthIncrement > 0) {
-            t.width = std::max(t.width - def.widthIncrement, 0.0);
+            double inc = def.widthIncrement;
+            if constexpr (kCpfg) inc *= x.scale;
+            t.width = std::max(t.width - inc, 0.0);
           } else {
             t.width *= def.widthFactor;
           }
@@ -658,8 +674,11 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kWidthUp:
           if (np) {
             t.width = p[0];
+            if constexpr (kCpfg) t.width *= x.scale;
           } else if (def.widthIncrement > 0) {
-            t.width += def.widthIncrement;
+            double inc = def.widthIncrement;
+            if constexpr (kCpfg) inc *= x.scale;
+            t.width += inc;
           } else if (def.widthFactor != 0) {
             t.width /= def.widthFactor;
           }
@@ -696,6 +715,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           } else if (np) {
             si.scale = Vec3(p[0], p[0], p[0]);
           }
+          if constexpr (kCpfg) si.scale *= x.scale;
           si.color = t.color;
           si.module = uint32_t(i);
           g.surfaces.push_back(std::move(si));
@@ -774,6 +794,27 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kTwistForce:
           // @Tf: cpfg records the frame so its next cylinder does not twist;
           // Sylva's tubes follow rotation-minimizing frames and never twist.
+          break;
+        case Op::kSubStart:  // ?(id, scale): cpfg's interpret.c UpdateCurrentLsystem
+          if constexpr (kCpfg) {
+            const double outer = x.scale;
+            subScales.push_back(outer);
+            x.scale = outer * (np >= 2 ? p[1] : 1.0);
+            if (outer != 0) t.width *= x.scale / outer;
+          }
+          break;
+        case Op::kSubEnd:
+          if constexpr (kCpfg) {
+            if (subScales.empty()) {
+              g.warnings.push_back("unmatched '$' (end of a sub-L-system) at module " +
+                                   std::to_string(i + 1) + " ignored");
+              break;
+            }
+            const double inner = x.scale;
+            x.scale = subScales.back();
+            subScales.pop_back();
+            if (inner != 0) t.width *= x.scale / inner;
+          }
           break;
         case Op::kNone:
           break;

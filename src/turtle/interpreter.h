@@ -35,6 +35,7 @@
 //          susceptibility e (cpfg's elasticity) of the turtle (kept by [ ]);
 //          i must be 1
 //   @Tf    accepted, nothing to do: Sylva's tubes never twist
+//   ?(id, s) ... $  in a grammar with sub-L-systems: the scale (TurtleDef::subLsystems)
 #pragma once
 
 #include <optional>
@@ -68,6 +69,11 @@ struct TurtleDef {
   double elasticityIncrement = 0;  // @Ti and @Td without a value add and subtract it
   int initialColor = 0;            // colour index the turtle starts with
   int colorIncrement = 1;          // ; and , without a parameter add and subtract it
+  // cpfg's sub-L-systems (lsys::Grammar::subLsystems): `?(id, scale)`
+  // multiplies the turtle's scale by `scale` (default 1) and `$` restores it
+  // (instead of rolling the turtle); the scale multiplies F f G g lengths,
+  // the width (at once, and what ! and # set or add later) and surfaces.
+  bool subLsystems = false;
 };
 
 TurtleDef TurtleDefFrom(const lsys::Grammar& g);

@@ -483,3 +483,43 @@ TEST(Turtle, TwistForceChangesNothing) {
 
 }  // namespace
 }  // namespace sylva::turtle
+
+namespace sylva::turtle {
+namespace {
+
+// cpfg's sub-L-systems: ?(id, s) multiplies the step and the width by s
+// until its `$` (interpret.c UpdateCurrentLsystem), and `$` does not roll.
+TEST(Turtle, SubLsystemScalesStepAndWidthUntilItsEnd) {
+  Drawn d = Draw(
+      "lsystem: 1\naxiom: F?(2,0.5)F!(2)F?(2,0.5)F$$F\nendlsystem\n"
+      "lsystem: 2\naxiom: F\nendlsystem\n",
+      0);
+  const auto& s = d.geometry.segments;
+  ASSERT_EQ(s.size(), 5u);
+  const double ends[5] = {1, 1.5, 2, 2.25, 3.25};
+  // Width 1; at ?(2,0.5) 0.5; !(2) sets 2 x 0.5 = 1; at the nested
+  // ?(2,0.5) 0.5 (scale 0.25); each $ divides by what its ?(..) multiplied.
+  const double radii[5] = {0.5, 0.25, 0.5, 0.25, 1.0};
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_VEC_NEAR(s[size_t(k)].end, Vec3(0, ends[k], 0), 1e-12);
+    EXPECT_NEAR(s[size_t(k)].radiusStart, radii[k], 1e-7) << "segment " << k;
+  }
+}
+
+TEST(Turtle, DollarEndsASubLsystemWithoutRolling) {
+  DrawOptions opt;
+  opt.recordModules = true;
+  Drawn d = Draw(
+      "lsystem: 1\naxiom: &(35)/(50)?(2)$F\nendlsystem\nlsystem: 2\naxiom: F\n"
+      "endlsystem\n",
+      0, opt);
+  Drawn roll = Draw("axiom: &(35)/(50)$F\n", 0, opt);
+  Drawn none = Draw("axiom: &(35)/(50)F\n", 0, opt);
+  ASSERT_EQ(d.geometry.moduleFrame.size(), 5u);
+  const Frame& f = d.geometry.moduleFrame.back();
+  EXPECT_VEC_NEAR(f.left, none.geometry.moduleFrame.back().left, 1e-12);
+  EXPECT_GT((f.left - roll.geometry.moduleFrame.back().left).norm(), 0.1);
+}
+
+}  // namespace
+}  // namespace sylva::turtle
