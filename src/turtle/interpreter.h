@@ -28,9 +28,16 @@
 //   @Gs @Gc(n) @Ge(n)  a generalized cylinder: a tube along the cubic
 //          Hermite curve through the turtle's positions at @Gs, each @Gc and
 //          @Ge (tangents: the headings there times the distance between the
-//          points), n segments per piece (default 8), the width running
-//          linearly between the points; F inside draws nothing; a branch
-//          `[` draws on its own and `]` resumes the cylinder
+//          points times the @Gt factors), n segments per piece (default 8),
+//          the width running linearly between the points unless @Gr says
+//          otherwise; F inside draws nothing; a branch `[` draws on its own
+//          and `]` resumes the cylinder
+//   @Gt(a, b)  tangent factors: a arriving at a control point, b leaving it
+//          (one value: both; cpfg's default 1.2)
+//   @Gr(a, l, a2, l2)  the radius along a piece follows a Hermite curve in
+//          the plane (t, radius) with tangent l (cos a, sin a) arriving at a
+//          control point and l2 (cos a2, sin a2) leaving it (2 values: both);
+//          @Gr(k), k != 0, multiplies their radius parts by the chord
 //   @Ts(i, e) @Ti(i, d) @Td(i, d)  set, raise and lower the tropism
 //          susceptibility e (cpfg's elasticity) of the turtle (kept by [ ]);
 //          i must be 1
