@@ -967,6 +967,8 @@ Status RunGlobalBlock(const Grammar& g, const std::optional<Expr>& block, const 
 // The global variables as the Start: block leaves them.
 Expected<std::vector<double>> StartGlobals(const Grammar& g, uint64_t seed) {
   std::vector<double> globals(g.globals.size(), 0.0);
+  for (size_t k = 0; k < g.globalInitial.size() && k < globals.size(); ++k)
+    globals[k] = g.globalInitial[k];
   if (Status s = RunGlobalBlock(g, g.startBlock, "Start", seed, 0, globals); !s.ok())
     return s.error();
   return globals;
@@ -1027,7 +1029,7 @@ struct Derivation::State {
         table(BuildStaticTable(grammar, grammar.main)) {}
 
   const Grammar& g;
-  const uint64_t seed;
+  uint64_t seed;  // srand(s) in Start: may set it (Derivation::Start)
   const uint64_t maxModules;
   ThreadPool ownPool;  // unused (one thread, no workers) with a shared pool
   ThreadPool& pool;
@@ -1051,6 +1053,11 @@ Expected<Derivation> Derivation::Start(const Grammar& g, const DeriveOptions& op
   auto globals = StartGlobals(g, state->seed);
   if (!globals) return globals.error();
   state->globals = std::move(globals).value();
+  // srand(seed) in Start: is the grammar's seed (a seed given in the options still wins).
+  if (g.srandGlobal >= 0 && !options.seed) {
+    const double v = state->globals[size_t(g.srandGlobal)];
+    if (std::abs(v) < 9e18) state->seed = uint64_t(int64_t(std::trunc(v)));  // NaN: not called
+  }
   auto axiom = BuildAxiom(g, state->seed, state->globals.data());
   if (!axiom) return axiom.error();
   state->word = std::move(axiom).value();

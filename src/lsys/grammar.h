@@ -17,6 +17,7 @@
 #include "core/diagnostic.h"
 #include "lsys/cpfg_function.h"
 #include "lsys/expr.h"
+#include "lsys/expr_parser.h"
 #include "lsys/symbols.h"
 #include "lsys/word.h"
 
@@ -185,6 +186,15 @@ struct Grammar {
   // axiom is built, StartEach before each derivation step, EndEach after it
   // (after decomposition and cut), End after the last step.
   std::vector<std::string> globals;
+  // Their values before Start: runs (empty: all 0); set by array initialisers.
+  std::vector<double> globalInitial;
+  // cpfg arrays (`define: { array a[3]; }`): elements are globals
+  // [base, base + size), named "a[0]", ... in `globals`.
+  std::vector<ArrayShape> arrays;
+  // The hidden global that `srand(seed);` in Start: sets (-1: none); after
+  // Start: a finite value there is the derivation's seed, as `seed:` (a
+  // --seed given to the command still wins).
+  int srandGlobal = -1;
   // cpfg function files (`functions: a.func b.func`), for func(id, x).
   std::vector<std::shared_ptr<const CpfgFunction>> functions;
   std::optional<Expr> startBlock, startEachBlock, endEachBlock, endBlock;

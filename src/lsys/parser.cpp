@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <set>
 #include <unordered_set>
@@ -186,6 +187,7 @@ class GrammarParser {
   void Conditionals();
   void ParseGlobalBlock(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseFunctions(const Line& l, size_t after, size_t end);
+  void ParseArrays(const Line& l, size_t after, size_t end);
   void CollectGlobals();
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
                       size_t lhsEnd);
@@ -818,6 +820,7 @@ void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end)
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   scope.functions = &g_.functions;
   scope.globals = &g_.globals;
+  scope.arrays = &g_.arrays;
   Successor s;
   if (!ParseActualWord(l, after, end, scope, &s)) return;
   if (s.symbols.empty()) {
@@ -1242,6 +1245,17 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   scope.functions = &g_.functions;
   scope.globals = &g_.globals;
+  scope.arrays = &g_.arrays;
+  if (k == "start" && t.find("srand", after) != std::string::npos) {
+    // srand(seed) there sets the seed: a hidden global holds it.
+    if (g_.srandGlobal < 0) {
+      g_.srandGlobal = int(g_.globals.size());
+      g_.globals.push_back("srand()");
+      g_.globalInitial.resize(g_.globals.size(), 0.0);
+      g_.globalInitial.back() = std::numeric_limits<double>::quiet_NaN();  // not called
+    }
+    scope.srandSlot = g_.srandGlobal;
+  }
   std::string_view view(t.data(), end);
   size_t pos = after;
   Expr block;
@@ -1256,6 +1270,164 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
     return;
   }
   *slot = std::move(block);
+}
+
+// cpfg's `define: { array a[3], b[2][2] = {1, 2, 3, 4}; array c[4]; }`:
+// arrays of global variables, 0 unless initialised (in row-major order; a
+// shorter list leaves the rest 0). Sizes and values are constant
+// expressions.
+void GrammarParser::ParseArrays(const Line& l, size_t after, size_t end) {
+  const std::string& t = l.text;
+  size_t p = after;
+  auto space = [&] {
+    while (p < end && IsSpace(t[p])) ++p;
+  };
+  // The extent of one constant expression from p: up to a top-level `stop`
+  // character.
+  auto exprEnd = [&](std::string_view stops) {
+    size_t q = p;
+    int depth = 0;
+    for (; q < end; ++q) {
+      if (t[q] == '(') ++depth;
+      if (t[q] == ')') --depth;
+      if (depth == 0 && stops.find(t[q]) != std::string_view::npos) break;
+    }
+    return q;
+  };
+  space();
+  if (p >= end || t[p] != '{') {
+    Error(l, int(p) + 1, "expected '{' after 'define:' (cpfg: define: { array a[3]; })");
+    return;
+  }
+  ++p;
+  constexpr size_t kMaxArrayElements = size_t(1) << 20;
+  for (;;) {
+    space();
+    if (p < end && t[p] == '}') {
+      ++p;
+      space();
+      if (p < end && t[p] == ';') ++p;
+      space();
+      if (p < end) Error(l, int(p) + 1, "unexpected text after the 'define:' block");
+      return;
+    }
+    if (p >= end) {
+      Error(l, int(after) + 1, "unclosed '{' of 'define:': no '}'");
+      return;
+    }
+    const size_t w = p;
+    while (p < end && IsIdentChar(t[p])) ++p;
+    const std::string word = t.substr(w, p - w);
+    if (word != "array") {
+      Error(l, int(w) + 1,
+            word == "external"
+                ? "'external' definitions (cpfg, for environment programs) are not supported"
+                : "expected 'array' in 'define:' (cpfg: define: { array a[3]; })",
+            std::max(1, int(word.size())));
+      return;
+    }
+    for (;;) {  // NAME [n]... [= {v, ...}] , ...
+      space();
+      const size_t ns = p;
+      while (p < end && IsIdentChar(t[p])) ++p;
+      if (p == ns || !IsIdentStart(t[ns])) {
+        Error(l, int(ns) + 1, "expected an array name after 'array'");
+        return;
+      }
+      const std::string name = t.substr(ns, p - ns);
+      const int nameCol = int(ns) + 1;
+      bool taken = defines_.count(name) || macros_.count(name) ||
+                   std::find(g_.globals.begin(), g_.globals.end(), name) != g_.globals.end();
+      for (const ArrayShape& a : g_.arrays) taken |= a.name == name;
+      if (taken) {
+        Error(l, nameCol, "'" + name + "' is already a constant, variable or array",
+              int(name.size()));
+        return;
+      }
+      ArrayShape a;
+      a.name = name;
+      size_t total = 1;
+      for (;;) {
+        space();
+        if (p >= end || t[p] != '[') break;
+        ++p;
+        const size_t e = exprEnd("]");
+        if (e >= end) {
+          Error(l, int(p) + 1, "expected ']' after the size of '" + name + "'");
+          return;
+        }
+        double v = 0;
+        if (!ParseConstExpr(l, p, e, &v)) return;
+        if (!(v >= 1 && v == std::floor(v) && v <= double(kMaxArrayElements))) {
+          Error(l, int(p) + 1, "an array size must be a whole number from 1 to 1048576");
+          return;
+        }
+        total *= size_t(v);
+        if (total > kMaxArrayElements) {
+          Error(l, nameCol, "array '" + name + "' has more than 1048576 elements",
+                int(name.size()));
+          return;
+        }
+        a.dims.push_back(uint32_t(v));
+        p = e + 1;
+      }
+      if (a.dims.empty()) {
+        Error(l, nameCol, "array '" + name + "' needs a size: " + name + "[n]", int(name.size()));
+        return;
+      }
+      if (g_.globals.size() + total > kMaxArrayElements * 4) {
+        Error(l, nameCol, "too many array elements in one grammar", int(name.size()));
+        return;
+      }
+      a.base = uint32_t(g_.globals.size());
+      for (size_t k = 0; k < total; ++k) g_.globals.push_back(name + "[" + std::to_string(k) + "]");
+      g_.globalInitial.resize(g_.globals.size(), 0.0);
+      space();
+      if (p < end && t[p] == '=') {  // = { v, v, ... }
+        ++p;
+        space();
+        if (p >= end || t[p] != '{') {
+          Error(l, int(p) + 1, "expected '{' with the values of '" + name + "'");
+          return;
+        }
+        ++p;
+        size_t k = 0;
+        for (;;) {
+          space();
+          if (p < end && t[p] == '}') {
+            ++p;
+            break;
+          }
+          const size_t e = exprEnd(",}");
+          if (e >= end) {
+            Error(l, int(p) + 1, "expected '}' after the values of '" + name + "'");
+            return;
+          }
+          if (k == total) {
+            Error(l, int(p) + 1,
+                  "more values than the " + std::to_string(total) + " elements of '" + name + "'");
+            return;
+          }
+          double v = 0;
+          if (!ParseConstExpr(l, p, e, &v)) return;
+          g_.globalInitial[a.base + k++] = v;
+          p = t[e] == ',' ? e + 1 : e;
+        }
+        space();
+      }
+      g_.arrays.push_back(std::move(a));
+      if (p < end && t[p] == ',') {
+        ++p;
+        continue;
+      }
+      if (p < end && t[p] == ';') {
+        ++p;
+        break;
+      }
+      Error(l, int(p) + 1, "expected ',' or ';' after array '" + name + "'");
+      return;
+    }
+  }
 }
 
 // The global variables: every name assigned in a Start:, StartEach:,
@@ -1353,6 +1525,7 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
       ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
       scope.functions = &g_.functions;
       scope.globals = &g_.globals;
+      scope.arrays = &g_.arrays;
       Successor unused;
       ParseActualWord(l, after, end, scope, &unused);
       return true;
@@ -1383,9 +1556,7 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
     return true;
   }
   if (k == "define") {
-    Error(l, col,
-          "'define:' (cpfg arrays) is not supported by Sylva: arrays cannot be declared or used",
-          6);
+    ParseArrays(l, after, end);
     return true;
   }
   if (k == "axiom") {
@@ -1681,6 +1852,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   p.formalCount = uint16_t(formals.size());
   ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
   scope.functions = &g_.functions;
+  scope.arrays = &g_.arrays;
 
   // Condition, with cpfg's statement blocks around it.
   std::vector<std::string> locals;
