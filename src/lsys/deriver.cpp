@@ -7,6 +7,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -162,6 +163,7 @@ class Pass {
       anyBlocks_ |= p.HasBlocks();
       multi_ |= !p.predTail.empty();
     }
+    special_ = multi_ || g.subLsystems;
     if (g.subLsystems) {  // the modules that start and end a sub-L-system
       subKind_.assign(g.symbols.size(), 0);
       for (size_t sy = 0; sy < g.symbols.size(); ++sy) {
@@ -253,6 +255,7 @@ class Pass {
   // The blocks and condition of a production with statement blocks.
   [[gnu::noinline]] int MatchBlocks(const Production& q, size_t i, double* formals,
                                     RandomStream& rng, Chunk& c);
+  template <bool kMulti>  // some production has a predecessor of several modules
   void Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams);
   // Runs the successor of a production with statement blocks (vars bound)
   // and appends its parameters to c.stash; false on an error (in c).
@@ -273,6 +276,7 @@ class Pass {
   bool needsMatch_ = false;
   bool anyBlocks_ = false;            // some production has statement blocks
   bool multi_ = false;                // some production has a predecessor of several modules
+  bool special_ = false;              // multi_, or a grammar with sub-L-systems
   std::vector<uint32_t> predLength_;  // per production
   std::vector<uint8_t> subKind_;      // per symbol: 1 `?(id..)`, 2 `$` (sub-L-systems only)
   std::vector<uint16_t> owner_;       // per module of the input: its L-system block
@@ -696,6 +700,7 @@ bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice
   return true;
 }
 
+template <bool kMulti>
 void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams) {
   std::vector<double> formals(maxFormals_ + 1);
   size_t o = c.outModuleAt;
@@ -707,8 +712,10 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
   for (size_t i = c.begin; i < c.end; ++i) {
     const SymbolId sym = w.symbols[i];
     const uint16_t ch16 = choice_[i];
-    if (ch16 >= kConsumed16) {
+    if constexpr (kMulti) {
       if (ch16 == kConsumed16) continue;  // part of the predecessor before it
+    }
+    if (ch16 == kIdentity16) {
       osym[o] = sym;
       if (ostart) {
         ostart[o] = uint32_t(po);
@@ -751,7 +758,7 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
         const double* src = in.params.data() + in.paramStart[i];
         for (int k = 0; k < a; ++k) formals[p.pred.firstFormal + k] = src[k];
       }
-      if (p.lsystem > 0 || !p.predTail.empty()) [[unlikely]] {
+      if (special_ && (p.lsystem > 0 || !p.predTail.empty())) [[unlikely]] {
         const WordView v = ViewFor(p, w);
         const size_t last = i + p.predTail.size();
         if (!p.left.empty()) MatchLeft(p, v, PrevInContext(v, i), formals.data());
@@ -845,7 +852,10 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
   }
   choice_.ResizeUninitialized(n);
   const auto& arities = g_.symbols.arities();
-  pool_.ParallelFor(chunks_.size(), [&](size_t k) {
+  // Compiled twice: only grammars with predecessors of several modules pay
+  // for the check of modules a match took.
+  auto count = [&](size_t k, auto multiTag) {
+    constexpr bool kMulti = decltype(multiTag)::value;
     Chunk& c = chunks_[k];
     std::vector<double> formals(maxFormals_ + 1);
     uint64_t modules = 0, params = 0;
@@ -854,11 +864,14 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
     const uint32_t* succParams = succParams_.data();
     const uint8_t* arity = arities.data();
     bool rewrote = false;
-    size_t consumedUntil = 0;  // modules before this belong to a chosen predecessor
+    [[maybe_unused]] size_t consumedUntil =
+        0;  // modules before this belong to a chosen predecessor
     for (size_t i = c.begin; i < c.end; ++i) {
-      if (i < consumedUntil) [[unlikely]] {
-        choice_[i] = kConsumed16;
-        continue;
+      if constexpr (kMulti) {
+        if (i < consumedUntil) {
+          choice_[i] = kConsumed16;
+          continue;
+        }
       }
       const SymbolId sym = w.symbols[i];
       uint32_t ch = symChoice[sym];
@@ -886,21 +899,31 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
         modules += succModules[ch];
         params += succParams[ch];
         rewrote = true;
-        if (multi_) consumedUntil = i + predLength_[ch];
+        if constexpr (kMulti) consumedUntil = i + predLength_[ch];
       }
     }
     c.changed = rewrote;
     c.outModules = modules;
     c.outParams = params;
-  });
+  };
+  if (multi_) {
+    pool_.ParallelFor(chunks_.size(), [&](size_t k) { count(k, std::true_type{}); });
+  } else {
+    pool_.ParallelFor(chunks_.size(), [&](size_t k) { count(k, std::false_type{}); });
+  }
   for (auto& c : chunks_) {
     if (c.error) return *c.error;
   }
   uint64_t totalParams = 0;
   for (auto& c : chunks_) totalParams += c.outParams;
   if (Status s = Allocate(out, totalParams > 0); !s.ok()) return s;
-  pool_.ParallelFor(chunks_.size(),
-                    [&](size_t k) { Write(w, in, out, chunks_[k], totalParams > 0); });
+  if (multi_) {
+    pool_.ParallelFor(chunks_.size(),
+                      [&](size_t k) { Write<true>(w, in, out, chunks_[k], totalParams > 0); });
+  } else {
+    pool_.ParallelFor(chunks_.size(),
+                      [&](size_t k) { Write<false>(w, in, out, chunks_[k], totalParams > 0); });
+  }
   for (auto& c : chunks_) {
     if (c.error) return *c.error;
   }

@@ -52,14 +52,6 @@ inline constexpr int kMaxRightContextNesting = 64;
 struct Production {
   std::vector<FormalModule> left;  // in word order; empty = any
   FormalModule pred;
-  // cpfg's predecessor of several modules (`A B --> C`): the modules after
-  // `pred`, matched on the modules right after it in the word (no skipping);
-  // the successor replaces them all, and the right context starts after the
-  // last. Empty for the usual one-module predecessor.
-  std::vector<FormalModule> predTail;
-  // The L-system block the production belongs to (Grammar::lsystems; 0 is
-  // the main one): it rewrites only modules inside that sub-L-system.
-  uint16_t lsystem = 0;
   std::vector<FormalModule> right;  // may contain brackets; empty = any
   uint16_t formalCount = 0;
   // Local variables of the statement blocks: slots after the formals, set
@@ -83,6 +75,14 @@ struct Production {
   // condition is evaluated (whether or not it holds), post when it holds.
   // (Cold: after the fields the derivation reads for every module.)
   std::optional<Expr> preBlock, postBlock;
+  // cpfg's predecessor of several modules (`A B --> C`): the modules after
+  // `pred`, matched on the modules right after it in the word (no skipping);
+  // the successor replaces them all, and the right context starts after the
+  // last. Empty for the usual one-module predecessor.
+  std::vector<FormalModule> predTail;
+  // The L-system block the production belongs to (Grammar::lsystems; 0 is
+  // the main one): it rewrites only modules inside that sub-L-system.
+  uint16_t lsystem = 0;
   // The file position of a column of the production as read.
   SourceLoc LocOf(int column) const;
 
