@@ -167,3 +167,34 @@ TEST(MultiModulePredecessor, BracketsCannotBePartOfIt) {
 
 }  // namespace
 }  // namespace sylva::lsys
+
+namespace sylva::lsys {
+namespace {
+
+TEST(SubLsystem, ExampleFileDerivesAsWrittenByHand) {
+  const std::string path = testing::SourcePath("grammars/cpfg/sub_lsystem.l");
+  ParseResult r = ParseGrammarFile(path);
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  EXPECT_TRUE(r.diagnostics.items.empty()) << r.diagnostics.FormatAll();  // --strict clean
+  DeriveOptions o;
+  o.steps = 2;
+  auto w = Derive(*r.grammar, o);
+  ASSERT_TRUE(w);
+  const std::string bud = "?(2,0.5);(1)!(0.2)";
+  EXPECT_EQ(FormatWord(w->word, r.grammar->symbols),
+            "!(0.12)F(1.12)[+(50)" + bud + "F(0.6)[+(30)L][-(30)L]S$][-(50)" + bud +
+                "F(0.6)[+(30)L][-(30)L]S$]/(137.5)F(1)[+(50)" + bud + "S$][-(50)" + bud +
+                "S$]/(137.5)A(2)");
+  // Step 3: the main L-system lengthens its F; L-system 2's F(0.6) stays
+  // and its L becomes F(0.4).
+  o.steps = 3;
+  auto w3 = Derive(*r.grammar, o);
+  ASSERT_TRUE(w3);
+  const std::string s3 = FormatWord(w3->word, r.grammar->symbols);
+  EXPECT_EQ(s3.rfind("!(0.12)F(1.2544)[+(50)" + bud + "F(0.6)[+(30)F(0.4)][-(30)F(0.4)]F(0.6)", 0),
+            0u)
+      << s3;
+}
+
+}  // namespace
+}  // namespace sylva::lsys
