@@ -987,6 +987,16 @@ Status RunGlobalBlock(const Grammar& g, const std::optional<Expr>& block, const 
   return d;
 }
 
+// srand(seed) in Start: is the grammar's seed, as `seed:` (a seed given in
+// the options still wins).
+uint64_t SeedAfterStart(const Grammar& g, const DeriveOptions& options,
+                        const std::vector<double>& globals, uint64_t seed) {
+  if (g.srandGlobal < 0 || options.seed) return seed;
+  const double v = globals[size_t(g.srandGlobal)];
+  if (!(std::abs(v) < 9e18)) return seed;  // NaN: srand was not called
+  return uint64_t(int64_t(std::trunc(v)));
+}
+
 // The global variables as the Start: block leaves them.
 Expected<std::vector<double>> StartGlobals(const Grammar& g, uint64_t seed) {
   std::vector<double> globals(g.globals.size(), 0.0);
@@ -1076,11 +1086,7 @@ Expected<Derivation> Derivation::Start(const Grammar& g, const DeriveOptions& op
   auto globals = StartGlobals(g, state->seed);
   if (!globals) return globals.error();
   state->globals = std::move(globals).value();
-  // srand(seed) in Start: is the grammar's seed (a seed given in the options still wins).
-  if (g.srandGlobal >= 0 && !options.seed) {
-    const double v = state->globals[size_t(g.srandGlobal)];
-    if (std::abs(v) < 9e18) state->seed = uint64_t(int64_t(std::trunc(v)));  // NaN: not called
-  }
+  state->seed = SeedAfterStart(g, options, state->globals, state->seed);
   auto axiom = BuildAxiom(g, state->seed, state->globals.data());
   if (!axiom) return axiom.error();
   state->word = std::move(axiom).value();
@@ -1207,13 +1213,14 @@ Expected<Word> Interpret(const Grammar& g, const Word& word, const DeriveOptions
   if (g.interpretation.empty()) return w;
   ThreadPool ownPool(options.pool ? 1 : options.threads);
   ThreadPool& pool = options.pool ? *options.pool : ownPool;
-  const uint64_t seed = options.seed.value_or(g.seed);
+  uint64_t seed = options.seed.value_or(g.seed);
   const uint64_t maxModules = std::min(options.maxModules, kMaxModulesCap);
   Scratch scratch;
   // The global variables as Start: leaves them (the derivation's own are
   // in Derivation::Interpreted).
   auto globals = StartGlobals(g, seed);
   if (!globals) return globals.error();
+  seed = SeedAfterStart(g, options, *globals, seed);
   if (Status s = RunSection(g, g.interpretation, pool, scratch, seed, kInterpretDraws, 0, 0,
                             maxModules, globals->data(), w);
       !s.ok())
