@@ -76,6 +76,14 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
     }
     return "'" + std::string(name) + "' is not a command Sylva knows: it does nothing";
   }
+  if (name == "$" && arity > 0) {
+    // Some files write $(id, scale) for the start of a sub-L-system; cpfg's
+    // source (generate.c CheckPred, interpret.c UpdateCurrentLsystem) starts
+    // one only at ?(id, scale) and ends one at any $.
+    return "'$' takes no parameters; here it has " + Params(arity) +
+           ", ignored ('$' ends a sub-L-system, or rolls the turtle horizontal; a "
+           "sub-L-system starts with ?(id, scale))";
+  }
   if (name == "?") {  // ?(id, scale): the start of a sub-L-system
     if (arity == 1 || arity == 2) return std::nullopt;
     return "'?' (start of a sub-L-system) uses 2 parameters, the L-system's number and the "

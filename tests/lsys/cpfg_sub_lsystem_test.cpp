@@ -107,6 +107,22 @@ TEST(SubLsystem, DefinesOfALaterBlockAreRead) {
             "?(2)A(4)$");
 }
 
+TEST(SubLsystem, DollarWithParametersWarnsThatItOnlyEnds) {
+  // Seen in real files as a start, $(2, s); cpfg's source ends a
+  // sub-L-system at any $ and starts one only at ?(id, s).
+  ParseResult r = ParseGrammarText(
+      "lsystem: 1\naxiom: $(2)C$\nendlsystem\nlsystem: 2\naxiom: C\nendlsystem\n", "c.l");
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  // (and: '$' is used with 1 parameter and with 0, two different modules)
+  ASSERT_EQ(r.diagnostics.items.size(), 2u) << r.diagnostics.FormatAll();
+  EXPECT_EQ(r.diagnostics.items[0].loc.line, 2);
+  EXPECT_EQ(r.diagnostics.items[0].loc.column, 8);
+  EXPECT_EQ(r.diagnostics.items[0].message.rfind(
+                "'$' takes no parameters; here it has 1 parameter, ignored", 0),
+            0u)
+      << r.diagnostics.items[0].message;
+}
+
 TEST(SubLsystem, SeedOfASubLsystemWarns) {
   ParseResult r = ParseGrammarText(
       "lsystem: 1\naxiom: F\nendlsystem\nlsystem: 2\nseed: 4\naxiom: G\nendlsystem\n", "c.l");
