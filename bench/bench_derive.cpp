@@ -113,6 +113,28 @@ BENCHMARK_CAPTURE(BM_DeriveBlocks, globals,
     ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 
+// cpfg's forms that derive left to right on one thread: sub-L-systems
+// (each module rewritten by its block's productions), a predecessor of two
+// modules, and reads of an array. Each grows to about 0.8-1.3 M modules.
+BENCHMARK_CAPTURE(BM_DeriveBlocks, sub_lsystems,
+                  "lsystem: 1\nderivation length: 17\naxiom: A\n"
+                  "A --> A[?(2,0.5)B$]A\nB --> X\nendlsystem\n"
+                  "lsystem: 2\naxiom: B\nB --> FB\nendlsystem\n")
+    ->Arg(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DeriveBlocks, two_module_predecessor,
+                  "derivation length: 18\naxiom: A B\nA B --> A B C A B\nC --> F\n")
+    ->Arg(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_DeriveBlocks, arrays,
+                  "define: { array a[4] = {1, 2, 3, 0}; }\nderivation length: 18\naxiom: A(0)\n"
+                  "A(x) --> A(a[x]) [B(a[3 - x])] A(a[x])\nB(x) --> B(a[x])\n")
+    ->Arg(1)
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+
 // Parsing and checking one grammar file (the monopodial tree).
 void BM_Parse(benchmark::State& state) {
   std::string path = std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys";

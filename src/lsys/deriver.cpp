@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -30,11 +32,19 @@ constexpr uint32_t kDynamic = 0xFFFFFFFEu;
 // Per-module choices are stored in 16 bits (the parser allows at most
 // kMaxProductionsPerSection productions per section).
 constexpr uint16_t kIdentity16 = 0xFFFF;
-static_assert(kMaxProductionsPerSection < kIdentity16);
+// A module taken by the predecessor of several modules that starts before it.
+constexpr uint16_t kConsumed16 = 0xFFFE;
+static_assert(kMaxProductionsPerSection < kConsumed16);
 constexpr size_t kMinChunk = 16384;
 // Successors of up to kOverCopy symbols are copied as one fixed-size block
 // (the table is padded, and the copy stays inside the chunk's own output).
 constexpr size_t kOverCopy = 16;
+
+std::string FormatParam(double v) {
+  std::string s;
+  AppendNumber(s, v);
+  return s;
+}
 
 Diagnostic LimitError(const std::string& what) {
   Diagnostic d;
@@ -65,7 +75,7 @@ StaticTable BuildStaticTable(const Grammar& g, const Section& sec) {
     }
     const Production& p = sec.productions[list[0]];
     if (p.HasContext() || p.condition || p.weight || p.HasBlocks() || !p.successor.params.empty() ||
-        g.symbols.arity(SymbolId(s)) != 0)
+        g.symbols.arity(SymbolId(s)) != 0 || !p.predTail.empty() || g.subLsystems)
       return t;  // not usable
     for (SymbolId x : p.successor.symbols) t.flat.push_back(x);
     t.length[s] = uint32_t(p.successor.symbols.size());
@@ -86,7 +96,10 @@ struct ProdInfo {
   uint8_t hasCondition;  // a condition or statement blocks
   uint8_t hasWeight;
   uint8_t hasBlocks;  // statement blocks (cpfg): the slow path of Matches
-  uint8_t pad[3] = {};
+  // A predecessor of several modules, or a grammar with sub-L-systems:
+  // MatchSpecial decides.
+  uint8_t special = 0;
+  uint16_t lsystem = 0;  // Production::lsystem
 };
 static_assert(sizeof(ProdInfo) == 16);
 
@@ -146,7 +159,19 @@ class Pass {
       needsMatch_ |= p.HasContext();
       succModules_.push_back(uint32_t(p.successor.symbols.size()));
       succParams_.push_back(uint32_t(p.successor.params.size()));
+      predLength_.push_back(uint32_t(p.PredLength()));
       anyBlocks_ |= p.HasBlocks();
+      multi_ |= !p.predTail.empty();
+    }
+    special_ = multi_ || g.subLsystems;
+    if (g.subLsystems) {  // the modules that start and end a sub-L-system
+      subKind_.assign(g.symbols.size(), 0);
+      for (size_t sy = 0; sy < g.symbols.size(); ++sy) {
+        const std::string& name = g.symbols.name(SymbolId(sy));
+        const int a = g.symbols.arity(SymbolId(sy));
+        if (name == "?" && a >= 1) subKind_[sy] = 1;
+        if (name == "$") subKind_[sy] = 2;
+      }
     }
     // Per symbol: no production (identity), a production that always
     // applies first (its index), or a choice to make per module.
@@ -170,6 +195,8 @@ class Pass {
         pi.hasCondition = p.condition.has_value() || p.HasBlocks();
         pi.hasBlocks = p.HasBlocks();
         pi.hasWeight = p.weight.has_value();
+        pi.special = !p.predTail.empty() || g.subLsystems;
+        pi.lsystem = p.lsystem;
         infos_.push_back(pi);
       }
       infoStart_.push_back(uint32_t(infos_.size()));
@@ -184,8 +211,10 @@ class Pass {
         continue;
       }
       const Production& p = sec.productions[list[0]];
-      symChoice_[s] =
-          (p.HasContext() || p.condition || p.weight || p.HasBlocks()) ? kDynamic : list[0];
+      symChoice_[s] = (p.HasContext() || p.condition || p.weight || p.HasBlocks() ||
+                       !p.predTail.empty() || g.subLsystems)
+                          ? kDynamic
+                          : list[0];
     }
   }
 
@@ -207,9 +236,26 @@ class Pass {
                                   uint32_t* choice);
   int Matches(const ProdInfo& pi, const WordView& w, size_t i, const double* pp, int arity,
               double* formals, size_t& prev, size_t& next, RandomStream& rng, Chunk& c);
+  // Matches for a predecessor of several modules or a sub-L-system grammar.
+  [[gnu::noinline]] int MatchSpecial(const ProdInfo& pi, const WordView& w, size_t i,
+                                     const double* pp, int arity, double* formals,
+                                     RandomStream& rng, Chunk& c);
+  // Binds every formal of production p (chosen for module i): predecessor,
+  // the modules after it, and its context read with its block's table.
+  void BindSpecial(const Production& p, const WordView& w, size_t i, double* formals) const;
+  // The word as seen by production p: its block's ignore:/consider:.
+  WordView ViewFor(const Production& p, const WordView& w) const {
+    WordView v = w;
+    if (p.lsystem > 0 && !g_.lsystems[p.lsystem].contextSkip.empty())
+      v.skip = g_.lsystems[p.lsystem].contextSkip.data();
+    return v;
+  }
+  // The L-system block of every module of `in` (sub-L-systems).
+  Status ComputeOwners(const Word& in);
   // The blocks and condition of a production with statement blocks.
   [[gnu::noinline]] int MatchBlocks(const Production& q, size_t i, double* formals,
                                     RandomStream& rng, Chunk& c);
+  template <bool kMulti>  // some production has a predecessor of several modules
   void Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams);
   // Runs the successor of a production with statement blocks (vars bound)
   // and appends its parameters to c.stash; false on an error (in c).
@@ -228,10 +274,15 @@ class Pass {
   uint64_t maxModules_;
   size_t maxFormals_ = 0;
   bool needsMatch_ = false;
-  bool anyBlocks_ = false;                             // some production has statement blocks
-  std::vector<uint32_t> symChoice_;                    // per symbol
-  std::vector<ProdInfo> infos_;                        // per symbol, in file order
-  std::vector<uint32_t> infoStart_;                    // symbol -> first info
+  bool anyBlocks_ = false;            // some production has statement blocks
+  bool multi_ = false;                // some production has a predecessor of several modules
+  bool special_ = false;              // multi_, or a grammar with sub-L-systems
+  std::vector<uint32_t> predLength_;  // per production
+  std::vector<uint8_t> subKind_;      // per symbol: 1 `?(id..)`, 2 `$` (sub-L-systems only)
+  std::vector<uint16_t> owner_;       // per module of the input: its L-system block
+  std::vector<uint32_t> symChoice_;   // per symbol
+  std::vector<ProdInfo> infos_;       // per symbol, in file order
+  std::vector<uint32_t> infoStart_;   // symbol -> first info
   std::vector<std::unique_ptr<ContextTable>> tables_;  // per symbol, or null
 
   void BuildTable(SymbolId sym) {
@@ -240,7 +291,8 @@ class Pass {
     if (first == last) return;
     std::vector<SymbolId> lefts, rights;
     for (const ProdInfo* pi = first; pi != last; ++pi) {
-      if (pi->leftKind > 1 || pi->rightKind > 1 || pi->hasCondition || pi->hasWeight) return;
+      if (pi->leftKind > 1 || pi->rightKind > 1 || pi->hasCondition || pi->hasWeight || pi->special)
+        return;
       if (pi->leftKind && std::find(lefts.begin(), lefts.end(), pi->left0) == lefts.end())
         lefts.push_back(pi->left0);
       if (pi->rightKind && std::find(rights.begin(), rights.end(), pi->right0) == rights.end())
@@ -329,7 +381,10 @@ void Pass::SplitChunks(const Word& in) {
   const size_t n = in.size();
   size_t count = 1;
   // Productions that assign global variables run in word order, as in cpfg.
-  if (n >= 2 * kMinChunk && pool_.threads() > 1 && !g_.productionsWriteGlobals)
+  // So do predecessors of several modules and sub-L-systems (each module's
+  // rewriting depends on the ones before it).
+  if (n >= 2 * kMinChunk && pool_.threads() > 1 && !g_.productionsWriteGlobals &&
+      !g_.multiModulePredecessors && !g_.subLsystems)
     count = std::min<size_t>(size_t(pool_.threads()) * 8, n / kMinChunk);
   chunks_.assign(count, Chunk{});
   for (size_t k = 0; k < count; ++k) {
@@ -384,6 +439,8 @@ constexpr size_t kNotLooked = kNoPosition - 1;
 
 int Pass::Matches(const ProdInfo& pi, const WordView& w, size_t i, const double* pp, int arity,
                   double* formals, size_t& prev, size_t& next, RandomStream& rng, Chunk& c) {
+  if (pi.special) [[unlikely]]
+    return MatchSpecial(pi, w, i, pp, arity, formals, rng, c);
   if (pi.leftKind) {
     if (prev == kNotLooked) prev = PrevInContext(w, i);
     if (prev == kNoPosition || w.symbols[prev] != pi.left0) return 0;
@@ -411,6 +468,74 @@ int Pass::Matches(const ProdInfo& pi, const WordView& w, size_t i, const double*
     if (v == 0) return 0;
   }
   return 1;
+}
+
+int Pass::MatchSpecial(const ProdInfo& pi, const WordView& w, size_t i, const double* pp, int arity,
+                       double* formals, RandomStream& rng, Chunk& c) {
+  if (!owner_.empty() && owner_[i] != pi.lsystem) return 0;  // another L-system's module
+  const Production& q = sec_.productions[pi.index];
+  // The modules after the first of the predecessor: the next ones in the word.
+  for (size_t k = 0; k < q.predTail.size(); ++k) {
+    const size_t j = i + 1 + k;
+    if (j >= w.size || w.symbols[j] != q.predTail[k].symbol) return 0;
+  }
+  for (int k = 0; k < arity; ++k) formals[q.pred.firstFormal + k] = pp[k];
+  const WordView v = ViewFor(q, w);
+  if (!q.left.empty() && !MatchLeft(q, v, PrevInContext(v, i), formals)) return 0;
+  const size_t last = i + q.predTail.size();
+  if (!q.right.empty() && !MatchRight(q, v, last, NextInContext(v, last + 1), formals)) return 0;
+  BindSpecial(q, w, i, formals);  // the predecessor's other modules
+  if (pi.hasBlocks) return MatchBlocks(q, i, formals, rng, c);
+  if (q.condition) {
+    double val;
+    EvalError e;
+    if (!q.condition->Eval(formals, rng, &val, &e, globals_)) {
+      Fail(c, q, e, q.conditionColumn, i);
+      return -1;
+    }
+    if (val == 0) return 0;
+  }
+  return 1;
+}
+
+void Pass::BindSpecial(const Production& p, const WordView& w, size_t i, double* formals) const {
+  if (!w.paramStart) return;
+  for (size_t k = 0; k < p.predTail.size(); ++k) {
+    const size_t j = i + 1 + k;
+    const uint32_t a = w.paramStart[j], b = w.paramStart[j + 1];
+    double* dst = formals + p.predTail[k].firstFormal;
+    for (uint32_t m = a; m < b; ++m) *dst++ = w.params[m];
+  }
+}
+
+Status Pass::ComputeOwners(const Word& in) {
+  const size_t n = in.size();
+  owner_.resize(n);
+  std::vector<uint16_t> stack{0};
+  for (size_t i = 0; i < n; ++i) {
+    const SymbolId s = in.symbols[i];
+    owner_[i] = stack.back();
+    const uint8_t kind = subKind_[s];
+    if (kind == 0) continue;
+    if (kind == 2) {  // `$` belongs to the sub-L-system it ends
+      if (stack.size() > 1) stack.pop_back();
+      continue;
+    }
+    const double id = in.params[in.paramStart[i]];
+    size_t b = 0;
+    while (b < g_.lsystems.size() && double(g_.lsystems[b].id) != std::trunc(id)) ++b;
+    if (b == g_.lsystems.size()) {
+      std::string ids;
+      for (const LsystemBlock& l : g_.lsystems)
+        ids += (ids.empty() ? "" : ", ") + std::to_string(l.id);
+      return LimitError("step " + std::to_string(stepForMessages_) + ": module " +
+                        std::to_string(i) + ", '?(" + FormatParam(id) +
+                        ", ...)', starts sub-L-system " + FormatParam(id) +
+                        ", but the file's 'lsystem:' blocks are numbered " + ids);
+    }
+    stack.push_back(uint16_t(b));
+  }
+  return {};
 }
 
 int Pass::MatchBlocks(const Production& q, size_t i, double* formals, RandomStream& rng, Chunk& c) {
@@ -575,6 +700,7 @@ bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice
   return true;
 }
 
+template <bool kMulti>
 void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool outHasParams) {
   std::vector<double> formals(maxFormals_ + 1);
   size_t o = c.outModuleAt;
@@ -586,6 +712,9 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
   for (size_t i = c.begin; i < c.end; ++i) {
     const SymbolId sym = w.symbols[i];
     const uint16_t ch16 = choice_[i];
+    if constexpr (kMulti) {
+      if (ch16 == kConsumed16) continue;  // part of the predecessor before it
+    }
     if (ch16 == kIdentity16) {
       osym[o] = sym;
       if (ostart) {
@@ -629,8 +758,16 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
         const double* src = in.params.data() + in.paramStart[i];
         for (int k = 0; k < a; ++k) formals[p.pred.firstFormal + k] = src[k];
       }
-      if (!p.left.empty()) MatchLeft(p, w, PrevInContext(w, i), formals.data());
-      if (!p.right.empty()) MatchRight(p, w, i, NextInContext(w, i + 1), formals.data());
+      if (special_ && (p.lsystem > 0 || !p.predTail.empty())) [[unlikely]] {
+        const WordView v = ViewFor(p, w);
+        const size_t last = i + p.predTail.size();
+        if (!p.left.empty()) MatchLeft(p, v, PrevInContext(v, i), formals.data());
+        if (!p.right.empty()) MatchRight(p, v, last, NextInContext(v, last + 1), formals.data());
+        BindSpecial(p, w, i, formals.data());
+      } else {
+        if (!p.left.empty()) MatchLeft(p, w, PrevInContext(w, i), formals.data());
+        if (!p.right.empty()) MatchRight(p, w, i, NextInContext(w, i + 1), formals.data());
+      }
     }
     RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2 + 1, 0};
     size_t e = 0;
@@ -710,9 +847,15 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
     MatchBrackets(in);
     w.bracketMatch = match_.data();
   }
+  if (!subKind_.empty()) {
+    if (Status st = ComputeOwners(in); !st.ok()) return st;
+  }
   choice_.ResizeUninitialized(n);
   const auto& arities = g_.symbols.arities();
-  pool_.ParallelFor(chunks_.size(), [&](size_t k) {
+  // Compiled twice: only grammars with predecessors of several modules pay
+  // for the check of modules a match took.
+  auto count = [&](size_t k, auto multiTag) {
+    constexpr bool kMulti = decltype(multiTag)::value;
     Chunk& c = chunks_[k];
     std::vector<double> formals(maxFormals_ + 1);
     uint64_t modules = 0, params = 0;
@@ -721,7 +864,15 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
     const uint32_t* succParams = succParams_.data();
     const uint8_t* arity = arities.data();
     bool rewrote = false;
+    [[maybe_unused]] size_t consumedUntil =
+        0;  // modules before this belong to a chosen predecessor
     for (size_t i = c.begin; i < c.end; ++i) {
+      if constexpr (kMulti) {
+        if (i < consumedUntil) {
+          choice_[i] = kConsumed16;
+          continue;
+        }
+      }
       const SymbolId sym = w.symbols[i];
       uint32_t ch = symChoice[sym];
       if (ch == kDynamic) {
@@ -748,20 +899,31 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
         modules += succModules[ch];
         params += succParams[ch];
         rewrote = true;
+        if constexpr (kMulti) consumedUntil = i + predLength_[ch];
       }
     }
     c.changed = rewrote;
     c.outModules = modules;
     c.outParams = params;
-  });
+  };
+  if (multi_) {
+    pool_.ParallelFor(chunks_.size(), [&](size_t k) { count(k, std::true_type{}); });
+  } else {
+    pool_.ParallelFor(chunks_.size(), [&](size_t k) { count(k, std::false_type{}); });
+  }
   for (auto& c : chunks_) {
     if (c.error) return *c.error;
   }
   uint64_t totalParams = 0;
   for (auto& c : chunks_) totalParams += c.outParams;
   if (Status s = Allocate(out, totalParams > 0); !s.ok()) return s;
-  pool_.ParallelFor(chunks_.size(),
-                    [&](size_t k) { Write(w, in, out, chunks_[k], totalParams > 0); });
+  if (multi_) {
+    pool_.ParallelFor(chunks_.size(),
+                      [&](size_t k) { Write<true>(w, in, out, chunks_[k], totalParams > 0); });
+  } else {
+    pool_.ParallelFor(chunks_.size(),
+                      [&](size_t k) { Write<false>(w, in, out, chunks_[k], totalParams > 0); });
+  }
   for (auto& c : chunks_) {
     if (c.error) return *c.error;
   }
@@ -825,9 +987,21 @@ Status RunGlobalBlock(const Grammar& g, const std::optional<Expr>& block, const 
   return d;
 }
 
+// srand(seed) in Start: is the grammar's seed, as `seed:` (a seed given in
+// the options still wins).
+uint64_t SeedAfterStart(const Grammar& g, const DeriveOptions& options,
+                        const std::vector<double>& globals, uint64_t seed) {
+  if (g.srandGlobal < 0 || options.seed) return seed;
+  const double v = globals[size_t(g.srandGlobal)];
+  if (!(std::abs(v) < 9e18)) return seed;  // NaN: srand was not called
+  return uint64_t(int64_t(std::trunc(v)));
+}
+
 // The global variables as the Start: block leaves them.
 Expected<std::vector<double>> StartGlobals(const Grammar& g, uint64_t seed) {
   std::vector<double> globals(g.globals.size(), 0.0);
+  for (size_t k = 0; k < g.globalInitial.size() && k < globals.size(); ++k)
+    globals[k] = g.globalInitial[k];
   if (Status s = RunGlobalBlock(g, g.startBlock, "Start", seed, 0, globals); !s.ok())
     return s.error();
   return globals;
@@ -888,7 +1062,7 @@ struct Derivation::State {
         table(BuildStaticTable(grammar, grammar.main)) {}
 
   const Grammar& g;
-  const uint64_t seed;
+  uint64_t seed;  // srand(s) in Start: may set it (Derivation::Start)
   const uint64_t maxModules;
   ThreadPool ownPool;  // unused (one thread, no workers) with a shared pool
   ThreadPool& pool;
@@ -912,6 +1086,7 @@ Expected<Derivation> Derivation::Start(const Grammar& g, const DeriveOptions& op
   auto globals = StartGlobals(g, state->seed);
   if (!globals) return globals.error();
   state->globals = std::move(globals).value();
+  state->seed = SeedAfterStart(g, options, state->globals, state->seed);
   auto axiom = BuildAxiom(g, state->seed, state->globals.data());
   if (!axiom) return axiom.error();
   state->word = std::move(axiom).value();
@@ -1038,13 +1213,14 @@ Expected<Word> Interpret(const Grammar& g, const Word& word, const DeriveOptions
   if (g.interpretation.empty()) return w;
   ThreadPool ownPool(options.pool ? 1 : options.threads);
   ThreadPool& pool = options.pool ? *options.pool : ownPool;
-  const uint64_t seed = options.seed.value_or(g.seed);
+  uint64_t seed = options.seed.value_or(g.seed);
   const uint64_t maxModules = std::min(options.maxModules, kMaxModulesCap);
   Scratch scratch;
   // The global variables as Start: leaves them (the derivation's own are
   // in Derivation::Interpreted).
   auto globals = StartGlobals(g, seed);
   if (!globals) return globals.error();
+  seed = SeedAfterStart(g, options, *globals, seed);
   if (Status s = RunSection(g, g.interpretation, pool, scratch, seed, kInterpretDraws, 0, 0,
                             maxModules, globals->data(), w);
       !s.ok())

@@ -13,6 +13,13 @@
 // Grammars whose choice per symbol is fixed and parameter-free (Koch curves,
 // bracketed plants) take a table-driven path that copies successors.
 //
+// cpfg's forms that make a module's rewriting depend on the modules before
+// it run on one chunk, left to right, as cpfg rewrites: a predecessor of
+// several modules takes the modules it matched (they are not rewritten
+// again), and in a grammar with sub-L-systems each module is rewritten by
+// the productions of the `lsystem:` block it lies in, found from the
+// `?(id, scale)` ... `$` nesting before it (docs/cpfg.md).
+//
 // Limits: a step that would make the word longer than maxModules, or hold
 // more than kMaxParams parameters, stops with an error naming the step and
 // the size, before any memory for it is allocated.

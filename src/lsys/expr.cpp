@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 
 #include "core/math.h"
@@ -251,6 +252,27 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
       case OpCode::kGlobal:
         stack[sp++] = globals[in.arg];
         break;
+      case OpCode::kIndex: {
+        const double v = stack[--sp];
+        if (!(v >= 0 && v < double(in.arg))) {
+          char b[160];
+          std::snprintf(b, sizeof b, "array index %.6g is outside 0 to %u", v, in.arg - 1);
+          return Fail(err, int(columns_[pc]), b);
+        }
+        stack[sp - 1] = stack[sp - 1] * in.arg + std::floor(v);  // cpfg: (int) index
+        break;
+      }
+      case OpCode::kGlobalAt:
+        stack[sp - 1] = globals[in.arg + size_t(stack[sp - 1])];
+        break;
+      case OpCode::kStoreGlobalAt: {
+        const double v = stack[--sp];
+        const size_t at = in.arg + size_t(stack[--sp]);
+        if (!std::isfinite(v))
+          return Fail(err, int(columns_[pc]), "assigned value is not a finite number (overflow)");
+        globals[at] = v;
+        break;
+      }
       case OpCode::kStore:
       case OpCode::kStoreGlobal: {
         const double v = stack[--sp];
@@ -649,6 +671,7 @@ class Parser {
       int len = int(name.size());
       SkipSpace();
       if (p_ < t_.size() && t_[p_] == '(') return Call(name, col, len, depth);
+      if (const ArrayShape* a = FindArray(name)) return Element(*a, col, len, depth);
       // Macro parameters, then formal parameters, shadow constants.
       if (bound_) {
         for (size_t i = 0; i < bound_->names.size(); ++i) {
@@ -683,6 +706,42 @@ class Parser {
                             ? std::string(1, c)
                             : std::string(hex);
     return Error(col, "unexpected character '" + shown + "' in expression");
+  }
+
+  const ArrayShape* FindArray(const std::string& name) const {
+    if (!scope_.arrays) return nullptr;
+    for (const ArrayShape& a : *scope_.arrays)
+      if (a.name == name) return &a;
+    return nullptr;
+  }
+
+  // `a[i][j]`: one index per dimension, each checked when it is evaluated.
+  NodePtr Element(const ArrayShape& a, int col, int len, int depth) {
+    auto acc = Make(OpCode::kConst, col);
+    acc->value = 0;
+    for (uint32_t d : a.dims) {
+      SkipSpace();
+      if (p_ >= t_.size() || t_[p_] != '[')
+        return Error(col,
+                     "array '" + a.name + "' needs " + std::to_string(a.dims.size()) +
+                         (a.dims.size() == 1 ? " index" : " indices") + ": " + a.name +
+                         std::string(a.dims.size() == 1 ? "[i]" : "[i][j]..."),
+                     len);
+      ++p_;
+      NodePtr index = Ternary(depth + 1);
+      if (!index) return nullptr;
+      if (!Accept("]")) return Error(Col(), "expected ']' after an index of '" + a.name + "'");
+      auto ix = Make(OpCode::kIndex, col, std::move(acc), std::move(index));
+      ix->slot = d;
+      acc = std::move(ix);
+    }
+    SkipSpace();
+    if (p_ < t_.size() && t_[p_] == '[')
+      return Error(Col(), "array '" + a.name + "' has " + std::to_string(a.dims.size()) +
+                              (a.dims.size() == 1 ? " dimension" : " dimensions"));
+    auto n = Make(OpCode::kGlobalAt, col, std::move(acc));
+    n->slot = a.base;
+    return n;
   }
 
   // A formal parameter, local or global variable of this name, or null.
@@ -910,7 +969,8 @@ class ExprCompiler {
   // Folds one node whose children are folded.
   bool FoldNode(Node& n) {
     if (n.op == OpCode::kConst || n.op == OpCode::kFormal || n.op == OpCode::kGlobal ||
-        n.op == OpCode::kFunc || IsRandom(n.op))
+        n.op == OpCode::kFunc || IsRandom(n.op) || n.op == OpCode::kIndex ||
+        n.op == OpCode::kGlobalAt)
       return true;
     for (auto& k : n.kids) {
       if (k->op != OpCode::kConst) {
@@ -1221,8 +1281,19 @@ class ExprCompiler {
     const std::string name(text.substr(at, e - at));
     size_t q = e;
     SkipSpace(text, &q);
-    if (q < text.size() && text[q] == '[')
-      return Err(int(q) + 1, "arrays are not supported by Sylva (cpfg 'define: { array ... }')");
+    if (q < text.size() && text[q] == '[') return ElementAssignment(text, pos, scope, name, col, q);
+    if (name == "srand" && q < text.size() && text[q] == '(') {
+      if (scope.srandSlot < 0)
+        return Err(col,
+                   "srand(seed) is read only in the Start: block, where it sets the seed (Sylva "
+                   "draws each module's random numbers from the seed, step and position, so "
+                   "there is no sequence to reseed later)",
+                   5);
+      *pos = q;  // `srand(x)`: x is stored as the seed
+      if (!Expression(text, pos, scope)) return false;
+      Push(OpCode::kStoreGlobal, uint32_t(scope.srandSlot), col);
+      return EndOfStatement(text, pos);
+    }
     if (q < text.size() && text[q] == '(')
       return Err(col,
                  "a call '" + name + "(...)' as a statement is not supported (cpfg's printf, ...)",
@@ -1274,6 +1345,58 @@ class ExprCompiler {
     }
     if (store == OpCode::kStoreGlobal && scope.writesGlobal) *scope.writesGlobal = true;
     Push(store, slot, col);
+    return EndOfStatement(text, pos);
+  }
+
+  // `a[i][j] = expr;` (text[q] is the first '[').
+  bool ElementAssignment(std::string_view text, size_t* pos, const ExprScope& scope,
+                         const std::string& name, int col, size_t q) {
+    const ArrayShape* a = nullptr;
+    if (scope.arrays)
+      for (const ArrayShape& x : *scope.arrays)
+        if (x.name == name) a = &x;
+    if (!a)
+      return Err(col,
+                 "'" + name + "' is not an array (arrays are declared in 'define: { array " + name +
+                     "[n]; }')",
+                 int(name.size()));
+    blockCode.push_back(Instr{OpCode::kConst, 0, 0});
+    blockColumns.push_back(uint32_t(col));
+    *pos = q;
+    for (uint32_t d : a->dims) {
+      SkipSpace(text, pos);
+      if (*pos >= text.size() || text[*pos] != '[')
+        return Err(int(*pos) + 1, "array '" + name + "' needs " + std::to_string(a->dims.size()) +
+                                      (a->dims.size() == 1 ? " index" : " indices"));
+      ++*pos;
+      const int before = blockDepth;
+      if (!Expression(text, pos, scope)) return false;
+      blockDepth = std::max(before, blockDepth + 1);  // the offset so far is below it
+      SkipSpace(text, pos);
+      if (*pos >= text.size() || text[*pos] != ']')
+        return Err(int(*pos) + 1, "expected ']' after an index of '" + name + "'");
+      ++*pos;
+      Push(OpCode::kIndex, d, col);
+    }
+    SkipSpace(text, pos);
+    if (*pos < text.size() && text[*pos] == '[')
+      return Err(int(*pos) + 1, "array '" + name + "' has " + std::to_string(a->dims.size()) +
+                                    (a->dims.size() == 1 ? " dimension" : " dimensions"));
+    if (*pos + 1 < text.size() && text[*pos + 1] == '=' && std::strchr("+-*/", text[*pos]))
+      return Err(int(*pos) + 1,
+                 "compound assignment to an array element is not supported: write '" + name +
+                     "[...] = " + name + "[...] " + std::string(1, text[*pos]) + " ...'",
+                 2);
+    if (*pos >= text.size() || text[*pos] != '=' ||
+        (*pos + 1 < text.size() && text[*pos + 1] == '='))
+      return Err(int(*pos) + 1, "expected '=' after '" + name + "[...]' (an assignment)");
+    ++*pos;
+    const int before = blockDepth;
+    blockDepth = 0;
+    if (!Expression(text, pos, scope)) return false;
+    blockDepth = std::max(before, blockDepth + 1);
+    if (scope.writesGlobal) *scope.writesGlobal = true;
+    Push(OpCode::kStoreGlobalAt, a->base, col);
     return EndOfStatement(text, pos);
   }
 

@@ -77,6 +77,12 @@ enum class OpCode : uint8_t {
   kStore,        // pop into vars[arg] (a formal slot or a local)
   kStoreGlobal,  // pop into globals[arg]
   kLoop,         // jump back to arg; counts iterations (kMaxLoopIterations)
+  // cpfg arrays, kept in the globals: an element's offset is built one
+  // index at a time (kIndex: top-1 = top-1 * arg + top, 0 <= top < arg, or
+  // an error), then read or written at globals[arg + offset].
+  kIndex,
+  kGlobalAt,       // top = globals[arg + top]
+  kStoreGlobalAt,  // value = pop, offset = pop: globals[arg + offset] = value
 };
 
 // A `while` loop in a statement block that runs more often than this in one

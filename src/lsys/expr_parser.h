@@ -38,6 +38,19 @@ struct ExprMacro {
   std::string body;  // checked when defined
 };
 
+// A cpfg array (`define: { array a[3][2]; }`): global variables
+// globals[base ...] in row-major order, indexed from 0.
+struct ArrayShape {
+  std::string name;
+  std::vector<uint32_t> dims;
+  uint32_t base = 0;
+  size_t Size() const {
+    size_t n = 1;
+    for (uint32_t d : dims) n *= d;
+    return n;
+  }
+};
+
 // What names mean inside one expression.
 struct ExprScope {
   const std::unordered_map<std::string, double>* constants = nullptr;
@@ -55,6 +68,11 @@ struct ExprScope {
   bool* writesGlobal = nullptr;
   // cpfg function files, for `func(id, x)`: id 1 is the first.
   const std::vector<std::shared_ptr<const CpfgFunction>>* functions = nullptr;
+  // cpfg arrays: `a[i][j]` in expressions, `a[i][j] = v;` in blocks.
+  const std::vector<ArrayShape>* arrays = nullptr;
+  // The global slot `srand(seed);` stores to (the Start: block only; -1:
+  // srand is an error here).
+  int srandSlot = -1;
 };
 
 // Parses one expression starting at text[pos]; stops before the first

@@ -17,6 +17,7 @@
 #include "core/diagnostic.h"
 #include "lsys/cpfg_function.h"
 #include "lsys/expr.h"
+#include "lsys/expr_parser.h"
 #include "lsys/symbols.h"
 #include "lsys/word.h"
 
@@ -74,10 +75,19 @@ struct Production {
   // condition is evaluated (whether or not it holds), post when it holds.
   // (Cold: after the fields the derivation reads for every module.)
   std::optional<Expr> preBlock, postBlock;
+  // cpfg's predecessor of several modules (`A B --> C`): the modules after
+  // `pred`, matched on the modules right after it in the word (no skipping);
+  // the successor replaces them all, and the right context starts after the
+  // last. Empty for the usual one-module predecessor.
+  std::vector<FormalModule> predTail;
+  // The L-system block the production belongs to (Grammar::lsystems; 0 is
+  // the main one): it rewrites only modules inside that sub-L-system.
+  uint16_t lsystem = 0;
   // The file position of a column of the production as read.
   SourceLoc LocOf(int column) const;
 
   bool HasContext() const { return !left.empty() || !right.empty(); }
+  size_t PredLength() const { return 1 + predTail.size(); }
   bool HasBlocks() const { return preBlock || postBlock || !successor.blocks.empty(); }
 };
 
@@ -111,6 +121,22 @@ struct Tropism {
   double x = 0, y = -1, z = 0, susceptibility = 0;
 };
 
+// One `lsystem:` block of a file (cpfg's sub-L-systems): the first is the
+// main L-system, whose axiom and derivation length are used; each later
+// one has the number its `lsystem:` line gives. In a word, `?(id, scale)`
+// starts the sub-L-system numbered id and `$` ends it: the modules between
+// are rewritten by that block's productions only (decomposition and
+// interpretation too), and the turtle multiplies its step and width by
+// scale there (docs/cpfg.md, "Sub-L-systems").
+struct LsystemBlock {
+  int id = 0;        // the number of its `lsystem:` line (cpfg: atof of the label)
+  std::string name;  // the label as written
+  SourceLoc loc;     // of the `lsystem:` line
+  // Its ignore:/consider: (per symbol id, 1: skipped by context matching);
+  // empty for the main L-system, whose table is Grammar::contextSkip.
+  std::vector<uint8_t> contextSkip;
+};
+
 struct Grammar {
   std::string name;  // `lsystem:` or the file name
   std::string path;  // main file
@@ -141,8 +167,17 @@ struct Grammar {
   // Per symbol id: 1 when context matching skips it (ignore:/consider:).
   std::vector<uint8_t> contextSkip;
   std::optional<SymbolId> cutSymbol;  // the id of `%` when the grammar uses it
-  bool usesContext = false;           // some production has a context
-  bool usesRandom = false;            // weights or random functions anywhere
+  // The L-system blocks, main first (one at least).
+  std::vector<LsystemBlock> lsystems;
+  // Several blocks, or `?(id)` / `?(id, scale)` modules: the derivation
+  // then tracks which block each module belongs to (one thread, left to
+  // right, as cpfg), and `$` ends a sub-L-system instead of rolling the
+  // turtle (cpfg's `$`).
+  bool subLsystems = false;
+  // Some production has a predecessor of several modules.
+  bool multiModulePredecessors = false;
+  bool usesContext = false;  // some production has a context
+  bool usesRandom = false;   // weights or random functions anywhere
 
   std::unordered_map<std::string, double> constants;  // after -D overrides
 
@@ -151,6 +186,15 @@ struct Grammar {
   // axiom is built, StartEach before each derivation step, EndEach after it
   // (after decomposition and cut), End after the last step.
   std::vector<std::string> globals;
+  // Their values before Start: runs (empty: all 0); set by array initialisers.
+  std::vector<double> globalInitial;
+  // cpfg arrays (`define: { array a[3]; }`): elements are globals
+  // [base, base + size), named "a[0]", ... in `globals`.
+  std::vector<ArrayShape> arrays;
+  // The hidden global that `srand(seed);` in Start: sets (-1: none); after
+  // Start: a finite value there is the derivation's seed, as `seed:` (a
+  // --seed given to the command still wins).
+  int srandGlobal = -1;
   // cpfg function files (`functions: a.func b.func`), for func(id, x).
   std::vector<std::shared_ptr<const CpfgFunction>> functions;
   std::optional<Expr> startBlock, startEachBlock, endEachBlock, endBlock;

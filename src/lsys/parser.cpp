@@ -10,8 +10,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <set>
 #include <unordered_set>
@@ -185,6 +187,7 @@ class GrammarParser {
   void Conditionals();
   void ParseGlobalBlock(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseFunctions(const Line& l, size_t after, size_t end);
+  void ParseArrays(const Line& l, size_t after, size_t end);
   void CollectGlobals();
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
                       size_t lhsEnd);
@@ -227,6 +230,19 @@ class GrammarParser {
   bool haveAxiom_ = false;
   bool ended_ = false;
   bool warnedAfterEnd_ = false;
+  // Sub-L-systems: the block being read (index into g_.lsystems), whether
+  // the line being read may start a new one (it follows `endlsystem`), and
+  // the ignore:/consider: names of each block before the current one.
+  uint16_t lsystem_ = 0;
+  bool blockMayStart_ = false;
+  struct ContextNames {
+    std::set<std::string> ignore, consider;
+    bool haveIgnore = false, haveConsider = false;
+  };
+  std::vector<ContextNames> blockContext_;
+  bool StartsLsystem(const Line& l) const;
+  void BeginLsystem(const Line& l, int col, size_t after, size_t end);
+  std::vector<uint8_t> SkipTable(const ContextNames& c) const;
   Successor axiom_;
   SourceLoc axiomLoc_;
   std::vector<int> axiomCols_;
@@ -443,12 +459,19 @@ bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string*
     return false;
   }
   if (c == '?') {
+    if (pos + 1 < end && t[pos + 1] == '(') {  // cpfg: ?(id, scale) starts a sub-L-system
+      *name = "?";
+      pos += 1;
+      return true;
+    }
     if (pos + 1 < end && std::isupper(static_cast<unsigned char>(t[pos + 1]))) {
       *name = t.substr(pos, 2);
       pos += 2;
       return true;
     }
-    Error(l, int(pos) + 1, "expected a query letter after '?' (?P, ?H, ?L, ?U)");
+    Error(l, int(pos) + 1,
+          "expected a query letter after '?' (?P, ?H, ?L, ?U) or '(' (?(id, scale): a "
+          "sub-L-system)");
     return false;
   }
   if (std::isalnum(static_cast<unsigned char>(c)) ||
@@ -798,6 +821,7 @@ void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end)
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   scope.functions = &g_.functions;
   scope.globals = &g_.globals;
+  scope.arrays = &g_.arrays;
   Successor s;
   if (!ParseActualWord(l, after, end, scope, &s)) return;
   if (s.symbols.empty()) {
@@ -1147,9 +1171,10 @@ void GrammarParser::Conditionals() {
     // After `endlsystem` nothing is read (it is warned about): a second
     // L-system's #defines are not this one's.
     size_t kwAfter = 0;
-    if (d.empty() && !ended) {
+    if (d.empty()) {  // a later `lsystem:` block (sub-L-systems) is read again
       const char* kw = MatchKeyword(l.text, pos, &kwAfter);
-      ended = kw && std::string_view(kw) == "endlsystem";
+      if (kw && std::string_view(kw) == "endlsystem") ended = true;
+      if (kw && std::string_view(kw) == "lsystem") ended = false;
     }
     kept.push_back(std::move(l));
   }
@@ -1250,6 +1275,17 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   scope.functions = &g_.functions;
   scope.globals = &g_.globals;
+  scope.arrays = &g_.arrays;
+  if (k == "start" && t.find("srand", after) != std::string::npos) {
+    // srand(seed) there sets the seed: a hidden global holds it.
+    if (g_.srandGlobal < 0) {
+      g_.srandGlobal = int(g_.globals.size());
+      g_.globals.push_back("srand()");
+      g_.globalInitial.resize(g_.globals.size(), 0.0);
+      g_.globalInitial.back() = std::numeric_limits<double>::quiet_NaN();  // not called
+    }
+    scope.srandSlot = g_.srandGlobal;
+  }
   std::string_view view(t.data(), end);
   size_t pos = after;
   Expr block;
@@ -1264,6 +1300,164 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
     return;
   }
   *slot = std::move(block);
+}
+
+// cpfg's `define: { array a[3], b[2][2] = {1, 2, 3, 4}; array c[4]; }`:
+// arrays of global variables, 0 unless initialised (in row-major order; a
+// shorter list leaves the rest 0). Sizes and values are constant
+// expressions.
+void GrammarParser::ParseArrays(const Line& l, size_t after, size_t end) {
+  const std::string& t = l.text;
+  size_t p = after;
+  auto space = [&] {
+    while (p < end && IsSpace(t[p])) ++p;
+  };
+  // The extent of one constant expression from p: up to a top-level `stop`
+  // character.
+  auto exprEnd = [&](std::string_view stops) {
+    size_t q = p;
+    int depth = 0;
+    for (; q < end; ++q) {
+      if (t[q] == '(') ++depth;
+      if (t[q] == ')') --depth;
+      if (depth == 0 && stops.find(t[q]) != std::string_view::npos) break;
+    }
+    return q;
+  };
+  space();
+  if (p >= end || t[p] != '{') {
+    Error(l, int(p) + 1, "expected '{' after 'define:' (cpfg: define: { array a[3]; })");
+    return;
+  }
+  ++p;
+  constexpr size_t kMaxArrayElements = size_t(1) << 20;
+  for (;;) {
+    space();
+    if (p < end && t[p] == '}') {
+      ++p;
+      space();
+      if (p < end && t[p] == ';') ++p;
+      space();
+      if (p < end) Error(l, int(p) + 1, "unexpected text after the 'define:' block");
+      return;
+    }
+    if (p >= end) {
+      Error(l, int(after) + 1, "unclosed '{' of 'define:': no '}'");
+      return;
+    }
+    const size_t w = p;
+    while (p < end && IsIdentChar(t[p])) ++p;
+    const std::string word = t.substr(w, p - w);
+    if (word != "array") {
+      Error(l, int(w) + 1,
+            word == "external"
+                ? "'external' definitions (cpfg, for environment programs) are not supported"
+                : "expected 'array' in 'define:' (cpfg: define: { array a[3]; })",
+            std::max(1, int(word.size())));
+      return;
+    }
+    for (;;) {  // NAME [n]... [= {v, ...}] , ...
+      space();
+      const size_t ns = p;
+      while (p < end && IsIdentChar(t[p])) ++p;
+      if (p == ns || !IsIdentStart(t[ns])) {
+        Error(l, int(ns) + 1, "expected an array name after 'array'");
+        return;
+      }
+      const std::string name = t.substr(ns, p - ns);
+      const int nameCol = int(ns) + 1;
+      bool taken = defines_.count(name) || macros_.count(name) ||
+                   std::find(g_.globals.begin(), g_.globals.end(), name) != g_.globals.end();
+      for (const ArrayShape& a : g_.arrays) taken |= a.name == name;
+      if (taken) {
+        Error(l, nameCol, "'" + name + "' is already a constant, variable or array",
+              int(name.size()));
+        return;
+      }
+      ArrayShape a;
+      a.name = name;
+      size_t total = 1;
+      for (;;) {
+        space();
+        if (p >= end || t[p] != '[') break;
+        ++p;
+        const size_t e = exprEnd("]");
+        if (e >= end) {
+          Error(l, int(p) + 1, "expected ']' after the size of '" + name + "'");
+          return;
+        }
+        double v = 0;
+        if (!ParseConstExpr(l, p, e, &v)) return;
+        if (!(v >= 1 && v == std::floor(v) && v <= double(kMaxArrayElements))) {
+          Error(l, int(p) + 1, "an array size must be a whole number from 1 to 1048576");
+          return;
+        }
+        total *= size_t(v);
+        if (total > kMaxArrayElements) {
+          Error(l, nameCol, "array '" + name + "' has more than 1048576 elements",
+                int(name.size()));
+          return;
+        }
+        a.dims.push_back(uint32_t(v));
+        p = e + 1;
+      }
+      if (a.dims.empty()) {
+        Error(l, nameCol, "array '" + name + "' needs a size: " + name + "[n]", int(name.size()));
+        return;
+      }
+      if (g_.globals.size() + total > kMaxArrayElements * 4) {
+        Error(l, nameCol, "too many array elements in one grammar", int(name.size()));
+        return;
+      }
+      a.base = uint32_t(g_.globals.size());
+      for (size_t k = 0; k < total; ++k) g_.globals.push_back(name + "[" + std::to_string(k) + "]");
+      g_.globalInitial.resize(g_.globals.size(), 0.0);
+      space();
+      if (p < end && t[p] == '=') {  // = { v, v, ... }
+        ++p;
+        space();
+        if (p >= end || t[p] != '{') {
+          Error(l, int(p) + 1, "expected '{' with the values of '" + name + "'");
+          return;
+        }
+        ++p;
+        size_t k = 0;
+        for (;;) {
+          space();
+          if (p < end && t[p] == '}') {
+            ++p;
+            break;
+          }
+          const size_t e = exprEnd(",}");
+          if (e >= end) {
+            Error(l, int(p) + 1, "expected '}' after the values of '" + name + "'");
+            return;
+          }
+          if (k == total) {
+            Error(l, int(p) + 1,
+                  "more values than the " + std::to_string(total) + " elements of '" + name + "'");
+            return;
+          }
+          double v = 0;
+          if (!ParseConstExpr(l, p, e, &v)) return;
+          g_.globalInitial[a.base + k++] = v;
+          p = t[e] == ',' ? e + 1 : e;
+        }
+        space();
+      }
+      g_.arrays.push_back(std::move(a));
+      if (p < end && t[p] == ',') {
+        ++p;
+        continue;
+      }
+      if (p < end && t[p] == ';') {
+        ++p;
+        break;
+      }
+      Error(l, int(p) + 1, "expected ',' or ';' after array '" + name + "'");
+      return;
+    }
+  }
 }
 
 // The global variables: every name assigned in a Start:, StartEach:,
@@ -1334,7 +1528,7 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
     return true;
   }
   if (k == "lsystem") {
-    g_.name = t.substr(after, end - after);
+    BeginLsystem(l, col, after, end);
     return true;
   }
   if (k == "module") return true;  // collected before parsing
@@ -1354,14 +1548,45 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
     return true;
   }
   if (!mainOnly()) return true;
+  if (lsystem_ > 0) {
+    // A sub-L-system block: cpfg reads its axiom and derivation length but
+    // uses only the main L-system's; its ignore:/consider: are its own.
+    if (k == "axiom") {
+      ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
+      scope.functions = &g_.functions;
+      scope.globals = &g_.globals;
+      scope.arrays = &g_.arrays;
+      Successor unused;
+      ParseActualWord(l, after, end, scope, &unused);
+      return true;
+    }
+    if (k == "derivation length") {
+      double unused;
+      ParseConstExpr(l, after, end, &unused);
+      return true;
+    }
+    if (k == "seed") {
+      Warn(Loc(l, col), OriginalAt(l, col),
+           "'seed:' of a sub-L-system is not used: Sylva draws every random number from the "
+           "main L-system's seed",
+           4);
+      return true;
+    }
+    if (k != "ignore" && k != "consider") {
+      Error(l, col,
+            "'" + k +
+                ":' belongs to the main L-system (the first 'lsystem:' block), not to a "
+                "sub-L-system",
+            int(k.size()));
+      return true;
+    }
+  }
   if (IsGlobalBlockKeyword(k)) {
     ParseGlobalBlock(l, k, after, end);
     return true;
   }
   if (k == "define") {
-    Error(l, col,
-          "'define:' (cpfg arrays) is not supported by Sylva: arrays cannot be declared or used",
-          6);
+    ParseArrays(l, after, end);
     return true;
   }
   if (k == "axiom") {
@@ -1577,12 +1802,15 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     Error(l, int(q) + 1, std::string("unexpected '") + t[q] + "' in the predecessor");
     return;
   }
-  if (pred->size() != 1 || (*pred)[0].wildcard) {
-    int c = pred->empty() ? int(pos) + 1 : (*pred)[0].column;
-    Error(l, c,
-          pred->empty() ? "production has no predecessor"
-                        : "the predecessor must be exactly one module");
+  if (pred->empty()) {
+    Error(l, int(pos) + 1, "production has no predecessor");
     return;
+  }
+  for (const Formal& f : *pred) {
+    if (f.wildcard) {
+      Error(l, f.column, "'*' cannot be (part of) a predecessor: it stands alone as a context");
+      return;
+    }
   }
   auto isWildcard = [](const std::vector<Formal>* w) {
     return w && w->size() == 1 && (*w)[0].wildcard;
@@ -1627,11 +1855,20 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     }
   }
   const Formal& pf = (*pred)[0];
-  if (pf.name == "[" || pf.name == "]" || pf.name == "%") {
-    Error(l, pf.column, "'" + pf.name + "' cannot be rewritten");
-    return;
+  // cpfg's strict predecessor may be several modules (`A B --> C`), matched
+  // on consecutive modules of the word.
+  for (const Formal& f : *pred) {
+    if (f.name == "[" || f.name == "]" || f.name == "%") {
+      Error(l, f.column, "'" + f.name + "' cannot be rewritten");
+      return;
+    }
   }
   if (!bind(pf, &p.pred)) return;
+  for (size_t k = 1; k < pred->size(); ++k) {
+    FormalModule fm;
+    if (!bind((*pred)[k], &fm)) return;
+    p.predTail.push_back(fm);
+  }
   if (right && !isWildcard(right)) {
     std::vector<int> cols;
     for (const auto& f : *right) {
@@ -1657,6 +1894,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   p.formalCount = uint16_t(formals.size());
   ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
   scope.functions = &g_.functions;
+  scope.arrays = &g_.arrays;
 
   // Condition, with cpfg's statement blocks around it.
   std::vector<std::string> locals;
@@ -1714,6 +1952,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     return;
   }
   p.localCount = uint16_t(locals.size());
+  p.lsystem = lsystem_;
   if (writesGlobal) g_.productionsWriteGlobals = true;
   p.loc = Loc(l, pf.column);
   if (!l.more.empty()) {
@@ -1838,6 +2077,71 @@ void GrammarParser::ParseLine(const Line& l) {
 }
 
 // ---------------------------------------------------------------------------
+// Sub-L-systems (cpfg): several `lsystem:` blocks in one file
+
+bool GrammarParser::StartsLsystem(const Line& l) const {
+  size_t pos = 0, after = 0;
+  while (pos < l.text.size() && IsSpace(l.text[pos])) ++pos;
+  const char* kw = MatchKeyword(l.text, pos, &after);
+  return kw && std::string_view(kw) == "lsystem";
+}
+
+// `lsystem: LABEL`. The first names the grammar; each later one (after an
+// `endlsystem`) starts a sub-L-system whose number is the label read as a
+// number, as cpfg reads it (atof: "2" is 2, a label that is not a number is 0).
+void GrammarParser::BeginLsystem(const Line& l, int col, size_t after, size_t end) {
+  const std::string label = l.text.substr(after, end - after);
+  LsystemBlock b;
+  b.name = label;
+  b.id = int(std::strtod(label.c_str(), nullptr));
+  b.loc = Loc(l, col);
+  if (g_.lsystems.empty()) {
+    g_.name = label;
+    g_.lsystems.push_back(std::move(b));
+    return;
+  }
+  if (!blockMayStart_) {
+    Error(l, col,
+          "a second 'lsystem:' inside an L-system: end the first with 'endlsystem' before a "
+          "sub-L-system starts",
+          7);
+    return;
+  }
+  for (const LsystemBlock& o : g_.lsystems) {
+    if (o.id != b.id) continue;
+    Error(l, col,
+          "two L-systems numbered " + std::to_string(b.id) + " (the other at line " +
+              std::to_string(o.loc.line) + "): ?(id, scale) could not tell them apart",
+          7);
+    return;
+  }
+  if (g_.lsystems.size() >= 65535) {
+    Error(l, col, "too many L-system blocks in one file", 7);
+    return;
+  }
+  blockContext_.push_back(
+      ContextNames{std::move(ignoreNames_), std::move(considerNames_), haveIgnore_, haveConsider_});
+  ignoreNames_.clear();
+  considerNames_.clear();
+  haveIgnore_ = haveConsider_ = false;
+  section_ = &g_.main;
+  lsystem_ = uint16_t(g_.lsystems.size());
+  g_.lsystems.push_back(std::move(b));
+}
+
+// Per symbol id: 1 when context matching skips it under these names.
+std::vector<uint8_t> GrammarParser::SkipTable(const ContextNames& c) const {
+  const size_t nsym = g_.symbols.size();
+  std::vector<uint8_t> skip(nsym, 0);
+  for (size_t s = 2; s < nsym; ++s) {
+    const std::string& name = g_.symbols.name(SymbolId(s));
+    if (c.haveConsider) skip[s] = !c.consider.count(name);
+    if (c.haveIgnore && c.ignore.count(name)) skip[s] = 1;
+  }
+  return skip;
+}
+
+// ---------------------------------------------------------------------------
 // After all lines
 
 // The first line with text after `endlsystem`: Sylva reads one L-system a
@@ -1848,19 +2152,8 @@ void GrammarParser::WarnAfterEnd(const Line& l) {
   while (pos < t.size() && IsSpace(t[pos])) ++pos;
   if (pos >= t.size()) return;
   warnedAfterEnd_ = true;
-  size_t e = pos;
-  while (e < t.size() && IsIdentChar(t[e])) ++e;
-  size_t c = e;
-  while (c < t.size() && IsSpace(t[c])) ++c;
-  if (Lower(t.substr(pos, e - pos)) == "lsystem" && c < t.size() && t[c] == ':') {
-    Warn(Loc(l, int(pos) + 1), l.original,
-         "a second 'lsystem:' block (a cpfg sub-L-system) is not supported: it and everything "
-         "after it are ignored",
-         int(e - pos));
-    return;
-  }
   Warn(Loc(l, int(pos) + 1), l.original,
-       "text after 'endlsystem' is ignored (Sylva reads one L-system a file)", 1);
+       "text after 'endlsystem' is ignored (it is not an 'lsystem:' block)", 1);
 }
 
 void GrammarParser::WarnUnmatchable() {
@@ -1882,13 +2175,17 @@ void GrammarParser::WarnUnmatchable() {
     const auto& occ = sec == &g_.interpretation ? occursInterp : occurs;
     // Per symbol: the first production that always applies (no context,
     // condition or weight), which shadows every later one.
-    std::vector<int64_t> firstAlways(g_.symbols.size(), -1);
+    // (Per L-system block: a sub-L-system's productions shadow only its own.)
+    const size_t blocks = std::max<size_t>(1, g_.lsystems.size());
+    std::vector<int64_t> firstAlways(g_.symbols.size() * blocks, -1);
     for (size_t i = 0; i < sec->productions.size(); ++i) {
       const Production& p = sec->productions[i];
       SymbolId s = p.pred.symbol;
       const std::string& name = g_.symbols.name(s);
-      const int64_t shadow = firstAlways[s];
-      if (shadow < 0 && !p.HasContext() && !p.condition && !p.weight) firstAlways[s] = int64_t(i);
+      int64_t& always = firstAlways[size_t(p.lsystem) * g_.symbols.size() + s];
+      const int64_t shadow = always;
+      if (shadow < 0 && !p.HasContext() && !p.condition && !p.weight && p.predTail.empty())
+        always = int64_t(i);
       if (!occ[s]) {
         int a = g_.symbols.arity(s);
         Warn(p.loc, g_.SourceLine(p.loc),
@@ -1964,12 +2261,19 @@ void GrammarParser::Finish() {
   }
   for (const auto* b : {&g_.startBlock, &g_.startEachBlock, &g_.endEachBlock, &g_.endBlock})
     if (*b) g_.usesRandom |= (*b)->UsesRandom();
-  g_.contextSkip.assign(nsym, 0);
-  for (size_t s = 2; s < nsym; ++s) {
-    const std::string& name = g_.symbols.name(SymbolId(s));
-    if (haveConsider_) g_.contextSkip[s] = !considerNames_.count(name);
-    if (haveIgnore_ && ignoreNames_.count(name)) g_.contextSkip[s] = 1;
-  }
+  // The context tables: the main L-system's, then each sub-L-system's.
+  blockContext_.push_back(
+      ContextNames{std::move(ignoreNames_), std::move(considerNames_), haveIgnore_, haveConsider_});
+  g_.contextSkip = SkipTable(blockContext_[0]);
+  for (size_t b = 1; b < blockContext_.size() && b < g_.lsystems.size(); ++b)
+    g_.lsystems[b].contextSkip = SkipTable(blockContext_[b]);
+  for (const auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation})
+    for (const Production& p : sec->productions)
+      if (!p.predTail.empty()) g_.multiModulePredecessors = true;
+  if (g_.lsystems.empty()) g_.lsystems.push_back(LsystemBlock{0, g_.name, SourceLoc{}, {}});
+  g_.subLsystems = g_.lsystems.size() > 1;
+  for (int a = 1; a <= kMaxArity && !g_.subLsystems; ++a)
+    g_.subLsystems = g_.symbols.Find("?", a).has_value();
   g_.cutSymbol = g_.symbols.Find("%", 0);
   g_.axiom = std::move(axiom_);
   g_.axiomLoc = axiomLoc_;
@@ -2022,6 +2326,13 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   declaredLengths_.erase(std::unique(declaredLengths_.begin(), declaredLengths_.end()),
                          declaredLengths_.end());
   for (const Line& l : lines_) {
+    if (ended_ && StartsLsystem(l)) {  // the next block of a file with sub-L-systems
+      ended_ = false;
+      blockMayStart_ = true;
+      ParseLine(l);
+      blockMayStart_ = false;
+      continue;
+    }
     if (ended_) {
       WarnAfterEnd(l);
       if (warnedAfterEnd_) break;

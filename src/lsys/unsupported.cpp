@@ -11,16 +11,10 @@ struct Command {
 
 // cpfg's @ commands that Sylva lexes but does not draw.
 constexpr Command kUndrawn[] = {
-    {"@Gr", "generalized cylinder radius"},
-    {"@Gt", "generalized cylinder tangent"},
-    {"@PS", "bicubic patch"},
-    {"@PD", "bicubic patch"},
-    {"@Sx", "surface command"},
-    {"@m", "move-to with drawing"},
-    {"@R", "set heading and up"},
-    {"@D", "scale factor"},
-    {"@i", "interpolation"},
-    {"@L", "label"},
+    {"@PS", "bicubic patch"},     {"@PD", "bicubic patch"},
+    {"@Sx", "surface command"},   {"@m", "move-to with drawing"},
+    {"@R", "set heading and up"}, {"@D", "scale factor"},
+    {"@i", "interpolation"},      {"@L", "label"},
     {"@b", "bounding box"},
     {"@Tx", "texture"},
     {"@#", "generalized cylinder contour"},
@@ -54,11 +48,18 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
         {"@Gs", "start of a generalized cylinder", "none", 0},
         {"@Gc", "generalized cylinder point", "the number of segments", 1},
         {"@Ge", "end of a generalized cylinder", "the number of segments", 1},
+        {"@Gt", "generalized cylinder tangents", "the arriving and leaving factors", 2},
+        {"@Gr", "generalized cylinder radius tangents", "4 (angle, length, angle, length)", 4},
         {"@Ts", "set tropism elasticity", "the tropism and the elasticity", 2},
         {"@Ti", "raise tropism elasticity", "the tropism and the step", 2},
         {"@Td", "lower tropism elasticity", "the tropism and the step", 2},
         {"@Tf", "keep the twist", "none", 0},
     };
+    if (name == "@Gr" && arity == 3) {
+      return std::string(
+          "'@Gr' (generalized cylinder radius tangents) with 3 parameters: the "
+          "third is ignored (a second tangent takes 2, angle and length)");
+    }
     for (const Used& u : kUsed) {
       if (name != u.name) continue;
       if (arity <= u.most) return std::nullopt;
@@ -78,6 +79,20 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
       }
     }
     return "'" + std::string(name) + "' is not a command Sylva knows: it does nothing";
+  }
+  if (name == "$" && arity > 0) {
+    // Some files write $(id, scale) for the start of a sub-L-system; cpfg's
+    // source (generate.c CheckPred, interpret.c UpdateCurrentLsystem) starts
+    // one only at ?(id, scale) and ends one at any $.
+    return "'$' takes no parameters; here it has " + Params(arity) +
+           ", ignored ('$' ends a sub-L-system, or rolls the turtle horizontal; a "
+           "sub-L-system starts with ?(id, scale))";
+  }
+  if (name == "?") {  // ?(id, scale): the start of a sub-L-system
+    if (arity == 1 || arity == 2) return std::nullopt;
+    return "'?' (start of a sub-L-system) uses 2 parameters, the L-system's number and the "
+           "scale; the other " +
+           std::to_string(arity - 2) + " are ignored";
   }
   if (name[0] == '?') {
     // ?P ?H ?L ?U are answered after each step (plant::Grower): 2 parameters

@@ -50,6 +50,10 @@ enum class Op : uint8_t {
   kTropismUp,    // @Ti
   kTropismDown,  // @Td
   kTwistForce,   // @Tf
+  kGcTangent,    // @Gt
+  kGcRadius,     // @Gr
+  kSubStart,     // ?(id, scale): a sub-L-system starts (grammars with sub-L-systems)
+  kSubEnd,       // $ there: it ends
 };
 
 Op OpFor(const std::string& name) {
@@ -111,6 +115,8 @@ Op OpFor(const std::string& name) {
   if (name == "@Gs") return Op::kGcStart;
   if (name == "@Gc") return Op::kGcPoint;
   if (name == "@Ge") return Op::kGcEnd;
+  if (name == "@Gt") return Op::kGcTangent;
+  if (name == "@Gr") return Op::kGcRadius;
   if (name == "@Ts") return Op::kTropismSet;
   if (name == "@Ti") return Op::kTropismUp;
   if (name == "@Td") return Op::kTropismDown;
@@ -131,9 +137,26 @@ struct State {
 // The part of the state only cpfg's @T and @G commands change, saved on its
 // own stack only when the word's symbols include them, so that State stays
 // small for every other word.
+// How the pieces of a generalized cylinder bend and swell (cpfg's turtle
+// fields tangent_parameter, radius_tangent, scale_radius_tangents), set by
+// @Gt and @Gr and read at each control point.
+struct CylinderShape {
+  // @Gt(a, b): the Hermite tangents are the headings times the chord times
+  // b leaving a control point and a arriving at one (cpfg's default 1.2).
+  double arriving = 1.2, leaving = 1.2;
+  // @Gr(a, l[, a2, l2]): the radius along a piece is a Hermite curve in the
+  // plane (t, radius) whose tangent arriving at a control point is
+  // l (cos a, sin a) and leaving it l2 (cos a2, sin a2) (the first pair
+  // when there is no second); (0, 0): none, a straight line.
+  Vec2 radiusArriving{0, 0}, radiusLeaving{0, 0};
+  bool scaleRadiusTangents = false;  // @Gr(k), k != 0: their radius parts times the chord
+};
+
 struct CpfgState {
   double elasticity = 0;  // tropism susceptibility (cpfg: elasticity), @Ts @Ti @Td change it
   int32_t cylinder = -1;  // the open generalized cylinder (@Gs), or -1
+  CylinderShape shape;
+  double scale = 1;  // sub-L-system scale (cpfg: scale_factor) of steps, widths, surfaces
 };
 
 // A control point of a generalized cylinder: where the turtle was at @Gs,
@@ -142,6 +165,7 @@ struct ControlPoint {
   Vec3 pos, heading, left;
   double width = 0;
   uint16_t color = 0;
+  CylinderShape shape;  // the turtle's @Gt and @Gr settings there
 };
 
 // An open generalized cylinder: its last control point and the branch id
@@ -250,6 +274,7 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   d.initialColor = g.initialColor;
   d.colorIncrement = g.colorIncrement;
   d.elasticityIncrement = g.elasticityIncrement;
+  d.subLsystems = g.subLsystems;
   return d;
 }
 
@@ -313,24 +338,42 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
   g.polygons.push_back(std::move(poly));
 }
 
-// One piece of a generalized cylinder (@Gc, @Ge): the cubic Hermite curve
-// from control point a to b with tangents H_a |b - a| and H_b |b - a|,
-// cut into `rings` segments of one branch whose width runs linearly from
-// a's to b's.
+// One piece of a generalized cylinder (@Gc, @Ge), as cpfg draws it
+// (vlab cpfg, generalized cylinders, version 3400 on): the cubic Hermite
+// curve from control point a to b with tangents H_a |b - a| a.leaving and
+// H_b |b - a| b.arriving (@Gt), cut into `rings` segments of one branch. At
+// ring k the curve parameter t and the radius are the cubic Hermite curve
+// in the plane (t, radius) from (0, r_a) to (1, r_b) with tangents
+// a.radiusLeaving and b.radiusArriving (@Gr; a zero tangent is (1, r_b - r_a),
+// so without @Gr t = k / rings and the width runs linearly).
 [[gnu::noinline]] static void AddCylinderPiece(const ControlPoint& a, const ControlPoint& b,
                                                int rings, double widthScale, uint32_t branch,
                                                uint32_t parent, uint16_t depth, uint32_t module,
                                                PlantGeometry& g) {
   const double chord = (b.pos - a.pos).norm();
-  const Vec3 m0 = a.heading * chord, m1 = b.heading * chord;
+  const Vec3 m0 = a.heading * (chord * a.shape.leaving);
+  const Vec3 m1 = b.heading * (chord * b.shape.arriving);
+  // The (t, radius) curve; radii are half widths (cpfg's line_width / 2).
+  const double r0 = 0.5 * a.width, dr = 0.5 * (b.width - a.width);
+  Vec2 s0 = a.shape.radiusLeaving, s1 = b.shape.radiusArriving;
+  if (b.shape.scaleRadiusTangents) {
+    s0.y() *= chord;
+    s1.y() *= chord;
+  }
+  if (s0.x() == 0 && s0.y() == 0) s0 = Vec2(1, dr);
+  if (s1.x() == 0 && s1.y() == 0) s1 = Vec2(1, dr);
+  const Vec2 c2(3 - 2 * s0.x() - s1.x(), 3 * dr - 2 * s0.y() - s1.y());
+  const Vec2 c3(-2 + s0.x() + s1.x(), -2 * dr + s0.y() + s1.y());
   Vec3 prev = a.pos;
   double prevWidth = a.width;
   for (int k = 1; k <= rings; ++k) {
-    const double t = double(k) / rings, t2 = t * t, t3 = t2 * t;
+    const double r = double(k) / rings;
+    const double t = ((c3.x() * r + c2.x()) * r + s0.x()) * r;
+    const double t2 = t * t, t3 = t2 * t;
     const Vec3 p = k == rings ? b.pos
                               : a.pos * (2 * t3 - 3 * t2 + 1) + m0 * (t3 - 2 * t2 + t) +
                                     b.pos * (3 * t2 - 2 * t3) + m1 * (t3 - t2);
-    const double w = a.width + (b.width - a.width) * t;
+    const double w = k == rings ? b.width : 2 * (((c3.y() * r + c2.y()) * r + s0.y()) * r + r0);
     Segment sg;
     sg.start = prev;
     sg.end = p;
@@ -491,6 +534,13 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
                      const DrawOptions& options, PlantGeometry& g) {
   std::vector<Op> ops(symbols.size());
   for (size_t s = 0; s < symbols.size(); ++s) ops[s] = OpFor(symbols.name(lsys::SymbolId(s)));
+  if (def.subLsystems) {  // cpfg's `?(id, scale)` and `$` (not the roll of ABOP's `$`)
+    for (size_t s = 0; s < symbols.size(); ++s) {
+      const std::string& name = symbols.name(lsys::SymbolId(s));
+      if (name == "?" && symbols.arity(lsys::SymbolId(s)) >= 1) ops[s] = Op::kSubStart;
+      if (name == "$") ops[s] = Op::kSubEnd;
+    }
+  }
 
   if (Status st = ClearAndReserve(word, ops, options, g); !st.ok()) return st;
   std::vector<uint32_t> branchParent{0};
@@ -502,6 +552,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   CpfgState x;
   x.elasticity = def.susceptibility;
   std::vector<CpfgState> xstack;
+  std::vector<double> subScales;  // the scale outside each open sub-L-system
   t.color = uint16_t(std::clamp(def.initialColor, 0, 65535));
   const int colorStep = def.colorIncrement;
   SinCos sincos;
@@ -510,9 +561,10 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   bool changesTropism = false, drawsCylinders = false;
   for (Op op : ops) {
     changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp || op == Op::kTropismDown;
-    drawsCylinders |= op == Op::kGcStart || op == Op::kGcPoint || op == Op::kGcEnd;
+    drawsCylinders |= op == Op::kGcStart || op == Op::kGcPoint || op == Op::kGcEnd ||
+                      op == Op::kGcTangent || op == Op::kGcRadius;
   }
-  const bool cpfgState = changesTropism || drawsCylinders;
+  const bool cpfgState = changesTropism || drawsCylinders || def.subLsystems;
   const bool tropism = def.susceptibility != 0 || changesTropism;
   Vec3 lo = t.pos, hi = t.pos;
   bool planar = true;
@@ -559,7 +611,8 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kForwardMove:
         case Op::kForwardDrawNoVertex:
         case Op::kForwardMoveNoVertex: {
-          const double len = np ? p[0] : def.step;
+          double len = np ? p[0] : def.step;
+          if constexpr (kCpfg) len *= x.scale;
           const Vec3 start = t.pos;
           t.pos += t.frame.heading * len;
           visit(t.pos);
@@ -649,8 +702,11 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kWidth:
           if (np) {
             t.width = p[0];
+            if constexpr (kCpfg) t.width *= x.scale;
           } else if (def.widthIncrement > 0) {
-            t.width = std::max(t.width - def.widthIncrement, 0.0);
+            double inc = def.widthIncrement;
+            if constexpr (kCpfg) inc *= x.scale;
+            t.width = std::max(t.width - inc, 0.0);
           } else {
             t.width *= def.widthFactor;
           }
@@ -658,8 +714,11 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kWidthUp:
           if (np) {
             t.width = p[0];
+            if constexpr (kCpfg) t.width *= x.scale;
           } else if (def.widthIncrement > 0) {
-            t.width += def.widthIncrement;
+            double inc = def.widthIncrement;
+            if constexpr (kCpfg) inc *= x.scale;
+            t.width += inc;
           } else if (def.widthFactor != 0) {
             t.width /= def.widthFactor;
           }
@@ -696,6 +755,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           } else if (np) {
             si.scale = Vec3(p[0], p[0], p[0]);
           }
+          if constexpr (kCpfg) si.scale *= x.scale;
           si.color = t.color;
           si.module = uint32_t(i);
           g.surfaces.push_back(std::move(si));
@@ -734,7 +794,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kGcStart:
         case Op::kGcPoint:
         case Op::kGcEnd: {
-          const ControlPoint here{t.pos, t.frame.heading, t.frame.left, t.width, t.color};
+          const ControlPoint here{t.pos, t.frame.heading, t.frame.left, t.width, t.color, x.shape};
           if (x.cylinder < 0) {
             if (op == Op::kGcEnd) break;  // nothing open: nothing to end
             branchParent.push_back(t.branch);
@@ -774,6 +834,48 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kTwistForce:
           // @Tf: cpfg records the frame so its next cylinder does not twist;
           // Sylva's tubes follow rotation-minimizing frames and never twist.
+          break;
+        case Op::kGcTangent:  // @Gt(a[, b]): blackbox.c, 't'
+          if (np >= 1) {
+            x.shape.arriving = p[0];
+            x.shape.leaving = np >= 2 ? p[1] : p[0];
+          }
+          break;
+        case Op::kGcRadius: {  // @Gr(k) or @Gr(a, l[, a2, l2]): blackbox.c, 'r'
+          if (np == 1) {
+            x.shape.scaleRadiusTangents = p[0] != 0;
+            break;
+          }
+          if (np < 2) break;
+          double sa, ca;
+          SinCosRadians(p[0] * kDegToRad, &sa, &ca);
+          x.shape.radiusArriving = x.shape.radiusLeaving = Vec2(ca, sa) * p[1];
+          if (np >= 4) {
+            SinCosRadians(p[2] * kDegToRad, &sa, &ca);
+            x.shape.radiusLeaving = Vec2(ca, sa) * p[3];
+          }
+          break;
+        }
+        case Op::kSubStart:  // ?(id, scale): cpfg's interpret.c UpdateCurrentLsystem
+          if constexpr (kCpfg) {
+            const double outer = x.scale;
+            subScales.push_back(outer);
+            x.scale = outer * (np >= 2 ? p[1] : 1.0);
+            if (outer != 0) t.width *= x.scale / outer;
+          }
+          break;
+        case Op::kSubEnd:
+          if constexpr (kCpfg) {
+            if (subScales.empty()) {
+              g.warnings.push_back("unmatched '$' (end of a sub-L-system) at module " +
+                                   std::to_string(i + 1) + " ignored");
+              break;
+            }
+            const double inner = x.scale;
+            x.scale = subScales.back();
+            subScales.pop_back();
+            if (inner != 0) t.width *= x.scale / inner;
+          }
           break;
         case Op::kNone:
           break;

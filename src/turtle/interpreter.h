@@ -28,13 +28,21 @@
 //   @Gs @Gc(n) @Ge(n)  a generalized cylinder: a tube along the cubic
 //          Hermite curve through the turtle's positions at @Gs, each @Gc and
 //          @Ge (tangents: the headings there times the distance between the
-//          points), n segments per piece (default 8), the width running
-//          linearly between the points; F inside draws nothing; a branch
-//          `[` draws on its own and `]` resumes the cylinder
+//          points times the @Gt factors), n segments per piece (default 8),
+//          the width running linearly between the points unless @Gr says
+//          otherwise; F inside draws nothing; a branch `[` draws on its own
+//          and `]` resumes the cylinder
+//   @Gt(a, b)  tangent factors: a arriving at a control point, b leaving it
+//          (one value: both; cpfg's default 1.2)
+//   @Gr(a, l, a2, l2)  the radius along a piece follows a Hermite curve in
+//          the plane (t, radius) with tangent l (cos a, sin a) arriving at a
+//          control point and l2 (cos a2, sin a2) leaving it (2 values: both);
+//          @Gr(k), k != 0, multiplies their radius parts by the chord
 //   @Ts(i, e) @Ti(i, d) @Td(i, d)  set, raise and lower the tropism
 //          susceptibility e (cpfg's elasticity) of the turtle (kept by [ ]);
 //          i must be 1
 //   @Tf    accepted, nothing to do: Sylva's tubes never twist
+//   ?(id, s) ... $  in a grammar with sub-L-systems: the scale (TurtleDef::subLsystems)
 #pragma once
 
 #include <optional>
@@ -68,6 +76,11 @@ struct TurtleDef {
   double elasticityIncrement = 0;  // @Ti and @Td without a value add and subtract it
   int initialColor = 0;            // colour index the turtle starts with
   int colorIncrement = 1;          // ; and , without a parameter add and subtract it
+  // cpfg's sub-L-systems (lsys::Grammar::subLsystems): `?(id, scale)`
+  // multiplies the turtle's scale by `scale` (default 1) and `$` restores it
+  // (instead of rolling the turtle); the scale multiplies F f G g lengths,
+  // the width (at once, and what ! and # set or add later) and surfaces.
+  bool subLsystems = false;
 };
 
 TurtleDef TurtleDefFrom(const lsys::Grammar& g);

@@ -50,7 +50,7 @@ std::vector<BadCase> Cases() {
       {"binary_garbage", "axiom: F\n\x01\x02\xff\xfe --> \x80\n", "2:1",
        "unexpected character '\\x01'"},
       {"nul_byte", std::string("axiom: F\0F\n", 11), "1:9", "unexpected character '\\x00'"},
-      {"two_module_predecessor", "axiom: F\nAB --> C\n", "2:1", "exactly one module"},
+      {"bracket_in_predecessor", "axiom: F\nA [ --> C\n", "2:3", "'[' cannot be rewritten"},
       {"no_predecessor", "axiom: F\n --> C\n", "2:2", "no predecessor"},
       {"empty_successor", "axiom: F\nF -->\n", "2:3", "empty successor"},
       {"duplicate_formal", "axiom: A(1,2)\nA(x,x) --> A(x,x)\n", "2:1", "appears twice"},

@@ -181,10 +181,10 @@ TEST(CliMesh, UnknownSurfacePointsAtTheTilde) {
 }
 
 TEST(Cli, StrictMakesWarningsErrorsOnEveryCommand) {
-  std::string f = WriteFile("gc.l", "axiom: A\nA --> F@Gr F@PS A\n");
+  std::string f = WriteFile("gc.l", "axiom: A\nA --> F@D F@PS A\n");
   auto plain = RunSylva({"check", f});
   EXPECT_EQ(plain.code, 0) << plain.err;
-  EXPECT_NE(plain.err.find("gc.l:2:8: warning: '@Gr' (cpfg: generalized cylinder radius) is "
+  EXPECT_NE(plain.err.find("gc.l:2:8: warning: '@D' (cpfg: scale factor) is "
                            "not implemented in Sylva: it does nothing"),
             std::string::npos)
       << plain.err;
@@ -237,13 +237,13 @@ TEST(CliMesh, UnknownLongSurfaceNameMentionsCpfgOneLetterNames) {
 }
 
 TEST(Cli, StrictAppliesToTheGrammarsOfAScene) {
-  std::string g = WriteFile("scene_gc.l", "axiom: F@Gr\n");
+  std::string g = WriteFile("scene_gc.l", "axiom: F@PS\n");
   std::string f = WriteFile("strict_scene.xml",
                             "<scene version=\"1\">\n  <plant id=\"p\" grammar=\"scene_gc.l\" "
                             "position=\"0 0 0\"/>\n</scene>\n");
   auto plain = RunSylva({"check", f});
   EXPECT_EQ(plain.code, 0) << plain.err;
-  EXPECT_NE(plain.err.find("scene_gc.l:1:9: warning: '@Gr'"), std::string::npos) << plain.err;
+  EXPECT_NE(plain.err.find("scene_gc.l:1:9: warning: '@PS'"), std::string::npos) << plain.err;
   auto strict = RunSylva({"check", "--strict", f});
   EXPECT_EQ(strict.code, 2) << strict.err;
   // One warning; the note that names the <plant> is not counted.

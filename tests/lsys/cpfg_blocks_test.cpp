@@ -210,11 +210,9 @@ TEST(CpfgBlocks, MalformedBlocksAreErrorsWithLocations) {
             "2:12 expected '(' after 'if'");
   EXPECT_EQ(FirstError("axiom: A(1)\nA(x) : {y = 2;} x > 1 z --> B(y)\n"),
             "2:23 unexpected text after the condition");
+  // Arrays: cpfg_arrays_test.cpp; an undeclared one is an error.
   EXPECT_EQ(FirstError("Start: {a[1] = 2;}\naxiom: A\n"),
-            "1:10 arrays are not supported by Sylva (cpfg 'define: { array ... }')");
-  EXPECT_EQ(FirstError("define: { array a[3]; }\naxiom: A\n"),
-            "1:1 'define:' (cpfg arrays) is not supported by Sylva: arrays cannot be declared or "
-            "used");
+            "1:9 'a' is not an array (arrays are declared in 'define: { array a[n]; }')");
   EXPECT_EQ(FirstError("Start: x = 1;\naxiom: A\n"), "1:8 expected '{' after 'Start:'");
   EXPECT_EQ(FirstError("axiom: A {x = 1;} B\n"),
             "1:10 a statement block belongs in a production, not here");

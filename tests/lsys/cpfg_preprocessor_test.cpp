@@ -60,9 +60,10 @@ TEST(CpfgPreprocessor, ConditionsSeeCommandLineOverrides) {
 }
 
 TEST(CpfgPreprocessor, DefinesAfterEndlsystemAreNotRead) {
-  // A second L-system's #defines (ignored with a warning) do not clash.
-  ParseResult r = ParseGrammarText(
-      "#define N 1\naxiom: A(N)\nendlsystem\nlsystem: 2\n#define N 2\naxiom: B\n", "c.l");
+  // Text after `endlsystem` that is not another `lsystem:` block is not
+  // read (it is warned about), its #defines included.
+  ParseResult r =
+      ParseGrammarText("#define N 1\naxiom: A(N)\nendlsystem\n#define N 2\nB --> C\n", "c.l");
   ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
   DeriveOptions d;
   d.steps = 0;

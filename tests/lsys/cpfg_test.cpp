@@ -36,14 +36,22 @@ std::string Joined(const std::vector<std::string>& v) {
 TEST(Cpfg, UnimplementedCommandsWarnOncePerSymbolAtTheirFirstUse) {
   auto w = Warnings(
       "axiom: A\n"
-      "A --> F@Gr(1) F@Gt(1)@Gt(2)@PS(1) A\n"
+      "A --> F@Gr(1,2,3) F@Gt(2,3,4)@Gt(5,6,7)@PS(1) A\n"
       "F --> @Gs F @Tf @Ts(1,2) @o(1) @c(1) @v @M(1,2) @O(2) @Ge\n");
   const std::string all = Joined(w);
   ASSERT_EQ(w.size(), 4u) << all;
-  EXPECT_EQ(w[0].rfind("2:8 '@Gr' (cpfg: generalized cylinder radius) is not implemented", 0), 0u)
+  EXPECT_EQ(w[0].rfind("2:8 '@Gr' (generalized cylinder radius tangents) with 3 parameters: the "
+                       "third is ignored",
+                       0),
+            0u)
       << all;
-  EXPECT_EQ(w[1].rfind("2:16 '@Gt'", 0), 0u) << all;  // once for @Gt(1) and @Gt(2)
-  EXPECT_EQ(w[2].rfind("2:28 '@PS'", 0), 0u) << all;
+  // @Gt(2,3,4) has one parameter too many (said once).
+  EXPECT_EQ(w[1].rfind("2:20 '@Gt' (generalized cylinder tangents) uses the arriving and leaving "
+                       "factors; the other 1 are ignored",
+                       0),
+            0u)
+      << all;
+  EXPECT_EQ(w[2].rfind("2:40 '@PS'", 0), 0u) << all;
   EXPECT_EQ(w[3].rfind("3:41 '@M' (move to) needs 3 parameters", 0), 0u) << all;
 }
 
@@ -149,17 +157,15 @@ TEST(Cpfg, SurfaceWithTwoScalesWarns) {
 TEST(Cpfg, TextAfterEndlsystemWarnsWhereItStarts) {
   auto w = Warnings("axiom: F\nendlsystem\n\n  F --> FF\nG --> GG\n");
   ASSERT_EQ(w.size(), 1u) << Joined(w);
-  EXPECT_EQ(w[0], "4:3 text after 'endlsystem' is ignored (Sylva reads one L-system a file)");
+  EXPECT_EQ(w[0], "4:3 text after 'endlsystem' is ignored (it is not an 'lsystem:' block)");
   // ... and it is ignored: F is not rewritten.
   EXPECT_EQ(DeriveText("axiom: F\nendlsystem\nF --> FF\n", 1), "F");
 }
 
-TEST(Cpfg, SecondLsystemBlockWarnsThatSubLsystemsAreNotSupported) {
-  auto w = Warnings("Lsystem: 1\naxiom: F\nendlsystem\nLsystem: 2\naxiom: G\nendlsystem\n");
-  ASSERT_EQ(w.size(), 1u) << Joined(w);
-  EXPECT_EQ(w[0].rfind("4:1 a second 'lsystem:' block (a cpfg sub-L-system) is not supported", 0),
-            0u)
-      << w[0];
+TEST(Cpfg, SecondLsystemBlockIsASubLsystem) {
+  // Read, not warned about (tests/lsys/cpfg_sub_lsystem_test.cpp).
+  EXPECT_TRUE(
+      Warnings("Lsystem: 1\naxiom: F\nendlsystem\nLsystem: 2\naxiom: G\nendlsystem\n").empty());
 }
 
 TEST(Cpfg, BlankLinesAndCommentsAfterEndlsystemAreSilent) {

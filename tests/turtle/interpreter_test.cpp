@@ -403,7 +403,8 @@ TEST(Turtle, RollToVerticalIsDollar) {
 }
 
 TEST(Turtle, GeneralizedCylinderAlongALineIsEvenlyCutAndTapers) {
-  Drawn d = Draw("axiom: !(1) @Gs F(3) !(2) @Ge(6)\n");
+  // @Gt(1): tangents as long as the chord, so a straight piece is cut evenly.
+  Drawn d = Draw("axiom: !(1) @Gt(1) @Gs F(3) !(2) @Ge(6)\n");
   ASSERT_EQ(d.geometry.segments.size(), 6u);  // F inside draws nothing
   for (size_t k = 0; k < 6; ++k) {
     const Segment& s = d.geometry.segments[k];
@@ -415,14 +416,56 @@ TEST(Turtle, GeneralizedCylinderAlongALineIsEvenlyCutAndTapers) {
 
 TEST(Turtle, GeneralizedCylinderFollowsTheHermiteCurveOfTheHeadings) {
   // From (0,0,0) heading +y to (1,1,0) heading +x: at t = 1/2 the cubic
-  // Hermite curve with tangents H |p1 - p0| is
-  // (p0 + p1)/2 + |p1 - p0| (H0 - H1)/8.
+  // Hermite curve with tangents 1.2 H |p1 - p0| (cpfg's default @Gt) is
+  // (p0 + p1)/2 + 1.2 |p1 - p0| (H0 - H1)/8.
   Drawn d = Draw("axiom: @Gs F -(90) F @Gc(2) F @Ge\n");
   ASSERT_EQ(d.geometry.segments.size(), 2u + 8u);
-  const double c = std::sqrt(2.0) / 8;
+  const double c = 1.2 * std::sqrt(2.0) / 8;
   EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(0.5 - c, 0.5 + c, 0), 1e-12);
   EXPECT_VEC_NEAR(d.geometry.segments[1].end, Vec3(1, 1, 0), 1e-12);
   EXPECT_VEC_NEAR(d.geometry.segments[9].end, Vec3(2, 1, 0), 1e-12);  // default: 8 pieces
+}
+
+TEST(Turtle, GeneralizedCylinderTangentFactorsOfGt) {
+  // @Gt(a, b): b scales the tangent leaving a control point, a the one
+  // arriving. Same curve as above with factors 2 (leaving the start) and
+  // 0.5 (arriving at the end): midpoint offset |p1 - p0| (2 H0 - 0.5 H1)/8.
+  Drawn d = Draw("axiom: @Gt(0.5,2) @Gs F -(90) F @Gc(2)\n");
+  ASSERT_EQ(d.geometry.segments.size(), 2u);
+  const double q = std::sqrt(2.0) / 8;
+  EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(0.5 - 0.5 * q, 0.5 + 2 * q, 0), 1e-12);
+  // One factor: both.
+  Drawn e = Draw("axiom: @Gt(1) @Gs F -(90) F @Gc(2)\n");
+  EXPECT_VEC_NEAR(e.geometry.segments[0].end, Vec3(0.5 - q, 0.5 + q, 0), 1e-12);
+}
+
+TEST(Turtle, GeneralizedCylinderRadiusTangentsOfGr) {
+  // A straight piece of length 4 from width 2 (radius 1) to width 4
+  // (radius 2), 2 rings. @Gr(90, 3, 0, 1): in the (t, radius) plane the
+  // tangent leaving the start is (1, 0) and the one arriving at the end
+  // (0, 3). Hermite from (0, 1) to (1, 2) at r = 1/2:
+  // t = r + (3 - 2 - 0) r^2 + (-2 + 1 + 0) r^3 = 0.625,
+  // radius = 1 + 0 r + (3 - 0 - 3) r^2 + (-2 + 0 + 3) r^3 = 1.125;
+  // the ring sits where the position curve (tangents 1.2 x 4 along H) is
+  // at t.
+  auto along = [](double t) {
+    const double t2 = t * t, t3 = t2 * t;
+    return 4 * (3 * t2 - 2 * t3) + 4.8 * (t3 - 2 * t2 + t) + 4.8 * (t3 - t2);
+  };
+  Drawn d = Draw("axiom: !(2) @Gr(90, 3, 0, 1) @Gs F(4) !(4) @Ge(2)\n");
+  ASSERT_EQ(d.geometry.segments.size(), 2u);
+  EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(0, along(0.625), 0), 1e-12);
+  EXPECT_NEAR(d.geometry.segments[0].radiusEnd, 1.125, 1e-6);
+  EXPECT_NEAR(d.geometry.segments[1].radiusEnd, 2.0, 1e-6);
+  // Without @Gr: t = r and the radius runs linearly.
+  Drawn plain = Draw("axiom: !(2) @Gs F(4) !(4) @Ge(2)\n");
+  EXPECT_VEC_NEAR(plain.geometry.segments[0].end, Vec3(0, along(0.5), 0), 1e-12);
+  EXPECT_NEAR(plain.geometry.segments[0].radiusEnd, 1.5, 1e-6);
+  // @Gr(1) multiplies the radius parts by the chord (4): (1, 0) and (0, 12):
+  // radius = 1 + (3 - 12) / 4 + (-2 + 12) / 8 = 0; t is unchanged.
+  Drawn s = Draw("axiom: !(2) @Gr(90, 3, 0, 1) @Gr(1) @Gs F(4) !(4) @Ge(2)\n");
+  EXPECT_NEAR(s.geometry.segments[0].radiusEnd, 0.0, 1e-6);
+  EXPECT_VEC_NEAR(s.geometry.segments[0].end, Vec3(0, along(0.625), 0), 1e-12);
 }
 
 TEST(Turtle, GeneralizedCylinderIsOneTubeAndBranchesDrawOnTheirOwn) {
@@ -479,6 +522,46 @@ TEST(Turtle, TwistForceChangesNothing) {
   const Frame b = FinalFrame("&(30)/(40)F F");
   EXPECT_VEC_NEAR(a.heading, b.heading, 1e-300);
   EXPECT_VEC_NEAR(a.up, b.up, 1e-300);
+}
+
+}  // namespace
+}  // namespace sylva::turtle
+
+namespace sylva::turtle {
+namespace {
+
+// cpfg's sub-L-systems: ?(id, s) multiplies the step and the width by s
+// until its `$` (interpret.c UpdateCurrentLsystem), and `$` does not roll.
+TEST(Turtle, SubLsystemScalesStepAndWidthUntilItsEnd) {
+  Drawn d = Draw(
+      "lsystem: 1\naxiom: F?(2,0.5)F!(2)F?(2,0.5)F$$F\nendlsystem\n"
+      "lsystem: 2\naxiom: F\nendlsystem\n",
+      0);
+  const auto& s = d.geometry.segments;
+  ASSERT_EQ(s.size(), 5u);
+  const double ends[5] = {1, 1.5, 2, 2.25, 3.25};
+  // Width 1; at ?(2,0.5) 0.5; !(2) sets 2 x 0.5 = 1; at the nested
+  // ?(2,0.5) 0.5 (scale 0.25); each $ divides by what its ?(..) multiplied.
+  const double radii[5] = {0.5, 0.25, 0.5, 0.25, 1.0};
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_VEC_NEAR(s[size_t(k)].end, Vec3(0, ends[k], 0), 1e-12);
+    EXPECT_NEAR(s[size_t(k)].radiusStart, radii[k], 1e-7) << "segment " << k;
+  }
+}
+
+TEST(Turtle, DollarEndsASubLsystemWithoutRolling) {
+  DrawOptions opt;
+  opt.recordModules = true;
+  Drawn d = Draw(
+      "lsystem: 1\naxiom: &(35)/(50)?(2)$F\nendlsystem\nlsystem: 2\naxiom: F\n"
+      "endlsystem\n",
+      0, opt);
+  Drawn roll = Draw("axiom: &(35)/(50)$F\n", 0, opt);
+  Drawn none = Draw("axiom: &(35)/(50)F\n", 0, opt);
+  ASSERT_EQ(d.geometry.moduleFrame.size(), 5u);
+  const Frame& f = d.geometry.moduleFrame.back();
+  EXPECT_VEC_NEAR(f.left, none.geometry.moduleFrame.back().left, 1e-12);
+  EXPECT_GT((f.left - roll.geometry.moduleFrame.back().left).norm(), 0.1);
 }
 
 }  // namespace
