@@ -62,8 +62,8 @@ double InverseMassOf(double m, uint32_t id, MassRecord* record);
 // first particle whose mass is bad and that is not pinned; clears the
 // record when none is left (pinned, given a mass in range, or removed).
 template <typename MassAt, typename PinnedAt, typename IdAt>
-Status CheckMasses(const char* what, MassRecord* record, size_t n, MassAt massAt,
-                   PinnedAt pinnedAt, IdAt idAt);
+Status CheckMasses(const char* what, MassRecord* record, size_t n, MassAt massAt, PinnedAt pinnedAt,
+                   IdAt idAt);
 
 // The faults of a step (see system.h, "Faults"). The per-particle loops
 // Flag() a particle that may be out of bounds and report unresolved
@@ -170,8 +170,8 @@ inline bool MaybeWithinLimit(const Vec3& x, const Vec3& v, double limit2) {
 // --- templates ---
 
 template <typename MassAt, typename PinnedAt, typename IdAt>
-Status CheckMasses(const char* what, MassRecord* record, size_t n, MassAt massAt,
-                   PinnedAt pinnedAt, IdAt idAt) {
+Status CheckMasses(const char* what, MassRecord* record, size_t n, MassAt massAt, PinnedAt pinnedAt,
+                   IdAt idAt) {
   if (!record->bad) return {};
   for (size_t i = 0; i < n; ++i) {
     const double m = massAt(i);

@@ -109,8 +109,8 @@ TEST(State, ZeroMassIsAnErrorNotAPin) {
     s.state.Add(Vec3(0, 2, 0), Vec3(1, 0, 0), bad);
     s.AddForce(std::make_shared<Gravity>(Vec3(0, -10, 0)));
     const Status st = s.Step(0.1, Integrator::kSymplecticEuler);
-    EXPECT_TRUE(Contains(st, "particle id 1 has mass")) << "mass " << bad << ": "
-                                                        << (st.ok() ? "stepped" : st.error().message);
+    EXPECT_TRUE(Contains(st, "particle id 1 has mass"))
+        << "mass " << bad << ": " << (st.ok() ? "stepped" : st.error().message);
     EXPECT_EQ(s.state.position[0], Vec3(0, 1, 0)) << "mass " << bad << ": something moved";
     // Pinned explicitly, it stays put; the others move.
     s.state.Pin(1);
