@@ -360,7 +360,8 @@ class System {
   // One step of length h: forces, integration, collisions, ageing.
   // h in (0, 1e6] s (NaN, 0, negative: a Diagnostic, nothing moves); the
   // settings above (maxMagnitude 1e-300..1e300, cgTolerance 0..1,
-  // cgMaxIterations 1..1e7) and every force's Check are verified first.
+  // cgMaxIterations 1..1e7), every force's Check and the masses (a bad
+  // mass given to ParticleState::Add, see there) are verified first.
   // Faults are reported as described at the top of this file.
   [[nodiscard]] Status Step(double h, Integrator integrator);
   // Advances by dt with adaptive Dormand-Prince RK45 substeps: dt as h
