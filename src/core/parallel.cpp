@@ -54,7 +54,7 @@ void ThreadPool::RunTasks(uint32_t gen) {
     // after the word that closed the call before; a value of a later call
     // makes the claim below fail, since its word was closed first.
     const size_t count = count_.load(std::memory_order_acquire);
-    const std::function<void(size_t)>* fn = fn_.load(std::memory_order_acquire);
+    const IndexFn* fn = fn_.load(std::memory_order_acquire);
     if (Index(word) >= count) return;
     if (!claim_.compare_exchange_weak(word, word + 1, std::memory_order_acq_rel,
                                       std::memory_order_acquire)) {
@@ -93,7 +93,7 @@ ThreadPool& SharedPool(int threads) {
   return pool;
 }
 
-void ThreadPool::ParallelFor(size_t n, const std::function<void(size_t)>& fn) {
+void ThreadPool::ParallelFor(size_t n, IndexFn fn) {
   if (n == 0) return;
   if (threads_ == 1 || n == 1) {
     RunSerially(n, fn);
@@ -102,7 +102,8 @@ void ThreadPool::ParallelFor(size_t n, const std::function<void(size_t)>& fn) {
   if (n >= std::numeric_limits<uint32_t>::max()) {  // the claim word holds 32-bit indices
     const size_t half = n / 2;
     ParallelFor(half, fn);
-    ParallelFor(n - half, [&](size_t i) { fn(half + i); });
+    auto rest = [&](size_t i) { fn(half + i); };
+    ParallelFor(n - half, rest);
     return;
   }
   // One call at a time: a second caller (another thread, or a task of this

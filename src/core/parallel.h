@@ -26,12 +26,31 @@
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
-#include <functional>
+#include <memory>
 #include <mutex>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 namespace sylva {
+
+// A non-owning reference to a callable taking an index (C++26's
+// std::function_ref, reduced to what the pool needs): two words, made
+// without allocating, valid while the callable it refers to lives. The pool
+// calls it only during ParallelFor, so a lambda passed to ParallelFor
+// outlives every call.
+class IndexFn {
+ public:
+  template <typename Fn, typename = std::enable_if_t<!std::is_same_v<std::decay_t<Fn>, IndexFn>>>
+  IndexFn(Fn&& fn)  // NOLINT: implicit, as std::function's
+      : object_(const_cast<void*>(static_cast<const void*>(std::addressof(fn)))),
+        call_([](void* o, size_t i) { (*static_cast<std::remove_reference_t<Fn>*>(o))(i); }) {}
+  void operator()(size_t i) const { call_(object_, i); }
+
+ private:
+  void* object_;
+  void (*call_)(void*, size_t);
+};
 
 class ThreadPool {
  public:
@@ -42,12 +61,13 @@ class ThreadPool {
   ThreadPool& operator=(const ThreadPool&) = delete;
 
   int threads() const { return threads_; }
-  void ParallelFor(size_t n, const std::function<void(size_t)>& fn);
+  // Allocates nothing (fn is referred to, not copied).
+  void ParallelFor(size_t n, IndexFn fn);
 
   static int HardwareThreads();
 
  private:
-  void RunSerially(size_t n, const std::function<void(size_t)>& fn) {
+  void RunSerially(size_t n, IndexFn fn) {
     for (size_t i = 0; i < n; ++i) fn(i);
   }
   std::atomic<bool> busy_{false};  // a ParallelFor is running
@@ -66,7 +86,7 @@ class ThreadPool {
   alignas(64) std::atomic<size_t> finished_{0};
   // Published by the store to claim_ (atomic only so that a late reader
   // racing the next call is defined; its claim then fails).
-  std::atomic<const std::function<void(size_t)>*> fn_{nullptr};
+  std::atomic<const IndexFn*> fn_{nullptr};
   std::atomic<size_t> count_{0};
   uint32_t generation_ = 0;  // the caller's copy
   std::mutex mutex_;

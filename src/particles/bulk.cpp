@@ -62,13 +62,19 @@ uint32_t BulkState::Add(const Vec3& p, const Vec3& v, double m, double life) {
   vx.push_back(float(v.x()));
   vy.push_back(float(v.y()));
   vz.push_back(float(v.z()));
-  invMass.push_back(m > 0 ? float(1 / m) : 0.0f);
+  invMass.push_back(float(InverseMassOf(m, nextId, &massRecord)));
   birth.push_back(float(time));
   lifetime.push_back(float(std::min(life, 1e30)));
   color.push_back(Vec3f(1, 1, 1));
   radius.push_back(0.0f);
   id.push_back(nextId);
   return nextId++;
+}
+
+uint32_t BulkState::AddPinned(const Vec3& p, double life) {
+  const uint32_t added = Add(p, Vec3::Zero(), 1, life);
+  Pin(size() - 1);
+  return added;
 }
 
 void BulkState::SetPosition(size_t i, const Vec3& p) {
@@ -95,19 +101,15 @@ BulkSystem::BulkSystem(int threads) {
 BulkSystem::~BulkSystem() = default;
 
 void BulkSystem::SetThreads(int threads) {
-  threads_ = threads <= 0 ? ThreadPool::HardwareThreads() : threads;
-  ownPool_ = threads_ > 1 ? std::make_unique<ThreadPool>(threads_) : nullptr;
-  pool_ = ownPool_.get();
+  pools_.SetThreads(threads);
 }
 
 void BulkSystem::UsePool(ThreadPool* pool) {
-  ownPool_.reset();
-  pool_ = pool && pool->threads() > 1 ? pool : nullptr;
-  threads_ = pool ? pool->threads() : 1;
+  pools_.UsePool(pool);
 }
 
 int BulkSystem::threads() const {
-  return threads_;
+  return pools_.threads();
 }
 
 void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::BulkParams& q) {
@@ -119,8 +121,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
   alignas(32) uint8_t flags[kChunk];
   for (size_t c = begin; c < end; c += kChunk) {
     const size_t ce = std::min(end, c + kChunk), m = ce - c;
-    if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds))
-      faulted_.store(true, std::memory_order_relaxed);
+    if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds)) faults_.Flag();
     if (colliders_.empty()) continue;
     std::memset(flags, 0, m);
     // The chunk's largest radius: planes moved out by it screen every
@@ -158,18 +159,11 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
         s.lifetime[i] = std::min(s.lifetime[i], life);
       }
       if (out == ContactOutcome::kStuck) s.invMass[i] = 0;
-      if (out == ContactOutcome::kUnresolved) {
-        // The lowest index wins, whatever the thread count.
-        size_t seen = unresolved_.load(std::memory_order_relaxed);
-        while (i < seen && !unresolved_.compare_exchange_weak(seen, i)) {
-        }
-        faulted_.store(true, std::memory_order_relaxed);
-      }
+      if (out == ContactOutcome::kUnresolved) faults_.Unresolved(i);
       const Vec3f xf = RoundOutside(colliders_, x, r, h);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
-      if (!MaybeWithinLimit(xf.cast<double>(), v, limit2_))
-        faulted_.store(true, std::memory_order_relaxed);
+      if (!MaybeWithinLimit(xf.cast<double>(), v, faults_.limit2())) faults_.Flag();
     }
   }
 }
@@ -190,11 +184,15 @@ Status BulkSystem::AddCollider(Collider c) {
 }
 
 Status BulkSystem::Step(double h) {
-  if (fault_) return *fault_;
+  if (faults_.fault()) return *faults_.fault();
   if (!(h > 0 && h <= 1e6))
     return check::Error("BulkSystem.Step h " + check::Num(h) + " is outside (0, 1e+06] s");
   SYLVA_CHECK_OK(check::Range("BulkSystem.maxMagnitude", maxMagnitude, 1e-30, 1e300));
   SYLVA_CHECK_OK(Validate(fields));
+  SYLVA_CHECK_OK(CheckMasses(
+      "BulkSystem.Step", &state.massRecord, state.size(),
+      [&](size_t i) { return 1 / double(state.invMass[i]); },
+      [&](size_t i) { return state.pinned(i); }, [&](size_t i) { return state.id[i]; }));
   const Vec3& g = fields.gravity;
   const Vec3& w = fields.wind;
   const float limit = float(std::min(maxMagnitude, double(FLT_MAX)));
@@ -208,14 +206,13 @@ Status BulkSystem::Step(double h) {
                               float(fields.quadraticDrag),
                               float(h),
                               limit};
-  faulted_ = false;
-  limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
+  faults_.Begin(maxMagnitude);
   const size_t n = state.size();
+  ThreadPool* const pool = pools_.pool();
   // Ranges of whole chunks, a few a thread.
-  const size_t grain =
-      (BalancedGrain(pool_, n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
+  const size_t grain = (BalancedGrain(pool, n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
   // Contacts see the step the kernel took (h rounded to a float).
-  ForRanges(pool_, n, grain, [&](size_t b, size_t e) { StepRange(b, e, double(q.h), q); });
+  ForRanges(pool, n, grain, [&](size_t b, size_t e) { StepRange(b, e, double(q.h), q); });
   for (Collider& c : colliders_) {
     if (c.moving()) c.Translate(double(q.h) * c.velocity);
   }
@@ -226,26 +223,19 @@ Status BulkSystem::Step(double h) {
 }
 
 Status BulkSystem::Fault() {
-  if (!faulted_.load()) return {};
-  if (const size_t i = unresolved_.exchange(SIZE_MAX); i != SIZE_MAX) {
-    fault_ =
-        UnresolvedContactDiagnostic("in bulk", steps, state.time, state.id[i], state.position(i));
-    return *fault_;
-  }
-  for (size_t i = 0; i < state.size(); ++i) {
-    const Vec3 x = state.position(i), v = state.velocity(i);
-    if (WithinLimit(x, v, maxMagnitude)) continue;
-    fault_ = ExplosionDiagnostic("in bulk", steps, state.time, state.id[i], x, v, maxMagnitude);
-    return *fault_;
-  }
-  faulted_ = false;
-  return {};
+  return faults_.Scan("in bulk", steps, state.time, state.size(), maxMagnitude, [&](size_t i) {
+    return FaultLatch::Particle{state.id[i], state.position(i), state.velocity(i)};
+  });
 }
 
 size_t BulkSystem::Append(const ParticleState& born, size_t begin) {
   const size_t n = born.size();
   if (begin >= n) return 0;
-  state.Reserve(state.size() + (n - begin));
+  // Geometric growth: reserving exactly what is appended would copy every
+  // array on every call (quadratic over many small births).
+  const size_t need = state.size() + (n - begin);
+  if (need > state.px.capacity()) state.Reserve(std::max(need, 2 * state.px.capacity()));
+  if (born.massRecord.bad && !state.massRecord.bad) state.massRecord = born.massRecord;
   for (size_t i = begin; i < n; ++i) {
     const Vec3 &p = born.position[i], &v = born.velocity[i];
     state.px.push_back(float(p.x()));
@@ -267,42 +257,24 @@ size_t BulkSystem::Append(const ParticleState& born, size_t begin) {
 
 size_t BulkSystem::RemoveDead() {
   BulkState& s = state;
-  const size_t n = s.size();
-  size_t w = 0;
-  for (size_t i = 0; i < n; ++i) {
-    if (s.dead(i)) continue;
-    if (w != i) {
-      for (auto* a : s.FloatArrays()) (*a)[w] = (*a)[i];
-      s.color[w] = s.color[i];
-      s.id[w] = s.id[i];
-    }
-    ++w;
-  }
-  for (auto* a : s.FloatArrays()) a->resize(w);
-  s.color.resize(w);
-  s.id.resize(w);
-  return n - w;
+  return RemoveIf(
+      s.size(), [&](size_t i) { return s.dead(i); }, nullptr, s.px, s.py, s.pz, s.vx, s.vy, s.vz,
+      s.invMass, s.birth, s.lifetime, s.color, s.radius, s.id);
 }
 
 double BulkSystem::KineticEnergy() const {
-  double e = 0;
-  for (size_t i = 0; i < state.size(); ++i) {
-    if (state.invMass[i] > 0) e += 0.5 * state.velocity(i).squaredNorm() / double(state.invMass[i]);
-  }
-  return e;
+  return KineticEnergyOf(state.size(), [&](size_t i) {
+    return std::pair(double(state.invMass[i]), state.velocity(i));
+  });
 }
 
 uint64_t BulkSystem::Hash() const {
-  uint64_t h = 1469598103934665603ULL;
+  BitHash h;
   for (size_t i = 0; i < state.size(); ++i) {
-    for (float c : {state.px[i], state.py[i], state.pz[i], state.vx[i], state.vy[i], state.vz[i]}) {
-      uint32_t bits;
-      std::memcpy(&bits, &c, 4);
-      h = (h ^ bits) * 1099511628211ULL;
-      h ^= h >> 29;
-    }
+    for (float c : {state.px[i], state.py[i], state.pz[i], state.vx[i], state.vy[i], state.vz[i]})
+      h.Mix(c);
   }
-  return h;
+  return h.value();
 }
 
 }  // namespace sylva::particles

@@ -39,6 +39,7 @@
 #include "core/status.h"
 #include "particles/collider.h"
 #include "particles/kernels.h"
+#include "particles/particle_core.h"
 
 namespace sylva::particles {
 
@@ -49,7 +50,7 @@ struct BulkState {
   // hot
   std::vector<float> px, py, pz, vx, vy, vz;
   // cold
-  std::vector<float> invMass;  // 0: immovable
+  std::vector<float> invMass;  // 1/kg; 0: pinned (immovable); NaN: a bad mass (Add)
   // The clock's time at birth (s): a particle's age is time - birth, so a
   // step does not touch it.
   std::vector<float> birth;
@@ -59,13 +60,22 @@ struct BulkState {
   std::vector<uint32_t> id;
   uint32_t nextId = 0;
   double time = 0;  // the clock (s), advanced by BulkSystem::Step
+  // The first particle added with a bad mass (particle_core.h), for Step.
+  MassRecord massRecord;
 
   size_t size() const { return px.size(); }
   double age(size_t i) const { return time - double(birth[i]); }
   bool dead(size_t i) const { return age(i) >= double(lifetime[i]); }
   // Adds a particle born now (rounded to single precision), of radius 0 (a
-  // point); mass 0 or less means immovable. Returns its id.
+  // point), and returns its id. mass in (0, 1e30] kg; any other mass (0,
+  // negative, NaN) leaves the particle still and makes the next
+  // BulkSystem::Step an error naming it: a mass of 0 does not mean
+  // immovable, pinning does.
   uint32_t Add(const Vec3& p, const Vec3& v, double mass = 1, double lifetime = 1e30);
+  // Adds an immovable particle at rest and returns its id.
+  uint32_t AddPinned(const Vec3& p, double lifetime = 1e30);
+  void Pin(size_t i) { invMass[i] = 0; }
+  bool pinned(size_t i) const { return invMass[i] == 0; }
   Vec3 position(size_t i) const { return Vec3(px[i], py[i], pz[i]); }
   Vec3 velocity(size_t i) const { return Vec3(vx[i], vy[i], vz[i]); }
   void SetPosition(size_t i, const Vec3& p);
@@ -120,8 +130,10 @@ class BulkSystem {
   [[nodiscard]] Status Step(double h);
 
   // Appends particles [begin, size) of `born` (an Emitter's output) with
-  // their ages, ids, colours and sizes; nextId moves past the largest id.
-  // Returns the number appended.
+  // their ages, ids, colours, sizes and pinned flags (a bad mass of `born`
+  // is reported by the next Step); nextId moves past the largest id. The
+  // arrays grow geometrically (appending a few particles a step costs
+  // amortised O(1) a particle). Returns the number appended.
   size_t Append(const ParticleState& born, size_t begin = 0);
   // Removes particles whose age has reached their lifetime (`dead`), keeping the
   // order (and ids) of the living. Returns the number removed.
@@ -143,15 +155,9 @@ class BulkSystem {
   Status Fault();
 
   std::vector<Collider> colliders_;
-  std::unique_ptr<ThreadPool> ownPool_;
-  ThreadPool* pool_ = nullptr;  // own or shared; null: serial
-  int threads_ = 1;
+  PoolChoice pools_;
   kernels::Kernel kernel_ = kernels::Best();
-  std::optional<Diagnostic> fault_;
-  std::atomic<bool> faulted_{false};
-  double limit2_ = 0;  // maxMagnitude squared (at most DBL_MAX), the contact path's fault screen
-  // The lowest index of a particle whose contacts were unresolved, or SIZE_MAX.
-  std::atomic<size_t> unresolved_{SIZE_MAX};
+  FaultLatch faults_;
 };
 
 }  // namespace sylva::particles

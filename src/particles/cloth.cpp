@@ -165,8 +165,13 @@ Cloth::Cloth(const ClothDef& def) : def_(def) {
     if (def_.pool) implicit_->UsePool(def_.pool);
     implicit_->cgMaxIterations = def_.cgIterations;
     implicit_->cgTolerance = 1e-12;
-    for (size_t i = 0; i < n; ++i)
-      implicit_->state.Add(x_[i], Vec3::Zero(), w_[i] > 0 ? 1 / w_[i] : 0);
+    for (size_t i = 0; i < n; ++i) {
+      if (w_[i] > 0) {
+        implicit_->state.Add(x_[i], Vec3::Zero(), 1 / w_[i]);
+      } else {
+        implicit_->state.AddPinned(x_[i], def_.mass / double(n));
+      }
+    }
     auto springs = std::make_shared<Springs>();
     for (const Constraint& c : constraints_) {
       const Status added =

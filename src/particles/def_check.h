@@ -2,7 +2,8 @@
 // Diagnostic naming the field and the offending value, in the words of
 // docs/design.md, "Bad numbers in definitions":
 //   EmitterDef.rate 1e+30 is outside 0..1e+09 particles/s
-// Every comparison is written so that NaN fails it.
+// Every comparison is written so that NaN fails it, and a check that passes
+// allocates nothing (fields are string views: the step checks run each step).
 #pragma once
 
 #include <cstdio>
@@ -40,8 +41,7 @@ inline Diagnostic Error(std::string message) {
 }
 
 // lo <= v <= hi (NaN and infinities outside any finite range).
-inline Status Range(const std::string& field, double v, double lo, double hi,
-                    const char* unit = "") {
+inline Status Range(std::string_view field, double v, double lo, double hi, const char* unit = "") {
   if (v >= lo && v <= hi) return {};
   return Error(
       Cat(field, " ", Num(v), " is outside ", Num(lo), "..", Num(hi), *unit ? " " : "", unit));
@@ -49,7 +49,7 @@ inline Status Range(const std::string& field, double v, double lo, double hi,
 
 // Every component finite and within [-limit, limit] (NaN hides in y and z
 // too: each component is compared, never a norm or a maximum).
-inline Status Finite(const std::string& field, const Vec3& v, double limit = 1e12,
+inline Status Finite(std::string_view field, const Vec3& v, double limit = 1e12,
                      const char* unit = "") {
   for (int k = 0; k < 3; ++k) {
     if (!(v[k] >= -limit && v[k] <= limit)) {
@@ -60,7 +60,7 @@ inline Status Finite(const std::string& field, const Vec3& v, double limit = 1e1
   return {};
 }
 
-inline Status Finite(const std::string& field, const Vec3f& v, double limit = 1e12,
+inline Status Finite(std::string_view field, const Vec3f& v, double limit = 1e12,
                      const char* unit = "") {
   return Finite(field, Vec3(double(v.x()), double(v.y()), double(v.z())), limit, unit);
 }

@@ -158,6 +158,19 @@ void Penalty::OnSphere(uint32_t i, const Vec3& centre, double radius, double ks,
   terms_.push_back({Kind::kSphere, i, i, centre, Vec3::Zero(), radius, ks, kd});
 }
 
+void Penalty::Renumber(const std::vector<uint32_t>& newIndex) {
+  size_t kept = 0;
+  maxIndex_ = 0;
+  for (Term t : terms_) {
+    t.i = t.i < newIndex.size() ? newIndex[t.i] : t.i;
+    t.j = t.j < newIndex.size() ? newIndex[t.j] : t.j;
+    if (t.i == kRemoved || t.j == kRemoved) continue;
+    maxIndex_ = std::max({maxIndex_, t.i, t.j});
+    terms_[kept++] = t;
+  }
+  terms_.resize(kept);
+}
+
 Status RandomDrift::Check(const ParticleState&) const {
   return check::Range("RandomDrift sigma", sigma_, 0, 1e12, "N");
 }

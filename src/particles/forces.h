@@ -107,6 +107,9 @@ class Penalty : public Force {
   void OnSphere(uint32_t i, const Vec3& centre, double radius, double ks, double kd);
   // Every particle index named is below s.size() (System::Step asks).
   Status Check(const ParticleState& s) const override;
+  // Follows System::RemoveDead: terms follow their particles; a term that
+  // names a removed particle goes.
+  void Renumber(const std::vector<uint32_t>& newIndex) override;
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
   // The implicit solver's Jacobian, for anchors and distances (the stiff
   // ones); plane and sphere terms are treated explicitly.

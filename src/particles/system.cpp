@@ -30,14 +30,20 @@ std::string Format(const Vec3& v) {
 uint32_t ParticleState::Add(const Vec3& p, const Vec3& v, double m, double life) {
   position.push_back(p);
   velocity.push_back(v);
-  mass.push_back(m > 0 ? m : 0);
-  invMass.push_back(m > 0 ? 1 / m : 0);
+  mass.push_back(m);
+  invMass.push_back(InverseMassOf(m, nextId, &massRecord));
   age.push_back(0);
   lifetime.push_back(life);
   color.push_back(Vec3f(1, 1, 1));
   radius.push_back(0.0f);
   id.push_back(nextId);
   return nextId++;
+}
+
+uint32_t ParticleState::AddPinned(const Vec3& p, double m, double life) {
+  const uint32_t added = Add(p, Vec3::Zero(), m, life);
+  Pin(size() - 1);
+  return added;
 }
 
 // --- forces ---
@@ -96,6 +102,25 @@ void Springs::Clear() {
   preparedX_ = nullptr;
   accumulateCached_ = false;
   colouredSprings_ = SIZE_MAX;  // colour again, even for as many springs
+}
+
+void Springs::Renumber(const std::vector<uint32_t>& newIndex) {
+  size_t kept = 0;
+  maxIndex_ = 0;
+  for (const Spring& sp : springs_) {
+    // An index past newIndex is left out of range, for Check to report.
+    const uint32_t a = sp.a < newIndex.size() ? newIndex[sp.a] : sp.a;
+    const uint32_t b = sp.b < newIndex.size() ? newIndex[sp.b] : sp.b;
+    if (a == kRemoved || b == kRemoved) continue;
+    springs_[kept++] = {a, b, sp.rest, sp.ks, sp.kd};
+    maxIndex_ = std::max({maxIndex_, a, b});
+  }
+  springs_.resize(kept);
+  linear_.clear();
+  length_.clear();
+  preparedX_ = nullptr;
+  accumulateCached_ = false;
+  colouredSprings_ = SIZE_MAX;  // colour again
 }
 
 Status Springs::Check(const ParticleState& s) const {
@@ -260,30 +285,104 @@ void Springs::AddJacobianDiagonal(const ParticleState&, const Vec3* x, const Vec
 System::System(int threads) {
   SetThreads(threads);
 }
-System::~System() = default;
+System::~System() {
+  for (auto& f : forces_) TakeBackPool(*f);
+}
 
 void System::SetThreads(int threads) {
-  threads_ = threads <= 0 ? ThreadPool::HardwareThreads() : threads;
-  ownPool_ = threads_ > 1 ? std::make_unique<ThreadPool>(threads_) : nullptr;
-  pool_ = ownPool_.get();
-  for (auto& f : forces_) f->set_pool(pool_);
+  for (auto& f : forces_) TakeBackPool(*f);
+  pools_.SetThreads(threads);
+  pool_ = pools_.pool();
+  LendPool();
 }
 
 void System::UsePool(ThreadPool* pool) {
-  ownPool_.reset();
-  pool_ = pool && pool->threads() > 1 ? pool : nullptr;
-  threads_ = pool ? pool->threads() : 1;
-  for (auto& f : forces_) f->set_pool(pool_);
+  for (auto& f : forces_) TakeBackPool(*f);
+  pools_.UsePool(pool);
+  pool_ = pools_.pool();
+  LendPool();
 }
 
 int System::threads() const {
-  return threads_;
+  return pools_.threads();
 }
 
-void System::AddForce(std::shared_ptr<Force> f) {
+namespace {
+std::atomic<uint64_t> gForceIds{0};  // the last handle made, over the process
+}  // namespace
+
+ForceHandle System::AddForce(std::shared_ptr<Force> f) {
+  SYLVA_ASSERT(f != nullptr);
   f->set_pool(pool_);
   hasNonLocal_ |= !f->local();
   forces_.push_back(std::move(f));
+  const uint64_t id = gForceIds.fetch_add(1) + 1;
+  forceIds_.push_back(id);
+  return {id};
+}
+
+size_t System::ForceIndex(ForceHandle handle) const {
+  for (size_t k = 0; k < forceIds_.size(); ++k) {
+    if (forceIds_[k] == handle.id && handle.id != 0) return k;
+  }
+  return SIZE_MAX;
+}
+
+Status System::HandleError(const char* what, ForceHandle handle) const {
+  return check::Error(check::Cat(what, ": force handle ", std::to_string(handle.id),
+                                 handle.id == 0 ? " is the default handle (no force)"
+                                                : " names no force of this system (removed, "
+                                                  "or another system's)"));
+}
+
+Force* System::force(ForceHandle handle) const {
+  const size_t k = ForceIndex(handle);
+  return k == SIZE_MAX ? nullptr : forces_[k].get();
+}
+
+void System::TakeBackPool(Force& f) const {
+  if (f.pool() == pool_) f.set_pool(nullptr);
+}
+
+void System::LendPool() {
+  for (auto& f : forces_) f->set_pool(pool_);
+}
+
+void System::UpdateLocality() {
+  hasNonLocal_ = false;
+  for (const auto& f : forces_) hasNonLocal_ |= !f->local();
+}
+
+Status System::ReplaceForce(ForceHandle handle, std::shared_ptr<Force> f) {
+  const size_t k = ForceIndex(handle);
+  if (k == SIZE_MAX) return HandleError("System.ReplaceForce", handle);
+  if (!f) return check::Error("System.ReplaceForce: the new force is null");
+  TakeBackPool(*forces_[k]);
+  f->set_pool(pool_);
+  forces_[k] = std::move(f);
+  UpdateLocality();
+  return {};
+}
+
+Status System::RemoveForce(ForceHandle handle) {
+  const size_t k = ForceIndex(handle);
+  if (k == SIZE_MAX) return HandleError("System.RemoveForce", handle);
+  TakeBackPool(*forces_[k]);
+  forces_.erase(forces_.begin() + std::ptrdiff_t(k));
+  forceIds_.erase(forceIds_.begin() + std::ptrdiff_t(k));
+  UpdateLocality();
+  return {};
+}
+
+size_t System::RemoveDead() {
+  ParticleState& s = state;
+  const size_t removed = RemoveIf(
+      s.size(), [&](size_t i) { return s.age[i] >= s.lifetime[i]; }, &remap_, s.position,
+      s.velocity, s.mass, s.invMass, s.age, s.lifetime, s.color, s.radius, s.id);
+  if (removed > 0) {
+    for (auto& f : forces_) f->Renumber(remap_);
+  }
+  return removed;
 }
 
 Status System::AddCollider(Collider c) {
@@ -359,28 +458,18 @@ void System::Accelerations(const Vec3* x, const Vec3* v, Vec3* a) const {
 }
 
 double System::KineticEnergy() const {
-  double e = 0;
-  for (size_t i = 0; i < state.size(); ++i) {
-    if (state.invMass[i] > 0) e += 0.5 * state.mass[i] * state.velocity[i].squaredNorm();
-  }
-  return e;
+  return KineticEnergyOf(state.size(),
+                         [&](size_t i) { return std::pair(state.invMass[i], state.velocity[i]); });
 }
 
 uint64_t System::Hash() const {
-  uint64_t h = 1469598103934665603ULL;
-  auto mix = [&](const std::vector<Vec3>& a) {
-    for (const Vec3& p : a) {
-      for (int k = 0; k < 3; ++k) {
-        uint64_t bits;
-        std::memcpy(&bits, &p[k], 8);
-        h = (h ^ bits) * 1099511628211ULL;
-        h ^= h >> 29;
-      }
+  BitHash h;
+  for (const std::vector<Vec3>* a : {&state.position, &state.velocity}) {
+    for (const Vec3& p : *a) {
+      for (int k = 0; k < 3; ++k) h.Mix(p[k]);
     }
-  };
-  mix(state.position);
-  mix(state.velocity);
-  return h;
+  }
+  return h.value();
 }
 
 // Contact response for particle i (see RespondToContacts); kill and stick
@@ -393,14 +482,9 @@ uint64_t System::Hash() const {
     case ContactOutcome::kStuck:
       state.invMass[i] = 0;
       break;
-    case ContactOutcome::kUnresolved: {
-      // The lowest index wins, whatever the thread count.
-      size_t seen = unresolved_.load(std::memory_order_relaxed);
-      while (i < seen && !unresolved_.compare_exchange_weak(seen, i)) {
-      }
-      faulted_.store(true, std::memory_order_relaxed);
+    case ContactOutcome::kUnresolved:
+      faults_.Unresolved(i);
       break;
-    }
     case ContactOutcome::kNone:
     case ContactOutcome::kResponded:
       break;
@@ -423,53 +507,15 @@ uint64_t System::Hash() const {
     }
   }
   state.age[i] += h;
-  if (!MaybeWithinLimit(x1, v1, limit2_)) faulted_.store(true, std::memory_order_relaxed);
+  if (!MaybeWithinLimit(x1, v1, faults_.limit2())) faults_.Flag();
   state.position[i] = x1;
   state.velocity[i] = v1;
 }
 
-Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
-                               const Vec3& x, const Vec3& v, double limit) {
-  const bool finite = x.allFinite() && v.allFinite();
-  std::ostringstream o;
-  o << "particles: " << what << " step " << step << " (from t = " << t << " s): particle id " << id
-    << " has position " << Format(x) << " and velocity " << Format(v)
-    << (finite ? " beyond the limit of " : " (not finite)");
-  if (finite) o << limit;
-  o << "; the state exploded: try a smaller step, a stabler integrator or softer forces";
-  Diagnostic d = MakeError({}, o.str());
-  d.kind = ErrorKind::kRuntime;
-  return d;
-}
-
-Diagnostic UnresolvedContactDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
-                                       const Vec3& x) {
-  std::ostringstream o;
-  o << "particles: " << what << " step " << step << " (from t = " << t << " s): particle id " << id
-    << " still met a collider after " << kMaxContacts
-    << " contacts in one step (a crevice narrower than the step resolves); it was stopped at its "
-       "last contact point "
-    << Format(x) << "; try a smaller step";
-  Diagnostic d = MakeError({}, o.str());
-  d.kind = ErrorKind::kRuntime;
-  return d;
-}
-
 Status System::CheckFaults(const char* what) {
-  if (!faulted_.load()) return {};
-  if (const size_t i = unresolved_.exchange(SIZE_MAX); i != SIZE_MAX) {
-    fault_ =
-        UnresolvedContactDiagnostic(what, state.step, state.time, state.id[i], state.position[i]);
-    return *fault_;
-  }
-  for (size_t i = 0; i < state.size(); ++i) {
-    const Vec3 &x = state.position[i], &v = state.velocity[i];
-    if (WithinLimit(x, v, maxMagnitude)) continue;
-    fault_ = ExplosionDiagnostic(what, state.step, state.time, state.id[i], x, v, maxMagnitude);
-    return *fault_;
-  }
-  faulted_ = false;
-  return {};
+  return faults_.Scan(what, state.step, state.time, state.size(), maxMagnitude, [&](size_t i) {
+    return FaultLatch::Particle{state.id[i], state.position[i], state.velocity[i]};
+  });
 }
 
 // x_ = X + c dx, out = V + c dv, for all particles: an RK stage's point.
@@ -484,7 +530,7 @@ void System::StagePoint(double c, const Vec3* dx, const Vec3* dv, Vec3* out) con
   });
 }
 
-Status System::CheckStep(const char* what, double h) const {
+Status System::CheckStep(const char* what, double h) {
   using namespace check;
   if (!(h > 0 && h <= 1e6))
     return Error(std::string(what) + " " + Num(h) + " is outside (0, 1e+06] s");
@@ -492,19 +538,22 @@ Status System::CheckStep(const char* what, double h) const {
   SYLVA_CHECK_OK(Range("System.cgTolerance", cgTolerance, 0, 1));
   SYLVA_CHECK_OK(Range("System.cgMaxIterations", cgMaxIterations, 1, 1e7));
   for (const auto& f : forces_) SYLVA_CHECK_OK(f->Check(state));
+  SYLVA_CHECK_OK(CheckMasses(
+      "System.Step", &state.massRecord, state.size(), [&](size_t i) { return state.mass[i]; },
+      [&](size_t i) { return state.pinned(i); }, [&](size_t i) { return state.id[i]; }));
+  LendPool();
   return {};
 }
 
 Status System::Step(double h, Integrator integrator) {
-  if (fault_) return *fault_;
+  if (faults_.fault()) return *faults_.fault();
   SYLVA_CHECK_OK(CheckStep("System.Step h", h));
-  limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
+  faults_.Begin(maxMagnitude);
   const size_t n = state.size();
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
   state.time = time;
   state.step = steps;
-  faulted_ = false;
   if (pairRadius_ > 0) SavePairStart();
   switch (integrator) {
     case Integrator::kExplicitEuler:
@@ -513,9 +562,9 @@ Status System::Step(double h, Integrator integrator) {
       NonLocalForces(X.data(), V.data());
       const bool symplectic = integrator == Integrator::kSymplecticEuler;
       ForChunks(n, [&](size_t b, size_t e) {
-        thread_local std::vector<Vec3> fc;
-        fc.resize(kChunk);
-        LocalForcesInto(b, e, X.data(), V.data(), fc.data());
+        // On the stack (96 KiB): a step allocates nothing, on any thread.
+        Vec3 fc[kChunk];
+        LocalForcesInto(b, e, X.data(), V.data(), fc);
         const double* w = state.invMass.data();
         for (size_t i = b; i < e; ++i) {
           const Vec3 x0 = X[i], v0 = V[i];
@@ -750,8 +799,7 @@ Status System::NonFiniteSolve(const char* what, const Vec3* a, int iteration) {
     << "); a force or its Jacobian is not finite; nothing moved";
   Diagnostic d = MakeError({}, o.str());
   d.kind = ErrorKind::kRuntime;
-  fault_ = d;
-  return d;
+  return faults_.Latch(d);
 }
 
 void System::SavePairStart() {
@@ -761,9 +809,9 @@ void System::SavePairStart() {
 
 // Dormand & Prince (1980) RK5(4)7M.
 Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats* stats) {
-  if (fault_) return *fault_;
+  if (faults_.fault()) return *faults_.fault();
   SYLVA_CHECK_OK(CheckStep("System.StepAdaptive dt", dt));
-  limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
+  faults_.Begin(maxMagnitude);
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.rtol", opt.rtol, 0, 1));
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.atol", opt.atol, 0, 1e12));
   if (!(opt.rtol > 0 || opt.atol > 0))
@@ -851,22 +899,22 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
         ei = cx > ei ? cx : ei;
         ei = cv > ei ? cv : ei;
         if (!(cx <= DBL_MAX && cv <= DBL_MAX && x_[i].allFinite() && v_[i].allFinite())) {
-          fault_ = ExplosionDiagnostic("in adaptive", steps, time, state.id[i], x_[i], v_[i],
-                                       maxMagnitude);
+          Diagnostic fault = ExplosionDiagnostic("in adaptive", steps, time, state.id[i], x_[i],
+                                                 v_[i], maxMagnitude);
           if (x_[i].allFinite() && v_[i].allFinite()) {
-            fault_->message = "particles: in adaptive step " + std::to_string(steps) +
-                              " (from t = " + check::Num(time) + " s): particle id " +
-                              std::to_string(state.id[i]) + " has an error estimate (" +
-                              check::Num(h * ex[k]) + " m, " + check::Num(h * ev[k]) +
-                              " m/s) that is not finite; the forces are not finite";
+            fault.message = "particles: in adaptive step " + std::to_string(steps) +
+                            " (from t = " + check::Num(time) + " s): particle id " +
+                            std::to_string(state.id[i]) + " has an error estimate (" +
+                            check::Num(h * ex[k]) + " m, " + check::Num(h * ev[k]) +
+                            " m/s) that is not finite; the forces are not finite";
           }
-          return *fault_;
+          return faults_.Latch(fault);
         }
       }
       err = std::max(err, ei);
     }
     if (err <= 1) {
-      faulted_ = false;
+      faults_.Begin(maxMagnitude);
       if (pairRadius_ > 0) SavePairStart();
       ForChunks(n, [&](size_t b, size_t e) {
         for (size_t i = b; i < e; ++i) Finish(i, X[i], V[i], x_[i], v_[i], h);
@@ -891,8 +939,7 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
         << " s (error norm " << err << "); the forces are too stiff or not finite";
       Diagnostic d = MakeError({}, o.str());
       d.kind = ErrorKind::kRuntime;
-      fault_ = d;
-      return d;
+      return faults_.Latch(d);
     }
   }
   adaptiveStep_ = h;

@@ -41,6 +41,7 @@
 #include "core/status.h"
 #include "particles/collider.h"
 #include "particles/kernels.h"
+#include "particles/particle_core.h"
 
 namespace sylva::particles {
 
@@ -61,10 +62,24 @@ struct ParticleState {
   double time = 0;
   uint64_t step = 0;
 
+  // The first particle added with a bad mass (particle_core.h), for Step.
+  MassRecord massRecord;
+
   size_t size() const { return position.size(); }
-  // Adds a particle of radius 0 (a point: set radius.back() for a ball);
-  // mass 0 or less means immovable (infinite mass).
+  // Adds a particle of radius 0 (a point: set radius.back() for a ball) and
+  // returns its id. mass in (0, 1e30] kg; any other mass (0, negative, NaN)
+  // leaves the particle still and makes the next System::Step an error
+  // naming it: a mass of 0 does not mean immovable, pinning does.
   uint32_t Add(const Vec3& p, const Vec3& v, double mass = 1, double lifetime = 1e300);
+  // Adds an immovable particle (pinned, of mass `mass` kg for the forces
+  // that ask, at rest) and returns its id.
+  uint32_t AddPinned(const Vec3& p, double mass = 1, double lifetime = 1e300);
+  // A pinned particle does not move: its inverse mass is 0, its mass kept.
+  // Unpin gives back the inverse of its mass (a pinned particle of a bad
+  // mass stays an error until it has a mass in range).
+  void Pin(size_t i) { invMass[i] = 0; }
+  void Unpin(size_t i) { invMass[i] = InverseMassOf(mass[i], id[i], &massRecord); }
+  bool pinned(size_t i) const { return invMass[i] == 0; }
 };
 
 // A force adds to f[i] (newtons) for every particle, given positions x and
@@ -93,8 +108,15 @@ class Force {
   // before any work, so an index out of range is a Diagnostic, never a
   // write past the end.
   virtual Status Check(const ParticleState& /*s*/) const { return {}; }
-  // The system hands its thread pool to every force it owns.
+  // After System::RemoveDead: newIndex[i] is the new index of the particle
+  // that was at i, or kRemoved. A force that names particles follows them
+  // and drops what named a removed one.
+  virtual void Renumber(const std::vector<uint32_t>& /*newIndex*/) {}
+  // The pool the force runs on: the system sets it to its own before every
+  // step and clears it when the force is removed or the system destroyed,
+  // so a force kept (shared_ptr) after its system never uses a freed pool.
   void set_pool(ThreadPool* pool) { pool_ = pool; }
+  ThreadPool* pool() const { return pool_; }
 
  protected:
   ThreadPool* pool_ = nullptr;
@@ -118,6 +140,9 @@ class LocalForce : public Force {
 class Gravity : public LocalForce {
  public:
   explicit Gravity(const Vec3& g) : g_(g) {}
+  // Changes g; the next step checks it.
+  void set_g(const Vec3& g) { g_ = g; }
+  const Vec3& g() const { return g_; }
   Status Check(const ParticleState& s) const override;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
@@ -131,6 +156,8 @@ class Gravity : public LocalForce {
 class Drag : public LocalForce {
  public:
   Drag(double linear, double quadratic = 0) : k1_(linear), k2_(quadratic) {}
+  // Changes the coefficients; the next step checks them.
+  void Set(double linear, double quadratic = 0) { k1_ = linear, k2_ = quadratic; }
   Status Check(const ParticleState& s) const override;
   void AccumulateRange(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f, size_t begin,
                        size_t end) const override;
@@ -160,9 +187,11 @@ class Springs : public Force {
   // a Diagnostic and adds nothing. The indices are checked against the
   // state by Check, on every System::Step.
   [[nodiscard]] Status Add(uint32_t a, uint32_t b, double rest, double ks, double kd);
-  // Removes every spring, for a caller that renumbers the particles
-  // (RemoveDead) and adds the springs again at their new indices.
+  // Removes every spring.
   void Clear();
+  // Follows System::RemoveDead: a spring joins the same two particles
+  // (stable ids) at their new indices; one with a removed end goes.
+  void Renumber(const std::vector<uint32_t>& newIndex) override;
   Status Check(const ParticleState& s) const override;
   void Accumulate(const ParticleState& s, const Vec3* x, const Vec3* v, Vec3* f) const override;
   // Baraff & Witkin's spring Jacobian, with the transverse term clamped at
@@ -260,6 +289,12 @@ struct SolveStats {
   double residual = 0;  // |r| / |b| at the end
 };
 
+// Names a force of a System (AddForce): unique over the process, so a
+// handle of another system or of a removed force names nothing.
+struct ForceHandle {
+  uint64_t id = 0;  // 0: none
+};
+
 class System {
  public:
   explicit System(int threads = 1);
@@ -282,7 +317,23 @@ class System {
   // results are the same as with SetThreads of any count.
   void UsePool(ThreadPool* pool);
   int threads() const;
-  void AddForce(std::shared_ptr<Force> f);
+  // Forces. AddForce returns the force's handle (the system shares the
+  // force: the caller may keep its pointer and change the force's
+  // parameters between steps, each checked by the next step). Forces are
+  // evaluated in the order added; ReplaceForce keeps the place.
+  // RemoveForce and ReplaceForce with a handle of a removed force, of
+  // another system or a default one are Diagnostics and change nothing.
+  ForceHandle AddForce(std::shared_ptr<Force> f);
+  [[nodiscard]] Status ReplaceForce(ForceHandle handle, std::shared_ptr<Force> f);
+  [[nodiscard]] Status RemoveForce(ForceHandle handle);
+  // The force of `handle`, or null when it names none of this system's.
+  Force* force(ForceHandle handle) const;
+  size_t forceCount() const { return forces_.size(); }
+  // Removes the particles whose age has reached their lifetime, keeping the
+  // order and ids of the living, and renumbers every force's particles
+  // (Force::Renumber: springs follow their particles, those of a removed
+  // one go). Returns the number removed.
+  size_t RemoveDead();
   // Adds a collider that passes Validate(Collider), else its Diagnostic.
   // One with a velocity moves by h times it after every step (colliders()
   // gives where they are).
@@ -309,7 +360,8 @@ class System {
   // One step of length h: forces, integration, collisions, ageing.
   // h in (0, 1e6] s (NaN, 0, negative: a Diagnostic, nothing moves); the
   // settings above (maxMagnitude 1e-300..1e300, cgTolerance 0..1,
-  // cgMaxIterations 1..1e7) and every force's Check are verified first.
+  // cgMaxIterations 1..1e7), every force's Check and the masses (a bad
+  // mass given to ParticleState::Add, see there) are verified first.
   // Faults are reported as described at the top of this file.
   [[nodiscard]] Status Step(double h, Integrator integrator);
   // Advances by dt with adaptive Dormand-Prince RK45 substeps: dt as h
@@ -347,13 +399,21 @@ class System {
   // Moves every moving collider by h times its velocity (after a step).
   void MoveColliders(double h);
   Status CheckFaults(const char* what);
-  Status CheckStep(const char* what, double h) const;
+  Status CheckStep(const char* what, double h);
+
+  // Hands the pool to every force (before a step) or takes it back.
+  void LendPool();
+  void TakeBackPool(Force& f) const;
+  size_t ForceIndex(ForceHandle handle) const;  // SIZE_MAX: none
+  Status HandleError(const char* what, ForceHandle handle) const;
+  void UpdateLocality();
 
   std::vector<std::shared_ptr<Force>> forces_;
+  std::vector<uint64_t> forceIds_;  // forces_[k]'s handle
+  std::vector<uint32_t> remap_;     // RemoveDead's new indices
   std::vector<Collider> colliders_;
-  std::unique_ptr<ThreadPool> ownPool_;  // SetThreads' pool
-  ThreadPool* pool_ = nullptr;           // the pool in use (own or shared), null: serial
-  int threads_ = 1;
+  PoolChoice pools_;
+  ThreadPool* pool_ = nullptr;  // pools_.pool(): the pool in use (own or shared), null: serial
   bool hasNonLocal_ = false;
   double pairRadius_ = 0, pairRestitution_ = 1;
   std::unique_ptr<NeighbourGrid> pairGrid_;
@@ -371,7 +431,7 @@ class System {
   std::vector<double> pairMove_;     // each particle's displacement over the step
   std::vector<uint32_t> pairStart_;  // particle i's contacts: [start[i], start[i + 1])
   std::vector<PairContact> pairs_;
-  std::optional<Diagnostic> fault_;
+  FaultLatch faults_;
   SolveStats solve_;
   double adaptiveStep_ = 0;
   // Scratch (sized once per particle count).
@@ -379,38 +439,6 @@ class System {
   std::vector<double> mass3_;   // the implicit solver's mass per coordinate
   std::vector<size_t> pinned_;  // and its immovable particles
   kernels::Kernel kernel_ = kernels::Best();
-  std::atomic<bool> faulted_{false};  // set by Finish, read by CheckFaults
-  double limit2_ = 0;                 // maxMagnitude squared (at most DBL_MAX), for Finish
-  // The lowest index of a particle whose contacts were unresolved, or SIZE_MAX.
-  std::atomic<size_t> unresolved_{SIZE_MAX};
 };
-
-// Whether every component of x and v lies in [-limit, limit]. NaN fails:
-// each of the six is compared on its own, never through a maximum (which
-// drops a NaN in y or z).
-inline bool WithinLimit(const Vec3& x, const Vec3& v, double limit) {
-  bool ok = true;
-  for (int k = 0; k < 3; ++k) ok &= std::abs(x[k]) <= limit && std::abs(v[k]) <= limit;
-  return ok;
-}
-
-// A cheap screen for WithinLimit in the per-particle loops: false whenever
-// WithinLimit is (a NaN or infinity makes the sum NaN or infinite, a
-// component beyond the limit makes it exceed limit2), and rarely otherwise;
-// the fault scan then applies WithinLimit itself. limit2 is the limit
-// squared, at most DBL_MAX.
-inline bool MaybeWithinLimit(const Vec3& x, const Vec3& v, double limit2) {
-  return x.squaredNorm() + v.squaredNorm() <= limit2;
-}
-
-// The report of a particle whose position or velocity left the limit (or is
-// not finite), for both particle systems: the step, its start time and the
-// particle's id, position and velocity.
-Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
-                               const Vec3& x, const Vec3& v, double limit);
-// The report of a particle whose contacts RespondToContacts left unresolved
-// (ContactOutcome::kUnresolved), stopped at x.
-Diagnostic UnresolvedContactDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
-                                       const Vec3& x);
 
 }  // namespace sylva::particles

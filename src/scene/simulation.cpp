@@ -305,12 +305,6 @@ struct ParticleSystem {
   std::unique_ptr<LeafStates> leaves;
   double plateK = 0;  // drag along the normal, N s/m
   uint64_t leafSeed = 0;
-  // <springs>: joined by particle id, so a spring survives the renumbering
-  // of RemoveDead; `springs` holds them at the current indices.
-  struct Joint {
-    uint32_t a, b;
-    double rest;
-  };
   // Colliders that are cloth: rebuilt from the sheet before every step.
   struct ClothCollider {
     size_t cloth;     // index into Impl::cloths
@@ -318,14 +312,13 @@ struct ParticleSystem {
     const CollideDef* def;
   };
   std::vector<ClothCollider> clothColliders;
+  // <springs>: the library's Springs, which System::RemoveDead renumbers
+  // (a spring follows its particles; one with a dead end goes).
   const SpringsDef* springsDef = nullptr;
   std::shared_ptr<particles::Springs> springs;
-  std::vector<Joint> joints;
   std::optional<uint32_t> lastBorn;  // chain: the id of the latest birth
   // Joins particle i, just born, as `between` says.
   Status Join(size_t i);
-  // After RemoveDead: the springs of living particles at their new indices.
-  Status Renumber();
   // Turns each leaf by the flow's torque and its spin; new ones get a
   // random orientation and spin, dead ones are forgotten.
   void TurnLeaves(double h, const Wind* wind, double time);
@@ -336,7 +329,6 @@ Status ParticleSystem::Join(size_t i) {
   const SpringsDef& d = *springsDef;
   auto join = [&](size_t j) -> Status {
     const double rest = d.rest.value_or((st.position[i] - st.position[j]).norm());
-    joints.push_back({st.id[j], st.id[i], rest});
     return springs->Add(uint32_t(j), uint32_t(i), rest, d.k, d.damping);
   };
   if (d.between == SpringTopology::kChain) {
@@ -363,25 +355,6 @@ Status ParticleSystem::Join(size_t i) {
     if (Status s = join(j); !s.ok()) return s;
     ++joined;
   }
-  return {};
-}
-
-Status ParticleSystem::Renumber() {
-  const ParticleState& st = system->state;
-  std::unordered_map<uint32_t, uint32_t> index;
-  index.reserve(st.size());
-  for (size_t i = 0; i < st.size(); ++i) index.emplace(st.id[i], uint32_t(i));
-  springs->Clear();
-  size_t kept = 0;
-  for (const Joint& j : joints) {
-    const auto a = index.find(j.a), b = index.find(j.b);
-    if (a == index.end() || b == index.end()) continue;  // an end died: the spring goes
-    joints[kept++] = j;
-    if (Status s = springs->Add(a->second, b->second, j.rest, springsDef->k, springsDef->damping);
-        !s.ok())
-      return s;
-  }
-  joints.resize(kept);
   return {};
 }
 
@@ -770,15 +743,7 @@ Status Simulation::Impl::Step() {
         }
       }
     }
-    const size_t before = st.size();
-    particles::RemoveDead(st);
-    if (ps->springs && st.size() != before) {
-      if (Status s = ps->Renumber(); !s.ok()) {
-        Diagnostic d = s.error();
-        d.loc = ps->springsDef->loc;
-        return d;
-      }
-    }
+    ps->system->RemoveDead();  // springs follow their particles
   }
   for (ClothSheet& c : cloths) {
     for (const ClothSheet::Other& o : c.others) {

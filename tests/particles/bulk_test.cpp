@@ -33,7 +33,12 @@ void Fill(BulkState& s, int n, uint32_t seed, bool pins) {
     const bool resting = i % 4 == 0;
     const Vec3 p(u(rng), resting ? -1 : u(rng), u(rng));
     const Vec3 v(u(rng), resting ? 0 : 3 * u(rng), u(rng));
-    s.Add(p, v, pins && i % 10 == 3 ? 0 : 0.5 + 0.5 * (u(rng) + 1));
+    if (pins && i % 10 == 3) {
+      s.Add(p, v);
+      s.Pin(s.size() - 1);
+    } else {
+      s.Add(p, v, 0.5 + 0.5 * (u(rng) + 1));
+    }
   }
 }
 
@@ -240,7 +245,8 @@ TEST(Bulk, RoundingNeverPutsAParticleThroughAThinPanel) {
 
 TEST(Bulk, ImmovableParticlesStayPutAndAge) {
   BulkSystem b;
-  b.state.Add(Vec3(1, 2, 3), Vec3(5, 5, 5), 0);
+  b.state.Add(Vec3(1, 2, 3), Vec3(5, 5, 5));
+  b.state.Pin(0);
   b.fields.gravity = Vec3(0, -kG, 0);
   b.fields.linearDrag = 1;
   for (int i = 0; i < 10; ++i) BULK_STEP_OK(b, 0.125);

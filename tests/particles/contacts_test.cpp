@@ -197,7 +197,7 @@ TEST(Contact, ContactsBeyondTheBoundAreReportedNotIgnored) {
                                           Collider::Plane(Vec3(0, -0.1, 0), Vec3(0, -1, 0))};
   System s;
   for (const Collider& c : noRoom) ASSERT_OK(s.AddCollider(c));
-  s.state.Add(Vec3(0, 1, 0), Vec3::Zero(), 0);  // immovable: never collides
+  s.state.AddPinned(Vec3(0, 1, 0));  // immovable: never collides
   s.state.Add(Vec3(0, 0.5, 0), Vec3(0, -1, 0), 1);
   const Status st = s.Step(1.0 / 60, Integrator::kSymplecticEuler);
   ASSERT_FALSE(st.ok()) << "the bound of " << kMaxContacts << " contacts was exceeded silently";
@@ -206,7 +206,7 @@ TEST(Contact, ContactsBeyondTheBoundAreReportedNotIgnored) {
   EXPECT_FALSE(s.Step(1.0 / 60, Integrator::kSymplecticEuler).ok()) << "stepped again";
   BulkSystem b;
   for (const Collider& c : noRoom) ASSERT_OK(b.AddCollider(c));
-  b.state.Add(Vec3(0, 1, 0), Vec3::Zero(), 0);
+  b.state.AddPinned(Vec3(0, 1, 0));
   b.state.Add(Vec3(0, 0.5, 0), Vec3(0, -1, 0));
   const Status bs = b.Step(1.0 / 60);
   ASSERT_FALSE(bs.ok()) << "BulkSystem: the bound was exceeded silently";

@@ -47,7 +47,7 @@ T Made(Expected<T> e) {
 // An immovable anchor at the origin (particle 0) and a unit mass at x0 on
 // the x axis (particle 1), joined by an undamped spring.
 inline void AddAnchoredSpring(System& s, double x0, double rest, double ks) {
-  s.state.Add(Vec3::Zero(), Vec3::Zero(), 0);
+  s.state.AddPinned(Vec3::Zero());
   s.state.Add(Vec3(x0, 0, 0), Vec3::Zero(), 1);
   auto springs = std::make_shared<Springs>();
   const Status added = springs->Add(1, 0, rest, ks, 0.0);

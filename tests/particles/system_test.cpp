@@ -55,7 +55,7 @@ double Energy(const System& s, double ks) {
 TEST(Integrators, SymplecticEulerKeepsEnergyWhereExplicitEulerDiverges) {
   for (Integrator in : {Integrator::kSymplecticEuler, Integrator::kExplicitEuler}) {
     System s;
-    s.state.Add(Vec3(0, 0, 0), Vec3::Zero(), 0);
+    s.state.AddPinned(Vec3(0, 0, 0));
     s.state.Add(Vec3(1, 0, 0), Vec3::Zero(), 1);
     auto springs = std::make_shared<Springs>();
     EXPECT_OK(springs->Add(1, 0, 0.0, 1.0, 0.0));
@@ -88,7 +88,7 @@ TEST(Forces, DampedSpringOscillatesAtItsDampedFrequency) {
   // m x'' = -ks x - kd x': omega_d = sqrt(ks/m - (kd / 2m)^2).
   const double ks = 100, kd = 2, m = 1;
   System s;
-  s.state.Add(Vec3(0, 0, 0), Vec3::Zero(), 0);
+  s.state.AddPinned(Vec3(0, 0, 0));
   s.state.Add(Vec3(1, 0, 0), Vec3::Zero(), m);
   auto springs = std::make_shared<Springs>();
   EXPECT_OK(springs->Add(1, 0, 0.0, ks, kd));
@@ -196,7 +196,8 @@ TEST(Collisions, FrictionKeepsTheNormalBounceAndSlowsTheTangent) {
 
 TEST(State, ImmovableParticlesStayPut) {
   System s;
-  s.state.Add(Vec3(1, 2, 3), Vec3(5, 5, 5), 0);
+  s.state.Add(Vec3(1, 2, 3), Vec3(5, 5, 5));
+  s.state.Pin(0);
   s.AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
   for (int i = 0; i < 10; ++i) ASSERT_TRUE(s.Step(0.1, Integrator::kRK4).ok());
   EXPECT_EQ(s.state.position[0], Vec3(1, 2, 3));
