@@ -11,10 +11,14 @@ struct Command {
 
 // cpfg's @ commands that Sylva lexes but does not draw.
 constexpr Command kUndrawn[] = {
-    {"@PS", "bicubic patch"},     {"@PD", "bicubic patch"},
-    {"@Sx", "surface command"},   {"@m", "move-to with drawing"},
-    {"@R", "set heading and up"}, {"@D", "scale factor"},
-    {"@i", "interpolation"},      {"@L", "label"},
+    {"@PS", "bicubic patch"},
+    {"@PD", "bicubic patch"},
+    {"@Sx", "surface command"},
+    {"@m", "move-to with drawing"},
+    {"@R", "set heading and up"},
+    {"@D", "scale factor"},
+    {"@i", "interpolation"},
+    {"@L", "label"},
     {"@b", "bounding box"},
     {"@Tx", "texture"},
     {"@#", "generalized cylinder contour"},
