@@ -99,8 +99,8 @@ void ExpectSameMesh(const TriangleMesh& a, const TriangleMesh& b, const std::str
   EXPECT_TRUE(a.coverage == b.coverage) << what;
   size_t differ = 0;
   for (size_t i = 0; i < a.vertexCount(); ++i) {
-    differ += !(a.positions[i] == b.positions[i] && a.normals[i] == b.normals[i] &&
-                a.uvs[i] == b.uvs[i]);
+    differ +=
+        !(a.positions[i] == b.positions[i] && a.normals[i] == b.normals[i] && a.uvs[i] == b.uvs[i]);
   }
   EXPECT_EQ(differ, 0u) << what << ": vertices that differ";
 }
