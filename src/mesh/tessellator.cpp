@@ -151,7 +151,8 @@ struct ChainPlan {
 // and radius) and the colour does not change there; caps only on tubes
 // at least a pixel wide.
 void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
-               const ScreenView& view, bool shadowOnly, int16_t* last, ChainPlan& plan) {
+               const ScreenView& view, bool shadowOnly, int16_t* last, uint16_t* lastRings,
+               ChainPlan& plan) {
   const size_t m = chain.size();
   std::vector<double> ppu(m + 1);
   double rPx = 0;
@@ -176,7 +177,7 @@ void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const
   if (m < 2) return;
   const double budget = view.eps / 2;
   constexpr size_t kMaxSpan = 64;
-  auto fits = [&](size_t a, size_t b) {
+  auto fits = [&](size_t a, size_t b, double tolerance) {
     const Vec3 d = f.P[b] - f.P[a];
     const double len2 = d.dot(d);
     for (size_t i = a + 1; i < b; ++i) {
@@ -185,17 +186,47 @@ void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const
       const double t = len2 > 0 ? std::clamp(q.dot(d) / len2, 0.0, 1.0) : 0.0;
       const double off = (q - t * d).norm();
       const double dr = std::abs(f.R[i] - (f.R[a] + t * (f.R[b] - f.R[a])));
-      if (!((off + dr) * ppu[i] <= budget)) return false;
+      if (!((off + dr) * ppu[i] <= tolerance)) return false;
     }
     return true;
   };
-  plan.joints.push_back(0);
-  size_t a = 0;
-  while (a < m) {
-    size_t b = a + 1;
-    while (b < m && b + 1 - a <= kMaxSpan && fits(a, b + 1)) ++b;
-    plan.joints.push_back(uint32_t(b));
-    a = b;
+  // The joints kept at a tolerance (pixels): greedy, each span as long as fits.
+  auto keep = [&](double tolerance, std::vector<uint32_t>& joints) {
+    joints.assign(1, 0);
+    size_t a = 0;
+    while (a < m) {
+      size_t b = a + 1;
+      while (b < m && b + 1 - a <= kMaxSpan && fits(a, b + 1, tolerance)) ++b;
+      joints.push_back(uint32_t(b));
+      a = b;
+    }
+    return joints.size();
+  };
+  const size_t coarse = keep(budget, plan.joints);
+  if (lastRings && !shadowOnly) {
+    // Hysteresis for the rings (as for the level): fewer rings than last
+    // frame only down to what a tolerance kHysteresis tighter keeps, and
+    // between the two the fewest rings at least as many as last frame's,
+    // by bisection on the tolerance. Never more error than eps / 2.
+    const size_t last = *lastRings;
+    if (last > coarse) {
+      std::vector<uint32_t> fine, mid;
+      const size_t most = keep(budget / (1 + kHysteresis), fine);
+      if (last < most) {
+        double lo = 0, hi = 1;  // exponents of the tightening; count(lo) < last <= count(hi)
+        for (int k = 0; k < 8; ++k) {
+          const double t = (lo + hi) / 2;
+          if (keep(budget / std::pow(1 + kHysteresis, t), mid) >= last) {
+            hi = t;
+            fine = mid;
+          } else {
+            lo = t;
+          }
+        }
+      }
+      plan.joints.swap(fine);
+    }
+    *lastRings = uint16_t(std::min<size_t>(plan.joints.size(), UINT16_MAX));
   }
   if (plan.joints.size() == m + 1) plan.joints.clear();  // every joint kept
 }
@@ -624,7 +655,10 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   // Choose every chain's detail first, so the arrays are sized exactly once.
   std::vector<ChainPlan> plans(nc);
   DetailHistory* history = view ? options.history : nullptr;
-  if (history && history->level.size() != nc) history->level.assign(nc, -1);
+  if (history && (history->level.size() != nc || history->rings.size() != nc)) {
+    history->level.assign(nc, -1);
+    history->rings.assign(nc, 0);
+  }
   auto plan = [&](size_t c, ChainFrames& frames) {
     const auto& chain = chains[c];
     double rmax = 0;
@@ -633,7 +667,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     if (view) {
       BuildFrames(g, chain, frames, FramePart::kAxis);
       PlanChain(g, chain, frames, *view, shadowOnly(c), history ? &history->level[c] : nullptr,
-                plans[c]);
+                history ? &history->rings[c] : nullptr, plans[c]);
       return;
     }
     Vec3 lo = g.segments[chain[0]].start, hi = lo;
