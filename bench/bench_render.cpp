@@ -3,10 +3,15 @@
 // (Mesa llvmpipe on machines with no GPU). One iteration = Draw + Finish.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
+#include <memory>
 #include <random>
 #include <string>
 
 #include "core/parallel.h"
+#include "draw/draw_list.h"
+#include "mesh/export.h"
 #include "mesh/tessellator.h"
 #include "plant/plant.h"
 #include "render/camera.h"
@@ -152,6 +157,80 @@ BENCHMARK(BM_TessellateScreenSpaceCoverage)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// The viewer's mesh swap (issue 15: no frame blocked over 50 ms): ABOP
+// 2.6a at n = 15 or 20 tessellated for two views of a 640x360 window
+// (screen-space detail with coverage, shadows 2048), drawn in a DrawList
+// with a sun. Frames, each waited for (Finish):
+//   mode 0: the shown mesh drawn again (a plain frame);
+//   mode 1: a new mesh drawn at once (upload and shadow pass in one frame);
+//   mode 2: a new mesh staged (Renderer::Stage, 8 MB and a shadow band a
+//           frame) while the shown one is drawn, then shown.
+// Counters: the mean and the slowest frame (ms).
+void BM_ViewerSwap(benchmark::State& state) {
+  const int n = int(state.range(0)), mode = int(state.range(1));
+  const int W = 640, H = 360;
+  plant::PlantSpec spec;
+  spec.path = std::string(SYLVA_SOURCE_DIR) + "/grammars/abop/fig2_06a_monopodial.lsys";
+  spec.steps = n;
+  spec.until = plant::Stage::kGeometry;
+  const mesh::PlantGeometry geometry = std::move(plant::BuildPlant(spec).plant->geometry);
+  const mesh::Box box = mesh::TessellatedBounds(geometry, nullptr);
+  Gl& gl = Context();
+  (void)gl.renderer->Resize(W, H);
+  gl.renderer->SetShadowMapSize(2048);
+  draw::DrawList lists[2];
+  render::Camera cams[2];
+  for (int k = 0; k < 2; ++k) {
+    cams[k] = render::Camera::Frame(box.lo, box.hi, double(W) / H, 30 + 3 * k, 12, false);
+    mesh::TessellateOptions opt;
+    opt.view = mesh::ScreenView{cams[k].ViewProjection(double(W) / H), W, H, 0.5};
+    opt.view->coverage = true;
+    auto m = std::make_shared<mesh::TriangleMesh>();
+    (void)mesh::Tessellate(geometry, opt, *m);
+    draw::MeshDraw d;
+    d.mesh = m;
+    d.palette = mesh::DefaultPalette();
+    d.instances.push_back({});
+    lists[k].meshes.push_back(d);
+    lists[k].lights = draw::DefaultLights();
+    lists[k].shadowBounds = std::pair{box.lo, box.hi};
+  }
+  int shown = 0;
+  (void)gl.renderer->Draw(lists[shown], cams[shown]);
+  gl.renderer->Finish();
+  bool staged = false;
+  double slowest = 0, sum = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (mode == 1) {
+      shown = 1 - shown;
+    } else if (mode == 2) {
+      if (staged) {
+        shown = 1 - shown;
+        staged = false;
+      } else {
+        staged = gl.renderer->Stage(lists[1 - shown], size_t(8) << 20).value();
+      }
+    }
+    (void)gl.renderer->Draw(lists[shown], cams[shown]);
+    gl.renderer->Finish();
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    state.SetIterationTime(s);
+    slowest = std::max(slowest, s * 1e3);
+    sum += s * 1e3;
+  }
+  state.counters["slowest_ms"] = slowest;
+  state.counters["mean_ms"] = sum / double(state.iterations());
+  state.counters["triangles"] = double(lists[0].meshes[0].mesh->triangleCount());
+  (void)gl.renderer->Resize(1920, 1080);
+  gl.renderer->SetShadowMapSize(render::Renderer::kDefaultShadowMapSize);
+}
+BENCHMARK(BM_ViewerSwap)
+    ->ArgsProduct({{15, 20}, {0, 1, 2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime()
+    ->Iterations(16);
 
 }  // namespace
 

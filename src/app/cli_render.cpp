@@ -320,12 +320,7 @@ int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err)
   if (!camera) return Report(camera.error(), err);
   if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
   spec->view = ViewOf(*camera, v.width, v.height, eps);
-  DiagnosticList warnings;
-  Status s = plant::Tessellate(*plant, *spec, warnings);
-  exit = Report(warnings, err, cmd.derive.maxErrors, cmd.derive.strict);
-  if (!s.ok()) return Report(s.error(), err);
-  if (exit != kExitOk) return exit;
-  return WriteMeshOf(cmd, *plant, err);
+  return TessellateAndWrite(cmd, *plant, *spec, err);
 }
 
 }  // namespace sylva::app

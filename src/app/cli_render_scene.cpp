@@ -82,8 +82,11 @@ int RunRenderScene(const RenderCommand& cmd, std::ostream& out, std::ostream& er
   size_t staticTriangles = built->trianglesDrawn;
   if (!cmd.sides) {
     DiagnosticList detailWarnings;
-    auto drawn =
-        scene::DetailForView(*built, ViewOf(camera, width, height, lodEps), detailWarnings);
+    mesh::ScreenView view = ViewOf(camera, width, height, lodEps);
+    // Twigs under a pixel fade as coverage lines, leaves under a pixel as
+    // points (the DrawList pipeline blends them), as for a grammar.
+    view.coverage = true;
+    auto drawn = scene::DetailForView(*built, view, detailWarnings);
     exit = Report(detailWarnings, err, cmd.derive.maxErrors, cmd.derive.strict);
     if (exit != kExitOk) return exit;
     if (!drawn) return Report(drawn.error(), err);

@@ -79,8 +79,11 @@ bool ParseCamera(const std::string& s, double v[3]);
 int RunMesh(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 // `sylva mesh --lod-eps` (sylva-graphics: the view is framed by render::Camera).
 int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
-// Writes plant.mesh to cmd.output and its summary to `err` (both mesh runners).
-int WriteMeshOf(const MeshCommand& cmd, const plant::Plant& plant, std::ostream& err);
+// Tessellates plant (built to its geometry) at spec's detail into
+// cmd.output and prints its summary to `err` (both mesh runners); a .glb
+// is streamed (mesh::WriteGlbStreamed), never holding the whole mesh.
+int TessellateAndWrite(const MeshCommand& cmd, plant::Plant& plant, const plant::PlantSpec& spec,
+                       std::ostream& err);
 // `sylva mesh scene.xml` (cli_mesh_scene.cpp): glTF with instances as nodes.
 int RunMeshScene(const MeshCommand& cmd, std::ostream& out, std::ostream& err);
 

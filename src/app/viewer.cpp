@@ -50,6 +50,9 @@ using Clock = std::chrono::steady_clock;
 // The viewer's shadow map (Renderer::SetShadowMapSize): smaller than
 // `sylva render`'s, for cheaper shadow samples.
 constexpr int kViewerShadowMapSize = 2048;
+// A re-tessellated mesh goes to the GPU at most this many bytes a frame
+// (Renderer::Stage), so its upload never stalls one frame.
+constexpr size_t kUploadBytesPerFrame = size_t(8) << 20;
 
 struct Job {
   uint64_t id = 0;
@@ -434,6 +437,10 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   (*renderer)->SetShadowMapSize(kViewerShadowMapSize);  // interactive: cheaper shadow samples
   // The default scene of the plant shown (a ground plane, the default lights).
   draw::DrawList drawn;
+  // A new tessellation on its way to the GPU (Renderer::Stage), and its scene.
+  std::optional<Result> pending, queued;  // queued: the next, while `pending` uploads
+  draw::DrawList pendingScene;
+  bool pendingUploaded = false;  // Stage() completed: shown from the next frame
 
   int exitCode = kExitOk;
   WorkerState state;  // the worker's alone; outlives it
@@ -452,7 +459,15 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   int retessellations = 0;
   uint64_t reportedFailure = 0;  // the job id of the last failed build reported
   double slowestFrameMs = 0, slowestSwapMs = 0;
+  // Of the swap: the slowest frame that uploads a slice of a new mesh, and
+  // the slowest that first shows one (its extra Draw time included).
+  double slowestSliceMs = 0, slowestShowMs = 0;
+  // Draw time (with the swap's work) of frames plain, uploading a slice,
+  // and showing a new mesh: their means compare robustly on a busy machine.
+  double drawSum[3] = {0, 0, 0};
+  int drawCount[3] = {0, 0, 0};
   std::optional<double> plainDrawMs;  // the last Draw of a frame without a new mesh
+  std::optional<double> lastPlainMs;  // the last Draw of a frame without any swap work
   auto post = [&] {
     job.id = nextId++;
     job.camera = framed ? std::optional<render::Camera>(camera) : std::nullopt;
@@ -482,11 +497,15 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
         post();
       }
     }
-    // The time a new mesh costs this thread (set when one came): building its
-    // scene, and its upload in the next Draw.
+    // The time a new mesh costs this thread in this frame: building its
+    // scene, a slice of its upload (Renderer::Stage), and in the frame that
+    // shows it what its Draw takes beyond a plain one.
     std::optional<double> swapMs;
     bool newScene = false;  // also the first mesh, which replaces none (not timed)
-    if (auto r = worker.Take()) {
+    std::optional<Result> taken = worker.Take();
+    bool staged = false;  // taken's scene is pendingScene, already on the GPU
+    if (auto& r = taken) {
+      // Diagnostics when they arrive (a mesh may be shown frames later).
       shown.diagnostics = r->diagnostics;
       // Report each failed build once, also when a newer view of the last
       // good plant (stale) overtook the failure itself.
@@ -495,6 +514,40 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
         err << "sylva view: the grammar has errors; keeping the last good plant\n"
             << shown.diagnostics;
       }
+    }
+    if (taken && taken->ok && shown.plant && !taken->lines && !lines) {
+      // A new tessellation of the plant shown: uploaded in slices over the
+      // next frames while the shown one is drawn, then swapped in. One
+      // arriving meanwhile waits (the newest only), so uploads finish.
+      queued = std::move(taken);
+      taken.reset();
+    }
+    if (!pending && queued) {
+      const auto t = Clock::now();
+      pendingScene = SceneOf(*queued);
+      pending = std::move(queued);
+      queued.reset();
+      pendingUploaded = false;
+      swapMs = std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    }
+    if (pending && pendingUploaded) {
+      // Uploaded by the last frame: shown from this one.
+      taken = std::move(pending);
+      pending.reset();
+      pendingUploaded = false;
+      staged = true;
+    } else if (pending) {
+      const auto t = Clock::now();
+      auto done = (*renderer)->Stage(pendingScene, kUploadBytesPerFrame);
+      if (!done) {
+        exitCode = Report(done.error(), err);
+        break;
+      }
+      swapMs =
+          swapMs.value_or(0) + std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+      pendingUploaded = *done;
+    }
+    if (auto& r = taken) {
       if (r->ok) {
         shown.constants = r->constants;
         for (const auto& [name, value] : r->constants)
@@ -504,12 +557,13 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
         shown.id = r->id;
         const bool wasLines = lines;
         lines = r->lines.has_value();
-        // The only work a new tessellation costs this thread: the upload
-        // (in the next Draw).
+        // A first mesh, or a 2D figure: its scene, uploaded whole in the
+        // next Draw (the first, replacing none, is not timed).
         const auto swapStart = Clock::now();
-        drawn = SceneOf(*r);
+        drawn = staged ? std::move(pendingScene) : SceneOf(*r);
         if (shown.plant)
-          swapMs = std::chrono::duration<double, std::milli>(Clock::now() - swapStart).count();
+          swapMs = swapMs.value_or(0) +
+                   std::chrono::duration<double, std::milli>(Clock::now() - swapStart).count();
         newScene = true;
         if (!framed) {
           // The view the mesh was tessellated for: `sylva render`'s framing.
@@ -572,7 +626,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
                        camera.elevation);
     // Re-tessellate in the background once the camera has moved far
     // enough, one job at a time; the shown mesh is drawn meanwhile.
-    if (retessellate && !worker.Busy() && MovedFarEnough(camera, posted)) {
+    if (retessellate && !worker.Busy() && !pending && !queued && MovedFarEnough(camera, posted)) {
       post();
       ++retessellations;
     }
@@ -583,14 +637,28 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
       exitCode = Report(s.error(), err);
       break;
     }
+    // Measuring (--frames): wait for the GPU, so drawMs holds the drawing
+    // itself (a new mesh's shadow pass included), not only its commands.
+    if (cmd.frames > 0) (*renderer)->Finish();
     const double drawMs =
         std::chrono::duration<double, std::milli>(Clock::now() - drawStart).count();
     // The upload is what the frame with a new mesh draws longer than the
     // last frame without one (the first mesh has none to compare with).
+    if (!newScene && !swapMs) lastPlainMs = drawMs;
     if (!newScene) {
       plainDrawMs = drawMs;
+      // A slice of an upload (and of the next shadow map): its work and
+      // what its Draw took beyond the last plain one.
+      if (swapMs && lastPlainMs)
+        slowestSliceMs = std::max(slowestSliceMs, *swapMs + std::max(0.0, drawMs - *lastPlainMs));
     } else if (swapMs && plainDrawMs) {
-      slowestSwapMs = std::max(slowestSwapMs, *swapMs + std::max(0.0, drawMs - *plainDrawMs));
+      slowestShowMs = std::max(slowestShowMs, *swapMs + std::max(0.0, drawMs - *plainDrawMs));
+    }
+    slowestSwapMs = std::max(slowestSliceMs, slowestShowMs);
+    if (frame > 1) {  // past the first mesh's frames
+      const int kind = newScene ? 2 : swapMs ? 1 : 0;
+      drawSum[kind] += drawMs + swapMs.value_or(0);
+      ++drawCount[kind];
     }
     (*renderer)->PresentToWindow(fbw, fbh);
     glViewport(0, 0, fbw, fbh);
@@ -625,11 +693,15 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     }
   }
   if (cmd.frames > 0) {
-    char line[256];
+    auto mean = [&](int k) { return drawCount[k] ? drawSum[k] / drawCount[k] : 0.0; };
+    char line[400];
     std::snprintf(line, sizeof line,
                   "frames: %d, re-tessellations: %d, slowest frame: %.1f ms, slowest mesh swap: "
-                  "%.1f ms\n",
-                  frame, retessellations, slowestFrameMs, slowestSwapMs);
+                  "%.1f ms (upload slice %.1f ms, first frame shown %.1f ms); mean draw: plain "
+                  "%.1f ms (%d), uploading %.1f ms (%d), showing a new mesh %.1f ms (%d)\n",
+                  frame, retessellations, slowestFrameMs, slowestSwapMs, slowestSliceMs,
+                  slowestShowMs, mean(0), drawCount[0], mean(1), drawCount[1], mean(2),
+                  drawCount[2]);
     out << line;
   }
   return exitCode;

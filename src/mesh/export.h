@@ -8,6 +8,7 @@
 // the grammar sets none.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,23 @@ Status WriteObj(const TriangleMesh& m, const Palette& palette, const std::string
 Status WritePly(const TriangleMesh& m, const Palette& palette, const std::string& path);
 Status WriteGltf(const TriangleMesh& m, const Palette& palette, const std::string& path,
                  bool binary);
+// A .glb written while it is tessellated, never holding the whole mesh:
+// `tessellate` is called once with a stream to pass on as
+// TessellateOptions::stream (mesh/tessellator.h), and each piece goes to
+// the file as it comes (peak memory: a piece, about 1 M vertices). The BIN
+// chunk is byte for byte WriteGltf's for the same mesh; the JSON chunk is
+// its text followed by more padding spaces (its room is reserved before
+// the bounds are known). A piece with a non-finite value stops the write
+// and leaves no file. A FIFO or device, which cannot seek, gets the pieces
+// gathered and WriteGltf. `counts` (may be null): what was written.
+struct MeshCounts {
+  size_t vertices = 0, triangles = 0;
+};
+struct MeshStream;
+Status WriteGlbStreamed(const Palette& palette, const std::string& path,
+                        const std::function<Status(const MeshStream&)>& tessellate,
+                        MeshCounts* counts = nullptr);
+
 // By extension.
 Status WriteMesh(const TriangleMesh& m, const Palette& palette, const std::string& path);
 

@@ -77,8 +77,11 @@ int ChainLevelAfter(int last, double radiusPx, double eps, bool coverage);
 // The level each chain of one geometry had in the last frame, for
 // TessellateOptions::history: index c is the c-th chain in Tessellate's
 // order (a different geometry resets it). -1: not drawn yet.
+// rings[c]: the rings it kept along its axis (0: none yet); a curved
+// chain keeps fewer only once a tolerance kHysteresis tighter allows it.
 struct DetailHistory {
   std::vector<int16_t> level;
+  std::vector<uint16_t> rings;
 };
 
 // The fewest sides (3..256) whose chord error r (1 - cos(pi/n)) is at most

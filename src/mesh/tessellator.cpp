@@ -5,6 +5,7 @@
 #include <optional>
 #include <type_traits>
 
+#include "core/assert.h"
 #include "core/memory.h"
 #include "core/parallel.h"
 #include "mesh/screen_detail.h"
@@ -150,7 +151,8 @@ struct ChainPlan {
 // and radius) and the colour does not change there; caps only on tubes
 // at least a pixel wide.
 void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
-               const ScreenView& view, bool shadowOnly, int16_t* last, ChainPlan& plan) {
+               const ScreenView& view, bool shadowOnly, int16_t* last, uint16_t* lastRings,
+               ChainPlan& plan) {
   const size_t m = chain.size();
   std::vector<double> ppu(m + 1);
   double rPx = 0;
@@ -175,7 +177,7 @@ void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const
   if (m < 2) return;
   const double budget = view.eps / 2;
   constexpr size_t kMaxSpan = 64;
-  auto fits = [&](size_t a, size_t b) {
+  auto fits = [&](size_t a, size_t b, double tolerance) {
     const Vec3 d = f.P[b] - f.P[a];
     const double len2 = d.dot(d);
     for (size_t i = a + 1; i < b; ++i) {
@@ -184,17 +186,47 @@ void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const
       const double t = len2 > 0 ? std::clamp(q.dot(d) / len2, 0.0, 1.0) : 0.0;
       const double off = (q - t * d).norm();
       const double dr = std::abs(f.R[i] - (f.R[a] + t * (f.R[b] - f.R[a])));
-      if (!((off + dr) * ppu[i] <= budget)) return false;
+      if (!((off + dr) * ppu[i] <= tolerance)) return false;
     }
     return true;
   };
-  plan.joints.push_back(0);
-  size_t a = 0;
-  while (a < m) {
-    size_t b = a + 1;
-    while (b < m && b + 1 - a <= kMaxSpan && fits(a, b + 1)) ++b;
-    plan.joints.push_back(uint32_t(b));
-    a = b;
+  // The joints kept at a tolerance (pixels): greedy, each span as long as fits.
+  auto keep = [&](double tolerance, std::vector<uint32_t>& joints) {
+    joints.assign(1, 0);
+    size_t a = 0;
+    while (a < m) {
+      size_t b = a + 1;
+      while (b < m && b + 1 - a <= kMaxSpan && fits(a, b + 1, tolerance)) ++b;
+      joints.push_back(uint32_t(b));
+      a = b;
+    }
+    return joints.size();
+  };
+  const size_t coarse = keep(budget, plan.joints);
+  if (lastRings && !shadowOnly) {
+    // Hysteresis for the rings (as for the level): fewer rings than last
+    // frame only down to what a tolerance kHysteresis tighter keeps, and
+    // between the two the fewest rings at least as many as last frame's,
+    // by bisection on the tolerance. Never more error than eps / 2.
+    const size_t last = *lastRings;
+    if (last > coarse) {
+      std::vector<uint32_t> fine, mid;
+      const size_t most = keep(budget / (1 + kHysteresis), fine);
+      if (last < most) {
+        double lo = 0, hi = 1;  // exponents of the tightening; count(lo) < last <= count(hi)
+        for (int k = 0; k < 8; ++k) {
+          const double t = (lo + hi) / 2;
+          if (keep(budget / std::pow(1 + kHysteresis, t), mid) >= last) {
+            hi = t;
+            fine = mid;
+          } else {
+            lo = t;
+          }
+        }
+      }
+      plan.joints.swap(fine);
+    }
+    *lastRings = uint16_t(std::min<size_t>(plan.joints.size(), UINT16_MAX));
   }
   if (plan.joints.size() == m + 1) plan.joints.clear();  // every joint kept
 }
@@ -457,6 +489,72 @@ void TessellateSphere(const Sphere& s, int sides, TriangleMesh& out) {
   }
 }
 
+// Tessellate's stream path (MeshStream): spheres, polygons and surfaces
+// first (small; the totals must be known before the first piece), the
+// triangles per material from the plans, then the chains in pieces of
+// about stream.pieceVertices vertices, then the rest. The pieces are the
+// mesh Tessellate would append to an empty mesh, cut between chains.
+template <typename EmitChains, typename EmitRest>
+Status StreamMesh(const MeshStream& stream, const PlantGeometry& g,
+                  const std::vector<std::vector<uint32_t>>& chains,
+                  const std::vector<ChainPlan>& plans, const std::vector<size_t>& vOffset,
+                  const std::vector<size_t>& tOffset, bool coverage, EmitChains& emitChains,
+                  EmitRest& emitRest, TriangleMesh& piece) {
+  SYLVA_ASSERT(piece.positions.empty() && piece.indices.empty());
+  const size_t nc = chains.size();
+  TriangleMesh rest;
+  emitRest(rest);
+  if (coverage) rest.coverage.resize(rest.positions.size(), 1.0f);
+  std::vector<size_t> perMaterial;
+  auto count = [&](uint16_t m, size_t n) {
+    if (m >= perMaterial.size()) perMaterial.resize(size_t(m) + 1, 0);
+    perMaterial[m] += n;
+  };
+  // As EmitChain and EmitRibbon assign materials: a span takes the colour
+  // of the segment at its first ring, a cap that of its end segment.
+  for (size_t c = 0; c < nc; ++c) {
+    const ChainPlan& p = plans[c];
+    if (!p.sides) continue;
+    const std::vector<uint32_t>& chain = chains[c];
+    const size_t m = chain.size(), K = p.rings(m);
+    const size_t perSpan = p.ribbon ? 2 : 2 * size_t(p.sides);
+    for (size_t r = 0; r + 1 < K; ++r) {
+      count(g.segments[chain[p.joints.empty() ? r : size_t(p.joints[r])]].color, perSpan);
+    }
+    if (!p.ribbon && p.caps) {
+      count(g.segments[chain[0]].color, size_t(p.sides));
+      count(g.segments[chain[m - 1]].color, size_t(p.sides));
+    }
+  }
+  for (uint16_t m : rest.material) count(m, 1);
+  const size_t chainVerts = vOffset[nc];
+  if (Status s = stream.begin(chainVerts + rest.vertexCount(), perMaterial); !s.ok()) return s;
+  for (size_t c0 = 0; c0 < nc;) {
+    size_t c1 = c0 + 1;
+    while (c1 < nc && vOffset[c1] - vOffset[c0] < stream.pieceVertices) ++c1;
+    const size_t nv = vOffset[c1] - vOffset[c0], nt = tOffset[c1] - tOffset[c0];
+    piece.positions.resize(nv);
+    piece.normals.resize(nv);
+    piece.uvs.resize(nv);
+    piece.indices.resize(3 * nt);
+    piece.material.resize(nt);
+    if (coverage) piece.coverage.assign(nv, 1.0f);
+    emitChains(c0, c1, 0, 0, piece);
+    const uint32_t shift = uint32_t(vOffset[c0]);
+    for (uint32_t& i : piece.indices) i += shift;
+    if (nv > 0 || nt > 0) {
+      if (Status s = stream.piece(piece, vOffset[c0]); !s.ok()) return s;
+    }
+    c0 = c1;
+  }
+  piece.Clear();
+  if (rest.vertexCount() > 0 || !rest.indices.empty()) {
+    for (uint32_t& i : rest.indices) i += uint32_t(chainVerts);
+    if (Status s = stream.piece(rest, chainVerts); !s.ok()) return s;
+  }
+  return {};
+}
+
 }  // namespace
 
 Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
@@ -557,7 +655,10 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   // Choose every chain's detail first, so the arrays are sized exactly once.
   std::vector<ChainPlan> plans(nc);
   DetailHistory* history = view ? options.history : nullptr;
-  if (history && history->level.size() != nc) history->level.assign(nc, -1);
+  if (history && (history->level.size() != nc || history->rings.size() != nc)) {
+    history->level.assign(nc, -1);
+    history->rings.assign(nc, 0);
+  }
   auto plan = [&](size_t c, ChainFrames& frames) {
     const auto& chain = chains[c];
     double rmax = 0;
@@ -566,7 +667,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     if (view) {
       BuildFrames(g, chain, frames, FramePart::kAxis);
       PlanChain(g, chain, frames, *view, shadowOnly(c), history ? &history->level[c] : nullptr,
-                plans[c]);
+                history ? &history->rings[c] : nullptr, plans[c]);
       return;
     }
     Vec3 lo = g.segments[chain[0]].start, hi = lo;
@@ -645,6 +746,109 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
         "; lower the derivation length (-n) or the sides (--sides), or raise --max-triangles";
     return d;
   }
+  // Chains [first, last) written into `dst` (in parallel), chain `first`'s
+  // vertices at vAt and its triangles at tAt, the others after it.
+  auto emitChains = [&](size_t first, size_t last, size_t vAt, size_t tAt, TriangleMesh& dst) {
+    const size_t vShift = vOffset[first] - vAt, tShift = tOffset[first] - tAt;
+    ForRanges(options.pool, last - first, BalancedGrain(options.pool, last - first, 256),
+              [&](size_t begin, size_t end) {
+                ChainFrames frames;
+                for (size_t c = first + begin; c < first + end; ++c) {
+                  if (!plans[c].sides) continue;
+                  BuildFrames(g, chains[c], frames,
+                              plans[c].ribbon ? FramePart::kTangents : FramePart::kAll);
+                  if (plans[c].ribbon) {
+                    EmitRibbon(g, chains[c], frames, plans[c], *view, vOffset[c] - vShift,
+                               tOffset[c] - tShift, dst);
+                    continue;
+                  }
+                  EmitChain(g, chains[c], frames, plans[c], vOffset[c] - vShift,
+                            tOffset[c] - tShift, dst);
+                }
+              });
+  };
+  // Spheres, polygons and surfaces, appended to `dst`.
+  auto emitRest = [&](TriangleMesh& dst) {
+    for (size_t i = 0; i < ns; ++i) {
+      if (sphereSides[i]) TessellateSphere(g.spheres[i], sphereSides[i], dst);
+    }
+    for (size_t i = 0; i < np; ++i) {
+      const Polygon& poly = g.polygons[i];
+      if (!shown(nc + ns + i)) continue;
+      if (points[i].coverage > 0) {
+        EmitPoint(points[i], poly.color, dst);
+        continue;
+      }
+      Vec3 normal;
+      std::vector<uint32_t> polyTris = TriangulatePolygon(poly.vertices, &normal);
+      if (polyTris.empty()) {
+        if (stats) {
+          ++stats->polygonsSkipped;
+          stats->warnings.push_back(
+              "polygon at module " + std::to_string(poly.module + 1) +
+              " is degenerate, crosses itself or is too complex to triangulate; skipped");
+        }
+        continue;
+      }
+      const Vec3 e1 = AnyPerpendicular(normal), e2 = normal.cross(e1);
+      Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
+      for (const Vec3& v : poly.vertices) {
+        Vec2 q(v.dot(e1), v.dot(e2));
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+      }
+      const Vec2 ext = (hi - lo).cwiseMax(Vec2(1e-12, 1e-12));
+      const uint32_t base = uint32_t(dst.positions.size());
+      for (const Vec3& v : poly.vertices) {
+        dst.positions.push_back(F(v));
+        dst.normals.push_back(F(normal));
+        Vec2 q((v.dot(e1) - lo.x()) / ext.x(), (v.dot(e2) - lo.y()) / ext.y());
+        dst.uvs.push_back(q.cast<float>());
+      }
+      for (size_t t = 0; t < polyTris.size(); t += 3) {
+        dst.indices.insert(dst.indices.end(),
+                           {base + polyTris[t], base + polyTris[t + 1], base + polyTris[t + 2]});
+        dst.material.push_back(poly.color);
+      }
+    }
+    for (size_t f = 0; f < nf; ++f) {
+      if (!shown(nc + ns + np + f)) continue;
+      const SurfaceInstance& si = g.surfaces[f];
+      if (points[np + f].coverage > 0) {
+        EmitPoint(points[np + f], si.color, dst);
+        continue;
+      }
+      const TriangleMesh& s = options.surfaces->at(si.name);
+      const uint32_t base = uint32_t(dst.positions.size());
+      // ~name(s) scales all axes alike (the common case, computed as it
+      // always was); ~name(sx,sy,sz) each its own, normals by the inverse.
+      const Vec3 sc = si.scale;
+      const bool uniform = sc.x() == sc.y() && sc.y() == sc.z();
+      std::optional<Vec3> inverseScale;
+      if (!uniform && sc.x() != 0 && sc.y() != 0 && sc.z() != 0) inverseScale = sc.cwiseInverse();
+      for (size_t i = 0; i < s.positions.size(); ++i) {
+        const Vec3 p = s.positions[i].cast<double>(), n = s.normals[i].cast<double>();
+        const Vec3 sp = uniform ? p : Vec3(p.cwiseProduct(sc));
+        const Vec3 local =
+            sp.x() * si.frame.left + sp.y() * si.frame.heading + sp.z() * si.frame.up;
+        const Vec3 wp = si.position + (uniform ? sc.x() * local : local);
+        const Vec3 sn = inverseScale ? Vec3(n.cwiseProduct(*inverseScale)) : n;
+        const Vec3 wn = sn.x() * si.frame.left + sn.y() * si.frame.heading + sn.z() * si.frame.up;
+        dst.positions.push_back(F(wp));
+        dst.normals.push_back(F(wn.normalized()));
+        dst.uvs.push_back(s.uvs[i]);
+      }
+      for (uint32_t i : s.indices) dst.indices.push_back(base + i);
+      for (size_t t = 0; t < s.triangleCount(); ++t) dst.material.push_back(si.color);
+    }
+  };
+  if (stats) {
+    stats->chains += chains.size();
+    for (size_t i = 0; i < inView.size(); ++i) stats->culled += shown(i) ? 0 : 1;
+  }
+  if (options.stream)
+    return StreamMesh(*options.stream, g, chains, plans, vOffset, tOffset, view && view->coverage,
+                      emitChains, emitRest, out);
   auto grow = [](auto& v, size_t extra) {
     using T = typename std::decay_t<decltype(v)>::value_type;
     const size_t want = v.size() + extra;
@@ -667,95 +871,9 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   out.indices.resize(3 * (tbase + tris));
   out.material.resize(tbase + tris);
   if (view && view->coverage) out.coverage.resize(vbase + verts, 1.0f);
-  ForRanges(options.pool, nc, BalancedGrain(options.pool, nc, 256), [&](size_t begin, size_t end) {
-    ChainFrames frames;
-    for (size_t c = begin; c < end; ++c) {
-      if (!plans[c].sides) continue;
-      BuildFrames(g, chains[c], frames, plans[c].ribbon ? FramePart::kTangents : FramePart::kAll);
-      if (plans[c].ribbon) {
-        EmitRibbon(g, chains[c], frames, plans[c], *view, vbase + vOffset[c], tbase + tOffset[c],
-                   out);
-        continue;
-      }
-      EmitChain(g, chains[c], frames, plans[c], vbase + vOffset[c], tbase + tOffset[c], out);
-    }
-  });
-  for (size_t i = 0; i < ns; ++i) {
-    if (sphereSides[i]) TessellateSphere(g.spheres[i], sphereSides[i], out);
-  }
-  for (size_t i = 0; i < np; ++i) {
-    const Polygon& poly = g.polygons[i];
-    if (!shown(nc + ns + i)) continue;
-    if (points[i].coverage > 0) {
-      EmitPoint(points[i], poly.color, out);
-      continue;
-    }
-    Vec3 normal;
-    std::vector<uint32_t> polyTris = TriangulatePolygon(poly.vertices, &normal);
-    if (polyTris.empty()) {
-      if (stats) {
-        ++stats->polygonsSkipped;
-        stats->warnings.push_back(
-            "polygon at module " + std::to_string(poly.module + 1) +
-            " is degenerate, crosses itself or is too complex to triangulate; skipped");
-      }
-      continue;
-    }
-    const Vec3 e1 = AnyPerpendicular(normal), e2 = normal.cross(e1);
-    Vec2 lo(1e300, 1e300), hi(-1e300, -1e300);
-    for (const Vec3& v : poly.vertices) {
-      Vec2 q(v.dot(e1), v.dot(e2));
-      lo = lo.cwiseMin(q);
-      hi = hi.cwiseMax(q);
-    }
-    const Vec2 ext = (hi - lo).cwiseMax(Vec2(1e-12, 1e-12));
-    const uint32_t base = uint32_t(out.positions.size());
-    for (const Vec3& v : poly.vertices) {
-      out.positions.push_back(F(v));
-      out.normals.push_back(F(normal));
-      Vec2 q((v.dot(e1) - lo.x()) / ext.x(), (v.dot(e2) - lo.y()) / ext.y());
-      out.uvs.push_back(q.cast<float>());
-    }
-    for (size_t t = 0; t < polyTris.size(); t += 3) {
-      out.indices.insert(out.indices.end(),
-                         {base + polyTris[t], base + polyTris[t + 1], base + polyTris[t + 2]});
-      out.material.push_back(poly.color);
-    }
-  }
-  for (size_t f = 0; f < nf; ++f) {
-    if (!shown(nc + ns + np + f)) continue;
-    const SurfaceInstance& si = g.surfaces[f];
-    if (points[np + f].coverage > 0) {
-      EmitPoint(points[np + f], si.color, out);
-      continue;
-    }
-    const TriangleMesh& s = options.surfaces->at(si.name);
-    const uint32_t base = uint32_t(out.positions.size());
-    // ~name(s) scales all axes alike (the common case, computed as it
-    // always was); ~name(sx,sy,sz) each its own, normals by the inverse.
-    const Vec3 sc = si.scale;
-    const bool uniform = sc.x() == sc.y() && sc.y() == sc.z();
-    std::optional<Vec3> inverseScale;
-    if (!uniform && sc.x() != 0 && sc.y() != 0 && sc.z() != 0) inverseScale = sc.cwiseInverse();
-    for (size_t i = 0; i < s.positions.size(); ++i) {
-      const Vec3 p = s.positions[i].cast<double>(), n = s.normals[i].cast<double>();
-      const Vec3 sp = uniform ? p : Vec3(p.cwiseProduct(sc));
-      const Vec3 local = sp.x() * si.frame.left + sp.y() * si.frame.heading + sp.z() * si.frame.up;
-      const Vec3 wp = si.position + (uniform ? sc.x() * local : local);
-      const Vec3 sn = inverseScale ? Vec3(n.cwiseProduct(*inverseScale)) : n;
-      const Vec3 wn = sn.x() * si.frame.left + sn.y() * si.frame.heading + sn.z() * si.frame.up;
-      out.positions.push_back(F(wp));
-      out.normals.push_back(F(wn.normalized()));
-      out.uvs.push_back(s.uvs[i]);
-    }
-    for (uint32_t i : s.indices) out.indices.push_back(base + i);
-    for (size_t t = 0; t < s.triangleCount(); ++t) out.material.push_back(si.color);
-  }
+  emitChains(0, nc, vbase, tbase, out);
+  emitRest(out);
   if (!out.coverage.empty()) out.coverage.resize(out.positions.size(), 1.0f);
-  if (stats) {
-    stats->chains += chains.size();
-    for (size_t i = 0; i < inView.size(); ++i) stats->culled += shown(i) ? 0 : 1;
-  }
   return {};
 }
 

@@ -59,6 +59,24 @@ constexpr size_t TubeTriangles(size_t segments, int sides) {
 // 12 of indices, 2 of material, and half a vertex of 32 bytes).
 inline constexpr uint64_t kDefaultMaxTriangles = uint64_t(1) << 26;
 
+// A mesh handed over in pieces instead of appended whole (TessellateOptions::
+// stream): `sylva mesh` writes a 50-million-triangle tree to a .glb without
+// ever holding it. The pieces, concatenated, are exactly the mesh Tessellate
+// would append to an empty `out` (same vertices, same triangles, same order).
+struct MeshStream {
+  // Chains are handed over in pieces of about this many vertices (a chain
+  // is never split); spheres, polygons and surfaces come last, in one piece.
+  size_t pieceVertices = size_t(1) << 20;
+  // Called once before any piece, with the whole mesh's vertex count and
+  // its triangles per material (trianglesPerMaterial[m]: those with
+  // material m; the vector is as long as the largest material used + 1).
+  std::function<Status(size_t vertices, const std::vector<size_t>& trianglesPerMaterial)> begin;
+  // Called with each piece in order. firstVertex: where the piece's
+  // vertices start in the whole mesh; its indices are the whole mesh's.
+  // The piece is reused after the call returns. An error stops tessellation.
+  std::function<Status(const TriangleMesh& piece, size_t firstVertex)> piece;
+};
+
 struct TessellateOptions {
   Detail detail;  // used when detailFn is empty and there is no view
   DetailFn detailFn;
@@ -93,6 +111,9 @@ struct TessellateOptions {
   uint64_t maxTriangles = kDefaultMaxTriangles;
   // Surfaces by name (without `~`), already loaded; unknown names are an error.
   const std::unordered_map<std::string, TriangleMesh>* surfaces = nullptr;
+  // When set, the mesh goes to the stream in pieces (MeshStream) and `out`,
+  // which must be empty, stays empty. Peak memory is a piece, not the mesh.
+  const MeshStream* stream = nullptr;
 };
 
 struct TessellateStats {

@@ -131,7 +131,8 @@ bool IsLineFigure(const mesh::PlantGeometry& geometry) {
          geometry.spheres.empty();
 }
 
-Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics) {
+Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics,
+                  const mesh::MeshStream* stream) {
   const auto t0 = Clock::now();
   SurfaceLibrary surfaces(plant.grammar.path, spec.surfacePath, spec.readFile);
   surfaces.Define(spec.cpfgSurfaces);
@@ -147,12 +148,22 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
   options.maxTriangles = spec.limits.maxTriangles;
   mesh::TessellateStats stats;
   plant.mesh = mesh::TriangleMesh();
+  size_t streamed = 0;  // triangles handed to `stream`
+  mesh::MeshStream counted;
+  if (stream) {
+    counted = *stream;
+    counted.piece = [&](const mesh::TriangleMesh& piece, size_t first) {
+      streamed += piece.triangleCount();
+      return stream->piece(piece, first);
+    };
+    options.stream = &counted;
+  }
   if (Status s = mesh::Tessellate(plant.geometry, options, plant.mesh, &stats); !s.ok()) {
     Diagnostic d = s.error();
     d.loc.file = plant.grammar.path;
     return d;
   }
-  if (plant.mesh.triangleCount() == 0) {
+  if (plant.mesh.triangleCount() + streamed == 0) {
     Diagnostic d;
     d.severity = Severity::kWarning;
     d.loc.file = plant.grammar.path;

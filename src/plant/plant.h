@@ -151,8 +151,11 @@ PlantResult BuildPlant(const PlantSpec& spec);
 
 // Loads the surfaces plant.geometry places and tessellates it into
 // plant.mesh (replacing what it held) at spec.detail. Warnings go to
-// `diagnostics`; an error is returned.
-Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics);
+// `diagnostics`; an error is returned. With a `stream`, the mesh goes to
+// it in pieces (mesh::MeshStream, for mesh::WriteGlbStreamed) and
+// plant.mesh is left empty.
+Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics,
+                  const mesh::MeshStream* stream = nullptr);
 
 // The box every triangle of plant.geometry's mesh lies in, at any detail
 // (mesh::TessellatedBounds, with the plant's surfaces loaded): a camera can

@@ -36,5 +36,8 @@ void UploadVertexAttributes(const unsigned buffers[3], const mesh::TriangleMesh&
 // 1, is set before drawing) and returns the index count.
 size_t UploadIndicesOpaqueFirst(const mesh::TriangleMesh& m, unsigned coverageBuffer,
                                 unsigned location);
+// The CPU half of it: with partial coverage, m's indices opaque first into
+// `sorted` and the opaque count; without, `sorted` empty and the index count.
+size_t OpaqueFirst(const mesh::TriangleMesh& m, std::vector<uint32_t>& sorted);
 
 }  // namespace sylva::render

@@ -92,19 +92,12 @@ void UploadVertexAttributes(const unsigned buffers[3], const mesh::TriangleMesh&
   }
 }
 
-size_t UploadIndicesOpaqueFirst(const mesh::TriangleMesh& m, unsigned coverageBuffer,
-                                unsigned location) {
+size_t OpaqueFirst(const mesh::TriangleMesh& m, std::vector<uint32_t>& sorted) {
+  sorted.clear();
   const bool partial =
       m.coverage.size() == m.vertexCount() &&
       std::any_of(m.coverage.begin(), m.coverage.end(), [](float c) { return c < 1; });
-  if (!partial) {
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
-                 GL_STATIC_DRAW);
-    glDisableVertexAttribArray(location);
-    return m.indices.size();
-  }
-  // Opaque triangles first, then those with partial coverage (in order).
-  std::vector<uint32_t> sorted;
+  if (!partial) return m.indices.size();
   sorted.reserve(m.indices.size());
   auto translucent = [&](size_t t) {
     return m.coverage[m.indices[3 * t]] < 1 || m.coverage[m.indices[3 * t + 1]] < 1 ||
@@ -117,6 +110,19 @@ size_t UploadIndicesOpaqueFirst(const mesh::TriangleMesh& m, unsigned coverageBu
       sorted.insert(sorted.end(), &m.indices[3 * t], &m.indices[3 * t] + 3);
     }
     if (pass == 0) opaque = sorted.size();
+  }
+  return opaque;
+}
+
+size_t UploadIndicesOpaqueFirst(const mesh::TriangleMesh& m, unsigned coverageBuffer,
+                                unsigned location) {
+  std::vector<uint32_t> sorted;
+  const size_t opaque = OpaqueFirst(m, sorted);
+  if (sorted.empty()) {
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), m.indices.data(),
+                 GL_STATIC_DRAW);
+    glDisableVertexAttribArray(location);
+    return opaque;
   }
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(sorted.size() * 4), sorted.data(),
                GL_STATIC_DRAW);

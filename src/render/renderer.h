@@ -110,6 +110,15 @@ class Renderer {
   // once while the list keeps sharing them. An error (Check()) draws
   // nothing.
   [[nodiscard]] Status Draw(const draw::DrawList& list, const Camera& camera);
+  // Uploads the meshes of `list` the renderer does not hold yet, at most
+  // `budgetBytes` of vertex and index data this call, into new buffers,
+  // without drawing; true once all of them are on the GPU (Draw(list) then
+  // uploads nothing). Call it once a frame with the next list while
+  // drawing the current one: a large mesh arrives over several frames
+  // instead of stalling one. The meshes
+  // of the last Stage() list are kept while other lists are drawn; a mesh
+  // that Draw needs before its upload completes is finished there.
+  [[nodiscard]] Expected<bool> Stage(const draw::DrawList& list, size_t budgetBytes);
   void Finish();  // waits for the GPU (for timing)
   // Copies the last frame to the window's framebuffer (the viewer), scaled
   // to width x height.
@@ -133,6 +142,7 @@ class Renderer {
   struct ScenePass;  // scene_pass.cpp: the DrawList pipelines, made on first use
   ScenePass* scene_ = nullptr;
   static void DestroyScenePass(ScenePass* pass);
+  Status InitScenePass();
   std::string shaderDir_;
 };
 

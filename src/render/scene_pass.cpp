@@ -5,8 +5,12 @@
 // cache holds a reference); per-instance data is uploaded each frame.
 #include <GL/glew.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <memory>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 #include "render/gl_program.h"
@@ -20,6 +24,21 @@ namespace {
 // 3..7 hold the instance's model matrix and tint).
 constexpr GLuint kCoverageLocation = 8;
 
+// What a mesh still has to upload (Renderer::Stage: in slices over several
+// frames): the CPU-side arrays made for the GPU and, part by part, the
+// bytes already sent.
+struct Staging {
+  std::vector<mesh::Vec3f> colors;
+  std::vector<uint32_t> sorted;  // indices, opaque triangles first (with partial coverage)
+  struct Part {
+    GLuint buffer;
+    const void* data;
+    size_t bytes;
+  };
+  std::vector<Part> parts;
+  size_t part = 0, offset = 0;  // the next byte to send
+};
+
 struct GpuMesh {
   std::shared_ptr<const mesh::TriangleMesh> mesh;  // keeps the key alive
   mesh::Palette palette;
@@ -27,6 +46,7 @@ struct GpuMesh {
   GLsizei indexCount = 0;
   GLsizei opaqueCount = 0;  // indices [opaqueCount, indexCount): partial coverage, blended last
   bool used = false;
+  std::unique_ptr<Staging> staging;  // set while parts are still to upload
 };
 
 void DeleteMesh(GpuMesh& m) {
@@ -43,6 +63,10 @@ struct GpuInstance {
   float tint[3];
 };
 static_assert(sizeof(GpuInstance) == 76, "instance layout");
+
+// Renderer::Stage draws the next list's shadow map in this many bands of
+// rows, one a call (a frame of the viewer).
+constexpr int kShadowBands = 4;
 
 // FNV-1a over bytes, continuing from `h`.
 constexpr uint64_t kFnvBasis = 1469598103934665603ull;
@@ -62,10 +86,17 @@ struct Renderer::ScenePass {
   GLint skyInverse = -1, skyTop = -1, skyHorizon = -1;
   GLint spriteViewProj = -1, spriteScale = -1, lineViewProj = -1;
   GLuint shadowFbo = 0, shadowDepth = 0, emptyVao = 0;
+  // The next list's shadow map, drawn by Stage() a band a frame: spareBands
+  // of kShadowBands done for spareKey (-1: nothing), swapped in by Draw.
+  GLuint spareFbo = 0, spareDepth = 0;
+  uint64_t spareKey = 0;
+  int spareBands = -1;
   int shadowSize = 0;      // texels on a side of the depth texture allocated
   uint64_t shadowKey = 0;  // what the shadow map shows (see Draw)
   bool shadowValid = false;
   std::unordered_map<const mesh::TriangleMesh*, GpuMesh> meshes;
+  // The meshes of the last Stage() list: kept while another list is drawn.
+  std::unordered_set<const mesh::TriangleMesh*> staged;
   GLuint spriteVao = 0, spriteBuffers[4] = {0, 0, 0, 0};
   GLuint lineVao = 0, lineBuffers[2] = {0, 0};
 
@@ -75,6 +106,8 @@ struct Renderer::ScenePass {
       glDeleteProgram(p);
     glDeleteFramebuffers(1, &shadowFbo);
     glDeleteTextures(1, &shadowDepth);
+    glDeleteFramebuffers(1, &spareFbo);
+    glDeleteTextures(1, &spareDepth);
     glDeleteVertexArrays(1, &emptyVao);
     glDeleteVertexArrays(1, &spriteVao);
     glDeleteBuffers(4, spriteBuffers);
@@ -111,20 +144,8 @@ struct Renderer::ScenePass {
     spriteViewProj = glGetUniformLocation(spriteProgram, "uViewProj");
     spriteScale = glGetUniformLocation(spriteProgram, "uPixelsPerUnit");
     lineViewProj = glGetUniformLocation(lineProgram, "uViewProj");
-    glGenTextures(1, &shadowDepth);
-    glBindTexture(GL_TEXTURE_2D, shadowDepth);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-    glGenFramebuffers(1, &shadowFbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, shadowFbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadowDepth, 0);
-    glDrawBuffer(GL_NONE);
-    glReadBuffer(GL_NONE);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    MakeShadowTarget(shadowFbo, shadowDepth);
+    MakeShadowTarget(spareFbo, spareDepth);
     glGenVertexArrays(1, &emptyVao);
     glGenVertexArrays(1, &spriteVao);
     glGenBuffers(4, spriteBuffers);
@@ -133,17 +154,119 @@ struct Renderer::ScenePass {
     return {};
   }
 
+  // A depth texture compared on lookup and a framebuffer drawing into it.
+  static void MakeShadowTarget(GLuint& fbo, GLuint& depth) {
+    glGenTextures(1, &depth);
+    glBindTexture(GL_TEXTURE_2D, depth);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, depth, 0);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+
   // (Re)allocates the shadow map at `size` texels a side.
   void SizeShadowMap(int size) {
     if (size == shadowSize) return;
-    glBindTexture(GL_TEXTURE_2D, shadowDepth);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, size, size, 0, GL_DEPTH_COMPONENT,
-                 GL_FLOAT, nullptr);
+    for (GLuint t : {shadowDepth, spareDepth}) {
+      glBindTexture(GL_TEXTURE_2D, t);
+      glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, size, size, 0, GL_DEPTH_COMPONENT,
+                   GL_FLOAT, nullptr);
+    }
     shadowSize = size;
     shadowValid = false;
+    spareBands = -1;
   }
 
+  // What a list's shadow map shows: the first sun (-1: none), its view of
+  // the casters' box (or the list's shadowBounds), and a key over the
+  // light's view, the casting meshes and their instances.
+  struct ShadowPlan {
+    int light = -1;
+    Eigen::Matrix4f viewProj = Eigen::Matrix4f::Identity();
+    uint64_t key = 0;
+  };
+  ShadowPlan PlanShadow(const draw::DrawList& list) const {
+    ShadowPlan plan;
+    // The shadow map covers what casts shadows (a wide terrain that does not
+    // cast would only spread its texels thin).
+    Vec3 lo, hi;
+    draw::DrawList casters;
+    for (const draw::MeshDraw& d : list.meshes)
+      if (d.castsShadow) casters.meshes.push_back(d);
+    bool any = casters.Bounds(lo, hi);
+    if (list.shadowBounds) {
+      lo = list.shadowBounds->first;
+      hi = list.shadowBounds->second;
+      any = true;
+    }
+    for (size_t i = 0; i < list.lights.size() && plan.light < 0; ++i)
+      if (list.lights[i].type == draw::Light::Type::kSun) plan.light = int(i);
+    if (plan.light < 0 || !any) {
+      plan.light = -1;
+      return plan;
+    }
+    const Vec3 toLight = -list.lights[size_t(plan.light)].direction.cast<double>().normalized();
+    plan.viewProj = SunViewProj(toLight, lo, hi);
+    plan.key = Fnv(kFnvBasis, plan.viewProj.data(), sizeof(float) * 16);
+    for (size_t i = 0; i < list.meshes.size(); ++i) {
+      const draw::MeshDraw& d = list.meshes[i];
+      if (!d.castsShadow || d.instances.empty()) continue;
+      const uintptr_t key[2] = {uintptr_t(d.mesh.get()), uintptr_t(d.mesh->indices.size())};
+      plan.key = Fnv(plan.key, key, sizeof key);
+      for (const draw::Instance& inst : d.instances)
+        plan.key = Fnv(plan.key, inst.transform.data(), sizeof(float) * 16);
+    }
+    return plan;
+  }
+
+  // Draws rows [size * band / bands, size * (band + 1) / bands) of the
+  // shadow map in `fbo` (band 0 clears it first); the meshes' instances
+  // must be uploaded.
+  void DrawShadow(const draw::DrawList& list, const std::vector<GpuMesh*>& gpu,
+                  const ShadowPlan& plan, GLuint fbo, int band, int bands) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, shadowSize, shadowSize);
+    if (band == 0) glClear(GL_DEPTH_BUFFER_BIT);
+    const int y0 = shadowSize * band / bands, y1 = shadowSize * (band + 1) / bands;
+    if (bands > 1) {
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(0, y0, shadowSize, y1 - y0);
+    }
+    glEnable(GL_DEPTH_TEST);
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(2.0f, 4.0f);
+    glUseProgram(shadowProgram);
+    glUniformMatrix4fv(shadowViewProj, 1, GL_FALSE, plan.viewProj.data());
+    glVertexAttrib1f(kCoverageLocation, 1.0f);  // meshes without coverage
+    // Coverage lines cast a screen-door shadow (shadow.frag).
+    for (size_t i = 0; i < list.meshes.size(); ++i) {
+      if (!list.meshes[i].castsShadow || list.meshes[i].instances.empty()) continue;
+      glBindVertexArray(gpu[i]->vao);
+      glDrawElementsInstanced(GL_TRIANGLES, gpu[i]->indexCount, GL_UNSIGNED_INT, nullptr,
+                              GLsizei(list.meshes[i].instances.size()));
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+    glDisable(GL_SCISSOR_TEST);
+  }
+
+  // The GPU copy of d's mesh, uploaded whole if it is not (yet).
   GpuMesh& Upload(const draw::MeshDraw& d) {
+    GpuMesh& g = Begin(d);
+    Continue(g, SIZE_MAX);
+    return g;
+  }
+
+  // The GPU copy of d's mesh: its buffers allocated at their sizes and its
+  // upload staged (nothing sent yet) when it is new or its palette changed.
+  GpuMesh& Begin(const draw::MeshDraw& d) {
     GpuMesh& g = meshes[d.mesh.get()];
     g.used = true;
     if (g.vao && g.palette == d.palette) return g;
@@ -153,13 +276,23 @@ struct Renderer::ScenePass {
     g.mesh = d.mesh;
     g.palette = d.palette;
     const mesh::TriangleMesh& m = *d.mesh;
-    const std::vector<mesh::Vec3f> color = VertexColors(m, d.palette);
+    auto st = std::make_unique<Staging>();
+    st->colors = VertexColors(m, d.palette);
+    const size_t opaque = OpaqueFirst(m, st->sorted);
+    const bool partial = !st->sorted.empty();
     glGenVertexArrays(1, &g.vao);
     glGenBuffers(3, g.buffers);
     glGenBuffers(1, &g.index);
     glGenBuffers(1, &g.instances);
+    glGenBuffers(1, &g.coverage);
     glBindVertexArray(g.vao);
-    UploadVertexAttributes(g.buffers, m, color);
+    const size_t nv = m.vertexCount();
+    for (int k = 0; k < 3; ++k) {
+      glBindBuffer(GL_ARRAY_BUFFER, g.buffers[k]);
+      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(nv * 12), nullptr, GL_STATIC_DRAW);
+      glEnableVertexAttribArray(GLuint(k));
+      glVertexAttribPointer(GLuint(k), 3, GL_FLOAT, GL_FALSE, 12, nullptr);
+    }
     glBindBuffer(GL_ARRAY_BUFFER, g.instances);
     for (int c = 0; c < 4; ++c) {
       glEnableVertexAttribArray(GLuint(3 + c));
@@ -172,11 +305,50 @@ struct Renderer::ScenePass {
                           reinterpret_cast<const void*>(size_t(64)));
     glVertexAttribDivisor(7, 1);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index);
-    glGenBuffers(1, &g.coverage);
-    g.opaqueCount = GLsizei(UploadIndicesOpaqueFirst(m, g.coverage, kCoverageLocation));
-    g.indexCount = GLsizei(m.indices.size());
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(m.indices.size() * 4), nullptr,
+                 GL_STATIC_DRAW);
+    if (partial) {
+      glBindBuffer(GL_ARRAY_BUFFER, g.coverage);
+      glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(nv * 4), nullptr, GL_STATIC_DRAW);
+      glEnableVertexAttribArray(kCoverageLocation);
+      glVertexAttribPointer(kCoverageLocation, 1, GL_FLOAT, GL_FALSE, 4, nullptr);
+    } else {
+      glDisableVertexAttribArray(kCoverageLocation);
+    }
     glBindVertexArray(0);
+    g.opaqueCount = GLsizei(partial ? opaque : m.indices.size());
+    g.indexCount = GLsizei(m.indices.size());
+    st->parts = {{g.buffers[0], m.positions.data(), nv * 12},
+                 {g.buffers[1], m.normals.data(), nv * 12},
+                 {g.buffers[2], st->colors.data(), nv * 12},
+                 {g.index, partial ? st->sorted.data() : m.indices.data(), m.indices.size() * 4}};
+    if (partial) st->parts.push_back({g.coverage, m.coverage.data(), nv * 4});
+    g.staging = std::move(st);
     return g;
+  }
+
+  // Sends at most `budget` bytes of g's staged upload; returns the bytes
+  // sent. The staging is freed once everything is on the GPU.
+  size_t Continue(GpuMesh& g, size_t budget) {
+    if (!g.staging) return 0;
+    Staging& st = *g.staging;
+    size_t sent = 0;
+    while (st.part < st.parts.size() && sent < budget) {
+      const Staging::Part& part = st.parts[st.part];
+      const size_t n = std::min(part.bytes - st.offset, budget - sent);
+      if (n > 0) {
+        glNamedBufferSubData(part.buffer, GLintptr(st.offset), GLsizeiptr(n),
+                             static_cast<const char*>(part.data) + st.offset);
+      }
+      sent += n;
+      st.offset += n;
+      if (st.offset == part.bytes) {
+        ++st.part;
+        st.offset = 0;
+      }
+    }
+    if (st.part == st.parts.size()) g.staging.reset();
+    return sent;
   }
 
   void UploadInstances(GpuMesh& g, const std::vector<draw::Instance>& instances) {
@@ -216,16 +388,61 @@ void Renderer::DestroyScenePass(ScenePass* pass) {
   delete pass;
 }
 
+Status Renderer::InitScenePass() {
+  if (scene_) return {};
+  auto* pass = new ScenePass();
+  if (Status s = pass->Init(shaderDir_); !s.ok()) {
+    delete pass;
+    return s;
+  }
+  scene_ = pass;
+  return {};
+}
+
+Expected<bool> Renderer::Stage(const draw::DrawList& list, size_t budgetBytes) {
+  if (Status s = list.Check(); !s.ok()) return s.error();
+  if (Status s = InitScenePass(); !s.ok()) return s.error();
+  ScenePass& p = *scene_;
+  p.staged.clear();
+  bool complete = true;
+  size_t left = budgetBytes;
+  for (const draw::MeshDraw& d : list.meshes) {
+    p.staged.insert(d.mesh.get());
+    auto it = p.meshes.find(d.mesh.get());
+    const bool fresh = it == p.meshes.end() || it->second.palette != d.palette;
+    if (!fresh && !it->second.staging) continue;  // already on the GPU
+    if (left == 0) {
+      complete = false;
+      continue;
+    }
+    GpuMesh& g = p.Begin(d);
+    left -= p.Continue(g, left);
+    complete = complete && !g.staging;
+  }
+  if (!complete) return false;
+  // Then its shadow map, a band a call, into the spare map Draw swaps in.
+  p.SizeShadowMap(shadowMapSize_);
+  const ScenePass::ShadowPlan shadow = p.PlanShadow(list);
+  if (shadow.light < 0 || (p.shadowValid && shadow.key == p.shadowKey)) return true;
+  if (p.spareKey != shadow.key || p.spareBands < 0) {
+    p.spareKey = shadow.key;
+    p.spareBands = 0;
+  }
+  if (p.spareBands == kShadowBands) return true;
+  std::vector<GpuMesh*> gpu;
+  for (const draw::MeshDraw& d : list.meshes) {
+    GpuMesh& g = p.Begin(d);
+    p.UploadInstances(g, d.instances);
+    gpu.push_back(&g);
+  }
+  p.DrawShadow(list, gpu, shadow, p.spareFbo, p.spareBands, kShadowBands);
+  ++p.spareBands;
+  return p.spareBands == kShadowBands;
+}
+
 Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
   if (Status s = list.Check(); !s.ok()) return s;
-  if (!scene_) {
-    auto* pass = new ScenePass();
-    if (Status s = pass->Init(shaderDir_); !s.ok()) {
-      delete pass;
-      return s;
-    }
-    scene_ = pass;
-  }
+  if (Status s = InitScenePass(); !s.ok()) return s;
   ScenePass& p = *scene_;
   p.SizeShadowMap(shadowMapSize_);
   for (auto& [k, m] : p.meshes) m.used = false;
@@ -235,9 +452,10 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     p.UploadInstances(g, d.instances);
     gpu.push_back(&g);
   }
-  // Meshes the list no longer shares are freed.
+  // Meshes the list no longer shares (and the last Stage() list does not
+  // have) are freed.
   for (auto it = p.meshes.begin(); it != p.meshes.end();) {
-    if (it->second.used) {
+    if (it->second.used || p.staged.count(it->first)) {
       ++it;
     } else {
       DeleteMesh(it->second);
@@ -245,64 +463,25 @@ Status Renderer::Draw(const draw::DrawList& list, const Camera& camera) {
     }
   }
 
-  // Lights: the first sun casts the shadow.
-  int shadowLight = -1;
-  Eigen::Matrix4f lightViewProj = Eigen::Matrix4f::Identity();
-  // The shadow map covers what casts shadows (a wide terrain that does not
-  // cast would only spread its texels thin).
-  Vec3 lo, hi;
-  draw::DrawList casters;
-  for (const draw::MeshDraw& d : list.meshes)
-    if (d.castsShadow) casters.meshes.push_back(d);
-  bool any = casters.Bounds(lo, hi);
-  if (list.shadowBounds) {
-    lo = list.shadowBounds->first;
-    hi = list.shadowBounds->second;
-    any = true;
-  }
-  for (size_t i = 0; i < list.lights.size() && shadowLight < 0; ++i)
-    if (list.lights[i].type == draw::Light::Type::kSun) shadowLight = int(i);
-  // The map is drawn again only when what it shows changed: the light's
-  // view, the casting meshes or their instances (a still plant in the
-  // viewer costs one shadow pass, not one per frame).
-  uint64_t shadowKey = 0;
-  if (shadowLight >= 0 && any) {
-    const Vec3 toLight = -list.lights[size_t(shadowLight)].direction.cast<double>().normalized();
-    lightViewProj = p.SunViewProj(toLight, lo, hi);
-    shadowKey = Fnv(kFnvBasis, lightViewProj.data(), sizeof(float) * 16);
-    for (size_t i = 0; i < list.meshes.size(); ++i) {
-      const draw::MeshDraw& d = list.meshes[i];
-      if (!d.castsShadow || d.instances.empty()) continue;
-      const uintptr_t key[2] = {uintptr_t(d.mesh.get()), uintptr_t(d.mesh->indices.size())};
-      shadowKey = Fnv(shadowKey, key, sizeof key);
-      for (const draw::Instance& inst : d.instances)
-        shadowKey = Fnv(shadowKey, inst.transform.data(), sizeof(float) * 16);
-    }
-  }
-  if (shadowLight >= 0 && any && p.shadowValid && shadowKey == p.shadowKey) {
+  // Lights: the first sun casts the shadow. The map is drawn again only
+  // when what it shows changed: the light's view, the casting meshes or
+  // their instances (a still plant in the viewer costs one shadow pass,
+  // not one per frame), or taken from Stage() when it drew this one.
+  const ScenePass::ShadowPlan shadow = p.PlanShadow(list);
+  int shadowLight = shadow.light;
+  const Eigen::Matrix4f lightViewProj = shadow.viewProj;
+  if (shadowLight >= 0 && p.shadowValid && shadow.key == p.shadowKey) {
     // The map drawn for an earlier frame still holds.
-  } else if (shadowLight >= 0 && any) {
-    p.shadowKey = shadowKey;
+  } else if (shadowLight >= 0 && p.spareBands == kShadowBands && shadow.key == p.spareKey) {
+    std::swap(p.shadowFbo, p.spareFbo);
+    std::swap(p.shadowDepth, p.spareDepth);
+    p.shadowKey = shadow.key;
     p.shadowValid = true;
-    glBindFramebuffer(GL_FRAMEBUFFER, p.shadowFbo);
-    glViewport(0, 0, p.shadowSize, p.shadowSize);
-    glClear(GL_DEPTH_BUFFER_BIT);
-    glEnable(GL_DEPTH_TEST);
-    glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(2.0f, 4.0f);
-    glUseProgram(p.shadowProgram);
-    glUniformMatrix4fv(p.shadowViewProj, 1, GL_FALSE, lightViewProj.data());
-    glVertexAttrib1f(kCoverageLocation, 1.0f);  // meshes without coverage
-    // Coverage lines cast a screen-door shadow (shadow.frag).
-    for (size_t i = 0; i < list.meshes.size(); ++i) {
-      if (!list.meshes[i].castsShadow || list.meshes[i].instances.empty()) continue;
-      glBindVertexArray(gpu[i]->vao);
-      glDrawElementsInstanced(GL_TRIANGLES, gpu[i]->indexCount, GL_UNSIGNED_INT, nullptr,
-                              GLsizei(list.meshes[i].instances.size()));
-    }
-    glDisable(GL_POLYGON_OFFSET_FILL);
-  } else {
-    shadowLight = -1;
+    p.spareBands = -1;
+  } else if (shadowLight >= 0) {
+    p.shadowKey = shadow.key;
+    p.shadowValid = true;
+    p.DrawShadow(list, gpu, shadow, p.shadowFbo, 0, 1);
   }
 
   glBindFramebuffer(GL_FRAMEBUFFER, MultisampleFramebuffer());

@@ -490,3 +490,87 @@ TEST(PlantSpec, BadScreenViewIsReported) {
 
 }  // namespace
 }  // namespace sylva::plant
+
+namespace sylva::mesh {
+namespace {
+
+// Without popping, along a curved branch: a slow dolly toward arcs of
+// several curvatures that wobbles (three steps of 3 % in, one back out)
+// changes each chain's ring count only one way with the history, and
+// never to fewer rings than the tolerance eps / 2 needs. Without the
+// history some chains flip back and forth, so the test can fail.
+TEST(ScreenDetail, SlowDollyDoesNotFlipRingSpacingBackAndForth) {
+  PlantGeometry g;
+  const int kArcs = 6, kSegments = 240;
+  for (int a = 0; a < kArcs; ++a) {
+    const double bend = 0.5 + 0.4 * a;  // radius of the arc
+    const Vec3 centre(-6 + 2.2 * a, 0, 0);
+    for (int k = 0; k < kSegments; ++k) {
+      auto at = [&](int i) {
+        const double phi = 1.5 * kPi * i / kSegments;
+        return Vec3(centre + bend * Vec3(std::cos(phi), std::sin(phi), 0));
+      };
+      Segment s;
+      s.start = at(k);
+      s.end = at(k + 1);
+      s.radiusStart = s.radiusEnd = 0.02f;
+      s.left = Vec3(0, 0, 1);
+      s.branch = uint32_t(a);
+      g.segments.push_back(s);
+    }
+  }
+  g.branchCount = kArcs;
+  std::vector<double> distances;
+  double d = 60;
+  for (int k = 0; k < 64; ++k) {
+    distances.push_back(d);
+    d *= k % 4 == 3 ? 1 / 0.97 : 0.97;
+  }
+  auto run = [&](bool hysteresis) {
+    DetailHistory history;
+    std::vector<std::vector<uint16_t>> rings;
+    for (double dist : distances) {
+      TessellateOptions opt;
+      opt.view = ScreenView{LookAtPerspective(Vec3(0, 0.3, dist), Vec3(0, 0, 0), 35, 960.0 / 540),
+                            960, 540, 0.5};
+      opt.history = &history;
+      if (!hysteresis) history.level.clear();  // a reset history: no hysteresis
+      TriangleMesh m;
+      EXPECT_TRUE(Tessellate(g, opt, m).ok());
+      rings.push_back(history.rings);
+    }
+    return rings;
+  };
+  const auto with = run(true), without = run(false);
+  ASSERT_EQ(with[0].size(), size_t(kArcs));
+  auto count = [&](const std::vector<std::vector<uint16_t>>& r) {
+    size_t reversals = 0, changes = 0;
+    for (size_t c = 0; c < r[0].size(); ++c) {
+      int lastDir = 0;
+      for (size_t k = 1; k < r.size(); ++k) {
+        const int dir = (r[k][c] > r[k - 1][c]) - (r[k][c] < r[k - 1][c]);
+        if (!dir) continue;
+        ++changes;
+        reversals += lastDir && dir != lastDir;
+        lastDir = dir;
+      }
+    }
+    return std::pair{reversals, changes};
+  };
+  const auto [reversals, changes] = count(with);
+  const auto [reversalsWithout, changesWithout] = count(without);
+  size_t coarser = 0;
+  for (size_t k = 0; k < with.size(); ++k)
+    for (size_t c = 0; c < with[k].size(); ++c) coarser += with[k][c] < without[k][c];
+  EXPECT_GT(changes, 0u) << "the dolly should change some chain's rings";
+  EXPECT_EQ(reversals, 0u) << reversals << " of " << changes
+                           << " ring changes went back against the previous one";
+  EXPECT_GT(reversalsWithout, 0u) << "without hysteresis the wobble should flip some chains ("
+                                  << changesWithout << " changes)";
+  EXPECT_EQ(coarser, 0u) << "frames x chains with fewer rings than eps / 2 needs";
+  std::printf("rings: %zu changes, %zu reversals; without hysteresis %zu changes, %zu reversals\n",
+              changes, reversals, changesWithout, reversalsWithout);
+}
+
+}  // namespace
+}  // namespace sylva::mesh

@@ -6,9 +6,16 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
+#include "app/commands.h"
 #include "app/graphics.h"
+#include "app/scene_camera.h"
+#include "mesh/screen_detail.h"
+#include "render/headless_context.h"
+#include "render/renderer.h"
+#include "scene/build.h"
 #include "scratch_dir.h"
 
 namespace sylva::render {
@@ -136,6 +143,64 @@ TEST(RenderCli, WireframeDrawsTheTrianglesEdges) {
   }
   EXPECT_GT(darkB, darkA + 200) << "near-black pixels: " << darkA << " without the wireframe, "
                                 << darkB << " with it";
+}
+
+}  // namespace
+}  // namespace sylva::render
+
+namespace sylva::render {
+namespace {
+
+// Scenes' own plant meshes with screen-space detail (scene::DetailForView,
+// as `sylva render scene.xml` calls it): with ScreenView::coverage the
+// forest's sub-pixel twigs become coverage lines, and the DrawList blends
+// them, so the picture is lighter than with the same lines drawn opaque.
+TEST(SceneRender, ForestTwigsUnderAPixelAreCoverageLines) {
+  std::ostringstream err;
+  int exit = 0;
+  auto run = app::StartScene({Example("snowy_forest.xml"), {}, 0, false, 1, 8}, err, &exit);
+  ASSERT_TRUE(run) << err.str();
+  const int W = 480, H = 270;
+  const Camera cam = app::SceneCamera(run->scene, run->built, double(W) / H);
+  mesh::ScreenView view;
+  view.viewProjection = cam.ViewProjection(double(W) / H);
+  view.width = W;
+  view.height = H;
+  view.coverage = true;
+  DiagnosticList warnings;
+  ASSERT_TRUE(scene::DetailForView(run->built, view, warnings).ok());
+  size_t lines = 0, vertices = 0;
+  for (const scene::BuiltMesh& m : run->built.meshes) {
+    if (!m.drawMesh) continue;
+    vertices += m.drawMesh->vertexCount();
+    for (float c : m.drawMesh->coverage) lines += c < 1;
+  }
+  EXPECT_GT(lines, 100u) << "vertices of coverage lines among " << vertices;
+  auto context = HeadlessContext::Create();
+  ASSERT_TRUE(context.ok());
+  auto renderer = Renderer::Create(std::string(SYLVA_SOURCE_DIR) + "/shaders");
+  ASSERT_TRUE(renderer.ok());
+  ASSERT_TRUE((*renderer)->Resize(W, H).ok());
+  auto sum = [&](const draw::DrawList& list) {
+    EXPECT_TRUE((*renderer)->Draw(list, cam).ok());
+    const Image im = (*renderer)->ReadPixels();
+    double s = 0;
+    for (uint8_t v : im.rgba) s += v;
+    return s / double(im.rgba.size());
+  };
+  const double blended = sum(scene::MakeDrawList(run->scene, run->built));
+  // The same meshes with their coverage dropped: the lines drawn opaque.
+  for (scene::BuiltMesh& m : run->built.meshes) {
+    if (!m.drawMesh) continue;
+    auto opaque = std::make_shared<mesh::TriangleMesh>(*m.drawMesh);
+    opaque->coverage.clear();
+    m.drawMesh = opaque;
+  }
+  const double opaque = sum(scene::MakeDrawList(run->scene, run->built));
+  EXPECT_GT(blended, opaque + 0.05)
+      << "mean 8-bit value with coverage " << blended << ", with the lines opaque " << opaque;
+  std::printf("forest: %zu coverage vertices of %zu; mean value %.3f blended, %.3f opaque\n", lines,
+              vertices, blended, opaque);
 }
 
 }  // namespace

@@ -538,3 +538,64 @@ TEST(ScreenDetailCli, MeshForOneView) {
 
 }  // namespace
 }  // namespace sylva::render
+
+namespace sylva::render {
+namespace {
+
+using StagedUpload = testing::RenderFixture;
+
+// The viewer's swap (Renderer::Stage): a new tessellation uploaded in
+// slices of 64 KB, and its shadow map drawn in bands, while the previous
+// one is drawn in between, shows exactly the picture Draw makes of it in
+// one go (on a fresh renderer). The slices are counted, so the test fails
+// if the budget is not kept.
+TEST_F(StagedUpload, SlicesShowTheSamePictureAsOneUpload) {
+  auto p =
+      sylva::testing::PlantFromFile("abop/fig2_06a_monopodial.lsys", 11, plant::Stage::kGeometry);
+  ASSERT_TRUE(p);
+  const mesh::Box box = mesh::TessellatedBounds(p->geometry, nullptr);
+  const int W = 320, H = 180;
+  auto sceneFor = [&](const Camera& cam) {
+    mesh::TessellateOptions opt;
+    opt.view = mesh::ScreenView{cam.ViewProjection(double(W) / H), W, H, 0.5};
+    opt.view->coverage = true;  // coverage lines: the sorted index buffer and attribute 8
+    opt.view->shadowFrom = KeyLightDirection();
+    opt.view->shadowPlaneY = box.lo.y();
+    opt.view->shadowTexelsPerUnit = ShadowTexelsPerUnit(box);
+    auto m = std::make_shared<mesh::TriangleMesh>();
+    EXPECT_TRUE(mesh::Tessellate(p->geometry, opt, *m).ok());
+    return scene::DefaultScene(m, mesh::DefaultPalette(), box.lo, box.hi);
+  };
+  Camera before = Camera::Frame(box.lo, box.hi, double(W) / H, 30, 12, false);
+  Camera after = before;
+  after.azimuth += 40;
+  after.distance *= 0.5;
+  const draw::DrawList shown = sceneFor(before), next = sceneFor(after);
+  const size_t bytes =
+      next.meshes[0].mesh->vertexCount() * 40 + next.meshes[0].mesh->indices.size() * 4;
+  ASSERT_TRUE(renderer_->Resize(W, H).ok());
+  ASSERT_TRUE(renderer_->Draw(shown, before).ok());
+  int calls = 0;
+  for (bool done = false; !done && calls < 10000; ++calls) {
+    auto r = renderer_->Stage(next, 64 << 10);
+    ASSERT_TRUE(r.ok()) << r.error().Format();
+    done = *r;
+    ASSERT_TRUE(renderer_->Draw(shown, before).ok());  // the shown mesh meanwhile
+  }
+  EXPECT_GE(calls, int(bytes / (64 << 10))) << bytes << " bytes in " << calls << " calls";
+  ASSERT_TRUE(renderer_->Draw(next, after).ok());
+  const Image staged = renderer_->ReadPixels();
+
+  auto fresh = Renderer::Create(std::string(SYLVA_SOURCE_DIR) + "/shaders");
+  ASSERT_TRUE(fresh.ok());
+  ASSERT_TRUE((*fresh)->Resize(W, H).ok());
+  ASSERT_TRUE((*fresh)->Draw(next, after).ok());
+  const Image whole = (*fresh)->ReadPixels();
+  ASSERT_EQ(staged.rgba.size(), whole.rgba.size());
+  size_t differ = 0;
+  for (size_t i = 0; i < whole.rgba.size(); ++i) differ += staged.rgba[i] != whole.rgba[i];
+  EXPECT_EQ(differ, 0u) << "bytes that differ after " << calls << " staged calls";
+}
+
+}  // namespace
+}  // namespace sylva::render
