@@ -123,17 +123,14 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       faulted_.store(true, std::memory_order_relaxed);
     if (colliders_.empty()) continue;
     std::memset(flags, 0, m);
-    // The chunk's largest radius: planes moved out by it screen every
-    // particle of the chunk.
-    float maxRadius = 0;
-    for (size_t i = c; i < ce; ++i) maxRadius = std::max(maxRadius, s.radius[i]);
     for (const Collider& col : colliders_) {
       if (col.kind == Collider::Kind::kPlane && !col.moving()) {
-        const Vec3 p = col.point + double(maxRadius) * col.normal;
-        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), p.data(), a, c, ce, flags);
+        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a,
+                                     s.radius.data(), c, ce, flags);
         continue;
       }
-      // A moving collider: the path in its frame at the start of the step.
+      // Any other collider (a moving one: the path in its frame at the start
+      // of the step).
       const Vec3 shift = h * col.velocity;
       for (size_t j = 0; j < m; ++j) {
         flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
@@ -141,6 +138,15 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       }
     }
     for (size_t j = 0; j < m; ++j) {
+      // Eight flags at a time: most particles touch nothing.
+      if (j % 8 == 0 && j + 8 <= m) {
+        uint64_t word;
+        std::memcpy(&word, flags + j, 8);
+        if (word == 0) {
+          j += 7;
+          continue;
+        }
+      }
       const size_t i = c + j;
       if (!flags[j] || s.invMass[i] == 0) continue;
       Vec3 x = s.position(i), v = s.velocity(i);

@@ -154,7 +154,8 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
 }
 
 [[gnu::target("avx")]] size_t BulkPlaneAvx(const double* n, const double* p, const BulkArrays& a,
-                                           size_t i, size_t e, uint8_t* flags) {
+                                           const float* radius, size_t i, size_t e,
+                                           uint8_t* flags) {
   // One byte a lane from a four-bit mask.
   static constexpr uint32_t kBytes[16] = {0x00000000, 0x00000001, 0x00000100, 0x00000101,
                                           0x00010000, 0x00010001, 0x00010100, 0x00010101,
@@ -162,7 +163,6 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
                                           0x01010000, 0x01010001, 0x01010100, 0x01010101};
   const __m256d n0 = _mm256_set1_pd(n[0]), n1 = _mm256_set1_pd(n[1]), n2 = _mm256_set1_pd(n[2]);
   const __m256d p0 = _mm256_set1_pd(p[0]), p1 = _mm256_set1_pd(p[1]), p2 = _mm256_set1_pd(p[2]);
-  const __m256d zero = _mm256_setzero_pd();
   uint8_t* f = flags;
   for (; i + 4 <= e; i += 4, f += 4) {
     const __m256d b0 = _mm256_cvtps_pd(_mm_loadu_ps(a.px + i));
@@ -171,7 +171,8 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, _mm256_sub_pd(b0, p0)),
                                                   _mm256_mul_pd(n1, _mm256_sub_pd(b1, p1))),
                                     _mm256_mul_pd(n2, _mm256_sub_pd(b2, p2)));
-    const int mask = _mm256_movemask_pd(_mm256_cmp_pd(d, zero, _CMP_LT_OQ));
+    const __m256d r = _mm256_cvtps_pd(_mm_loadu_ps(radius + i));
+    const int mask = _mm256_movemask_pd(_mm256_cmp_pd(d, r, _CMP_LT_OQ));
     if (mask) {
       uint32_t bytes;
       std::memcpy(&bytes, f, 4);
@@ -222,13 +223,13 @@ bool BulkAdvance(Kernel kernel, const BulkParams& q, const BulkArrays& a, size_t
 }
 
 void BulkPlaneCandidates(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
-                         size_t begin, size_t end, uint8_t* flags) {
+                         const float* radius, size_t begin, size_t end, uint8_t* flags) {
   size_t i = begin;
-  if (kernel == Kernel::kAvx) i = BulkPlaneAvx(n, p, a, begin, end, flags);
+  if (kernel == Kernel::kAvx) i = BulkPlaneAvx(n, p, a, radius, begin, end, flags);
   for (; i < end; ++i) {
     const double d = (n[0] * (double(a.px[i]) - p[0]) + n[1] * (double(a.py[i]) - p[1])) +
                      n[2] * (double(a.pz[i]) - p[2]);
-    flags[i - begin] |= d < 0;
+    flags[i - begin] |= d < double(radius[i]);
   }
 }
 

@@ -94,9 +94,11 @@ bool BulkAdvance(Kernel kernel, const BulkParams& q, const BulkArrays& a, size_t
                  float* const* old);
 
 // flags[i - begin] |= 1 for the particles of [begin, end) whose new position
-// b (the arrays, as doubles) has n . (b - p) < 0: a plane collider's MayHit,
-// computed as (n0 (b0 - p0) + n1 (b1 - p1)) + n2 (b2 - p2).
+// b (the arrays, as doubles) has n . (b - p) < radius[i]: a plane collider's
+// MayHit for a ball of that radius, computed as
+// (n0 (b0 - p0) + n1 (b1 - p1)) + n2 (b2 - p2). The radii are read four at
+// a time with the positions (no separate pass over them).
 void BulkPlaneCandidates(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
-                         size_t begin, size_t end, uint8_t* flags);
+                         const float* radius, size_t begin, size_t end, uint8_t* flags);
 
 }  // namespace sylva::particles::kernels

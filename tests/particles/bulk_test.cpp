@@ -112,17 +112,20 @@ TEST(Bulk, PlaneCandidatesAreExactlyTheColliderTest) {
     p -= c.normal.dot(p - c.point) * c.normal;  // onto the plane, then a few ulps off
     p += c.normal * (1e-7 * std::round(4 * u(rng)));
     s.Add(p, Vec3::Zero());
+    // A third of them balls of a radius of up to a few ulps of the offset.
+    if (i % 3 == 1) s.radius.back() = float(1e-7 * std::abs(std::round(4 * u(rng))));
+    if (i % 3 == 2) s.radius.back() = 0.25f;
   }
   const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
                               s.vy.data(), s.vz.data(), s.invMass.data()};
   std::vector<uint8_t> fa(s.size(), 0), fs(s.size(), 0);
-  kernels::BulkPlaneCandidates(kernels::Kernel::kAvx, c.normal.data(), c.point.data(), a, 0,
-                               s.size(), fa.data());
-  kernels::BulkPlaneCandidates(kernels::Kernel::kScalar, c.normal.data(), c.point.data(), a, 0,
-                               s.size(), fs.data());
+  kernels::BulkPlaneCandidates(kernels::Kernel::kAvx, c.normal.data(), c.point.data(), a,
+                               s.radius.data(), 0, s.size(), fa.data());
+  kernels::BulkPlaneCandidates(kernels::Kernel::kScalar, c.normal.data(), c.point.data(), a,
+                               s.radius.data(), 0, s.size(), fs.data());
   int below = 0;
   for (size_t i = 0; i < s.size(); ++i) {
-    const bool expected = c.MayHit(s.position(i), s.position(i));
+    const bool expected = c.MayHit(s.position(i), s.position(i), double(s.radius[i]));
     below += expected;
     ASSERT_EQ(bool(fa[i]), expected) << "AVX flag of point " << i;
     ASSERT_EQ(bool(fs[i]), expected) << "scalar flag of point " << i;
