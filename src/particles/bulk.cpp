@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include "particles/def_check.h"
 #include "particles/system.h"
@@ -117,6 +118,21 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
   alignas(32) float old[6][kChunk];
   float* const olds[6] = {old[0], old[1], old[2], old[3], old[4], old[5]};
   alignas(32) uint8_t flags[kChunk];
+  uint8_t done[kChunk];
+  uint16_t idx[kChunk];
+  // The vector path for resting contact: one static plane that bounces.
+  std::optional<kernels::PlaneRest> floorRest;
+  if (kernel_ == kernels::Kernel::kAvx && colliders_.size() == 1 &&
+      colliders_[0].kind == Collider::Kind::kPlane && !colliders_[0].moving() &&
+      colliders_[0].response == Response::kBounce) {
+    const Collider& f = colliders_[0];
+    floorRest = kernels::PlaneRest{{f.normal.x(), f.normal.y(), f.normal.z()},
+                                   {f.point.x(), f.point.y(), f.point.z()},
+                                   f.friction,
+                                   h,
+                                   limit2_};
+  }
+  const kernels::PlaneRest* floor = floorRest ? &*floorRest : nullptr;
   for (size_t c = begin; c < end; c += kChunk) {
     const size_t ce = std::min(end, c + kChunk), m = ce - c;
     if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds))
@@ -137,8 +153,10 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
                                double(s.radius[c + j]));
       }
     }
+    // The candidates, in order; eight flags at a time (most particles touch
+    // nothing).
+    size_t count = 0;
     for (size_t j = 0; j < m; ++j) {
-      // Eight flags at a time: most particles touch nothing.
       if (j % 8 == 0 && j + 8 <= m) {
         uint64_t word;
         std::memcpy(&word, flags + j, 8);
@@ -147,8 +165,15 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
           continue;
         }
       }
-      const size_t i = c + j;
-      if (!flags[j] || s.invMass[i] == 0) continue;
+      if (flags[j] && s.invMass[c + j] != 0) idx[count++] = uint16_t(j);
+    }
+    // A lone static floor: its resting contacts four at a time (the same
+    // bits as the path below).
+    std::memset(done, 0, count);
+    if (floor) kernels::BulkRestOnPlane(*floor, a, s.radius.data(), olds, c, idx, count, done);
+    for (size_t k = 0; k < count; ++k) {
+      if (done[k]) continue;
+      const size_t j = idx[k], i = c + j;
       Vec3 x = s.position(i), v = s.velocity(i);
       const double r = double(s.radius[i]);
       const ContactOutcome out =
