@@ -193,9 +193,16 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   return _mm256_andnot_pd(_mm256_set1_pd(-0.0), x);
 }
 
-// std::max(a, b) = a < b ? b : a, lane by lane.
+// std::max(a, b) = a < b ? b : a, lane by lane: maxpd(b, a) is b > a ? b : a,
+// the same for equal values (a signed zero included) and a NaN in either.
 [[gnu::target("avx")]] inline __m256d Max(__m256d a, __m256d b) {
-  return _mm256_blendv_pd(a, b, _mm256_cmp_pd(a, b, _CMP_LT_OQ));
+  return _mm256_max_pd(b, a);
+}
+
+// base[j[0..3]] as doubles; one load when they are consecutive (run).
+[[gnu::target("avx")]] inline __m256d Lanes(const float* base, const size_t j[4], bool run) {
+  if (run) return _mm256_cvtps_pd(_mm_loadu_ps(base + j[0]));
+  return _mm256_cvtps_pd(_mm_set_ps(base[j[3]], base[j[2]], base[j[1]], base[j[0]]));
 }
 
 [[gnu::target("avx")]] void RestOnPlaneAvx(const PlaneRest& q, const BulkArrays& ar,
@@ -210,23 +217,24 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   const __m256d tol = _mm256_set1_pd(1e-12), mtol = _mm256_set1_pd(-1e-12);
   const __m256d limit2 = _mm256_set1_pd(q.limit2);
   for (size_t k0 = 0; k0 < count; k0 += 4) {
-    // Gather four lanes (the last repeated past the end).
-    alignas(32) double in[13][4];
-    for (int l = 0; l < 4; ++l) {
-      const size_t j = idx[std::min(k0 + size_t(l), count - 1)], i = begin + j;
-      for (int c = 0; c < 6; ++c) in[c][l] = double(old[c][j]);
-      in[6][l] = double(ar.px[i]), in[7][l] = double(ar.py[i]), in[8][l] = double(ar.pz[i]);
-      in[9][l] = double(ar.vx[i]), in[10][l] = double(ar.vy[i]), in[11][l] = double(ar.vz[i]);
-      in[12][l] = double(radius[i]);
-    }
+    // Four lanes (the last repeated past the end): one load an array where
+    // they are consecutive, the common case.
+    size_t j[4];
+    for (int l = 0; l < 4; ++l) j[l] = idx[std::min(k0 + size_t(l), count - 1)];
+    const bool run = j[3] == j[0] + 3 && k0 + 4 <= count;
+    auto load = [&](const float* base) { return Lanes(base, j, run); };
     __m256d a[3], va[3], x[3], v[3];
     for (int c = 0; c < 3; ++c) {
-      a[c] = _mm256_load_pd(in[c]);
-      va[c] = _mm256_load_pd(in[3 + c]);
-      x[c] = _mm256_load_pd(in[6 + c]);
-      v[c] = _mm256_load_pd(in[9 + c]);
+      a[c] = load(old[c]);
+      va[c] = load(old[3 + c]);
     }
-    const __m256d r = _mm256_load_pd(in[12]);
+    const float* const now[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
+                                 ar.vx + begin, ar.vy + begin, ar.vz + begin};
+    for (int c = 0; c < 3; ++c) {
+      x[c] = load(now[c]);
+      v[c] = load(now[3 + c]);
+    }
+    const __m256d r = load(radius + begin);
     __m256d dv[3], A[3], u[3], xp[3], ap[3];
     for (int c = 0; c < 3; ++c) {
       dv[c] = _mm256_sub_pd(v[c], va[c]);
@@ -301,18 +309,28 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
                       _mm256_mul_pd(out[2], out[2]));
     ok = _mm256_and_pd(ok, _mm256_cmp_pd(_mm256_add_pd(xx, vv), limit2, _CMP_LE_OQ));
     const int mask = _mm256_movemask_pd(ok);
+    __m128 fv[3];
+    for (int c = 0; c < 3; ++c) fv[c] = _mm256_cvtpd_ps(out[c]);
+    float* const to[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
+                          ar.vx + begin, ar.vy + begin, ar.vz + begin};
+    if (run && mask == 0xf) {
+      for (int c = 0; c < 3; ++c) {
+        _mm_storeu_ps(to[c] + j[0], xf[c]);
+        _mm_storeu_ps(to[3 + c] + j[0], fv[c]);
+      }
+      std::memset(done + k0, 1, 4);
+      continue;
+    }
     alignas(16) float fx[6][4];
     for (int c = 0; c < 3; ++c) {
       _mm_store_ps(fx[c], xf[c]);
-      _mm_store_ps(fx[3 + c], _mm256_cvtpd_ps(out[c]));
+      _mm_store_ps(fx[3 + c], fv[c]);
     }
     for (int l = 0; l < 4 && k0 + size_t(l) < count; ++l) {
       const bool d = (mask >> l) & 1;
       done[k0 + l] = d;
       if (!d) continue;
-      const size_t i = begin + idx[k0 + l];
-      ar.px[i] = fx[0][l], ar.py[i] = fx[1][l], ar.pz[i] = fx[2][l];
-      ar.vx[i] = fx[3][l], ar.vy[i] = fx[4][l], ar.vz[i] = fx[5][l];
+      for (int c = 0; c < 6; ++c) to[c][j[l]] = fx[c][l];
     }
   }
 }
