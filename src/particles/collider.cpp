@@ -387,10 +387,7 @@ Status Validate(const Collider& c) {
       break;
   }
   SYLVA_CHECK_OK(Finite("Collider.velocity", c.velocity, 1e12, "m/s"));
-  if (c.moving() && (c.kind == Collider::Kind::kMesh || c.kind == Collider::Kind::kCapsules)) {
-    return Error("Collider.velocity " + Vec(c.velocity) +
-                 ": a mesh or capsules collider cannot move (only plane, sphere, box and polygon)");
-  }
+  SYLVA_CHECK_OK(Finite("Collider.offset", c.offset, 1e12, "m"));
   SYLVA_CHECK_OK(Range("Collider.restitution", c.restitution, 0, 1));
   SYLVA_CHECK_OK(Range("Collider.friction", c.friction, 0, 1e3));
   return {};
@@ -401,6 +398,7 @@ void Collider::Translate(const Vec3& d) {
   lo += d;
   hi += d;
   for (Vec3& p : polygon) p += d;
+  offset += d;
 }
 
 Collider Collider::Plane(const Vec3& point, const Vec3& normal) {
@@ -478,9 +476,14 @@ Collider Collider::Capsules(std::shared_ptr<const CapsuleBvh> bvh) {
       return true;
     }
     case Kind::kMesh:
-      return mesh && mesh->Intersect(a, b, c, r);
-    case Kind::kCapsules:
-      return capsules && capsules->Intersect(a, b, c, r);
+    case Kind::kCapsules: {
+      // In the hierarchy's coordinates (offset 0 unless the solid moved).
+      const Vec3 ao = a - offset, bo = b - offset;
+      const bool hit = kind == Kind::kMesh ? mesh && mesh->Intersect(ao, bo, c, r)
+                                           : capsules && capsules->Intersect(ao, bo, c, r);
+      if (hit) c->point += offset;
+      return hit;
+    }
     case Kind::kSphere:
     case Kind::kBox:
       break;
