@@ -49,6 +49,7 @@ namespace {
 
 constexpr int kVelocityPasses = 16;
 constexpr int kPositionPasses = 4;
+constexpr double kRestFraction = 0.5;
 
 // The first t in [0, 1] where |d0 + t dd| = R, or -1; 0 when |d0| < R.
 double TimeOfImpact(const Vec3& d0, const Vec3& dd, double R) {
@@ -166,6 +167,12 @@ void System::ParticleCollisions(double h) {
     }
   });
 
+  // From here pairMove_ holds what the step's forces changed each
+  // velocity by (|v - v0| before the solve), for the rest test at the end.
+  Ranges(pool_, n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) pairMove_[i] = (V[i] - V0[i]).norm();
+  });
+
   // Velocity passes (Jacobi).
   pairV_.assign(V.begin(), V.end());
   pairScratch_.resize(n);
@@ -254,7 +261,13 @@ void System::ParticleCollisions(double h) {
       if (w[i] == 0) continue;
       bool resting = false;
       for (uint32_t k = pairStart_[i]; k < pairStart_[i + 1]; ++k) resting |= !pairs_[k].bounce;
-      if (resting) V[i] = (X[i] - X0[i]) * (1 / h);
+      if (!resting) continue;
+      V[i] = (X[i] - X0[i]) * (1 / h);
+      // At rest: a particle in resting contact that moved over the step at
+      // less than half the speed its forces alone gave it in the step is
+      // held by its neighbours; its velocity is zeroed, so what the passes
+      // leave of the forces' push does not make a pile jitter.
+      if (V[i].norm() < kRestFraction * pairMove_[i]) V[i] = Vec3::Zero();
     }
   });
 }
