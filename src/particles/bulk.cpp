@@ -4,6 +4,7 @@
 #include <cfloat>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 #include "particles/def_check.h"
 #include "particles/system.h"
@@ -119,31 +120,61 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
   alignas(32) float old[6][kChunk];
   float* const olds[6] = {old[0], old[1], old[2], old[3], old[4], old[5]};
   alignas(32) uint8_t flags[kChunk];
+  uint8_t done[kChunk];
+  uint16_t idx[kChunk];
+  // The vector path for resting contact: one static plane that bounces.
+  std::optional<kernels::PlaneRest> floorRest;
+  if (kernel_ == kernels::Kernel::kAvx && colliders_.size() == 1 &&
+      colliders_[0].kind == Collider::Kind::kPlane && !colliders_[0].moving() &&
+      colliders_[0].response == Response::kBounce) {
+    const Collider& f = colliders_[0];
+    floorRest = kernels::PlaneRest{{f.normal.x(), f.normal.y(), f.normal.z()},
+                                   {f.point.x(), f.point.y(), f.point.z()},
+                                   f.friction,
+                                   h,
+                                   limit2_};
+  }
+  const kernels::PlaneRest* floor = floorRest ? &*floorRest : nullptr;
   for (size_t c = begin; c < end; c += kChunk) {
     const size_t ce = std::min(end, c + kChunk), m = ce - c;
     if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds)) faults_.Flag();
     if (colliders_.empty()) continue;
     std::memset(flags, 0, m);
-    // The chunk's largest radius: planes moved out by it screen every
-    // particle of the chunk.
-    float maxRadius = 0;
-    for (size_t i = c; i < ce; ++i) maxRadius = std::max(maxRadius, s.radius[i]);
     for (const Collider& col : colliders_) {
       if (col.kind == Collider::Kind::kPlane && !col.moving()) {
-        const Vec3 p = col.point + double(maxRadius) * col.normal;
-        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), p.data(), a, c, ce, flags);
+        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a,
+                                     s.radius.data(), c, ce, flags);
         continue;
       }
-      // A moving collider: the path in its frame at the start of the step.
+      // Any other collider (a moving one: the path in its frame at the start
+      // of the step).
       const Vec3 shift = h * col.velocity;
       for (size_t j = 0; j < m; ++j) {
         flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
                                double(s.radius[c + j]));
       }
     }
+    // The candidates, in order; eight flags at a time (most particles touch
+    // nothing).
+    size_t count = 0;
     for (size_t j = 0; j < m; ++j) {
-      const size_t i = c + j;
-      if (!flags[j] || s.invMass[i] == 0) continue;
+      if (j % 8 == 0 && j + 8 <= m) {
+        uint64_t word;
+        std::memcpy(&word, flags + j, 8);
+        if (word == 0) {
+          j += 7;
+          continue;
+        }
+      }
+      if (flags[j] && s.invMass[c + j] != 0) idx[count++] = uint16_t(j);
+    }
+    // A lone static floor: its resting contacts four at a time (the same
+    // bits as the path below).
+    std::memset(done, 0, count);
+    if (floor) kernels::BulkRestOnPlane(*floor, a, s.radius.data(), olds, c, idx, count, done);
+    for (size_t k = 0; k < count; ++k) {
+      if (done[k]) continue;
+      const size_t j = idx[k], i = c + j;
       Vec3 x = s.position(i), v = s.velocity(i);
       const double r = double(s.radius[i]);
       const ContactOutcome out =

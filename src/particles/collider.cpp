@@ -83,8 +83,8 @@ bool InsidePolygon(const Vec3* poly, size_t count, const Vec3& n, const Vec3& q)
 // touches the polygon. The contact point is the ball's centre, nudged out by
 // the skin; a path that starts within r of the polygon reports s = 0 at the
 // nearest point at distance r.
-bool IntersectGrown(const Vec3* poly, size_t count, const Vec3& n, const Vec3& a, const Vec3& b,
-                    double r, double sBound, Contact* c) {
+[[gnu::flatten]] bool IntersectGrown(const Vec3* poly, size_t count, const Vec3& n, const Vec3& a,
+                                     const Vec3& b, double r, double sBound, Contact* c) {
   const Vec3 d = b - a;
   const double d0 = n.dot(a - poly[0]), d1 = n.dot(b - poly[0]);
   const double side = d0 > 0 ? 1 : d0 < 0 ? -1 : (d1 <= 0 ? 1 : -1);
@@ -251,7 +251,8 @@ bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r
   return true;
 }
 
-bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r) const {
+[[gnu::noinline]] bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c,
+                                              double r) const {
   if (nodes_.empty()) return false;
   const Vec3 d = b - a;
   double best = 2;
@@ -386,10 +387,7 @@ Status Validate(const Collider& c) {
       break;
   }
   SYLVA_CHECK_OK(Finite("Collider.velocity", c.velocity, 1e12, "m/s"));
-  if (c.moving() && (c.kind == Collider::Kind::kMesh || c.kind == Collider::Kind::kCapsules)) {
-    return Error("Collider.velocity " + Vec(c.velocity) +
-                 ": a mesh or capsules collider cannot move (only plane, sphere, box and polygon)");
-  }
+  SYLVA_CHECK_OK(Finite("Collider.offset", c.offset, 1e12, "m"));
   SYLVA_CHECK_OK(Range("Collider.restitution", c.restitution, 0, 1));
   SYLVA_CHECK_OK(Range("Collider.friction", c.friction, 0, 1e3));
   return {};
@@ -400,6 +398,7 @@ void Collider::Translate(const Vec3& d) {
   lo += d;
   hi += d;
   for (Vec3& p : polygon) p += d;
+  offset += d;
 }
 
 Collider Collider::Plane(const Vec3& point, const Vec3& normal) {
@@ -454,14 +453,45 @@ Collider Collider::Capsules(std::shared_ptr<const CapsuleBvh> bvh) {
   return c;
 }
 
-bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r) const {
+[[gnu::noinline, gnu::flatten]] bool Collider::IntersectAny(const Vec3& a, const Vec3& b,
+                                                            Contact* c, double r) const {
   const Vec3 d = b - a;
+  // The thin kinds and the plane first: they need no grown sphere or box.
+  switch (kind) {
+    case Kind::kPlane:
+      return Intersect(a, b, c, r);  // inline in the header
+    case Kind::kPolygon: {
+      if (r > 0) return IntersectGrownPolygon(a, b, r, c);
+      double s, side;
+      if (!CrossPlane(a, b, point, normal, &s, &side)) return false;
+      const Vec3 q = a + s * d;
+      for (size_t i = 0; i < polygon.size(); ++i) {
+        const Vec3& p0 = polygon[i];
+        const Vec3& p1 = polygon[(i + 1) % polygon.size()];
+        if ((p1 - p0).cross(q - p0).dot(normal) < -1e-12 * (p1 - p0).squaredNorm()) return false;
+      }
+      c->s = s;
+      c->normal = side * normal;
+      c->point = Skin(q, c->normal);
+      return true;
+    }
+    case Kind::kMesh:
+    case Kind::kCapsules: {
+      // In the hierarchy's coordinates (offset 0 unless the solid moved).
+      const Vec3 ao = a - offset, bo = b - offset;
+      const bool hit = kind == Kind::kMesh ? mesh && mesh->Intersect(ao, bo, c, r)
+                                           : capsules && capsules->Intersect(ao, bo, c, r);
+      if (hit) c->point += offset;
+      return hit;
+    }
+    case Kind::kSphere:
+    case Kind::kBox:
+      break;
+  }
   double R;
   Vec3 L, H;
   Grown(*this, r, &R, &L, &H);
   switch (kind) {
-    case Kind::kPlane:
-      return Intersect(a, b, c, r);  // inline in the header
     case Kind::kSphere: {
       const Vec3 ac = a - point;
       const double C = ac.squaredNorm() - R * R;
@@ -546,36 +576,24 @@ bool Collider::IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r) 
       c->point[axis] = b[axis] < L[axis] ? L[axis] : H[axis];
       return true;
     }
-    case Kind::kPolygon: {
-      if (r > 0) return IntersectGrownPolygon(a, b, r, c);
-      double s, side;
-      if (!CrossPlane(a, b, point, normal, &s, &side)) return false;
-      const Vec3 q = a + s * d;
-      for (size_t i = 0; i < polygon.size(); ++i) {
-        const Vec3& p0 = polygon[i];
-        const Vec3& p1 = polygon[(i + 1) % polygon.size()];
-        if ((p1 - p0).cross(q - p0).dot(normal) < -1e-12 * (p1 - p0).squaredNorm()) return false;
-      }
-      c->s = s;
-      c->normal = side * normal;
-      c->point = Skin(q, c->normal);
-      return true;
-    }
+    case Kind::kPlane:
+    case Kind::kPolygon:
     case Kind::kMesh:
-      return mesh && mesh->Intersect(a, b, c, r);
     case Kind::kCapsules:
-      return capsules && capsules->Intersect(a, b, c, r);
+      break;  // above
   }
   return false;
 }
 
-bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n, double r) const {
+[[gnu::noinline, gnu::flatten]] bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n,
+                                                          double r) const {
   double R;
   Vec3 L, H;
+  if (kind == Kind::kPlane) return Project(x, surface, n, r);  // inline in the header
+  // Thin kinds are entered from outside; a point inside is not projected.
+  if (kind != Kind::kSphere && kind != Kind::kBox) return false;
   Grown(*this, r, &R, &L, &H);
   switch (kind) {
-    case Kind::kPlane:
-      return Project(x, surface, n, r);  // inline in the header
     case Kind::kSphere: {
       const Vec3 rel = x - point;
       const double r2 = rel.squaredNorm();
@@ -619,15 +637,22 @@ bool Collider::ProjectAny(const Vec3& x, Vec3* surface, Vec3* n, double r) const
       (*n)[axis] = x[axis] < L[axis] ? 1 : -1;
       return true;
     }
+    case Kind::kPlane:
     case Kind::kPolygon:
     case Kind::kMesh:
-    case Kind::kCapsules:  // entered from outside; a point inside is not projected
-      return false;
+    case Kind::kCapsules:
+      return false;  // above
   }
   return false;
 }
 
 // --- contact response ---
+//
+// The hot functions here are flattened (every call inlined but those marked
+// noinline): since particles have a radius and colliders can move, GCC's
+// inliner gave up on the small Eigen expressions (a dot of a difference, a
+// sum assigned) in them and called them out of line, a third slower in
+// the cube benchmark. -ffp-contract=off keeps inlining from changing a bit.
 
 namespace {
 
@@ -754,8 +779,9 @@ namespace {
 
 }  // namespace
 
-ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
-                                 Vec3& v, double h, double radius) {
+[[gnu::flatten]] ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
+                                                  Vec3 va, Vec3& x, Vec3& v, double h,
+                                                  double radius) {
   // The step as a path of constant acceleration from a, through x at its
   // end: p(tau) = a + tau u + tau^2 A / 2 for tau = t / h in [0, 1], with
   // u = h w (w the path's velocity at a) and A = h^2 acc, so that nothing

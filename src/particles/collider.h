@@ -120,9 +120,13 @@ struct Collider {
   // component within +-1e12), and a contact responds to the particle's
   // velocity relative to it (a moving plane or ball pushes and carries
   // particles). System::Step and BulkSystem::Step move it by h times its
-  // velocity after each step (Translate). Plane, sphere, box and polygon;
-  // a mesh or capsules with a velocity fail Validate (not supported yet).
+  // velocity after each step (Translate). Every kind; a mesh or capsules
+  // keep their shared hierarchy and move by `offset`.
   Vec3 velocity{0, 0, 0};
+  // Mesh and capsules: where the triangles or capsules are, relative to
+  // their hierarchy's coordinates (Translate adds to it; queries subtract
+  // it from the path and add it to the contact point). 0 unless moved.
+  Vec3 offset{0, 0, 0};
   // Material.
   double restitution = 1;  // e: normal speed out / in, 0..1
   double friction = 0;     // Coulomb mu, 0..1e3: tangential impulse <= mu * normal impulse
@@ -153,7 +157,8 @@ struct Collider {
     return *this;
   }
   bool moving() const { return velocity.x() != 0 || velocity.y() != 0 || velocity.z() != 0; }
-  // Moves the solid by d (point, polygon vertices, box corners).
+  // Moves the solid by d (point, polygon vertices, box corners, the offset
+  // of a mesh or capsules).
   void Translate(const Vec3& d);
 
   // First entry of the path a -> b into the solid. A path that starts inside
@@ -286,7 +291,7 @@ inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n, double r) c
       return std::min(d0, d1) <= r && std::max(d0, d1) >= -r;
     }
     case Kind::kMesh:
-      return mesh && mesh->Near(a, b, r);
+      return mesh && mesh->Near(a - offset, b - offset, r);
     case Kind::kCapsules:
       return true;
   }

@@ -154,7 +154,8 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
 }
 
 [[gnu::target("avx")]] size_t BulkPlaneAvx(const double* n, const double* p, const BulkArrays& a,
-                                           size_t i, size_t e, uint8_t* flags) {
+                                           const float* radius, size_t i, size_t e,
+                                           uint8_t* flags) {
   // One byte a lane from a four-bit mask.
   static constexpr uint32_t kBytes[16] = {0x00000000, 0x00000001, 0x00000100, 0x00000101,
                                           0x00010000, 0x00010001, 0x00010100, 0x00010101,
@@ -162,7 +163,6 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
                                           0x01010000, 0x01010001, 0x01010100, 0x01010101};
   const __m256d n0 = _mm256_set1_pd(n[0]), n1 = _mm256_set1_pd(n[1]), n2 = _mm256_set1_pd(n[2]);
   const __m256d p0 = _mm256_set1_pd(p[0]), p1 = _mm256_set1_pd(p[1]), p2 = _mm256_set1_pd(p[2]);
-  const __m256d zero = _mm256_setzero_pd();
   uint8_t* f = flags;
   for (; i + 4 <= e; i += 4, f += 4) {
     const __m256d b0 = _mm256_cvtps_pd(_mm_loadu_ps(a.px + i));
@@ -171,7 +171,8 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, _mm256_sub_pd(b0, p0)),
                                                   _mm256_mul_pd(n1, _mm256_sub_pd(b1, p1))),
                                     _mm256_mul_pd(n2, _mm256_sub_pd(b2, p2)));
-    const int mask = _mm256_movemask_pd(_mm256_cmp_pd(d, zero, _CMP_LT_OQ));
+    const __m256d r = _mm256_cvtps_pd(_mm_loadu_ps(radius + i));
+    const int mask = _mm256_movemask_pd(_mm256_cmp_pd(d, r, _CMP_LT_OQ));
     if (mask) {
       uint32_t bytes;
       std::memcpy(&bytes, f, 4);
@@ -180,6 +181,158 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     }
   }
   return i;
+}
+
+// (n0 y0 + n1 y1) + n2 y2, Eigen's order for a Vec3 dot product.
+[[gnu::target("avx")]] inline __m256d Dot3(const __m256d n[3], __m256d y0, __m256d y1, __m256d y2) {
+  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n[0], y0), _mm256_mul_pd(n[1], y1)),
+                       _mm256_mul_pd(n[2], y2));
+}
+
+[[gnu::target("avx")]] inline __m256d Abs(__m256d x) {
+  return _mm256_andnot_pd(_mm256_set1_pd(-0.0), x);
+}
+
+// std::max(a, b) = a < b ? b : a, lane by lane: maxpd(b, a) is b > a ? b : a,
+// the same for equal values (a signed zero included) and a NaN in either.
+[[gnu::target("avx")]] inline __m256d Max(__m256d a, __m256d b) {
+  return _mm256_max_pd(b, a);
+}
+
+// base[j[0..3]] as doubles; one load when they are consecutive (run).
+[[gnu::target("avx")]] inline __m256d Lanes(const float* base, const size_t j[4], bool run) {
+  if (run) return _mm256_cvtps_pd(_mm_loadu_ps(base + j[0]));
+  return _mm256_cvtps_pd(_mm_set_ps(base[j[3]], base[j[2]], base[j[1]], base[j[0]]));
+}
+
+[[gnu::target("avx")]] void RestOnPlaneAvx(const PlaneRest& q, const BulkArrays& ar,
+                                           const float* radius, const float* const* old,
+                                           size_t begin, const uint16_t* idx, size_t count,
+                                           uint8_t* done) {
+  const __m256d n[3] = {_mm256_set1_pd(q.n[0]), _mm256_set1_pd(q.n[1]), _mm256_set1_pd(q.n[2])};
+  const __m256d p[3] = {_mm256_set1_pd(q.p[0]), _mm256_set1_pd(q.p[1]), _mm256_set1_pd(q.p[2])};
+  const __m256d h = _mm256_set1_pd(q.h), mh = _mm256_set1_pd(-q.h), half = _mm256_set1_pd(0.5);
+  const __m256d mu = _mm256_set1_pd(q.friction), zero = _mm256_setzero_pd();
+  const __m256d one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(1e-300);
+  const __m256d tol = _mm256_set1_pd(1e-12), mtol = _mm256_set1_pd(-1e-12);
+  const __m256d limit2 = _mm256_set1_pd(q.limit2);
+  for (size_t k0 = 0; k0 < count; k0 += 4) {
+    // Four lanes (the last repeated past the end): one load an array where
+    // they are consecutive, the common case.
+    size_t j[4];
+    for (int l = 0; l < 4; ++l) j[l] = idx[std::min(k0 + size_t(l), count - 1)];
+    const bool run = j[3] == j[0] + 3 && k0 + 4 <= count;
+    auto load = [&](const float* base) { return Lanes(base, j, run); };
+    __m256d a[3], va[3], x[3], v[3];
+    for (int c = 0; c < 3; ++c) {
+      a[c] = load(old[c]);
+      va[c] = load(old[3 + c]);
+    }
+    const float* const now[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
+                                 ar.vx + begin, ar.vy + begin, ar.vz + begin};
+    for (int c = 0; c < 3; ++c) {
+      x[c] = load(now[c]);
+      v[c] = load(now[3 + c]);
+    }
+    const __m256d r = load(radius + begin);
+    __m256d dv[3], A[3], u[3], xp[3], ap[3];
+    for (int c = 0; c < 3; ++c) {
+      dv[c] = _mm256_sub_pd(v[c], va[c]);
+      A[c] = _mm256_mul_pd(h, dv[c]);
+      u[c] = _mm256_sub_pd(_mm256_sub_pd(x[c], a[c]), _mm256_mul_pd(half, A[c]));
+      xp[c] = _mm256_sub_pd(x[c], p[c]);
+      ap[c] = _mm256_sub_pd(a[c], p[c]);
+    }
+    // The plane's contact at the start: d1 < 0 (a contact), d0 <= 0 (s = 0).
+    const __m256d d1 = _mm256_sub_pd(Dot3(n, xp[0], xp[1], xp[2]), r);
+    const __m256d d0 = _mm256_sub_pd(Dot3(n, ap[0], ap[1], ap[2]), r);
+    __m256d ok =
+        _mm256_and_pd(_mm256_cmp_pd(d1, zero, _CMP_LT_OQ), _mm256_cmp_pd(d0, zero, _CMP_LE_OQ));
+    __m256d point[3], px[3];
+    for (int c = 0; c < 3; ++c) {
+      point[c] = _mm256_sub_pd(a[c], _mm256_mul_pd(d0, n[c]));
+      px[c] = _mm256_sub_pd(point[c], x[c]);
+    }
+    // Not a graze (sliding along the plane within rounding).
+    const __m256d xmax = Max(one, Max(Max(Abs(x[0]), Abs(x[1])), Abs(x[2])));
+    const __m256d umax = Max(tiny, Max(Max(Abs(u[0]), Abs(u[1])), Abs(u[2])));
+    const __m256d un = Dot3(n, u[0], u[1], u[2]);
+    const __m256d slides = _mm256_and_pd(
+        _mm256_cmp_pd(Dot3(n, px[0], px[1], px[2]), _mm256_mul_pd(tol, xmax), _CMP_LE_OQ),
+        _mm256_cmp_pd(un, _mm256_mul_pd(mtol, umax), _CMP_GE_OQ));
+    ok = _mm256_andnot_pd(slides, ok);
+    // Resting: no faster toward the plane than the step's forces made it.
+    const __m256d gained = Max(zero, _mm256_mul_pd(mh, Dot3(n, dv[0], dv[1], dv[2])));
+    ok = _mm256_andnot_pd(
+        _mm256_cmp_pd(_mm256_xor_pd(un, _mm256_set1_pd(-0.0)), gained, _CMP_GT_OQ), ok);
+    // The response.
+    const __m256d en = Dot3(n, v[0], v[1], v[2]);
+    const __m256d jn = Max(zero, _mm256_xor_pd(en, _mm256_set1_pd(-0.0)));
+    __m256d vt[3];
+    for (int c = 0; c < 3; ++c) vt[c] = _mm256_sub_pd(v[c], _mm256_mul_pd(en, n[c]));
+    const __m256d change = _mm256_mul_pd(mu, jn);
+    const __m256d len = _mm256_sqrt_pd(
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(vt[0], vt[0]), _mm256_mul_pd(vt[1], vt[1])),
+                      _mm256_mul_pd(vt[2], vt[2])));
+    const __m256d stops = _mm256_cmp_pd(len, change, _CMP_LE_OQ);
+    const __m256d keep = _mm256_sub_pd(one, _mm256_div_pd(change, len));
+    const __m256d up = Max(en, zero);
+    __m256d out[3], x1[3], x1p[3];
+    for (int c = 0; c < 3; ++c) {
+      const __m256d f = _mm256_blendv_pd(_mm256_mul_pd(vt[c], keep), zero, stops);
+      out[c] = _mm256_add_pd(f, _mm256_mul_pd(up, n[c]));
+      x1[c] = _mm256_add_pd(point[c], _mm256_mul_pd(h, out[c]));
+      x1p[c] = _mm256_sub_pd(x1[c], p[c]);
+    }
+    // Ends on the plane: no second contact, nothing to project.
+    ok = _mm256_and_pd(
+        ok, _mm256_cmp_pd(_mm256_sub_pd(Dot3(n, x1p[0], x1p[1], x1p[2]), r), zero, _CMP_GE_OQ));
+    // Rounded to floats on the plane's side: a rounding's displacement,
+    // doubled, must not cross it (else RoundOutside's push is needed).
+    __m128 xf[3];
+    __m256d rx[3], by[3];
+    __m256d same = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+    for (int c = 0; c < 3; ++c) {
+      xf[c] = _mm256_cvtpd_ps(x1[c]);
+      rx[c] = _mm256_cvtps_pd(xf[c]);
+      same = _mm256_and_pd(same, _mm256_cmp_pd(rx[c], x1[c], _CMP_EQ_OQ));
+      by[c] = _mm256_sub_pd(_mm256_add_pd(rx[c], _mm256_sub_pd(rx[c], x1[c])), p[c]);
+    }
+    const __m256d db = _mm256_sub_pd(Dot3(n, by[0], by[1], by[2]), r);
+    ok = _mm256_and_pd(ok, _mm256_or_pd(same, _mm256_cmp_pd(db, zero, _CMP_GE_OQ)));
+    // Within the magnitude limit.
+    const __m256d xx =
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(rx[0], rx[0]), _mm256_mul_pd(rx[1], rx[1])),
+                      _mm256_mul_pd(rx[2], rx[2]));
+    const __m256d vv =
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(out[0], out[0]), _mm256_mul_pd(out[1], out[1])),
+                      _mm256_mul_pd(out[2], out[2]));
+    ok = _mm256_and_pd(ok, _mm256_cmp_pd(_mm256_add_pd(xx, vv), limit2, _CMP_LE_OQ));
+    const int mask = _mm256_movemask_pd(ok);
+    __m128 fv[3];
+    for (int c = 0; c < 3; ++c) fv[c] = _mm256_cvtpd_ps(out[c]);
+    float* const to[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
+                          ar.vx + begin, ar.vy + begin, ar.vz + begin};
+    if (run && mask == 0xf) {
+      for (int c = 0; c < 3; ++c) {
+        _mm_storeu_ps(to[c] + j[0], xf[c]);
+        _mm_storeu_ps(to[3 + c] + j[0], fv[c]);
+      }
+      std::memset(done + k0, 1, 4);
+      continue;
+    }
+    alignas(16) float fx[6][4];
+    for (int c = 0; c < 3; ++c) {
+      _mm_store_ps(fx[c], xf[c]);
+      _mm_store_ps(fx[3 + c], fv[c]);
+    }
+    for (int l = 0; l < 4 && k0 + size_t(l) < count; ++l) {
+      const bool d = (mask >> l) & 1;
+      done[k0 + l] = d;
+      if (!d) continue;
+      for (int c = 0; c < 6; ++c) to[c][j[l]] = fx[c][l];
+    }
+  }
 }
 
 }  // namespace
@@ -222,14 +375,20 @@ bool BulkAdvance(Kernel kernel, const BulkParams& q, const BulkArrays& a, size_t
 }
 
 void BulkPlaneCandidates(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
-                         size_t begin, size_t end, uint8_t* flags) {
+                         const float* radius, size_t begin, size_t end, uint8_t* flags) {
   size_t i = begin;
-  if (kernel == Kernel::kAvx) i = BulkPlaneAvx(n, p, a, begin, end, flags);
+  if (kernel == Kernel::kAvx) i = BulkPlaneAvx(n, p, a, radius, begin, end, flags);
   for (; i < end; ++i) {
     const double d = (n[0] * (double(a.px[i]) - p[0]) + n[1] * (double(a.py[i]) - p[1])) +
                      n[2] * (double(a.pz[i]) - p[2]);
-    flags[i - begin] |= d < 0;
+    flags[i - begin] |= d < double(radius[i]);
   }
+}
+
+void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radius,
+                     const float* const* old, size_t begin, const uint16_t* idx, size_t count,
+                     uint8_t* done) {
+  RestOnPlaneAvx(q, a, radius, old, begin, idx, count, done);
 }
 
 }  // namespace sylva::particles::kernels

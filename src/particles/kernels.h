@@ -94,9 +94,36 @@ bool BulkAdvance(Kernel kernel, const BulkParams& q, const BulkArrays& a, size_t
                  float* const* old);
 
 // flags[i - begin] |= 1 for the particles of [begin, end) whose new position
-// b (the arrays, as doubles) has n . (b - p) < 0: a plane collider's MayHit,
-// computed as (n0 (b0 - p0) + n1 (b1 - p1)) + n2 (b2 - p2).
+// b (the arrays, as doubles) has n . (b - p) < radius[i]: a plane collider's
+// MayHit for a ball of that radius, computed as
+// (n0 (b0 - p0) + n1 (b1 - p1)) + n2 (b2 - p2). The radii are read four at
+// a time with the positions (no separate pass over them).
 void BulkPlaneCandidates(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
-                         size_t begin, size_t end, uint8_t* flags);
+                         const float* radius, size_t begin, size_t end, uint8_t* flags);
+
+// Resting contact on a single static plane (the bulk step's floor), four
+// particles at a time in double precision: the operations, in the same order,
+// that RespondToContacts (its fast path for one resting contact at the start
+// of the step), ProjectOut and the bulk step's rounding take for a particle
+// that starts on or below the plane (d0 = n . (a - p) - r <= 0), approaches
+// it no faster than the step's forces could make it, and ends the step
+// strictly on it: same bits. The new velocity is
+//   en = v . n, vt = v - en n, jn = max(0, -en),
+//   out = (|vt| <= mu jn ? 0 : vt (1 - mu jn / |vt|)) + max(en, 0) n
+// and the position (a - d0 n) + h out, rounded to floats (which must not
+// cross the plane) and within the magnitude limit (x.x + v.v <= limit2).
+// Every other particle (a faster approach, a start above the plane, a
+// graze, a crossing after rounding, a NaN) is left for the general path.
+struct PlaneRest {
+  double n[3], p[3];
+  double friction, h, limit2;
+};
+// For the candidates idx[0..count) (indices into [begin, begin + kChunk) of
+// the arrays; `old` holds the step's start state by chunk index as in
+// BulkAdvance): writes the particles it resolves into the arrays and sets
+// done[k] to 1 for them, 0 for the rest. AVX only (callers test Best()).
+void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radius,
+                     const float* const* old, size_t begin, const uint16_t* idx, size_t count,
+                     uint8_t* done);
 
 }  // namespace sylva::particles::kernels

@@ -49,6 +49,7 @@ namespace {
 
 constexpr int kVelocityPasses = 16;
 constexpr int kPositionPasses = 4;
+constexpr double kRestFraction = 0.5;
 
 // The first t in [0, 1] where |d0 + t dd| = R, or -1; 0 when |d0| < R.
 double TimeOfImpact(const Vec3& d0, const Vec3& dd, double R) {
@@ -95,7 +96,9 @@ void System::ParticleCollisions(double h) {
   }
   if (!(maxMove <= 1e12)) return;  // an explosion: the fault scan reports it
   const double reach = 2 * maxR + 2 * maxMove;
-  pairGrid_->Build(X0, n, reach, pool_);
+  // With a copy of the start positions in slot order: every particle
+  // queries, and reads its candidates contiguously.
+  pairGrid_->Build(X0, n, reach, pool_, true);
 
   // Contacts, particle by particle: count, offsets, fill.
   auto find = [&](size_t i, auto&& emit) {
@@ -153,6 +156,23 @@ void System::ParticleCollisions(double h) {
     return 1.0 / double(std::max(ci, cj));
   };
 
+  // Each contact's target speed and sharing factor, once.
+  Ranges(pool_, n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      for (uint32_t k = pairStart_[i]; k < pairStart_[i + 1]; ++k) {
+        PairContact& c = pairs_[k];
+        c.target = c.bounce ? -pairRestitution_ * c.vn0 : 0;
+        c.k = w[i] > 0 ? factor(i, c.j) / (w[i] + w[c.j]) : 0;
+      }
+    }
+  });
+
+  // From here pairMove_ holds what the step's forces changed each
+  // velocity by (|v - v0| before the solve), for the rest test at the end.
+  Ranges(pool_, n, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) pairMove_[i] = (V[i] - V0[i]).norm();
+  });
+
   // Velocity passes (Jacobi).
   pairV_.assign(V.begin(), V.end());
   pairScratch_.resize(n);
@@ -164,12 +184,10 @@ void System::ParticleCollisions(double h) {
           for (uint32_t k = pairStart_[i]; k < pairStart_[i + 1]; ++k) {
             PairContact& c = pairs_[k];
             const double vn = c.n.dot(pairV_[i] - pairV_[c.j]);
-            const double target = c.bounce ? -pairRestitution_ * c.vn0 : 0;
             // The impulse toward the target, its sum over the passes kept
             // at 0 or more (contacts push, never pull). Both particles of a
             // pair compute the same numbers.
-            const double acc =
-                std::max(0.0, c.impulse + (target - vn) / (w[i] + w[c.j]) * factor(i, c.j));
+            const double acc = std::max(0.0, c.impulse + (c.target - vn) * c.k);
             const double J = acc - c.impulse;
             c.impulse = acc;
             dv += (J * w[i]) * c.n;
@@ -243,7 +261,13 @@ void System::ParticleCollisions(double h) {
       if (w[i] == 0) continue;
       bool resting = false;
       for (uint32_t k = pairStart_[i]; k < pairStart_[i + 1]; ++k) resting |= !pairs_[k].bounce;
-      if (resting) V[i] = (X[i] - X0[i]) * (1 / h);
+      if (!resting) continue;
+      V[i] = (X[i] - X0[i]) * (1 / h);
+      // At rest: a particle in resting contact that moved over the step at
+      // less than half the speed its forces alone gave it in the step is
+      // held by its neighbours; its velocity is zeroed, so what the passes
+      // leave of the forces' push does not make a pile jitter.
+      if (V[i].norm() < kRestFraction * pairMove_[i]) V[i] = Vec3::Zero();
     }
   });
 }

@@ -417,13 +417,15 @@ class System {
   bool hasNonLocal_ = false;
   double pairRadius_ = 0, pairRestitution_ = 1;
   std::unique_ptr<NeighbourGrid> pairGrid_;
-  // The pair contacts of a step (pairs.cpp): 72 bytes each.
+  // The pair contacts of a step (pairs.cpp): 88 bytes each.
   struct PairContact {
     Vec3 n;          // unit, from the other particle toward this one, at impact
     double t;        // time of impact, fraction of the step
     double R;        // the two radii
     double vn0;      // relative normal speed before the solve (negative: approaching)
     double impulse;  // summed over the velocity passes (N s times the inverse mass sum's unit)
+    double target;   // relative normal speed the velocity passes aim for
+    double k;        // the pair's sharing factor over its inverse mass sum
     uint32_t j;      // the other particle
     bool bounce;     // faster than the step's forces: leaves at e times vn0
   };

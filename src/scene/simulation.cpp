@@ -403,6 +403,15 @@ struct ClothSheet {
   std::vector<Other> others;
   std::unique_ptr<WindGrid> windGrid = std::make_unique<WindGrid>();  // the gusts over it
   Vec3 gravity = Vec3::Zero();
+  // Its triangles as a collider's hierarchy where the sheet is now: built on
+  // first use, shared by every particle system, substep and other sheet
+  // that collides with it, dropped when the sheet steps.
+  std::shared_ptr<const particles::TriangleBvh> bvh;
+  const std::shared_ptr<const particles::TriangleBvh>& Bvh() {
+    if (!bvh)
+      bvh = std::make_shared<const particles::TriangleBvh>(cloth->positions(), cloth->triangles());
+    return bvh;
+  }
 };
 
 struct Flock {
@@ -575,9 +584,8 @@ Status Simulation::Impl::AddColliders(particles::System& system,
 }
 
 // A cloth where it is now, as the triangle collider `def` describes.
-static particles::Collider ClothAsCollider(const particles::Cloth& cloth, const CollideDef& def) {
-  auto bvh = std::make_shared<const particles::TriangleBvh>(cloth.positions(), cloth.triangles());
-  particles::Collider c = particles::Collider::Mesh(std::move(bvh));
+static particles::Collider ClothAsCollider(ClothSheet& sheet, const CollideDef& def) {
+  particles::Collider c = particles::Collider::Mesh(sheet.Bvh());
   c.Restitution(def.restitution)
       .Friction(std::min(def.friction, 1e3))
       .Respond(def.stick ? particles::Response::kStick : particles::Response::kBounce);
@@ -586,7 +594,7 @@ static particles::Collider ClothAsCollider(const particles::Cloth& cloth, const 
 
 Status Simulation::Impl::RefreshClothColliders(ParticleSystem& ps) {
   for (const ParticleSystem::ClothCollider& cc : ps.clothColliders) {
-    particles::Collider c = ClothAsCollider(*cloths[cc.cloth].cloth, *cc.def);
+    particles::Collider c = ClothAsCollider(cloths[cc.cloth], *cc.def);
     if (Status s = ps.system->SetCollider(cc.collider, std::move(c)); !s.ok()) {
       Diagnostic d = s.error();
       d.loc = cc.def->loc;
@@ -747,7 +755,7 @@ Status Simulation::Impl::Step() {
   }
   for (ClothSheet& c : cloths) {
     for (const ClothSheet::Other& o : c.others) {
-      particles::Collider other = ClothAsCollider(*cloths[o.cloth].cloth, *o.def);
+      particles::Collider other = ClothAsCollider(cloths[o.cloth], *o.def);
       if (Status s = c.cloth->SetCollider(o.collider, std::move(other)); !s.ok()) {
         Diagnostic d = s.error();
         d.loc = o.def->loc;
@@ -764,6 +772,7 @@ Status Simulation::Impl::Step() {
                    ? c.cloth->StepInWindField(h, c.gravity,
                                               [air, t](const Vec3& x) { return air->At(x, t); })
                    : c.cloth->Step(h, c.gravity, hasWind && c.def->wind ? wind.mean : Vec3::Zero());
+    c.bvh.reset();  // the sheet moved
     if (!s.ok()) {
       Diagnostic d = s.error();
       d.loc = c.def->loc;
@@ -1239,7 +1248,7 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
         for (size_t k = 0; k < m.cloths.size(); ++k) {
           if (m.cloths[k].def->id != id || &m.cloths[k] == &sheet) continue;
           sheet.others.push_back({k, sheet.cloth->colliders().size(), &c});
-          if (Status s = sheet.cloth->AddCollider(ClothAsCollider(*m.cloths[k].cloth, c),
+          if (Status s = sheet.cloth->AddCollider(ClothAsCollider(m.cloths[k], c),
                                                   std::min(thickness, 1e3));
               !s.ok()) {
             Diagnostic diag = s.error();

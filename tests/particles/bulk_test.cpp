@@ -104,6 +104,47 @@ TEST(Bulk, AvxKernelMatchesTheScalarKernelBitForBit) {
   }
 }
 
+TEST(Bulk, RestingFloorKernelMatchesTheScalarPathBitForBit) {
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
+  // A lone tilted floor with friction (the vector path for resting contact):
+  // a quarter resting on it, the rest falling onto it, balls of three radii,
+  // a ragged count, immovable lanes, and a slow and a fast friction regime.
+  for (double mu : {0.3, 5.0}) {
+    BulkSystem avx, scalar;
+    const Vec3 n = Vec3(0.1, 1, -0.05).normalized();
+    for (BulkSystem* b : {&avx, &scalar}) {
+      Fill(b->state, 1003, 13, true);
+      for (size_t i = 0; i < b->state.size(); ++i) {
+        b->state.radius[i] = i % 3 == 0 ? 0.0f : i % 3 == 1 ? 0.01f : 0.1f;
+        // Onto the floor (through (0, -1, 0)) at its radius, those marked resting.
+        if (i % 4 == 0) {
+          const Vec3 p = b->state.position(i);
+          b->state.SetPosition(i, p - (n.dot(p - Vec3(0, -1, 0)) - b->state.radius[i]) * n);
+        }
+      }
+      b->fields.gravity = Vec3(0, -kG, 0);
+      b->fields.linearDrag = 0.1;
+      EXPECT_OK(b->AddCollider(Collider::Plane(Vec3(0, -1, 0), n).Restitution(0.5).Friction(mu)));
+    }
+    scalar.SetKernel(kernels::Kernel::kScalar);
+    for (int k = 0; k < 240; ++k) {
+      BULK_STEP_OK(avx, 1.0 / 240);
+      BULK_STEP_OK(scalar, 1.0 / 240);
+      ASSERT_EQ(avx.Hash(), scalar.Hash()) << "mu " << mu << ": states differ after step " << k;
+    }
+    // Most of them ended resting on the floor (what the vector path serves).
+    int onFloor = 0;
+    for (size_t i = 0; i < avx.state.size(); ++i) {
+      if (avx.state.invMass[i] == 0) continue;  // pinned where it was put
+      const double d = n.dot(avx.state.position(i) - Vec3(0, -1, 0)) - avx.state.radius[i];
+      onFloor += d < 1e-5;
+      // Within rounding of the tilted plane's projection (both paths).
+      ASSERT_GE(d, -1e-12) << "particle " << i << " below the floor by " << -d << " m";
+    }
+    EXPECT_GT(onFloor, 250) << "mu " << mu << ": particles on the floor: " << onFloor;
+  }
+}
+
 TEST(Bulk, PlaneCandidatesAreExactlyTheColliderTest) {
   if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
   // Points on, just above and just below a tilted plane through a point
@@ -117,17 +158,20 @@ TEST(Bulk, PlaneCandidatesAreExactlyTheColliderTest) {
     p -= c.normal.dot(p - c.point) * c.normal;  // onto the plane, then a few ulps off
     p += c.normal * (1e-7 * std::round(4 * u(rng)));
     s.Add(p, Vec3::Zero());
+    // A third of them balls of a radius of up to a few ulps of the offset.
+    if (i % 3 == 1) s.radius.back() = float(1e-7 * std::abs(std::round(4 * u(rng))));
+    if (i % 3 == 2) s.radius.back() = 0.25f;
   }
   const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
                               s.vy.data(), s.vz.data(), s.invMass.data()};
   std::vector<uint8_t> fa(s.size(), 0), fs(s.size(), 0);
-  kernels::BulkPlaneCandidates(kernels::Kernel::kAvx, c.normal.data(), c.point.data(), a, 0,
-                               s.size(), fa.data());
-  kernels::BulkPlaneCandidates(kernels::Kernel::kScalar, c.normal.data(), c.point.data(), a, 0,
-                               s.size(), fs.data());
+  kernels::BulkPlaneCandidates(kernels::Kernel::kAvx, c.normal.data(), c.point.data(), a,
+                               s.radius.data(), 0, s.size(), fa.data());
+  kernels::BulkPlaneCandidates(kernels::Kernel::kScalar, c.normal.data(), c.point.data(), a,
+                               s.radius.data(), 0, s.size(), fs.data());
   int below = 0;
   for (size_t i = 0; i < s.size(); ++i) {
-    const bool expected = c.MayHit(s.position(i), s.position(i));
+    const bool expected = c.MayHit(s.position(i), s.position(i), double(s.radius[i]));
     below += expected;
     ASSERT_EQ(bool(fa[i]), expected) << "AVX flag of point " << i;
     ASSERT_EQ(bool(fs[i]), expected) << "scalar flag of point " << i;

@@ -248,6 +248,44 @@ TEST(SceneSimulation, ParticlesCollideWithACloth) {
   EXPECT_EQ(through, 0u) << "particles through the cloth of " << n;
 }
 
+TEST(SceneSimulation, ParticlesRideAFallingCloth) {
+  // A free sheet falls flat from y = 3 with stones lying on it (two
+  // particle systems, one with substeps, sharing the sheet's collider, which
+  // is built once a step): the stones fall with the sheet (a collider left
+  // where the sheet started would hold them up at y = 3).
+  auto run = Start(R"(<scene version="1">
+    <cloth id="sheet" size="2 2" resolution="10 10" position="-1 3 1" rotate="90 0 0"
+           pin="none">
+      <gravity/>
+    </cloth>
+    <particles id="a" max="20">
+      <emitter shape="box" at="0 3.1 0" size="1 0 1" burst="20" speed="0" lifetime="100"
+               radius="0.02"/>
+      <gravity/>
+      <collide with="sheet" restitution="0"/>
+    </particles>
+    <particles id="b" max="20" substeps="3">
+      <emitter shape="box" at="0 3.1 0" size="1 0 1" burst="20" speed="0" lifetime="100"
+               radius="0.02"/>
+      <gravity/>
+      <collide with="sheet" restitution="0"/>
+    </particles>
+  </scene>)");
+  ASSERT_TRUE(run);
+  ASSERT_TRUE(run->sim->AdvanceTo(0.5).ok());
+  double sheetLow = HUGE_VAL, stoneHigh = -HUGE_VAL;
+  size_t stones = 0;
+  for (const Row& r : Rows(*run->sim)) {
+    if (r.system == "sheet") sheetLow = std::min(sheetLow, r.x.y());
+    if (r.system == "a" || r.system == "b") stoneHigh = std::max(stoneHigh, r.x.y()), ++stones;
+  }
+  ASSERT_EQ(stones, 40u);
+  // Free fall for 0.5 s: 1.23 m. The sheet has fallen; so have the stones.
+  EXPECT_LT(sheetLow, 2.0) << "the sheet did not fall";
+  EXPECT_LT(stoneHigh, 2.2) << "a stone stayed up at y = " << stoneHigh
+                            << " (the sheet's lowest point is at " << sheetLow << ")";
+}
+
 TEST(SceneSimulation, AClothLandsOnAnotherCloth) {
   // A hammock (a sheet turned 90 degrees about x, so it lies flat and
   // extends toward -z from its position; pinned at its four corners at
