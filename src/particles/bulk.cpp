@@ -132,7 +132,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
                                    {f.point.x(), f.point.y(), f.point.z()},
                                    f.friction,
                                    h,
-                                   limit2_};
+                                   faults_.limit2()};
   }
   const kernels::PlaneRest* floor = floorRest ? &*floorRest : nullptr;
   for (size_t c = begin; c < end; c += kChunk) {
