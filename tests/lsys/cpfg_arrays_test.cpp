@@ -11,16 +11,8 @@ namespace sylva::lsys {
 namespace {
 
 using testing::DeriveText;
+using testing::FirstError;
 using testing::MustParse;
-
-std::string FirstError(const std::string& text) {
-  ParseResult r = ParseGrammarText(text, "c.l");
-  for (const auto& d : r.diagnostics.items) {
-    if (d.severity == Severity::kError)
-      return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " + d.message;
-  }
-  return "<no error>";
-}
 
 TEST(CpfgArrays, InitialisedArraysAreReadRowMajor) {
   const std::string text =

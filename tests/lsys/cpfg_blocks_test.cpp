@@ -13,20 +13,11 @@ namespace sylva::lsys {
 namespace {
 
 using testing::DeriveText;
+using testing::FirstError;
 using testing::MustDerive;
 using testing::MustParse;
 
 // "line:col message" of the first error.
-std::string FirstError(const std::string& text) {
-  ParseResult r = ParseGrammarText(text, "c.l");
-  EXPECT_FALSE(r.grammar) << text;
-  for (const auto& d : r.diagnostics.items) {
-    if (d.severity == Severity::kError)
-      return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " + d.message;
-  }
-  return "<no error>";
-}
-
 TEST(CpfgBlocks, PreConditionBlockDefinesLocalsForTheConditionAndSuccessor) {
   const std::string g =
       "derivation length: 2\n"

@@ -10,17 +10,9 @@
 namespace sylva::lsys {
 namespace {
 
-using testing::DeriveText;
+using testing::FirstError;
 
-std::string FirstError(const std::string& text) {
-  ParseResult r = ParseGrammarText(text, "c.l");
-  EXPECT_FALSE(r.grammar) << text;
-  for (const auto& d : r.diagnostics.items) {
-    if (d.severity == Severity::kError)
-      return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " + d.message;
-  }
-  return "<no error>";
-}
+using testing::DeriveText;
 
 const char* kFile =
     "#define TWO\n"

@@ -41,4 +41,15 @@ inline std::string SourcePath(const std::string& rel) {
   return std::string(SYLVA_SOURCE_DIR) + "/" + rel;
 }
 
+// The first error of parsing `text` as "line:column message", or
+// "<no error>".
+inline std::string FirstError(const std::string& text) {
+  ParseResult r = ParseGrammarText(text, "c.l");
+  for (const auto& d : r.diagnostics.items) {
+    if (d.severity == Severity::kError)
+      return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " + d.message;
+  }
+  return "<no error>";
+}
+
 }  // namespace sylva::lsys::testing
