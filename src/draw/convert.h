@@ -30,7 +30,7 @@ namespace sylva::draw {
 
 // How a batch of points looks where the arrays say nothing.
 struct PointStyle {
-  float size = 0.05f;  // diameter, m, for every point when `radii` is empty
+  float size = 0.05f;    // diameter, m, for every point when `radii` is empty
   Vec3f color{1, 1, 1};  // linear RGB, for every point when `colors` is empty
   float alpha = 1;       // every point's opacity (1: opaque, no alpha array)
   Blend blend = Blend::kAlpha;

@@ -19,6 +19,7 @@
 
 #include "core/assert.h"
 #include "core/rng.h"
+#include "draw/convert.h"
 #include "mesh/obj_reader.h"
 #include "particles/cloth.h"
 #include "particles/emitter.h"
@@ -1295,21 +1296,6 @@ Vec3 ColorAt(const DrawDef& d, double age, double lifetime) {
   return d.color + t * (*d.colorEnd - d.color);
 }
 
-// A model matrix turning +Z to `forward` (Y up), scaled.
-draw::Mat4f Facing(const Vec3& at, const Vec3& forward, double scale) {
-  Vec3 f = forward.norm() > 1e-9 ? forward.normalized() : Vec3::UnitZ();
-  Vec3 side = Vec3::UnitY().cross(f);
-  if (side.norm() < 1e-6) side = Vec3::UnitX();
-  side.normalize();
-  const Vec3 up = f.cross(side);
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.block<3, 1>(0, 0) = side * scale;
-  m.block<3, 1>(0, 1) = up * scale;
-  m.block<3, 1>(0, 2) = f * scale;
-  m.block<3, 1>(0, 3) = at;
-  return m.cast<float>();
-}
-
 }  // namespace
 
 void Simulation::AddToDrawList(draw::DrawList& list) const {
@@ -1376,37 +1362,28 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
       list.lines.push_back(std::move(l));
       continue;
     }
-    draw::Sprites s;
-    s.name = p.id;
-    s.blend = d.blend == Blend::kAdditive ? draw::Blend::kAdditive : draw::Blend::kAlpha;
-    for (size_t i = 0; i < st.size(); ++i) {
-      s.positions.push_back(st.position[i].cast<float>());
-      s.sizes.push_back(float(d.size));
-      s.colors.push_back(ColorAt(d, st.age[i], st.lifetime[i]).cast<float>());
-      s.alphas.push_back(float(d.alpha));
+    draw::PointStyle style;
+    style.name = p.id;
+    style.size = float(d.size);
+    style.color = d.color.cast<float>();
+    style.alpha = float(d.alpha);
+    style.blend = d.blend == Blend::kAdditive ? draw::Blend::kAdditive : draw::Blend::kAlpha;
+    std::vector<mesh::Vec3f> colors;
+    if (d.colorEnd) {
+      colors.resize(st.size());
+      for (size_t i = 0; i < st.size(); ++i)
+        colors[i] = ColorAt(d, st.age[i], st.lifetime[i]).cast<float>();
     }
-    list.sprites.push_back(std::move(s));
+    auto sprites = draw::PointSprites(st.position, style, colors);
+    SYLVA_ASSERT(sprites.ok());  // one colour a particle, or none
+    list.sprites.push_back(std::move(*sprites));
   }
   for (const ClothSheet& c : m.cloths) {
-    auto mesh = std::make_shared<mesh::TriangleMesh>();
-    const std::vector<Vec3>& x = c.cloth->positions();
-    mesh->positions.reserve(x.size());
-    std::vector<Vec3> normals(x.size(), Vec3::Zero());
-    for (const auto& t : c.cloth->triangles()) {
-      const Vec3 n = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
-      for (uint32_t k : t) normals[k] += n;
-      mesh->indices.insert(mesh->indices.end(), {t[0], t[1], t[2]});
-      mesh->material.push_back(0);
-    }
-    for (size_t i = 0; i < x.size(); ++i) {
-      mesh->positions.push_back(x[i].cast<float>());
-      const double len = normals[i].norm();
-      mesh->normals.push_back(len > 0 ? (normals[i] / len).cast<float>() : mesh::Vec3f(0, 0, 1));
-      mesh->uvs.push_back({0, 0});
-    }
+    auto sheet = draw::SheetMesh(c.cloth->positions(), c.cloth->triangles());
+    SYLVA_ASSERT(sheet.ok());  // the cloth's own triangles index its vertices
     draw::MeshDraw md;
     md.name = c.def->id;
-    md.mesh = mesh;
+    md.mesh = std::make_shared<const mesh::TriangleMesh>(std::move(*sheet));
     md.palette = {c.def->color.cast<float>()};
     md.instances.push_back({});
     list.meshes.push_back(std::move(md));
@@ -1414,23 +1391,23 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
   for (const Flock& f : m.flocks) {
     const ParticleState& st = f.system->state;
     if (f.def->draw.as == DrawAs::kPoints || f.def->draw.as == DrawAs::kSprites) {
-      draw::Sprites s;
-      s.name = f.def->id;
-      for (size_t i = 0; i < st.size(); ++i) {
-        s.positions.push_back(st.position[i].cast<float>());
-        s.sizes.push_back(float(f.def->draw.size));
-        s.colors.push_back(f.def->draw.color.cast<float>());
-      }
-      list.sprites.push_back(std::move(s));
+      draw::PointStyle style;
+      style.name = f.def->id;
+      style.size = float(f.def->draw.size);
+      style.color = f.def->draw.color.cast<float>();
+      auto sprites = draw::PointSprites(st.position, style);
+      SYLVA_ASSERT(sprites.ok());
+      list.sprites.push_back(std::move(*sprites));
       continue;
     }
     draw::MeshDraw md;
     md.name = f.def->id;
     md.mesh = f.drawMesh;
     md.palette = {mesh::Vec3f(1, 1, 1)};
-    for (size_t i = 0; i < st.size(); ++i)
-      md.instances.push_back({Facing(st.position[i], st.velocity[i], f.def->draw.size),
-                              f.def->draw.color.cast<float>()});
+    auto instances = draw::FacingInstances(st.position, st.velocity, f.def->draw.size,
+                                           f.def->draw.color.cast<float>());
+    SYLVA_ASSERT(instances.ok());  // one velocity a boid
+    md.instances = std::move(*instances);
     list.meshes.push_back(std::move(md));
   }
 }
