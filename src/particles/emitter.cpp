@@ -14,15 +14,27 @@ static Vec3 InBall(RandomStream& r) {
   }
 }
 
-Vec3 InCone(const Vec3& axis, double spreadDegrees, double u1, double u2) {
-  const Vec3 a = axis.normalized();
-  const double cosMax = std::cos(spreadDegrees * kDegToRad);
+// An orthonormal frame (t, b) perpendicular to the unit vector a.
+static void Frame(const Vec3& a, Vec3* t, Vec3* b) {
+  *t = std::abs(a.x()) < 0.9 ? a.cross(Vec3::UnitX()).normalized()
+                             : a.cross(Vec3::UnitY()).normalized();
+  *b = a.cross(*t);
+}
+
+// Uniform over the cap cos(angle to a) >= cosMax: the cosine is uniform
+// (Archimedes), the turn about a too.
+static Vec3 OnCap(const Vec3& a, const Vec3& t, const Vec3& b, double cosMax, double u1,
+                  double u2) {
   const double c = 1 - u1 * (1 - cosMax), s = std::sqrt(std::max(0.0, 1 - c * c));
   const double phi = 2 * kPi * u2;
-  const Vec3 t = std::abs(a.x()) < 0.9 ? a.cross(Vec3::UnitX()).normalized()
-                                       : a.cross(Vec3::UnitY()).normalized();
-  const Vec3 b = a.cross(t);
   return c * a + s * (std::cos(phi) * t + std::sin(phi) * b);
+}
+
+Vec3 InCone(const Vec3& axis, double spreadDegrees, double u1, double u2) {
+  const Vec3 a = axis.normalized();
+  Vec3 t, b;
+  Frame(a, &t, &b);
+  return OnCap(a, t, b, std::cos(spreadDegrees * kDegToRad), u1, u2);
 }
 
 // The mesh's triangles checked, and their areas summed (the prefix sums
@@ -105,7 +117,37 @@ Expected<Emitter> Emitter::Create(const EmitterDef& def) {
   if (def.shape == EmitterShape::kMesh) {
     auto sum = CumulativeArea(*def.mesh);
     if (!sum) return sum.error();
-    e.cumulativeArea_ = std::make_shared<const std::vector<double>>(std::move(*sum));
+    // Vose's alias method: scaled areas p_i = n area_i / total; each column
+    // keeps p_i of itself (a small one) and lends the rest to a large one.
+    const size_t n = sum->size();
+    auto table = std::make_shared<AliasTable>();
+    table->accept.resize(n);
+    table->alias.resize(n);
+    std::vector<double> p(n);
+    for (size_t i = 0; i < n; ++i)
+      p[i] = ((*sum)[i] - (i ? (*sum)[i - 1] : 0)) * double(n) / sum->back();
+    std::vector<uint32_t> small, large;
+    for (size_t i = 0; i < n; ++i) (p[i] < 1 ? small : large).push_back(uint32_t(i));
+    while (!small.empty() && !large.empty()) {
+      const uint32_t s = small.back(), l = large.back();
+      small.pop_back();
+      table->accept[s] = p[s];
+      table->alias[s] = l;
+      p[l] -= 1 - p[s];
+      if (p[l] < 1) {
+        large.pop_back();
+        small.push_back(l);
+      }
+    }
+    for (uint32_t i : large) table->accept[i] = 1, table->alias[i] = i;
+    for (uint32_t i : small) table->accept[i] = 1, table->alias[i] = i;  // rounding leftovers
+    e.triangles_ = std::move(table);
+  }
+  e.speed_ = def.velocity.norm();
+  if (def.spreadDegrees > 0 && e.speed_ > 0) {
+    e.coneA_ = def.velocity / e.speed_;
+    Frame(e.coneA_, &e.coneT_, &e.coneB_);
+    e.coneCosMax_ = std::cos(def.spreadDegrees * kDegToRad);
   }
   return e;
 }
@@ -130,12 +172,12 @@ Vec3 Emitter::Place(RandomStream& r) const {
       break;
     }
     case EmitterShape::kMesh: {
-      // A triangle by area (binary search of the prefix sums), then a point
-      // uniform in it (Osada et al. 2002: sqrt of one uniform).
-      const std::vector<double>& sum = *cumulativeArea_;
-      const double pick = r.Uniform() * sum.back();
-      const size_t t = std::min(
-          sum.size() - 1, size_t(std::upper_bound(sum.begin(), sum.end(), pick) - sum.begin()));
+      // A triangle by area (the alias table), then a point uniform in it
+      // (Osada et al. 2002: sqrt of one uniform).
+      const AliasTable& table = *triangles_;
+      const double pick = r.Uniform() * double(table.accept.size());
+      const size_t column = std::min(table.accept.size() - 1, size_t(pick));
+      const size_t t = pick - double(column) < table.accept[column] ? column : table.alias[column];
       const auto& tri = d.mesh->triangles[t];
       const double r1 = std::sqrt(r.Uniform()), r2 = r.Uniform();
       x += (1 - r1) * d.mesh->positions[tri[0]] + r1 * (1 - r2) * d.mesh->positions[tri[1]] +
@@ -156,9 +198,9 @@ Birth Emitter::Next() {
   RandomStream r{def_.seed, 0x5e7f00d, def_.stream, births_++, 0};
   const Vec3 x = Place(r);
   Vec3 v = def_.velocity;
-  if (def_.spreadDegrees > 0 && v != Vec3::Zero()) {
+  if (def_.spreadDegrees > 0 && speed_ > 0) {
     const double u1 = r.Uniform(), u2 = r.Uniform();
-    v = v.norm() * InCone(v, def_.spreadDegrees, u1, u2);
+    v = speed_ * OnCap(coneA_, coneT_, coneB_, coneCosMax_, u1, u2);
   }
   if (def_.velocitySpread > 0) v += def_.velocitySpread * InBall(r);
   const double life = std::max(1e-9, def_.lifetime + def_.lifetimeJitter * (2 * r.Uniform() - 1));

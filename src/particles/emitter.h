@@ -132,7 +132,17 @@ class Emitter {
   // How many of n births the limits let through into s (counting the rest).
   uint64_t Allowed(const ParticleState& s, uint64_t n);
   EmitterDef def_;
-  std::shared_ptr<const std::vector<double>> cumulativeArea_;  // kMesh: prefix sums
+  // kMesh: Walker's alias table over the triangles by area (Vose 1991), so
+  // a pick is O(1): triangle i = floor(u n) if the rest of u n is below
+  // accept[i], else alias[i].
+  struct AliasTable {
+    std::vector<double> accept;
+    std::vector<uint32_t> alias;
+  };
+  std::shared_ptr<const AliasTable> triangles_;
+  // The velocity cone, set up once: unit axis a and a frame t, b about it.
+  Vec3 coneA_ = Vec3::UnitY(), coneT_ = Vec3::UnitX(), coneB_ = Vec3::UnitZ();
+  double coneCosMax_ = 1, speed_ = 0;
   double carry_ = 0;
   uint64_t births_ = 0, made_ = 0, dropped_ = 0;
 };
