@@ -232,6 +232,32 @@ TEST(Emitter, MeshSurfaceIsUniformByArea) {
   EXPECT_NEAR(meanSecond.y(), 2.0 / 3, 0.01) << "centroid y of the second triangle";
 }
 
+TEST(Emitter, EveryTriangleGetsItsShareOfTheArea) {
+  // 64 triangles of areas 1, 2, ..., 64 (base i + 1, height 2), 100 m
+  // apart: each gets (i + 1) / 2080 of the births, within 5 standard errors.
+  auto mesh = std::make_shared<EmitterMesh>();
+  for (uint32_t i = 0; i < 64; ++i) {
+    const double x = 100.0 * i;
+    mesh->positions.insert(mesh->positions.end(),
+                           {Vec3(x, 0, 0), Vec3(x + i + 1, 0, 0), Vec3(x, 2, 0)});
+    mesh->triangles.push_back({3 * i, 3 * i + 1, 3 * i + 2});
+  }
+  EmitterDef def;
+  def.shape = EmitterShape::kMesh;
+  def.mesh = mesh;
+  const int n = 200000;
+  ParticleState s;
+  testing::Made(Emitter::Create(def)).Burst(s, n);
+  std::vector<int> count(64, 0);
+  for (const Vec3& p : s.position) ++count[size_t(std::floor(p.x() / 100))];
+  double worst = 0;  // in standard errors
+  for (int i = 0; i < 64; ++i) {
+    const double want = (i + 1) / 2080.0, got = double(count[size_t(i)]) / n;
+    worst = std::max(worst, std::abs(got - want) / std::sqrt(want * (1 - want) / n));
+  }
+  EXPECT_LT(worst, 5) << "the worst triangle's share is off by " << worst << " standard errors";
+}
+
 TEST(Emitter, VelocitiesStayInTheirCone) {
   EmitterDef def;
   def.velocity = Vec3(0, 0, 5);
