@@ -267,7 +267,10 @@ Status Emitter::Emit(ParticleState& s, double h, std::span<const Collider> colli
   const uint64_t ok = Allowed(s, n);
   Reserve(s, ok);
   for (uint64_t j = 0; j < ok; ++j) {
-    const double f = std::clamp((double(j) + 1 - start) / (def_.rate * h), 0.0, 1.0);
+    // (Never a division by a zero interval: floor(due + 1e-9) leaves a
+    // carry below 1 - 1e-9, so h = 0 brings no birth; guarded all the same.)
+    const double span = def_.rate * h;
+    const double f = span > 0 ? std::clamp((double(j) + 1 - start) / span, 0.0, 1.0) : 1.0;
     Add(s, Next(), (1 - f) * h, colliders);
   }
   return {};
