@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <random>
 
+#include "draw/convert.h"
 #include "particles/system.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
@@ -70,15 +71,23 @@ int main(int argc, char** argv) {
   }
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer || !(*renderer)->Resize(480, 360).ok()) return 1;
-  render::PointBatch batch;
+  draw::DrawList list;
+  list.background = mesh::Srgb(0.08f, 0.08f, 0.1f);
+  std::vector<mesh::Vec3f> colors(sys.state.size());
   for (size_t i = 0; i < sys.state.size(); ++i) {
     const float speed = float(std::min(sys.state.velocity[i].norm() / 6.0, 1.0));
-    batch.positions.push_back(sys.state.position[i].cast<float>());
-    batch.sizes.push_back(0.035f);
-    batch.colors.push_back(mesh::Srgb(0.95f, 0.35f + 0.6f * speed, 0.15f + 0.5f * (1 - speed)));
+    colors[i] = mesh::Srgb(0.95f, 0.35f + 0.6f * speed, 0.15f + 0.5f * (1 - speed));
   }
+  draw::PointStyle style;
+  style.size = 0.035f;
+  auto points = draw::PointSprites(sys.state.position, style, colors);
+  if (!points) {
+    std::fputs(points.error().Format().c_str(), stderr);
+    return 1;
+  }
+  list.sprites.push_back(std::move(*points));
   // The cube's edges as lines.
-  render::LineBatch edges;
+  draw::Lines& edges = list.lines.emplace_back();
   for (int a = 0; a < 8; ++a) {
     for (int bit = 0; bit < 3; ++bit) {
       const int b = a | (1 << bit);
@@ -92,17 +101,12 @@ int main(int argc, char** argv) {
       edges.colors.push_back(mesh::Srgb(0.6f, 0.6f, 0.65f));
     }
   }
-  (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
-  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+  if (Status st = (*renderer)->Draw(
+          list, render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 480.0 / 360, 30, 20, false));
+      !st.ok()) {
     std::fputs(st.error().Format().c_str(), stderr);
     return 1;
   }
-  if (Status st = (*renderer)->SetLines(edges); !st.ok()) {
-    std::fputs(st.error().Format().c_str(), stderr);
-    return 1;
-  }
-  (*renderer)->Draw(
-      render::Camera::Frame(Vec3(-1, -1, -1), Vec3(1, 1, 1), 480.0 / 360, 30, 20, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
     std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
                                         ec);  // out/ by default

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <map>
 
+#include "draw/convert.h"
 #include "particles/emitter.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
@@ -120,21 +121,27 @@ int main(int argc, char** argv) {
   }
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer || !(*renderer)->Resize(480, 360).ok()) return 1;
-  render::PointBatch batch;
+  // Drawn sizes: rockets larger than sparks (radii, half the diameters).
+  std::vector<float> radii(sys.state.size());
   Vec3 lo = sys.state.size() ? sys.state.position[0] : Vec3::Zero(), hi = lo;
   for (size_t i = 0; i < sys.state.size(); ++i) {
-    batch.positions.push_back(sys.state.position[i].cast<float>());
-    batch.sizes.push_back(kind[sys.state.id[i]] == kRocket ? 0.12f : 0.07f);
-    batch.colors.push_back(sys.state.color[i]);
+    radii[i] = kind[sys.state.id[i]] == kRocket ? 0.06f : 0.035f;
     lo = lo.cwiseMin(sys.state.position[i]);
     hi = hi.cwiseMax(sys.state.position[i]);
   }
-  (*renderer)->SetBackground(mesh::Srgb(0.03f, 0.03f, 0.07f));
-  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+  draw::DrawList list;
+  list.background = mesh::Srgb(0.03f, 0.03f, 0.07f);
+  auto points = draw::PointSprites(sys.state.position, {}, sys.state.color, radii);
+  if (!points) {
+    std::fputs(points.error().Format().c_str(), stderr);
+    return 1;
+  }
+  list.sprites.push_back(std::move(*points));
+  if (Status st = (*renderer)->Draw(list, render::Camera::Frame(lo, hi, 480.0 / 360, 0, 5, false));
+      !st.ok()) {
     std::fputs(st.error().Format().c_str(), stderr);
     return 1;
   }
-  (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 0, 5, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
     std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
                                         ec);  // out/ by default

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "draw/convert.h"
 #include "particles/cloth.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
@@ -77,23 +78,17 @@ int main(int argc, char** argv) {
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer || !(*renderer)->Resize(480, 360).ok()) return 1;
   // The cloth's triangles as a mesh: smooth normals, striped colours.
-  mesh::TriangleMesh m;
-  const auto& x = flag.positions();
-  std::vector<Vec3> normal(x.size(), Vec3::Zero());
+  std::vector<uint16_t> stripes;
   for (const auto& t : flag.triangles()) {
-    const Vec3 n = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
-    for (uint32_t k : t) normal[k] += n;
-  }
-  for (size_t i = 0; i < x.size(); ++i) {
-    m.positions.push_back(x[i].cast<float>());
-    m.normals.push_back(normal[i].normalized().cast<float>());
-    m.uvs.push_back(mesh::Vec2f(0, 0));
-  }
-  for (const auto& t : flag.triangles()) {
-    m.indices.insert(m.indices.end(), {t[0], t[1], t[2]});
     const int row = int(t[0]) / def.columns;
-    m.material.push_back(uint16_t((row * 3 / def.rows) % 2 == 0 ? 7 : 5));  // red and white
+    stripes.push_back(uint16_t((row * 3 / def.rows) % 2 == 0 ? 7 : 5));  // red and white
   }
+  auto m = draw::SheetMesh(flag.positions(), flag.triangles(), stripes);
+  if (!m) {
+    std::fputs(m.error().Format().c_str(), stderr);
+    return 1;
+  }
+  const auto& x = flag.positions();
   // The pole: a thin column of the mesh's own palette colour 0.
   Vec3 lo = x[0], hi = x[0];
   for (const Vec3& p : x) {
@@ -102,7 +97,7 @@ int main(int argc, char** argv) {
   }
   // The default scene (a ground plane, the default lights) under the flag.
   const draw::DrawList list = scene::DefaultScene(
-      std::make_shared<const mesh::TriangleMesh>(std::move(m)), mesh::DefaultPalette(), lo, hi);
+      std::make_shared<const mesh::TriangleMesh>(std::move(*m)), mesh::DefaultPalette(), lo, hi);
   if (Status s = (*renderer)->Draw(list, render::Camera::Frame(lo, hi, 480.0 / 360, 25, 15, false));
       !s.ok()) {
     std::fprintf(stderr, "%s", s.error().Format().c_str());

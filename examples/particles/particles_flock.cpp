@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <random>
 
+#include "draw/convert.h"
 #include "particles/flocking.h"
 #include "particles/system.h"
 #include "render/headless_context.h"
@@ -80,15 +81,24 @@ int main(int argc, char** argv) {
   }
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer || !(*renderer)->Resize(480, 360).ok()) return 1;
-  render::PointBatch batch;
+  draw::DrawList list;
+  list.background = mesh::Srgb(0.08f, 0.08f, 0.1f);
+  std::vector<mesh::Vec3f> colors(sys.state.size());
   for (size_t i = 0; i < sys.state.size(); ++i) {
     const Vec3 v = sys.state.velocity[i].normalized();
-    batch.positions.push_back(sys.state.position[i].cast<float>());
-    batch.sizes.push_back(0.1f);
-    batch.colors.push_back(mesh::Srgb(0.55f + 0.45f * float(v.x()), 0.6f + 0.4f * float(v.y()),
-                                      0.65f + 0.35f * float(v.z())));
+    colors[i] = mesh::Srgb(0.55f + 0.45f * float(v.x()), 0.6f + 0.4f * float(v.y()),
+                           0.65f + 0.35f * float(v.z()));
   }
+  draw::PointStyle style;
+  style.size = 0.1f;
+  auto boids = draw::PointSprites(sys.state.position, style, colors);
+  if (!boids) {
+    std::fputs(boids.error().Format().c_str(), stderr);
+    return 1;
+  }
+  list.sprites.push_back(std::move(*boids));
   // The obstacle as a ring of points on three great circles.
+  draw::Sprites& batch = list.sprites.emplace_back();
   for (int k = 0; k < 360; ++k) {
     const double t = 2 * M_PI * k / 360;
     for (int c = 0; c < 3; ++c) {
@@ -101,12 +111,12 @@ int main(int argc, char** argv) {
     }
   }
   Vec3 lo = Vec3::Constant(-4.5), hi = Vec3::Constant(4.5);
-  (*renderer)->SetBackground(mesh::Srgb(0.08f, 0.08f, 0.1f));
-  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+  if (Status st =
+          (*renderer)->Draw(list, render::Camera::Frame(lo, hi, 480.0 / 360, 30, 25, false));
+      !st.ok()) {
     std::fputs(st.error().Format().c_str(), stderr);
     return 1;
   }
-  (*renderer)->Draw(render::Camera::Frame(lo, hi, 480.0 / 360, 30, 25, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
     std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
                                         ec);  // out/ by default

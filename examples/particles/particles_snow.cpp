@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "draw/convert.h"
 #include "particles/bulk.h"
 #include "particles/emitter.h"
 #include "render/headless_context.h"
@@ -121,15 +122,22 @@ int main(int argc, char** argv) {
   }
   auto renderer = render::Renderer::Create(render::FindShaderDir());
   if (!renderer || !(*renderer)->Resize(480, 360).ok()) return 1;
-  render::PointBatch batch;
+  draw::DrawList list;
+  list.background = mesh::Srgb(0.12f, 0.14f, 0.2f);
+  std::vector<mesh::Vec3f> colors(snow.state.size());
   for (size_t i = 0; i < snow.state.size(); ++i) {
     const bool stuck = snow.state.invMass[i] == 0;
-    batch.positions.push_back(snow.state.position(i).cast<float>());
-    batch.sizes.push_back(0.012f);
-    batch.colors.push_back(stuck ? mesh::Srgb(0.75f, 0.85f, 1.0f)
-                                 : mesh::Srgb(0.95f, 0.95f, 0.95f));
+    colors[i] = stuck ? mesh::Srgb(0.75f, 0.85f, 1.0f) : mesh::Srgb(0.95f, 0.95f, 0.95f);
   }
-  render::LineBatch lines;
+  draw::PointStyle style;
+  style.size = 0.012f;
+  auto points = draw::PointSprites(snow.state.px, snow.state.py, snow.state.pz, style, colors);
+  if (!points) {
+    std::fputs(points.error().Format().c_str(), stderr);
+    return 1;
+  }
+  list.sprites.push_back(std::move(*points));
+  draw::Lines& lines = list.lines.emplace_back();
   for (int k = 0; k < 64; ++k) {
     const double a0 = 2 * M_PI * k / 64, a1 = 2 * M_PI * (k + 1) / 64;
     for (double a : {a0, a1}) {
@@ -145,17 +153,12 @@ int main(int argc, char** argv) {
     lines.points.push_back(mesh::Vec3f(2, 0, float(x)));
     for (int c = 0; c < 4; ++c) lines.colors.push_back(mesh::Srgb(0.5f, 0.55f, 0.6f));
   }
-  (*renderer)->SetBackground(mesh::Srgb(0.12f, 0.14f, 0.2f));
-  if (Status st = (*renderer)->SetPoints(batch); !st.ok()) {
+  if (Status st = (*renderer)->Draw(
+          list, render::Camera::Frame(Vec3(-2, 0, -2), Vec3(2, 3, 2), 480.0 / 360, 25, 15, false));
+      !st.ok()) {
     std::fputs(st.error().Format().c_str(), stderr);
     return 1;
   }
-  if (Status st = (*renderer)->SetLines(lines); !st.ok()) {
-    std::fputs(st.error().Format().c_str(), stderr);
-    return 1;
-  }
-  (*renderer)->Draw(
-      render::Camera::Frame(Vec3(-2, 0, -2), Vec3(2, 3, 2), 480.0 / 360, 25, 15, false));
   if (std::error_code ec; !std::filesystem::path(out).parent_path().empty()) {
     std::filesystem::create_directories(std::filesystem::path(out).parent_path(),
                                         ec);  // out/ by default

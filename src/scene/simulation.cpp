@@ -19,6 +19,7 @@
 
 #include "core/assert.h"
 #include "core/rng.h"
+#include "draw/convert.h"
 #include "mesh/obj_reader.h"
 #include "particles/cloth.h"
 #include "particles/emitter.h"
@@ -204,80 +205,87 @@ class PlateDrag : public particles::LocalForce {
 
 // --- emission ----------------------------------------------------------------
 
-// A unit vector in the cone of half-angle `spread` (degrees) about `axis`,
-// uniform over the spherical cap.
-Vec3 InCone(const Vec3& axis, double spreadDegrees, double u1, double u2) {
-  const Vec3 a = axis.normalized();
-  const double cosMax = std::cos(spreadDegrees * kDegToRad);
-  const double c = 1 - u1 * (1 - cosMax), s = std::sqrt(std::max(0.0, 1 - c * c));
-  const double phi = 2 * kPi * u2;
-  const Vec3 t = std::abs(a.x()) < 0.9 ? a.cross(Vec3::UnitX()).normalized()
-                                       : a.cross(Vec3::UnitY()).normalized();
-  const Vec3 b = a.cross(t);
-  return c * a + s * (std::cos(phi) * t + std::sin(phi) * b);
-}
+using particles::InCone;
 
+// One <emitter>: the particles library's Emitter made from it, with its
+// shape, cone, lifetimes and the system's `max` (simulation.h).
 struct Source {
   const EmitterDef* def = nullptr;
-  uint64_t seed = 0;    // the stream of this emitter
-  uint64_t births = 0;  // draws so far
-  double carry = 0;     // fractional births carried to the next step
-  const terrain::HeightField* terrain = nullptr;
-  const PlantPoints* points = nullptr;
-  std::vector<double> cumulative;  // segment lengths, summed (part="segments")
+  std::optional<particles::Emitter> emitter;
 };
 
-struct Birth {
-  Vec3 x, v;
-  double lifetime, mass;
-};
-
-Birth Draw(Source& src) {
-  const EmitterDef& e = *src.def;
-  const uint64_t n = src.births++;
-  auto u = [&](uint64_t k) { return ToUnit(CounterHash(src.seed, n, k)); };
-  Vec3 x = e.at;
+// The library's definition of a scene emitter. Terrains and plants are
+// placements of the scene's own (uniform over the terrain's x-z extent, on
+// its surface; a plant's tips or leaves, or its segments by length).
+Expected<particles::Emitter> MakeEmitter(const EmitterDef& e, uint64_t seed, uint64_t max,
+                                         const terrain::HeightField* terrain,
+                                         const PlantPoints* points) {
+  particles::EmitterDef d;
+  d.rate = e.rate;
+  d.position = e.at;
+  d.size = e.size;
   switch (e.shape) {
     case EmitterShape::kPoint:
+      d.shape = particles::EmitterShape::kPoint;
       break;
-    case EmitterShape::kSphere: {
-      const Vec3 d = InCone(Vec3::UnitY(), 180, u(0), u(1)) * std::cbrt(u(2));
-      x += 0.5 * e.size.cwiseProduct(d);
+    case EmitterShape::kSphere:
+      d.shape = particles::EmitterShape::kSphere;
       break;
-    }
     case EmitterShape::kBox:
-      x += Vec3(u(0) - 0.5, u(1) - 0.5, u(2) - 0.5).cwiseProduct(e.size);
+      d.shape = particles::EmitterShape::kBox;
       break;
-    case EmitterShape::kDisc: {
-      const double r = 0.5 * e.size.x() * std::sqrt(u(0)), phi = 2 * kPi * u(1);
-      x += Vec3(r * std::cos(phi), 0, r * std::sin(phi));
+    case EmitterShape::kDisc:
+      d.shape = particles::EmitterShape::kDisc;
       break;
-    }
     case EmitterShape::kTerrain: {
-      const terrain::HeightField& t = *src.terrain;
-      const double hx = t.def().sizeX / 2, hz = t.def().sizeZ / 2;
-      const double px = -hx + 2 * hx * u(0), pz = -hz + 2 * hz * u(1);
-      x = Vec3(px, t.Height(px, pz), pz) + 0.01 * t.Normal(px, pz);
+      d.shape = particles::EmitterShape::kFunction;
+      d.place = [terrain](const Vec3& u) {
+        const terrain::HeightField& t = *terrain;
+        const double hx = t.def().sizeX / 2, hz = t.def().sizeZ / 2;
+        const double px = -hx + 2 * hx * u.x(), pz = -hz + 2 * hz * u.y();
+        return Vec3(Vec3(px, t.Height(px, pz), pz) + 0.01 * t.Normal(px, pz));
+      };
       break;
     }
     case EmitterShape::kPlant: {
-      const PlantPoints& p = *src.points;
+      d.shape = particles::EmitterShape::kFunction;
       if (e.part == PlantPart::kSegments) {
-        const double pick = u(0) * src.cumulative.back();
-        const size_t i =
-            size_t(std::lower_bound(src.cumulative.begin(), src.cumulative.end(), pick) -
-                   src.cumulative.begin());
-        x = p.segmentPoints[std::min(i, p.segmentPoints.size() - 1)];
+        auto cumulative = std::make_shared<std::vector<double>>();
+        double sum = 0;
+        for (double len : points->segmentLengths) cumulative->push_back(sum += len);
+        d.place = [points, cumulative](const Vec3& u) {
+          const double pick = u.x() * cumulative->back();
+          const size_t i = size_t(std::lower_bound(cumulative->begin(), cumulative->end(), pick) -
+                                  cumulative->begin());
+          return points->segmentPoints[std::min(i, points->segmentPoints.size() - 1)];
+        };
       } else {
-        const std::vector<Vec3>& from = e.part == PlantPart::kTips ? p.tips : p.leaves;
-        x = from[std::min(from.size() - 1, size_t(u(0) * double(from.size())))];
+        const std::vector<Vec3>* from =
+            e.part == PlantPart::kTips ? &points->tips : &points->leaves;
+        d.place = [from](const Vec3& u) {
+          return (*from)[std::min(from->size() - 1, size_t(u.x() * double(from->size())))];
+        };
       }
       break;
     }
   }
-  const Vec3 dir = InCone(e.direction, e.spreadDegrees, u(3), u(4));
-  const double life = e.lifetime.x() + (e.lifetime.y() - e.lifetime.x()) * u(5);
-  return Birth{x, e.speed * dir, life, e.mass};
+  d.velocity = e.speed * e.direction.normalized();
+  d.spreadDegrees = e.spreadDegrees;
+  d.lifetime = (e.lifetime.x() + e.lifetime.y()) / 2;
+  d.lifetimeJitter = (e.lifetime.y() - e.lifetime.x()) / 2;
+  d.mass = e.mass;
+  d.radiusStart = d.radiusEnd = float(e.radius);
+  d.maxAlive = max;
+  d.seed = seed;
+  auto made = particles::Emitter::Create(d);
+  if (!made) {
+    Diagnostic diag = made.error();
+    diag.loc = e.loc;
+    diag.kind = ErrorKind::kInput;
+    diag.message = "<emitter>: " + diag.message;
+    return diag;
+  }
+  return made;
 }
 
 // --- the systems -------------------------------------------------------------
@@ -623,37 +631,21 @@ Status Simulation::Impl::AddClothColliders(ParticleSystem& ps) {
 
 Status Simulation::Impl::Emit(ParticleSystem& ps, double step) {
   ParticleState& st = ps.system->state;
+  const std::vector<particles::Collider>& colliders = ps.system->colliders();
   for (Source& src : ps.sources) {
-    const EmitterDef& e = *src.def;
-    uint64_t n = 0;
-    if (steps == 0) n += e.burst;
-    const double due = src.carry + e.rate * step;
-    const uint64_t fromRate = uint64_t(std::floor(due));
-    src.carry = due - double(fromRate);
-    n += fromRate;
-    for (uint64_t j = 0; j < n; ++j) {
-      if (st.size() >= ps.def->max) {
-        ps.dropped += n - j;
-        break;
-      }
-      const Birth b = Draw(src);
-      // Born at a point in the step, not at its start: spread births over
-      // the step so a stream shows no bands.
-      const double remaining =
-          j < fromRate ? step * (1 - (double(j) + 0.5) / double(std::max<uint64_t>(fromRate, 1)))
-                       : 0;
-      // The advance into the step must not pass through a collider (a
-      // particle born 0.5 m over a terrain at 100 m/s went through it): one
-      // that would is born at the emitter, and the step meets the collider.
-      Vec3 at = b.x + b.v * remaining;
-      particles::Contact contact;
-      for (const particles::Collider& c : ps.system->colliders())
-        if (at != b.x && c.Intersect(b.x, at, &contact, e.radius)) at = b.x;
-      st.Add(at, b.v, b.mass, b.lifetime);
-      st.radius.back() = float(e.radius);  // the ball the colliders see
-      st.age.back() = remaining;
-      if (ps.springs) {
-        if (Status s = ps.Join(st.size() - 1); !s.ok()) {
+    // Births spread over the step, moved on for their age unless that move
+    // would cross a collider (then born at the emitter: the step meets the
+    // collider); the first step adds the burst.
+    const size_t first = st.size();
+    if (Status s = src.emitter->Emit(st, step, colliders); !s.ok()) {
+      Diagnostic d = s.error();
+      d.loc = src.def->loc;
+      return d;
+    }
+    if (steps == 0) src.emitter->Burst(st, src.def->burst);
+    if (ps.springs) {
+      for (size_t i = first; i < st.size(); ++i) {
+        if (Status s = ps.Join(i); !s.ok()) {
           Diagnostic d = s.error();
           d.loc = ps.springsDef->loc;
           return d;
@@ -736,17 +728,18 @@ Status Simulation::Impl::Step() {
             death.target->dropped += uint64_t(death.def->count - c);  // full: no loop over them
             break;
           }
-          Birth b{st.position[i], Vec3::Zero(), 1, 1};
+          Vec3 v = Vec3::Zero();
+          double mass = 1, lifetime = 1;
           float radius = 0;
           if (!death.target->sources.empty()) {
-            radius = float(death.target->sources[0].def->radius);
-            Source& src = death.target->sources[0];
-            const Birth drawn = Draw(src);
-            b.v = drawn.v;
-            b.lifetime = drawn.lifetime;
-            b.mass = drawn.mass;
+            particles::Emitter& e = *death.target->sources[0].emitter;
+            const particles::Birth drawn = e.Next();
+            v = drawn.velocity;
+            lifetime = drawn.lifetime;
+            mass = e.def().mass;
+            radius = e.def().radiusStart;
           }
-          target.Add(st.position[i], st.velocity[i] + b.v, b.mass, b.lifetime);
+          target.Add(st.position[i], st.velocity[i] + v, mass, lifetime);
           target.radius.back() = radius;
         }
       }
@@ -1004,16 +997,17 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
     }
     for (size_t k = 0; k < p.emitters.size(); ++k) {
       const EmitterDef& e = p.emitters[k];
-      Source src;
-      src.def = &e;
-      src.seed = CounterHash(ElementSeed(scene.seed, p.id, "particles", size_t(p.loc.line)), k);
+      const uint64_t seed =
+          CounterHash(ElementSeed(scene.seed, p.id, "particles", size_t(p.loc.line)), k);
+      const terrain::HeightField* terrain = nullptr;
+      const PlantPoints* pts = nullptr;
       if (e.shape == EmitterShape::kTerrain) {
         for (size_t t = 0; t < scene.terrains.size(); ++t)
-          if (scene.terrains[t].id == e.of) src.terrain = &built.terrains[t];
+          if (scene.terrains[t].id == e.of) terrain = &built.terrains[t];
       }
       if (e.shape == EmitterShape::kPlant) {
         const auto it = built.points.find(e.of);
-        const PlantPoints* pts = it == built.points.end() ? nullptr : &it->second;
+        pts = it == built.points.end() ? nullptr : &it->second;
         const size_t n = !pts                           ? 0
                          : e.part == PlantPart::kTips   ? pts->tips.size()
                          : e.part == PlantPart::kLeaves ? pts->leaves.size()
@@ -1027,10 +1021,14 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
                                                   : std::string("segments")) +
                   " to emit from",
               ErrorKind::kInput);
-        src.points = pts;
-        double sum = 0;
-        for (double len : pts->segmentLengths) src.cumulative.push_back(sum += len);
       }
+      if (e.shape == EmitterShape::kTerrain && !terrain)  // the reader checks `of`: a bug
+        return Fail(e.loc, "'of=\"" + e.of + "\"' names no terrain");
+      auto made = MakeEmitter(e, seed, p.max, terrain, pts);
+      if (!made) return made.error();
+      Source src;
+      src.def = &e;
+      src.emitter.emplace(std::move(*made));
       ps->sources.push_back(std::move(src));
     }
     if (p.draw.as == DrawAs::kMesh) {
@@ -1272,21 +1270,6 @@ Vec3 ColorAt(const DrawDef& d, double age, double lifetime) {
   return d.color + t * (*d.colorEnd - d.color);
 }
 
-// A model matrix turning +Z to `forward` (Y up), scaled.
-draw::Mat4f Facing(const Vec3& at, const Vec3& forward, double scale) {
-  Vec3 f = forward.norm() > 1e-9 ? forward.normalized() : Vec3::UnitZ();
-  Vec3 side = Vec3::UnitY().cross(f);
-  if (side.norm() < 1e-6) side = Vec3::UnitX();
-  side.normalize();
-  const Vec3 up = f.cross(side);
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.block<3, 1>(0, 0) = side * scale;
-  m.block<3, 1>(0, 1) = up * scale;
-  m.block<3, 1>(0, 2) = f * scale;
-  m.block<3, 1>(0, 3) = at;
-  return m.cast<float>();
-}
-
 }  // namespace
 
 void Simulation::AddToDrawList(draw::DrawList& list) const {
@@ -1353,37 +1336,28 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
       list.lines.push_back(std::move(l));
       continue;
     }
-    draw::Sprites s;
-    s.name = p.id;
-    s.blend = d.blend == Blend::kAdditive ? draw::Blend::kAdditive : draw::Blend::kAlpha;
-    for (size_t i = 0; i < st.size(); ++i) {
-      s.positions.push_back(st.position[i].cast<float>());
-      s.sizes.push_back(float(d.size));
-      s.colors.push_back(ColorAt(d, st.age[i], st.lifetime[i]).cast<float>());
-      s.alphas.push_back(float(d.alpha));
+    draw::PointStyle style;
+    style.name = p.id;
+    style.size = float(d.size);
+    style.color = d.color.cast<float>();
+    style.alpha = float(d.alpha);
+    style.blend = d.blend == Blend::kAdditive ? draw::Blend::kAdditive : draw::Blend::kAlpha;
+    std::vector<mesh::Vec3f> colors;
+    if (d.colorEnd) {
+      colors.resize(st.size());
+      for (size_t i = 0; i < st.size(); ++i)
+        colors[i] = ColorAt(d, st.age[i], st.lifetime[i]).cast<float>();
     }
-    list.sprites.push_back(std::move(s));
+    auto sprites = draw::PointSprites(st.position, style, colors);
+    SYLVA_ASSERT(sprites.ok());  // one colour a particle, or none
+    list.sprites.push_back(std::move(*sprites));
   }
   for (const ClothSheet& c : m.cloths) {
-    auto mesh = std::make_shared<mesh::TriangleMesh>();
-    const std::vector<Vec3>& x = c.cloth->positions();
-    mesh->positions.reserve(x.size());
-    std::vector<Vec3> normals(x.size(), Vec3::Zero());
-    for (const auto& t : c.cloth->triangles()) {
-      const Vec3 n = (x[t[1]] - x[t[0]]).cross(x[t[2]] - x[t[0]]);
-      for (uint32_t k : t) normals[k] += n;
-      mesh->indices.insert(mesh->indices.end(), {t[0], t[1], t[2]});
-      mesh->material.push_back(0);
-    }
-    for (size_t i = 0; i < x.size(); ++i) {
-      mesh->positions.push_back(x[i].cast<float>());
-      const double len = normals[i].norm();
-      mesh->normals.push_back(len > 0 ? (normals[i] / len).cast<float>() : mesh::Vec3f(0, 0, 1));
-      mesh->uvs.push_back({0, 0});
-    }
+    auto sheet = draw::SheetMesh(c.cloth->positions(), c.cloth->triangles());
+    SYLVA_ASSERT(sheet.ok());  // the cloth's own triangles index its vertices
     draw::MeshDraw md;
     md.name = c.def->id;
-    md.mesh = mesh;
+    md.mesh = std::make_shared<const mesh::TriangleMesh>(std::move(*sheet));
     md.palette = {c.def->color.cast<float>()};
     md.instances.push_back({});
     list.meshes.push_back(std::move(md));
@@ -1391,23 +1365,23 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
   for (const Flock& f : m.flocks) {
     const ParticleState& st = f.system->state;
     if (f.def->draw.as == DrawAs::kPoints || f.def->draw.as == DrawAs::kSprites) {
-      draw::Sprites s;
-      s.name = f.def->id;
-      for (size_t i = 0; i < st.size(); ++i) {
-        s.positions.push_back(st.position[i].cast<float>());
-        s.sizes.push_back(float(f.def->draw.size));
-        s.colors.push_back(f.def->draw.color.cast<float>());
-      }
-      list.sprites.push_back(std::move(s));
+      draw::PointStyle style;
+      style.name = f.def->id;
+      style.size = float(f.def->draw.size);
+      style.color = f.def->draw.color.cast<float>();
+      auto sprites = draw::PointSprites(st.position, style);
+      SYLVA_ASSERT(sprites.ok());
+      list.sprites.push_back(std::move(*sprites));
       continue;
     }
     draw::MeshDraw md;
     md.name = f.def->id;
     md.mesh = f.drawMesh;
     md.palette = {mesh::Vec3f(1, 1, 1)};
-    for (size_t i = 0; i < st.size(); ++i)
-      md.instances.push_back({Facing(st.position[i], st.velocity[i], f.def->draw.size),
-                              f.def->draw.color.cast<float>()});
+    auto instances = draw::FacingInstances(st.position, st.velocity, f.def->draw.size,
+                                           f.def->draw.color.cast<float>());
+    SYLVA_ASSERT(instances.ok());  // one velocity a boid
+    md.instances = std::move(*instances);
     list.meshes.push_back(std::move(md));
   }
 }

@@ -45,6 +45,40 @@ TEST(EmitterDef, RejectsEveryOutOfRangeField) {
   bad([](EmitterDef& d) { d.rate = 1e30; }, "EmitterDef.rate", "1e+30");
   bad([](EmitterDef& d) { d.rate = kInf; }, "EmitterDef.rate", "inf");
   bad([](EmitterDef& d) { d.rate = -1; }, "EmitterDef.rate", "-1");
+  bad([](EmitterDef& d) { d.rate = kNaN; }, "EmitterDef.rate", "nan");
+  bad([](EmitterDef& d) { d.size.z() = kNaN; }, "EmitterDef.size", "nan");
+  bad([](EmitterDef& d) { d.size.y() = -1; }, "EmitterDef.size", "-1");
+  bad([](EmitterDef& d) { d.spreadDegrees = 190; }, "EmitterDef.spreadDegrees", "190");
+  bad([](EmitterDef& d) { d.shape = EmitterShape::kMesh; }, "EmitterDef.mesh", "empty");
+  bad([](EmitterDef& d) { d.shape = EmitterShape::kFunction; }, "EmitterDef.place", "empty");
+  bad(
+      [](EmitterDef& d) {
+        auto m = std::make_shared<EmitterMesh>();  // three points on a line: no area
+        m->positions = {Vec3(0, 0, 0), Vec3(1, 1, 1), Vec3(2, 2, 2)};
+        m->triangles = {{0, 1, 2}};
+        d.shape = EmitterShape::kMesh;
+        d.mesh = m;
+      },
+      "EmitterDef.mesh", "area 0");
+  bad(
+      [](EmitterDef& d) {
+        auto m = std::make_shared<EmitterMesh>();
+        m->positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+        m->triangles = {{0, 1, 7}};
+        d.shape = EmitterShape::kMesh;
+        d.mesh = m;
+      },
+      "EmitterDef.mesh triangle 0", "index 7");
+  bad(
+      [](EmitterDef& d) {
+        auto m = std::make_shared<EmitterMesh>();
+        m->positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, kNaN)};
+        m->triangles = {{0, 1, 2}};
+        d.shape = EmitterShape::kMesh;
+        d.mesh = m;
+      },
+      "EmitterDef.mesh position 2", "nan");
+  bad([](EmitterDef& d) { d.maxAlive = 0; }, "EmitterDef.maxAlive", "0");
   bad([](EmitterDef& d) { d.position.z() = kNaN; }, "EmitterDef.position", "nan");
   bad([](EmitterDef& d) { d.velocity.y() = kNaN; }, "EmitterDef.velocity", "nan");
   bad([](EmitterDef& d) { d.positionRadius = -0.5; }, "EmitterDef.positionRadius", "-0.5");
