@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "particles/def_check.h"
+#include "particles/particle_core.h"
 
 namespace sylva::particles {
 
@@ -95,6 +96,10 @@ Status Validate(const EmitterDef& d) {
   SYLVA_CHECK_OK(
       Range("EmitterDef.lifetimeJitter", d.lifetimeJitter, 0, d.lifetime, "s (0..lifetime)"));
   SYLVA_CHECK_OK(Range("EmitterDef.mass", d.mass, 0, 1e30, "kg"));
+  if (d.mass == 0)
+    return check::Error(
+        "EmitterDef.mass: 0 kg; a particle needs a positive mass (pin it with "
+        "System::Pin to hold it still)");
   for (const Vec3f* c : {&d.colorStart, &d.colorEnd}) {
     const char* name = c == &d.colorStart ? "EmitterDef.colorStart" : "EmitterDef.colorEnd";
     for (int k = 0; k < 3; ++k) {
@@ -300,33 +305,9 @@ void Emitter::Age(ParticleState& s, size_t begin, size_t end) const {
   }
 }
 size_t RemoveDead(ParticleState& s) {
-  size_t w = 0;
-  const size_t n = s.size();
-  for (size_t i = 0; i < n; ++i) {
-    if (s.age[i] >= s.lifetime[i]) continue;
-    if (w != i) {
-      s.position[w] = s.position[i];
-      s.velocity[w] = s.velocity[i];
-      s.mass[w] = s.mass[i];
-      s.invMass[w] = s.invMass[i];
-      s.age[w] = s.age[i];
-      s.lifetime[w] = s.lifetime[i];
-      s.color[w] = s.color[i];
-      s.radius[w] = s.radius[i];
-      s.id[w] = s.id[i];
-    }
-    ++w;
-  }
-  s.position.resize(w);
-  s.velocity.resize(w);
-  s.mass.resize(w);
-  s.invMass.resize(w);
-  s.age.resize(w);
-  s.lifetime.resize(w);
-  s.color.resize(w);
-  s.radius.resize(w);
-  s.id.resize(w);
-  return n - w;
+  return RemoveIf(
+      s.size(), [&](size_t i) { return s.age[i] >= s.lifetime[i]; }, nullptr, s.position,
+      s.velocity, s.mass, s.invMass, s.age, s.lifetime, s.color, s.radius, s.id);
 }
 
 }  // namespace sylva::particles

@@ -70,7 +70,7 @@ struct EmitterDef {
   double velocitySpread = 0;  // m/s, 0..1e6
   double lifetime = 2;        // s, 1e-9..1e300: uniform in [lifetime - jitter, lifetime + jitter]
   double lifetimeJitter = 0;  // s, 0..lifetime
-  double mass = 1;            // kg, 0..1e30 (0: immovable)
+  double mass = 1;            // kg, (0, 1e30]
   Vec3f colorStart{1, 1, 1},
       colorEnd{1, 1, 1};  // linear RGB, each 0..1e6; linear in age / lifetime
   // Metres, 0..1e6, linear in age / lifetime: the particle's radius (its
@@ -152,7 +152,8 @@ class Emitter {
 Vec3 InCone(const Vec3& axis, double spreadDegrees, double u1, double u2);
 
 // Removes particles whose age has reached their lifetime, keeping the order
-// (and ids) of the living. Returns the number removed.
+// (and ids) of the living. Returns the number removed. A state with springs
+// or penalty forces uses System::RemoveDead, which renumbers them too.
 size_t RemoveDead(ParticleState& s);
 
 }  // namespace sylva::particles

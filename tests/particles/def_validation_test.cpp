@@ -86,6 +86,7 @@ TEST(EmitterDef, RejectsEveryOutOfRangeField) {
   bad([](EmitterDef& d) { d.lifetime = 0; }, "EmitterDef.lifetime", "0");
   bad([](EmitterDef& d) { d.lifetimeJitter = 3; }, "EmitterDef.lifetimeJitter", "3");
   bad([](EmitterDef& d) { d.mass = -1; }, "EmitterDef.mass", "-1");
+  bad([](EmitterDef& d) { d.mass = 0; }, "EmitterDef.mass", "0 kg");
   bad([](EmitterDef& d) { d.colorEnd.z() = std::nanf(""); }, "EmitterDef.colorEnd", "nan");
   bad([](EmitterDef& d) { d.radiusStart = -1; }, "EmitterDef.radiusStart", "-1");
 }
