@@ -43,6 +43,9 @@ void main() {
   vec3 n = normalize(vNormal);
   vec3 toEye = normalize(uEye - vPosition);
   if (dot(n, toEye) < 0.0) n = -n;
+  // The shadow lookup once, outside the loop: llvmpipe runs both sides of
+  // a branch, so a lookup inside it costs every light.
+  float visibility = uShadowLight >= 0 ? Visibility(n) : 1.0;
   vec3 light = vec3(0.0);
   float spec = 0.0;
   for (int i = 0; i < uLightCount; ++i) {
@@ -54,7 +57,7 @@ void main() {
     vec3 c = uLightColor[i];
     if (uLightType[i] == 0) {
       l = normalize(uLightVector[i]);
-      if (i == uShadowLight) c *= Visibility(n);
+      if (i == uShadowLight) c *= visibility;
     } else {
       vec3 d = uLightVector[i] - vPosition;
       float d2 = max(dot(d, d), 1e-4);

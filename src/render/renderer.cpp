@@ -562,6 +562,12 @@ std::string LowerExtension(const std::string& path) {
 }
 
 Status EncodeAndWrite(const Image& image, const std::string& path, bool jpeg) {
+  // PNG rows all with the Sub filter instead of stb's per-row trial of all
+  // five: the same pixels, a 1920x1080 render written in about half the
+  // time (2.6a n=20: 180-250 -> 76-113 ms) and a smaller file (511 -> 491
+  // KB). Set once, before any encoding (stb reads a global).
+  static const bool subFilter = (stbi_write_force_png_filter = 1, true);
+  (void)subFilter;
   std::string bytes;
   auto append = [](void* context, void* data, int size) {
     static_cast<std::string*>(context)->append(static_cast<const char*>(data), size_t(size));
