@@ -423,6 +423,7 @@ constexpr FunctionInfo kFunctions[] = {
     {"max", OpCode::kMax, 2},       {"clamp", OpCode::kClamp, 3}, {"sign", OpCode::kSign, 1},
     {"trunc", OpCode::kTrunc, 1},   {"ran", OpCode::kRan, 1},     {"uniform", OpCode::kUniform, 2},
     {"normal", OpCode::kNormal, 2}, {"nran", OpCode::kNormal, 2},  // nran: cpfg's name
+    {"fabs", OpCode::kAbs, 1},                                     // cpfg's (C's) name
     {"bran", OpCode::kBran, 2},     {"biran", OpCode::kBiran, 2},
 };
 
@@ -991,6 +992,7 @@ class ExprCompiler {
       if (!ApplyPure(n.op, args, &r, &e, n.column)) {
         err_->column = e.column;
         err_->message = e.message;
+        err_->evaluation = true;
         return false;
       }
     }

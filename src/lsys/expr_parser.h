@@ -56,6 +56,9 @@ struct ExprParseError {
   int column = 0;
   int length = 1;
   std::string message;
+  // The text is an expression, but computing a constant part of it failed
+  // (division by zero, say).
+  bool evaluation = false;
 };
 
 struct ExprScope {

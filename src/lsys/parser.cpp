@@ -809,7 +809,7 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     size_t q = pos;
     bool isExpr = ParseExpr(view, &q, scope, &e, &err);
     while (isExpr && q < end && IsSpace(t[q])) ++q;
-    if (!isExpr || q < end) {
+    if ((!isExpr && !err.evaluation) || (isExpr && q < end)) {
       TextMacro m;
       m.body = t.substr(pos, end - pos);
       AddTextMacro(l, name, col, std::move(m));
@@ -887,6 +887,10 @@ void GrammarParser::ParseMacro(const Line& l, const std::string& name, int col, 
   size_t q = pos;
   bool isExpr = ParseExpr(view, &q, scope, &body, &err);
   while (isExpr && q < end && IsSpace(t[q])) ++q;
+  if (!isExpr && err.evaluation) {
+    Error(l, err.column, err.message, err.length);
+    return;
+  }
   if (!isExpr || q < end) {
     // Not an expression of its parameters: text, substituted where used
     // with the arguments in place of the parameters (cpfg's preprocessor).
@@ -2061,8 +2065,13 @@ void GrammarParser::JoinContinuations() {
         isProduction(out.back())) {
       // Without its arrow yet, the production goes on with a line that
       // starts with the arrow or with a statement block (cpfg's
-      // `A(t) : t < 5` / `  {nt = t + 1;}` / `  --> ...`).
-      join = curArrow ? !hasArrow(l.text) : (startsWithArrow(l.text) || l.text[p] == '{');
+      // `A(t) : t < 5` / `  {nt = t + 1;}` / `  --> ...`), or, after the
+      // ':' of a condition, with any indented line (`A(x) : {...}` /
+      // `  x < 5 -->`): without its arrow it is no production on its own.
+      join = curArrow ? !hasArrow(l.text)
+                      : (startsWithArrow(l.text) || l.text[p] == '{' ||
+                         FindTopLevel(out.back().text, 0, out.back().text.size(), ":") !=
+                             std::string::npos);
     }
     if (!join) {
       out.push_back(std::move(l));

@@ -172,6 +172,10 @@ TEST(CpfgBlocks, IndentedBlocksAndArrowContinueTheProduction) {
       DeriveText(
           "axiom: A(9)\nA(t) : t < 5\n  {nt = 1;}\n  --> B\nA(t) :\n  {q = 2;} *\n  --> C(q)\n", 1),
       "C(2)");
+  // vlab's clover and fern-leaf: the condition on the line after the block,
+  // the arrow on the line after that.
+  EXPECT_EQ(DeriveText("axiom: A(1)A(7)\nA(x) : {y = fabs(x - 5);}\n\t\t(y > 3)\n\t--> B(y)\n", 1),
+            "B(4)A(7)");
 }
 
 TEST(CpfgBlocks, AWeightAfterABlockWithAConditionalExpression) {
