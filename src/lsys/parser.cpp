@@ -999,6 +999,10 @@ std::string SubstituteParams(std::string_view text, const std::vector<std::strin
 // the result rescanned with the #define being expanded hidden, so a
 // #define that names itself stops. `uses` (top level only) receives where
 // each use was. On failure *problem says why and *problemAt is where in `s`.
+// A line with its text #defines substituted is at most this long (nested
+// #defines can double the text at each level).
+constexpr size_t kMaxExpandedLine = size_t(1) << 20;
+
 bool GrammarParser::ExpandText(std::string_view s, std::vector<std::string>& hiding, int depth,
                                std::string* out, std::vector<Line::Expansion>* uses,
                                size_t* problemAt, std::string* problem) {
@@ -1086,8 +1090,12 @@ bool GrammarParser::ExpandText(std::string_view s, std::vector<std::string>& hid
     usedConstants_.insert(name);
     hiding.push_back(name);
     const size_t at = out->size();
-    const bool ok = ExpandText(text, hiding, depth + 1, out, nullptr, problemAt, problem);
+    bool ok = ExpandText(text, hiding, depth + 1, out, nullptr, problemAt, problem);
     hiding.pop_back();
+    if (ok && out->size() > kMaxExpandedLine) {
+      ok = false;
+      *problem = "the #defines on this line expand to more than " + SizeText(kMaxExpandedLine);
+    }
     if (!ok) {
       *problemAt = i;
       return false;

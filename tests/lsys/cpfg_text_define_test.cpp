@@ -87,6 +87,15 @@ TEST(CpfgTextDefine, RunTimeErrorsPointIntoTheFile) {
   EXPECT_EQ(r.error().loc.column, 15) << r.error().Format();
 }
 
+TEST(CpfgTextDefine, NestedDefinesThatDoubleAreStoppedAtALimit) {
+  std::string text = "#define X0 F\n";
+  for (int i = 1; i <= 40; ++i)
+    text += "#define X" + std::to_string(i) + " X" + std::to_string(i - 1) + " X" +
+            std::to_string(i - 1) + "\n";
+  text += "axiom: A X40\n";
+  EXPECT_EQ(FirstError(text), "42:10 the #defines on this line expand to more than 1 MiB");
+}
+
 TEST(CpfgTextDefine, UndefForgetsATextDefineFromThere) {
   EXPECT_EQ(DeriveText("#define P F\naxiom: P\n#undef P\n#define P G\nA --> P\n", 0), "F");
   EXPECT_EQ(DeriveText("#define P F\n#undef P\n#define P G\naxiom: P\n#undef NEVER\n", 0), "G");
