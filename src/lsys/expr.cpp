@@ -423,6 +423,7 @@ constexpr FunctionInfo kFunctions[] = {
     {"max", OpCode::kMax, 2},       {"clamp", OpCode::kClamp, 3}, {"sign", OpCode::kSign, 1},
     {"trunc", OpCode::kTrunc, 1},   {"ran", OpCode::kRan, 1},     {"uniform", OpCode::kUniform, 2},
     {"normal", OpCode::kNormal, 2}, {"nran", OpCode::kNormal, 2},  // nran: cpfg's name
+    {"fabs", OpCode::kAbs, 1},                                     // cpfg's (C's) name
     {"bran", OpCode::kBran, 2},     {"biran", OpCode::kBiran, 2},
 };
 
@@ -991,6 +992,7 @@ class ExprCompiler {
       if (!ApplyPure(n.op, args, &r, &e, n.column)) {
         err_->column = e.column;
         err_->message = e.message;
+        err_->evaluation = true;
         return false;
       }
     }
@@ -1205,6 +1207,25 @@ class ExprCompiler {
     ++*pos;
     return true;
   }
+  // The call's parentheses from text[open] == '(' to the matching ')',
+  // "strings" (with their escapes) skipped; *pos is set just past it.
+  bool SkipCall(std::string_view text, size_t open, size_t* pos, const std::string& name) {
+    int nest = 0;
+    for (size_t i = open; i < text.size(); ++i) {
+      const char ch = text[i];
+      if (ch == '"') {
+        for (++i; i < text.size() && text[i] != '"'; ++i)
+          if (text[i] == '\\') ++i;
+        if (i >= text.size()) return Err(int(open) + 1, "unclosed string in '" + name + "(...)'");
+      } else if (ch == '(') {
+        ++nest;
+      } else if (ch == ')' && --nest == 0) {
+        *pos = i + 1;
+        return true;
+      }
+    }
+    return Err(int(open) + 1, "unclosed '(' of '" + name + "(...)'");
+  }
   // An optional ';' (required unless a '}' follows).
   bool EndOfStatement(std::string_view text, size_t* pos) {
     SkipSpace(text, pos);
@@ -1294,6 +1315,17 @@ class ExprCompiler {
       Push(OpCode::kStoreGlobal, uint32_t(scope.srandSlot), col);
       return EndOfStatement(text, pos);
     }
+    if (q < text.size() && text[q] == '(' && scope.outputCalls &&
+        (name == "printf" || name == "fprintf" || name == "fclose" || name == "fflush")) {
+      // cpfg's output: read, checked for balance, and compiled to nothing.
+      if (!SkipCall(text, q, pos, name)) return false;
+      const bool print = name == "printf" || name == "fprintf";
+      scope.outputCalls->push_back(ExprParseError{
+          col, int(name.size()),
+          "'" + name + "(...)' " + (print ? "prints nothing" : "does nothing") +
+              ": Sylva writes no output from a grammar (cpfg's printf, fprintf and files)"});
+      return EndOfStatement(text, pos);
+    }
     if (q < text.size() && text[q] == '(')
       return Err(col,
                  "a call '" + name + "(...)' as a statement is not supported (cpfg's printf, ...)",
@@ -1310,6 +1342,40 @@ class ExprCompiler {
     if (q >= text.size() || text[q] != '=' || (q + 1 < text.size() && text[q + 1] == '='))
       return Err(int(q) + 1, "expected '=' after '" + name + "' (an assignment)");
     *pos = q + 1;
+    // `f = fopen(NAME, "w")`: cpfg's output file, not opened (f is 0).
+    size_t f = *pos;
+    SkipSpace(text, &f);
+    bool fopenCall = false;
+    if (compound == OpCode::kConst && scope.outputCalls && Keyword(text, f, "fopen")) {
+      size_t paren = f + 5;
+      SkipSpace(text, &paren);
+      if (paren < text.size() && text[paren] == '(') {
+        const size_t open = paren;
+        if (!SkipCall(text, paren, pos, "fopen")) return false;
+        // The mode: the last "string" among the arguments.
+        const std::string_view args = text.substr(open, *pos - open);
+        const size_t close = args.rfind('"');
+        const size_t start = close == std::string_view::npos || close == 0
+                                 ? std::string_view::npos
+                                 : args.rfind('"', close - 1);
+        const std::string_view mode = start == std::string_view::npos
+                                          ? std::string_view()
+                                          : args.substr(start + 1, close - start - 1);
+        if (mode.empty() || mode.find_first_of("r+") != std::string_view::npos)
+          return Err(int(f) + 1,
+                     "fopen for reading is not supported (cpfg's fopen with \"r\" and fscanf: "
+                     "Sylva reads no data files from a grammar)",
+                     5);
+        scope.outputCalls->push_back(ExprParseError{
+            int(f) + 1, 5,
+            "'fopen(...)' opens no file: Sylva writes no output from a grammar (cpfg's printf, "
+            "fprintf and files); '" +
+                name + "' is 0"});
+        Push(OpCode::kConst, 0, int(f) + 1);
+        blockDepth = std::max(blockDepth, 1);
+        fopenCall = true;
+      }
+    }
     // The target: a formal or local, a global, or a new local.
     uint32_t slot = 0;
     OpCode store = OpCode::kStore;
@@ -1327,7 +1393,7 @@ class ExprCompiler {
       return Err(col, "'" + name + "' has no value before this assignment", int(name.size()));
     if (compound != OpCode::kConst)
       Push(store == OpCode::kStore ? OpCode::kFormal : OpCode::kGlobal, slot, col);
-    if (!Expression(text, pos, scope)) return false;
+    if (!fopenCall && !Expression(text, pos, scope)) return false;
     if (compound != OpCode::kConst) {
       Push(compound, 0, col);
       blockDepth = std::max(blockDepth, 2);
@@ -1428,7 +1494,10 @@ bool IsStatementBlock(std::string_view text, size_t pos, std::string_view next) 
     const std::string_view word = t.substr(p, e - p);
     size_t q = e;
     while (q < t.size() && (t[q] == ' ' || t[q] == '\t')) ++q;
-    if ((word == "if" || word == "while") && q < t.size() && t[q] == '(') return true;
+    if ((word == "if" || word == "while" || word == "printf" || word == "fprintf" ||
+         word == "fclose" || word == "fflush") &&
+        q < t.size() && t[q] == '(')
+      return true;
     if (word == "do" && (q >= t.size() || t[q] == '{' || q > e)) return true;
     if (q < t.size() && t[q] == '[') {  // an array element: name[...] =
       while (q < t.size() && t[q] != ']') ++q;

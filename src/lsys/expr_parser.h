@@ -52,6 +52,15 @@ struct ArrayShape {
 };
 
 // What names mean inside one expression.
+struct ExprParseError {
+  int column = 0;
+  int length = 1;
+  std::string message;
+  // The text is an expression, but computing a constant part of it failed
+  // (division by zero, say).
+  bool evaluation = false;
+};
+
 struct ExprScope {
   const std::unordered_map<std::string, double>* constants = nullptr;
   std::unordered_set<std::string>* usedConstants = nullptr;  // may be null; macros too
@@ -66,6 +75,12 @@ struct ExprScope {
   const std::vector<std::string>* globals = nullptr;
   // Set when a block assigns a global variable.
   bool* writesGlobal = nullptr;
+  // Where cpfg's output calls in statement blocks go (`printf(...);`,
+  // `fprintf(...);`, `fclose(...);`, `fflush(...);`, `f = fopen(NAME, "w");`):
+  // Sylva writes no output from a grammar, so they compile to nothing (fopen
+  // to 0) and each is noted here, column and message, for the caller to warn
+  // about. Null: they are errors.
+  std::vector<ExprParseError>* outputCalls = nullptr;
   // cpfg function files, for `func(id, x)`: id 1 is the first.
   const std::vector<std::shared_ptr<const CpfgFunction>>* functions = nullptr;
   // cpfg arrays: `a[i][j]` in expressions, `a[i][j] = v;` in blocks.
@@ -78,11 +93,6 @@ struct ExprScope {
 // Parses one expression starting at text[pos]; stops before the first
 // character that cannot continue it (',' ')' ':' or end) and sets *pos
 // there. Columns in errors are 1 + byte offset into `text` + colBase.
-struct ExprParseError {
-  int column = 0;
-  int length = 1;
-  std::string message;
-};
 
 bool ParseExpr(std::string_view text, size_t* pos, const ExprScope& scope, Expr* out,
                ExprParseError* err);

@@ -37,6 +37,35 @@ struct Line {
     std::string_view original;
   };
   std::vector<Piece> more;
+  // Uses of text #defines substituted into `text` (ExpandTextMacros), in
+  // column order: text[at, at + len) replaced text[from, from + fromLen) of
+  // the line before (0-based).
+  struct Expansion {
+    int at = 0, len = 0, from = 0, fromLen = 0;
+    std::string name;
+    int defineLine = 0;
+  };
+  std::vector<Expansion> expansions;
+
+  // The use of a text #define that column `col` (1-based) lies in; null: none.
+  const Expansion* ExpansionAt(int col) const {
+    for (const Expansion& e : expansions) {
+      if (col - 1 < e.at) break;
+      if (col - 1 < e.at + e.len) return &e;
+    }
+    return nullptr;
+  }
+  // Column `col` of `text` in the line before the #defines were substituted:
+  // inside a substituted text, the column of the name that was replaced.
+  int PreExpansionCol(int col) const {
+    int shift = 0;
+    for (const Expansion& e : expansions) {
+      if (col - 1 < e.at) break;
+      if (col - 1 < e.at + e.len) return e.from + 1;
+      shift = (e.from + e.fromLen) - (e.at + e.len);
+    }
+    return col + shift;
+  }
 
   // The piece that column `col` (1-based, of `text`) came from; null: the first line.
   const Piece* PieceAt(int col) const {
@@ -146,18 +175,24 @@ class GrammarParser {
   // The file position of column `col` of a (possibly joined) line, and the
   // text of the file line it is on.
   SourceLoc Loc(const Line& l, int col) const {
+    col = l.PreExpansionCol(col);
     if (const Line::Piece* p = l.PieceAt(col))
       return SourceLoc{files_[l.file], p->number, p->column + (col - 1 - p->at)};
     return SourceLoc{files_[l.file], l.number, col};
   }
   static std::string_view OriginalAt(const Line& l, int col) {
-    const Line::Piece* p = l.PieceAt(col);
+    const Line::Piece* p = l.PieceAt(l.PreExpansionCol(col));
     return p ? p->original : l.original;
   }
   void Error(const Line& l, int col, std::string msg, int len = 1) {
     if (int(diags_.ErrorCount()) >= kMaxErrors) {
       ++diags_.droppedErrors;  // counted, so the report can say how many
       return;
+    }
+    if (const Line::Expansion* e = l.ExpansionAt(col)) {
+      msg += " (in the text of '#define " + e->name + "' at line " + std::to_string(e->defineLine) +
+             ")";
+      len = int(e->name.size());
     }
     diags_.Add(MakeError(Loc(l, col), std::move(msg), len, OriginalAt(l, col)));
   }
@@ -192,10 +227,27 @@ class GrammarParser {
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
                       size_t lhsEnd);
   void ParseMacro(const Line& l, const std::string& name, int col, size_t pos);
+  // cpfg's preprocessor substitutes text: a #define whose value is not an
+  // expression (a piece of a word) is kept as text and substituted.
+  struct TextMacro {
+    bool function = false;  // NAME(a, b)
+    std::vector<std::string> params;
+    std::string body;
+    int line = 0;
+  };
+  void ParseUndef(const Line& l, size_t after);
+  void AddTextMacro(const Line& l, const std::string& name, int col, TextMacro m);
+  bool ExpandText(std::string_view s, std::vector<std::string>& hiding, int depth, std::string* out,
+                  std::vector<Line::Expansion>* uses, size_t* problemAt, std::string* problem);
+  void ExpandTextMacros(Line& l);
   void ParseProduction(const Line& l, size_t pos, size_t arrow, size_t arrowLen);
   bool LexName(const Line& l, size_t& pos, size_t end, std::string* name);
   bool ParseActualWord(const Line& l, size_t pos, size_t end, const ExprScope& scope,
                        Successor* out);
+  // ParseBlock with its errors reported, and cpfg's output calls in it
+  // (printf, ...; ExprScope::outputCalls) warned about once per call name.
+  bool ParseBlockAt(const Line& l, std::string_view view, size_t* pos, const ExprScope& scope,
+                    Expr* out);
   struct Formal {
     std::string name;
     std::vector<std::string> params;
@@ -254,6 +306,7 @@ class GrammarParser {
   std::unordered_set<std::string_view> declaredSet_;
   std::unordered_map<std::string, Define> defines_;
   std::unordered_map<std::string, ExprMacro> macros_;  // #define NAME(params) body
+  std::unordered_map<std::string, TextMacro> textMacros_;
   std::unordered_set<std::string> usedConstants_;
   std::set<std::string> usedOverrides_;
   std::unordered_map<std::string, ArityUse> arityUse_;
@@ -549,6 +602,24 @@ bool GrammarParser::CheckBrackets(const Line& l, const std::vector<SymbolId>& sy
   return true;
 }
 
+bool GrammarParser::ParseBlockAt(const Line& l, std::string_view view, size_t* pos,
+                                 const ExprScope& scope, Expr* out) {
+  ExprScope withOutput = scope;
+  std::vector<ExprParseError> calls;
+  withOutput.outputCalls = &calls;
+  ExprParseError err;
+  if (!ParseBlock(view, pos, withOutput, out, &err)) {
+    Error(l, err.column, err.message, err.length);
+    return false;
+  }
+  for (const ExprParseError& c : calls) {
+    const std::string name(view.substr(size_t(c.column) - 1, size_t(c.length)));
+    if (unsupportedWarned_.insert(name + "\x01output").second)
+      Warn(Loc(l, c.column), OriginalAt(l, c.column), c.message, c.length);
+  }
+  return true;
+}
+
 bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const ExprScope& scope,
                                     Successor* out) {
   const std::string& t = l.text;
@@ -565,11 +636,7 @@ bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const
       }
       Successor::Block b;
       b.before = uint32_t(out->symbols.size());
-      ExprParseError err;
-      if (!ParseBlock(view, &pos, scope, &b.code, &err)) {
-        Error(l, err.column, err.message, err.length);
-        return false;
-      }
+      if (!ParseBlockAt(l, view, &pos, scope, &b.code)) return false;
       out->blocks.push_back(std::move(b));
       out->allConstant = false;
       continue;
@@ -729,6 +796,26 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     defines_[name] = Define{Loc(l, col), int(name.size())};
     return;
   }
+  size_t end = t.size();
+  while (end > pos && IsSpace(t[end - 1])) --end;
+  {
+    // Not an expression (it does not parse, names what is not a constant,
+    // or goes on after one): text, substituted where the name is used.
+    ExprScope scope{&g_.constants, nullptr, nullptr, &macros_};
+    scope.functions = &g_.functions;
+    std::string_view view(t.data(), end);
+    Expr e;
+    ExprParseError err;
+    size_t q = pos;
+    bool isExpr = ParseExpr(view, &q, scope, &e, &err);
+    while (isExpr && q < end && IsSpace(t[q])) ++q;
+    if ((!isExpr && !err.evaluation) || (isExpr && q < end)) {
+      TextMacro m;
+      m.body = t.substr(pos, end - pos);
+      AddTextMacro(l, name, col, std::move(m));
+      return;
+    }
+  }
   double v;
   if (!ParseConstExpr(l, pos, t.size(), &v)) return;
   auto ov = opt_.overrides.find(name);
@@ -798,18 +885,243 @@ void GrammarParser::ParseMacro(const Line& l, const std::string& name, int col, 
   Expr body;
   ExprParseError err;
   size_t q = pos;
-  if (!ParseExpr(view, &q, scope, &body, &err)) {
+  bool isExpr = ParseExpr(view, &q, scope, &body, &err);
+  while (isExpr && q < end && IsSpace(t[q])) ++q;
+  if (!isExpr && err.evaluation) {
     Error(l, err.column, err.message, err.length);
     return;
   }
-  while (q < end && IsSpace(t[q])) ++q;
-  if (q < end) {
-    Error(l, int(q) + 1, "unexpected text after the body of '#define " + name + "'");
+  if (!isExpr || q < end) {
+    // Not an expression of its parameters: text, substituted where used
+    // with the arguments in place of the parameters (cpfg's preprocessor).
+    TextMacro tm;
+    tm.function = true;
+    tm.params = std::move(m.params);
+    tm.body = t.substr(pos, end - pos);
+    AddTextMacro(l, name, col, std::move(tm));
     return;
   }
   m.body = t.substr(pos, end - pos);
   macros_.emplace(name, std::move(m));
   defines_[name] = Define{Loc(l, col), int(name.size())};
+}
+
+// `#undef NAME`: a text #define is forgotten from here on (lines are
+// substituted in order); a name never defined is no error, as in C. A
+// constant or an expression #define is read before any production, so it
+// cannot be undone for the lines below only: an error.
+void GrammarParser::ParseUndef(const Line& l, size_t after) {
+  const std::string& t = l.text;
+  size_t q = after;
+  while (q < t.size() && IsSpace(t[q])) ++q;
+  size_t e = q;
+  while (e < t.size() && IsIdentChar(t[e])) ++e;
+  if (e == q) {
+    Error(l, int(q) + 1, "expected a name after #undef");
+    return;
+  }
+  const std::string name = t.substr(q, e - q);
+  if (textMacros_.erase(name)) {
+    defines_.erase(name);
+    return;
+  }
+  if (defines_.count(name)) {
+    Error(l, int(q) + 1,
+          "#undef of '" + name +
+              "' is not supported: a #define that is a number or an expression holds for the "
+              "whole file",
+          int(name.size()));
+  }
+}
+
+void GrammarParser::AddTextMacro(const Line& l, const std::string& name, int col, TextMacro m) {
+  if (opt_.overrides.count(name)) {
+    usedOverrides_.insert(name);
+    Error(l, col,
+          "-D " + name + ": '#define " + name +
+              "' is text (a piece of a word), not a number, and cannot be overridden",
+          int(name.size()));
+    return;
+  }
+  m.line = Loc(l, col).line;
+  textMacros_[name] = std::move(m);
+  defines_[name] = Define{Loc(l, col), int(name.size())};
+}
+
+namespace {
+
+// The end of the "..." string literal that starts at s[i] (just past it).
+size_t SkipString(std::string_view s, size_t i) {
+  for (++i; i < s.size(); ++i) {
+    if (s[i] == '\\') {
+      ++i;
+    } else if (s[i] == '"') {
+      return i + 1;
+    }
+  }
+  return s.size();
+}
+
+// `text` with every identifier in `params` replaced by the same-index `args`.
+std::string SubstituteParams(std::string_view text, const std::vector<std::string>& params,
+                             const std::vector<std::string>& args) {
+  std::string r;
+  for (size_t i = 0; i < text.size();) {
+    if (text[i] == '"') {
+      const size_t e = SkipString(text, i);
+      r.append(text.substr(i, e - i));
+      i = e;
+      continue;
+    }
+    if (!IsIdentStart(text[i]) || (i > 0 && IsIdentChar(text[i - 1]))) {
+      r += text[i++];
+      continue;
+    }
+    size_t e = i;
+    while (e < text.size() && IsIdentChar(text[e])) ++e;
+    const std::string_view word = text.substr(i, e - i);
+    auto it = std::find(params.begin(), params.end(), word);
+    if (it != params.end()) {
+      r += args[size_t(it - params.begin())];
+    } else {
+      r.append(word);
+    }
+    i = e;
+  }
+  return r;
+}
+
+}  // namespace
+
+// Substitutes the text #defines in `s` as cpfg's (C's) preprocessor does:
+// identifiers only, not inside "strings"; a NAME(a, b) #define only where
+// its name is followed by '(' and its arguments (themselves expanded first);
+// the result rescanned with the #define being expanded hidden, so a
+// #define that names itself stops. `uses` (top level only) receives where
+// each use was. On failure *problem says why and *problemAt is where in `s`.
+// A line with its text #defines substituted is at most this long (nested
+// #defines can double the text at each level).
+constexpr size_t kMaxExpandedLine = size_t(1) << 20;
+
+bool GrammarParser::ExpandText(std::string_view s, std::vector<std::string>& hiding, int depth,
+                               std::string* out, std::vector<Line::Expansion>* uses,
+                               size_t* problemAt, std::string* problem) {
+  constexpr int kMaxDepth = 64;
+  for (size_t i = 0; i < s.size();) {
+    if (s[i] == '"') {
+      const size_t e = SkipString(s, i);
+      out->append(s.substr(i, e - i));
+      i = e;
+      continue;
+    }
+    if (!IsIdentStart(s[i]) || (i > 0 && IsIdentChar(s[i - 1]))) {
+      *out += s[i++];
+      continue;
+    }
+    size_t e = i;
+    while (e < s.size() && IsIdentChar(s[e])) ++e;
+    const std::string name(s.substr(i, e - i));
+    auto it = textMacros_.find(name);
+    if (it == textMacros_.end() || std::find(hiding.begin(), hiding.end(), name) != hiding.end()) {
+      out->append(name);
+      i = e;
+      continue;
+    }
+    const TextMacro& m = it->second;
+    if (depth >= kMaxDepth) {
+      *problemAt = i;
+      *problem =
+          "#define '" + name + "' expands more than " + std::to_string(kMaxDepth) + " levels deep";
+      return false;
+    }
+    std::string text = m.body;
+    size_t useEnd = e;
+    if (m.function) {
+      size_t q = e;
+      while (q < s.size() && IsSpace(s[q])) ++q;
+      if (q >= s.size() || s[q] != '(') {  // the name alone is not a use (as in C)
+        out->append(name);
+        i = e;
+        continue;
+      }
+      // The arguments: split at commas outside parentheses and brackets.
+      std::vector<std::string> args;
+      int nest = 0;
+      size_t a = q + 1;
+      size_t c = q + 1;
+      for (; c < s.size(); ++c) {
+        const char ch = s[c];
+        if (ch == '"') {
+          c = SkipString(s, c) - 1;
+        } else if (ch == '(' || ch == '[' || ch == '{') {
+          ++nest;
+        } else if ((ch == ')' || ch == ']' || ch == '}') && nest > 0) {
+          --nest;
+        } else if (ch == ')' || (ch == ',' && nest == 0)) {
+          std::string arg;
+          if (!ExpandText(s.substr(a, c - a), hiding, depth + 1, &arg, nullptr, problemAt,
+                          problem)) {
+            *problemAt = i;
+            return false;
+          }
+          const size_t b = arg.find_first_not_of(" \t");
+          arg = b == std::string::npos ? std::string() : arg.substr(b);
+          while (!arg.empty() && IsSpace(arg.back())) arg.pop_back();
+          args.push_back(std::move(arg));
+          a = c + 1;
+          if (ch == ')') break;
+        }
+      }
+      if (c >= s.size()) {
+        *problemAt = i;
+        *problem = "unclosed '(' in the use of '#define " + name + "'";
+        return false;
+      }
+      if (args.size() == 1 && args[0].empty() && m.params.empty()) args.clear();
+      if (args.size() != m.params.size()) {
+        *problemAt = i;
+        *problem = "'#define " + name + "' takes " + std::to_string(m.params.size()) +
+                   " arguments, given " + std::to_string(args.size());
+        return false;
+      }
+      text = SubstituteParams(m.body, m.params, args);
+      useEnd = c + 1;
+    }
+    usedConstants_.insert(name);
+    hiding.push_back(name);
+    const size_t at = out->size();
+    bool ok = ExpandText(text, hiding, depth + 1, out, nullptr, problemAt, problem);
+    hiding.pop_back();
+    if (ok && out->size() > kMaxExpandedLine) {
+      ok = false;
+      *problem = "the #defines on this line expand to more than " + SizeText(kMaxExpandedLine);
+    }
+    if (!ok) {
+      *problemAt = i;
+      return false;
+    }
+    if (uses)
+      uses->push_back(
+          Line::Expansion{int(at), int(out->size() - at), int(i), int(useEnd - i), name, m.line});
+    i = useEnd;
+  }
+  return true;
+}
+
+void GrammarParser::ExpandTextMacros(Line& l) {
+  if (textMacros_.empty()) return;
+  std::string out;
+  std::vector<Line::Expansion> uses;
+  std::vector<std::string> hiding;
+  size_t at = 0;
+  std::string problem;
+  if (!ExpandText(l.text, hiding, 0, &out, &uses, &at, &problem)) {
+    Error(l, int(at) + 1, problem);
+    return;
+  }
+  if (uses.empty()) return;
+  l.text = std::move(out);
+  l.expansions = std::move(uses);
 }
 
 // Header statements: "keyword:" at the start of a line, case-insensitive.
@@ -1168,6 +1480,11 @@ void GrammarParser::Conditionals() {
       ParseDefine(l, pos);
       continue;
     }
+    if (d == "undef" && !ended) {
+      ParseUndef(l, after);
+      continue;
+    }
+    if (d.empty()) ExpandTextMacros(l);
     // After `endlsystem` nothing is read (it is warned about): a second
     // L-system's #defines are not this one's.
     size_t kwAfter = 0;
@@ -1289,11 +1606,7 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
   std::string_view view(t.data(), end);
   size_t pos = after;
   Expr block;
-  ExprParseError err;
-  if (!ParseBlock(view, &pos, scope, &block, &err)) {
-    Error(l, err.column, err.message, err.length);
-    return;
-  }
+  if (!ParseBlockAt(l, view, &pos, scope, &block)) return;
   while (pos < end && (IsSpace(t[pos]) || t[pos] == ';')) ++pos;
   if (pos < end) {
     Error(l, int(pos) + 1, std::string("unexpected text after the '") + shown + ":' block");
@@ -1720,6 +2033,11 @@ void GrammarParser::JoinContinuations() {
     while (e > 0 && IsSpace(l.text[e - 1])) --e;
     if (e == 0 || l.text[e - 1] != '\\') return false;
     l.text[e - 1] = ' ';
+    // cpfg's files end some #define lines with `\\` (two backslashes):
+    // both continue the line there.
+    const size_t d = firstText(l.text);
+    if (e >= 2 && l.text[e - 2] == '\\' && l.text.compare(d, 7, "#define") == 0)
+      l.text[e - 2] = ' ';
     return true;
   };
   std::vector<Line> out;
@@ -1755,8 +2073,13 @@ void GrammarParser::JoinContinuations() {
         isProduction(out.back())) {
       // Without its arrow yet, the production goes on with a line that
       // starts with the arrow or with a statement block (cpfg's
-      // `A(t) : t < 5` / `  {nt = t + 1;}` / `  --> ...`).
-      join = curArrow ? !hasArrow(l.text) : (startsWithArrow(l.text) || l.text[p] == '{');
+      // `A(t) : t < 5` / `  {nt = t + 1;}` / `  --> ...`), or, after the
+      // ':' of a condition, with any indented line (`A(x) : {...}` /
+      // `  x < 5 -->`): without its arrow it is no production on its own.
+      join = curArrow ? !hasArrow(l.text)
+                      : (startsWithArrow(l.text) || l.text[p] == '{' ||
+                         FindTopLevel(out.back().text, 0, out.back().text.size(), ":") !=
+                             std::string::npos);
     }
     if (!join) {
       out.push_back(std::move(l));
@@ -1955,7 +2278,17 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   p.lsystem = lsystem_;
   if (writesGlobal) g_.productionsWriteGlobals = true;
   p.loc = Loc(l, pf.column);
-  if (!l.more.empty()) {
+  if (!l.expansions.empty()) {
+    // Columns of the text with #defines substituted, mapped one by one:
+    // a new piece wherever the file position does not follow on.
+    SourceLoc prev;
+    for (int c = 1; c <= int(l.text.size()); ++c) {
+      const SourceLoc at = Loc(l, c);
+      if (c == 1 || at.line != prev.line || at.column != prev.column + 1)
+        p.pieces.push_back(Production::LinePiece{c - 1, at.line, at.column});
+      prev = at;
+    }
+  } else if (!l.more.empty()) {
     p.pieces.push_back(Production::LinePiece{0, l.number, 1});
     for (const Line::Piece& q : l.more)
       p.pieces.push_back(Production::LinePiece{q.at, q.number, q.column});
@@ -1980,11 +2313,7 @@ bool GrammarParser::ParseCondition(const Line& l, Production& p, const ExprScope
   };
   auto block = [&](std::optional<Expr>* out) {
     Expr b;
-    ExprParseError err;
-    if (!ParseBlock(view, &c, scope, &b, &err)) {
-      Error(l, err.column, err.message, err.length);
-      return false;
-    }
+    if (!ParseBlockAt(l, view, &c, scope, &b)) return false;
     *out = std::move(b);
     skip();
     return true;
@@ -2224,7 +2553,9 @@ void GrammarParser::Finish() {
   }
   for (const auto& [name, def] : defines_) {
     if (!usedConstants_.count(name)) {
-      Warn(def.loc, g_.SourceLine(def.loc), "constant '" + name + "' is never used", def.length);
+      Warn(def.loc, g_.SourceLine(def.loc),
+           (textMacros_.count(name) ? "#define '" : "constant '") + name + "' is never used",
+           def.length);
     }
   }
   if (diags_.HasErrors()) return;

@@ -31,7 +31,8 @@ std::vector<BadCase> Cases() {
       {"unbalanced_close", "axiom: F]F\n", "1:9", "unbalanced ']'"},
       {"unbalanced_open", "axiom: F\nF --> F[+F\n", "2:8", "unbalanced '['"},
       {"unknown_name", "axiom: A(1)\nA(x) --> A(y)\n", "2:12", "unknown name 'y'"},
-      {"unknown_constant", "#define a b+1\naxiom: F(a)\n", "1:11", "unknown name 'b'"},
+      // Not an expression of constants: text (cpfg), found wrong where used.
+      {"unknown_constant", "#define a b+1\naxiom: F(a)\n", "2:10", "unknown name 'b'"},
       {"function_arity", "axiom: F(min(1))\n", "1:10", "takes 2 arguments, given 1"},
       {"bad_number", "axiom: F(1.2.3)\n", "1:10", "malformed number '1.2.3'"},
       {"bad_exponent", "axiom: F(1e)\n", "1:10", "exponent has no digits"},

@@ -163,6 +163,10 @@ TEST(CpfgBlocks, IndentedBlocksAndArrowContinueTheProduction) {
       DeriveText(
           "axiom: A(9)\nA(t) : t < 5\n  {nt = 1;}\n  --> B\nA(t) :\n  {q = 2;} *\n  --> C(q)\n", 1),
       "C(2)");
+  // vlab's clover and fern-leaf: the condition on the line after the block,
+  // the arrow on the line after that.
+  EXPECT_EQ(DeriveText("axiom: A(1)A(7)\nA(x) : {y = fabs(x - 5);}\n\t\t(y > 3)\n\t--> B(y)\n", 1),
+            "B(4)A(7)");
 }
 
 TEST(CpfgBlocks, AWeightAfterABlockWithAConditionalExpression) {
@@ -207,8 +211,37 @@ TEST(CpfgBlocks, MalformedBlocksAreErrorsWithLocations) {
   EXPECT_EQ(FirstError("Start: x = 1;\naxiom: A\n"), "1:8 expected '{' after 'Start:'");
   EXPECT_EQ(FirstError("axiom: A {x = 1;} B\n"),
             "1:10 a statement block belongs in a production, not here");
-  EXPECT_EQ(FirstError("axiom: A(1)\nA(x) : {printf(\"%f\", x);} * --> B(x)\n"),
-            "2:9 a call 'printf(...)' as a statement is not supported (cpfg's printf, ...)");
+  EXPECT_EQ(FirstError("axiom: A(1)\nA(x) : {sin(x);} * --> B(x)\n"),
+            "2:9 a call 'sin(...)' as a statement is not supported (cpfg's printf, ...)");
+  EXPECT_EQ(FirstError("Start: {fp = fopen(\"data.txt\", \"r\");}\naxiom: A\n"),
+            "1:14 fopen for reading is not supported (cpfg's fopen with \"r\" and fscanf: Sylva "
+            "reads no data files from a grammar)");
+}
+
+TEST(CpfgBlocks, OutputCallsAreReadAndWarnedOnceEach) {
+  // cpfg's canalization-file tutorial: the output goes nowhere, the rest runs.
+  const std::string text =
+      "Start: {n = 0; fp = fopen(\"out.txt\", \"w\");}\n"
+      "EndEach: {n = n + 1; fprintf(fp, \"step %.0f (%s)\\n\", n, \"a;b)\"); fflush(fp);}\n"
+      "End: {fclose(fp);}\n"
+      "axiom: A(0)\n"
+      "A(x) : {printf(\"%f\\n\", x); printf(\"again\");} * --> A(x + n + fp)\n";
+  ParseResult r = ParseGrammarText(text, "c.l");
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  std::vector<std::string> warnings;
+  for (const auto& d : r.diagnostics.items)
+    if (d.severity == Severity::kWarning)
+      warnings.push_back(std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " +
+                         d.message.substr(0, d.message.find(':')));
+  const std::vector<std::string> expected{
+      "1:21 'fopen(...)' opens no file", "2:22 'fprintf(...)' prints nothing",
+      "2:66 'fflush(...)' does nothing", "3:7 'fclose(...)' does nothing",
+      "5:9 'printf(...)' prints nothing"};
+  EXPECT_EQ(warnings, expected) << r.diagnostics.FormatAll();
+  // fp is 0; n counts the steps: A(0) -> A(0) -> A(1) -> A(3).
+  DeriveOptions opt;
+  opt.steps = 3;
+  EXPECT_EQ(FormatWord(MustDerive(*r.grammar, opt).word, r.grammar->symbols), "A(3)");
 }
 
 }  // namespace

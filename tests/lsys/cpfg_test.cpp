@@ -298,7 +298,10 @@ TEST(Cpfg, DefineWithArgumentsErrorsAreLocated) {
     const Diagnostic& d = r.diagnostics.items[0];
     return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " + d.message;
   };
-  EXPECT_EQ(firstError("#define f(x) (x + y)\naxiom: A\n"), "1:19 unknown name 'y' in expression");
+  // A body that is not an expression of its parameters is text (cpfg's
+  // preprocessor): its errors are found where it is used.
+  EXPECT_EQ(firstError("#define f(x) (x + y)\naxiom: A(f(1))\n"),
+            "2:10 unknown name 'y' in expression (in the text of '#define f' at line 1)");
   EXPECT_EQ(firstError("#define f(x, x) x\naxiom: A\n"), "1:14 parameter 'x' appears twice");
   EXPECT_EQ(firstError("#define f(x) x\naxiom: A(f(1, 2))\n"),
             "2:10 'f' (#define) takes 1 argument, given 2");
