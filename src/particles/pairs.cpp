@@ -22,9 +22,15 @@
 //             1 / max(contacts of i, contacts of j): the same factor on
 //             both sides, so momentum is conserved exactly and an isolated
 //             pair gets its exact impulse (elastic: velocities swapped for
-//             equal masses). After the passes a particle's position moves
-//             by its velocity change times the rest of the step after its
-//             first contact.
+//             equal masses). A step with no resting contact (a gas) goes
+//             on past the fixed passes until every collision meets its
+//             target, so at e = 1 it keeps its energy (the impulses' work is
+//             zero when each contact leaves at the speed it came in); a
+//             pair overlapping at the start of the step bounces there only
+//             when the step's forces changed neither velocity (free flight:
+//             a collision the step before missed). After the passes a
+//             particle's position moves by its velocity change times the
+//             rest of the step after its first contact.
 //   position  the remaining overlap along each contact's normal is shared
 //             out by inverse mass, with the same factor; velocities are
 //             left alone (no energy is created). Then each particle is
