@@ -225,16 +225,19 @@ bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r) const {
 bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r, double best,
                               Contact* c) const {
   const Vec3 &v0 = v_[tris_[i][0]], &v1 = v_[tris_[i][1]], &v2 = v_[tris_[i][2]];
-  const Vec3 n = (v1 - v0).cross(v2 - v0);
-  const double nn = n.squaredNorm();
-  if (!(nn > 0)) return false;  // degenerate
   if (r > 0) {
-    // The triangle's box against the path's box grown by r.
+    // The triangle's box against the path's box grown by r, before the
+    // normal (most of a cell's triangles miss a short path's box).
     const Vec3 plo = a.cwiseMin(b) - Vec3::Constant(r), phi = a.cwiseMax(b) + Vec3::Constant(r);
     if ((v0.cwiseMin(v1).cwiseMin(v2).array() > phi.array()).any() ||
         (v0.cwiseMax(v1).cwiseMax(v2).array() < plo.array()).any()) {
       return false;
     }
+  }
+  const Vec3 n = (v1 - v0).cross(v2 - v0);
+  const double nn = n.squaredNorm();
+  if (!(nn > 0)) return false;  // degenerate
+  if (r > 0) {
     const Vec3 tri[3] = {v0, v1, v2};
     return IntersectGrown(tri, 3, n / std::sqrt(nn), a, b, r, best, c);
   }

@@ -430,8 +430,9 @@ class System {
     bool bounce;     // faster than the step's forces: leaves at e times vn0
   };
   std::vector<Vec3> pairX0_, pairV0_, pairV_, pairScratch_;
-  std::vector<double> pairMove_;     // each particle's displacement over the step
-  std::vector<uint32_t> pairStart_;  // particle i's contacts: [start[i], start[i + 1])
+  std::vector<double> pairMove_;      // each particle's displacement over the step
+  std::vector<double> pairResidual_;  // each particle's largest bounce residual in a pass
+  std::vector<uint32_t> pairStart_;   // particle i's contacts: [start[i], start[i + 1])
   std::vector<PairContact> pairs_;
   FaultLatch faults_;
   SolveStats solve_;
