@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <span>
 #include <type_traits>
 
 #include "core/assert.h"
@@ -40,8 +41,22 @@ int ClampSides(int s) {
 
 // Builds chains: runs of segments of one branch where each starts where the
 // previous ended.
-std::vector<std::vector<uint32_t>> BuildChains(const PlantGeometry& g) {
-  std::vector<std::vector<uint32_t>> chains;
+// Every chain's segments, in order, in one array (a chain is a span of it):
+// one allocation for all, not one for each of a million twigs.
+struct Chains {
+  std::vector<uint32_t> start;     // chain c is segments [start[c], start[c + 1])
+  std::vector<uint32_t> segments;  // indices into g.segments
+  size_t size() const { return start.empty() ? 0 : start.size() - 1; }
+  std::span<const uint32_t> operator[](size_t c) const {
+    return {segments.data() + start[c], segments.data() + start[c + 1]};
+  }
+};
+
+Chains BuildChains(const PlantGeometry& g) {
+  // First each segment's chain (-1: zero length, no chain) and each chain's
+  // length, then the segments in place: a chain's segments in their order.
+  std::vector<int64_t> chainOf(g.segments.size(), -1);
+  std::vector<uint32_t> lastOf, count;
   std::vector<int64_t> open(std::max<size_t>(g.branchCount, 1), -1);
   for (uint32_t k = 0; k < g.segments.size(); ++k) {
     const Segment& s = g.segments[k];
@@ -50,14 +65,27 @@ std::vector<std::vector<uint32_t>> BuildChains(const PlantGeometry& g) {
     if (s.branch >= open.size()) open.resize(s.branch + 1, -1);
     int64_t c = open[s.branch];
     if (c >= 0) {
-      const Segment& last = g.segments[chains[size_t(c)].back()];
+      const Segment& last = g.segments[lastOf[size_t(c)]];
       if ((last.end - s.start).norm() <= 1e-9 * (1 + last.end.norm())) {
-        chains[size_t(c)].push_back(k);
+        chainOf[k] = c;
+        lastOf[size_t(c)] = k;
+        ++count[size_t(c)];
         continue;
       }
     }
-    open[s.branch] = int64_t(chains.size());
-    chains.push_back({k});
+    c = int64_t(lastOf.size());
+    open[s.branch] = c;
+    chainOf[k] = c;
+    lastOf.push_back(k);
+    count.push_back(1);
+  }
+  Chains chains;
+  chains.start.assign(count.size() + 1, 0);
+  for (size_t c = 0; c < count.size(); ++c) chains.start[c + 1] = chains.start[c] + count[c];
+  chains.segments.resize(chains.start.back());
+  std::vector<uint32_t> at(chains.start.begin(), chains.start.end() - 1);
+  for (uint32_t k = 0; k < g.segments.size(); ++k) {
+    if (chainOf[k] >= 0) chains.segments[at[size_t(chainOf[k])]++] = k;
   }
   return chains;
 }
@@ -67,13 +95,14 @@ std::vector<std::vector<uint32_t>> BuildChains(const PlantGeometry& g) {
 struct ChainFrames {
   std::vector<Vec3> P, T, N;
   std::vector<double> R, V;
+  std::vector<double> ppu;  // PlanChain's scratch: pixels per unit at each joint
 };
 
 // How much of a chain's frames to compute: the axis (P, R) for planning,
 // with tangents and lengths (T, V) for a ribbon, everything for a tube.
 enum class FramePart { kAxis, kTangents, kAll };
 
-void BuildFrames(const PlantGeometry& g, const std::vector<uint32_t>& chain, ChainFrames& f,
+void BuildFrames(const PlantGeometry& g, std::span<const uint32_t> chain, ChainFrames& f,
                  FramePart part = FramePart::kAll) {
   const size_t m = chain.size();
   auto& P = f.P;
@@ -150,11 +179,12 @@ struct ChainPlan {
 // last kept joint to a later one passes within eps/2 pixels of it (axis
 // and radius) and the colour does not change there; caps only on tubes
 // at least a pixel wide.
-void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
+void PlanChain(const PlantGeometry& g, std::span<const uint32_t> chain, ChainFrames& f,
                const ScreenView& view, bool shadowOnly, int16_t* last, uint16_t* lastRings,
                ChainPlan& plan) {
   const size_t m = chain.size();
-  std::vector<double> ppu(m + 1);
+  std::vector<double>& ppu = f.ppu;
+  ppu.resize(m + 1);
   double rPx = 0;
   for (size_t k = 0; k <= m; ++k) {
     ppu[k] = shadowOnly ? view.shadowTexelsPerUnit : PixelsPerUnit(view, f.P[k]);
@@ -237,7 +267,7 @@ void PlanChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const
 // radius either way along the direction perpendicular to both the axis and
 // the line of sight, with the normal turned toward the eye. A line is
 // at least kLinePixels wide, its coverage the true width over the drawn one.
-void EmitRibbon(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
+void EmitRibbon(const PlantGeometry& g, std::span<const uint32_t> chain, const ChainFrames& f,
                 const ChainPlan& plan, const ScreenView& view, size_t vbase, size_t tbase,
                 TriangleMesh& out) {
   const size_t m = chain.size();
@@ -292,7 +322,7 @@ void EmitRibbon(const PlantGeometry& g, const std::vector<uint32_t>& chain, cons
   }
 }
 
-void EmitChain(const PlantGeometry& g, const std::vector<uint32_t>& chain, const ChainFrames& f,
+void EmitChain(const PlantGeometry& g, std::span<const uint32_t> chain, const ChainFrames& f,
                const ChainPlan& plan, size_t vbase, size_t tbase, TriangleMesh& out) {
   const size_t m = chain.size();
   const int S = plan.sides;
@@ -495,8 +525,7 @@ void TessellateSphere(const Sphere& s, int sides, TriangleMesh& out) {
 // about stream.pieceVertices vertices, then the rest. The pieces are the
 // mesh Tessellate would append to an empty mesh, cut between chains.
 template <typename EmitChains, typename EmitRest>
-Status StreamMesh(const MeshStream& stream, const PlantGeometry& g,
-                  const std::vector<std::vector<uint32_t>>& chains,
+Status StreamMesh(const MeshStream& stream, const PlantGeometry& g, const Chains& chains,
                   const std::vector<ChainPlan>& plans, const std::vector<size_t>& vOffset,
                   const std::vector<size_t>& tOffset, bool coverage, EmitChains& emitChains,
                   EmitRest& emitRest, TriangleMesh& piece) {
@@ -515,7 +544,7 @@ Status StreamMesh(const MeshStream& stream, const PlantGeometry& g,
   for (size_t c = 0; c < nc; ++c) {
     const ChainPlan& p = plans[c];
     if (!p.sides) continue;
-    const std::vector<uint32_t>& chain = chains[c];
+    const std::span<const uint32_t> chain = chains[c];
     const size_t m = chain.size(), K = p.rings(m);
     const size_t perSpan = p.ribbon ? 2 : 2 * size_t(p.sides);
     for (size_t r = 0; r + 1 < K; ++r) {
