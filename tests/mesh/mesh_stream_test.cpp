@@ -14,12 +14,11 @@
 
 #include "mesh/export.h"
 #include "mesh/tessellator.h"
+#include "mesh/view_test_util.h"
 #include "plant/plant_test_util.h"
 
 namespace sylva::mesh {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 PlantGeometry DrawFile(const std::string& name, int steps) {
   auto p = testing::PlantFromFile("abop/" + name + ".lsys", steps);
@@ -28,26 +27,10 @@ PlantGeometry DrawFile(const std::string& name, int steps) {
 
 // A perspective view (OpenGL conventions) from eye toward target.
 ScreenView ViewFrom(const Vec3& eye, const Vec3& target, bool coverage) {
-  const Vec3 f = (target - eye).normalized();
-  const Vec3 s = f.cross(Vec3::UnitY()).normalized(), u = s.cross(f);
-  Mat4 v = Mat4::Identity();
-  v.block<1, 3>(0, 0) = s.transpose();
-  v.block<1, 3>(1, 0) = u.transpose();
-  v.block<1, 3>(2, 0) = -f.transpose();
-  v(0, 3) = -s.dot(eye);
-  v(1, 3) = -u.dot(eye);
-  v(2, 3) = f.dot(eye);
-  const double zn = 0.01, zf = 1000, t = 1 / std::tan(35 * kPi / 360), aspect = 16.0 / 9;
-  Mat4 p = Mat4::Zero();
-  p(0, 0) = t / aspect;
-  p(1, 1) = t;
-  p(2, 2) = -(zf + zn) / (zf - zn);
-  p(2, 3) = -2 * zf * zn / (zf - zn);
-  p(3, 2) = -1;
   ScreenView view;
   view.width = 960;
   view.height = 540;
-  view.viewProjection = p * v;
+  view.viewProjection = testing::LookAtPerspective(eye, target, 35, 960.0 / 540);
   view.coverage = coverage;
   return view;
 }
