@@ -7,6 +7,7 @@
 #include "core/parallel.h"
 #include "lsys/parser.h"
 #include "mesh/color.h"
+#include "plant/cpfg_environment.h"
 #include "plant/surface_library.h"
 
 namespace sylva::plant {
@@ -191,6 +192,13 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
   popt.overrides = spec.defines;
   popt.readFile = spec.readFile;
   popt.environmentGiven = spec.environment != nullptr;
+  // A cpfg folder names its environment program in a .e file
+  // (plant/cpfg_environment.h); it answers ?E when the grammar names none.
+  std::optional<CpfgEnvironmentRef> cpfgEnv;
+  if (!spec.environment && (!spec.text || spec.readFile)) {
+    cpfgEnv = FindCpfgEnvironment(spec.path, spec.readFile);
+    if (cpfgEnv) popt.environmentGiven = true;  // its own warnings say what is answered
+  }
   popt.functionFiles = spec.cpfgFunctions;
   // `~lF`: cpfg's one-letter surface `l` then `F` when l.obj exists and lF.obj does not.
   SurfaceLibrary surfaces(spec.path, spec.surfacePath, spec.readFile);
@@ -232,6 +240,14 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
       return std::nullopt;
     }
     g.ownEnvironment_ = std::move(*env);
+  }
+  if (!grammar.environment && !spec.environment && cpfgEnv && g.queries_.environment) {
+    DiagnosticList envDiags;
+    g.ownEnvironment_ = LoadCpfgEnvironment(*cpfgEnv, spec.readFile, envDiags);
+    for (const Diagnostic& d : envDiags.items) {
+      diagnostics.Add(d);
+      g.diagnostics_.Add(d);
+    }
   }
   g.environment_ = spec.environment ? spec.environment : g.ownEnvironment_.get();
   if (spec.until == Stage::kGrammar) return g;

@@ -1,0 +1,409 @@
+#include "plant/cpfg_environment.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "core/atomic_file.h"
+#include "plant/density_environment.h"
+
+namespace sylva::plant {
+namespace {
+
+using Reader = std::function<std::optional<std::string>(const std::string&)>;
+
+constexpr size_t kMaxEnvFileBytes = size_t(1) << 20;
+
+std::optional<std::string> ReadText(const std::string& path, const Reader& readFile) {
+  if (readFile) return readFile(path);
+  auto text = ReadFile(path, kMaxEnvFileBytes);
+  if (!text) return std::nullopt;
+  return std::move(*text);
+}
+
+std::string ParentOf(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+std::string BaseOf(const std::string& path) {
+  const size_t slash = path.rfind('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string Join(const std::string& dir, const std::string& file) {
+  if (!file.empty() && file[0] == '/') return file;
+  if (dir.empty() || dir == ".") return file;
+  return dir.back() == '/' ? dir + file : dir + "/" + file;
+}
+
+struct Line {
+  int number = 0;
+  std::string text;
+};
+
+std::vector<Line> LinesOf(const std::string& text) {
+  std::vector<Line> out;
+  size_t start = 0;
+  int n = 0;
+  while (start <= text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    out.push_back(Line{++n, std::move(line)});
+    if (end == text.size()) break;
+    start = end + 1;
+  }
+  return out;
+}
+
+// Words separated by any of `seps`, each with its 0-based column.
+std::vector<std::pair<std::string, int>> Split(const std::string& s, const char* seps) {
+  std::vector<std::pair<std::string, int>> out;
+  size_t i = 0;
+  const std::string delims(seps);
+  while (i < s.size()) {
+    while (i < s.size() && delims.find(s[i]) != std::string::npos) ++i;
+    if (i >= s.size()) break;
+    size_t j = i;
+    while (j < s.size() && delims.find(s[j]) == std::string::npos) ++j;
+    out.emplace_back(s.substr(i, j - i), int(i));
+    i = j;
+  }
+  return out;
+}
+
+std::string Trim(const std::string& s) {
+  size_t a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
+  return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
+}
+
+// A "keyword: value" line as cpfg and its programs read it (strtok on tab
+// and colon): the keyword, trimmed, and what follows the delimiters after it.
+struct Directive {
+  std::string key;
+  std::string value;
+  int valueColumn = 0;  // 0-based
+};
+
+std::optional<Directive> DirectiveOf(const std::string& line) {
+  size_t i = line.find_first_not_of("\t:");
+  if (i == std::string::npos) return std::nullopt;
+  size_t j = line.find_first_of("\t:", i);
+  Directive d;
+  d.key = Trim(line.substr(i, j == std::string::npos ? std::string::npos : j - i));
+  if (d.key.empty() || d.key[0] == '#') return std::nullopt;
+  if (j != std::string::npos) {
+    size_t k = line.find_first_not_of("\t:", j);
+    if (k != std::string::npos) {
+      d.value = line.substr(k);
+      d.valueColumn = int(k);
+    }
+  }
+  return d;
+}
+
+Diagnostic Warning(const std::string& file, const Line& line, int column0, int length,
+                   std::string message) {
+  Diagnostic d = MakeError(SourceLoc{file, line.number, column0 + 1}, std::move(message),
+                           std::max(1, length), line.text);
+  d.severity = Severity::kWarning;
+  return d;
+}
+
+// A printf conversion of cpfg's `turtle position:` format.
+struct Conversion {
+  char kind = 'f';     // f, e or g (their upper-case forms print the same digits)
+  int precision = 6;   // printf's default
+};
+
+// The conversions of a format, at most 3 as cpfg counts them; nullopt when
+// one is not a floating-point conversion Sylva can reproduce.
+std::optional<std::vector<Conversion>> ConversionsOf(const std::string& format) {
+  std::vector<Conversion> out;
+  for (size_t i = 0; i < format.size(); ++i) {
+    if (format[i] != '%') continue;
+    if (i + 1 < format.size() && format[i + 1] == '%') {
+      ++i;
+      continue;
+    }
+    size_t j = i + 1;
+    while (j < format.size() && std::string("-+ #0").find(format[j]) != std::string::npos) ++j;
+    while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j]))) ++j;
+    Conversion c;
+    if (j < format.size() && format[j] == '.') {
+      ++j;
+      int p = 0;
+      while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j])))
+        p = std::min(40, p * 10 + (format[j++] - '0'));
+      c.precision = p;
+    }
+    if (j < format.size() && format[j] == 'l') ++j;
+    if (j >= format.size()) return std::nullopt;
+    const char k = char(std::tolower(static_cast<unsigned char>(format[j])));
+    if (k != 'f' && k != 'e' && k != 'g') return std::nullopt;
+    c.kind = k;
+    if (out.size() < 3) out.push_back(c);
+    i = j;
+  }
+  return out;
+}
+
+// x as the program reads it back after `c` printed it.
+double ThroughFormat(double x, const Conversion& c) {
+  char buf[512];
+  const char* fmt = c.kind == 'f' ? "%.*f" : c.kind == 'e' ? "%.*e" : "%.*g";
+  std::snprintf(buf, sizeof buf, fmt, c.precision, x);
+  return std::strtod(buf, nullptr);
+}
+
+enum class Program { kHonda81, kEcosystem };
+
+// Answers ?E as cpfg's program would: positions through the file's format,
+// then the program's rule.
+class CpfgProgramEnvironment final : public Environment {
+ public:
+  CpfgProgramEnvironment(Program program, std::vector<Conversion> position, Honda81Def honda,
+                         EcosystemDef eco)
+      : program_(program), position_(std::move(position)), honda_(honda), eco_(eco) {}
+
+  Status Answer(std::span<EnvQuery> queries) override {
+    // Both programs need x, y and z; with fewer coordinates in the format
+    // they store no query and answer nothing (as in cpfg).
+    if (position_.size() < 3) return {};
+    std::vector<DensityQuery> in;
+    std::vector<size_t> which;
+    in.reserve(queries.size());
+    for (size_t i = 0; i < queries.size(); ++i) {
+      const EnvQuery& q = queries[i];
+      // ecosystem with `vigor: on` needs 2 parameters, the others 1.
+      const size_t need = program_ == Program::kEcosystem && eco_.vigor ? 2 : 1;
+      if (q.params.size() < need) continue;
+      Vec3 p;
+      for (int c = 0; c < 3; ++c) p[c] = ThroughFormat(q.position[c], position_[size_t(c)]);
+      in.push_back(DensityQuery{p, {q.params.data(), q.params.size()}});
+      which.push_back(i);
+    }
+    const std::vector<double> answers = program_ == Program::kHonda81
+                                            ? Honda81Answers(honda_, in)
+                                            : EcosystemAnswers(eco_, in);
+    for (size_t k = 0; k < which.size(); ++k) queries[which[k]].params[0] = answers[k];
+    return {};
+  }
+
+ private:
+  Program program_;
+  std::vector<Conversion> position_;
+  Honda81Def honda_;
+  EcosystemDef eco_;
+};
+
+// The spec file of honda81 or ecosystem: `keyword: value` lines.
+void ReadSpec(Program program, const std::string& path, const std::string& text,
+              Honda81Def& honda, EcosystemDef& eco, DiagnosticList& diags) {
+  const char* name = program == Program::kHonda81 ? "honda81" : "ecosystem";
+  for (const Line& line : LinesOf(text)) {
+    auto d = DirectiveOf(line.text);
+    if (!d) continue;
+    const auto words = Split(d->value, "x,; \t:");
+    const std::string first = words.empty() ? std::string() : words[0].first;
+    const int col = words.empty() ? d->valueColumn : d->valueColumn + words[0].second;
+    const bool on = first == "on" || (program == Program::kEcosystem && first == "yes");
+    if (d->key == "verbose") continue;  // the program's log on stderr: nothing to draw
+    if (d->key == "3d case") {
+      (program == Program::kHonda81 ? honda.is3d : eco.is3d) = on;
+      continue;
+    }
+    if (program == Program::kHonda81 && d->key == "radius") {
+      char* end = nullptr;
+      const double r = std::strtod(first.c_str(), &end);
+      if (first.empty() || end == first.c_str() || !std::isfinite(r)) {
+        diags.Add(Warning(path, line, col, int(first.size()) + 1,
+                          "honda81's 'radius:' needs a number; the radius stays 0"));
+        continue;
+      }
+      honda.radius = r;
+      continue;
+    }
+    if (program == Program::kEcosystem && d->key == "vigor") {
+      eco.vigor = first == "on";
+      continue;
+    }
+    if (program == Program::kEcosystem && d->key == "grid size") continue;  // speed only
+    diags.Add(Warning(path, line, line.text.find_first_not_of("\t:"), int(d->key.size()),
+                      std::string("unknown directive '") + d->key + "' in " + name +
+                          "'s specification file: ignored, as " + name + " does"));
+  }
+}
+
+}  // namespace
+
+std::optional<CpfgEnvironmentRef> FindCpfgEnvironment(const std::string& grammarPath,
+                                                      const Reader& readFile) {
+  const std::string dir = ParentOf(grammarPath);
+  const std::string base = BaseOf(grammarPath);
+  for (const char* specName : {"specifications", "LSspecifications"}) {
+    const std::string specPath = Join(dir, specName);
+    auto text = ReadText(specPath, readFile);
+    if (!text) continue;
+    for (const Line& line : LinesOf(*text)) {
+      const auto words = Split(line.text, " \t");
+      size_t cpfg = words.size();
+      for (size_t i = 0; i < words.size(); ++i) {
+        if (BaseOf(words[i].first).rfind("cpfg", 0) == 0) {
+          cpfg = i;
+          break;
+        }
+      }
+      if (cpfg == words.size()) continue;
+      bool namesGrammar = false;
+      size_t e = 0;
+      for (size_t i = cpfg + 1; i < words.size(); ++i) {
+        if (words[i].first == base) namesGrammar = true;
+        if (words[i].first == "-e" && i + 1 < words.size() && e == 0) e = i + 1;
+      }
+      if (!namesGrammar || e == 0) continue;
+      CpfgEnvironmentRef ref;
+      ref.file = Join(dir, words[e].first);
+      ref.namedAt = SourceLoc{specPath, line.number, words[e].second + 1};
+      ref.namedLine = line.text;
+      ref.namedLength = int(words[e].first.size());
+      return ref;
+    }
+  }
+  const size_t dot = base.rfind('.');
+  const std::string beside = Join(dir, (dot == std::string::npos ? base : base.substr(0, dot)) + ".e");
+  if (ReadText(beside, readFile)) return CpfgEnvironmentRef{beside, {}, {}, 1};
+  return std::nullopt;
+}
+
+std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
+                                                 const Reader& readFile,
+                                                 DiagnosticList& diags) {
+  auto text = ReadText(ref.file, readFile);
+  if (!text) {
+    Diagnostic d = MakeError(ref.namedAt,
+                             "the environment file " + ref.file +
+                                 " named here cannot be read: ?E is not answered, its parameters "
+                                 "keep the values written in the grammar",
+                             ref.namedLength, ref.namedLine);
+    d.severity = Severity::kWarning;
+    diags.Add(std::move(d));
+    return nullptr;
+  }
+  std::optional<Line> executableLine;
+  std::string executable;
+  int executableColumn = 0;
+  std::optional<std::vector<Conversion>> position;
+  for (const Line& line : LinesOf(*text)) {
+    auto d = DirectiveOf(line.text);
+    if (!d) continue;
+    const int keyCol = int(line.text.find_first_not_of("\t:"));
+    if (d->key == "executable") {
+      executableLine = line;
+      executable = d->value;
+      executableColumn = d->valueColumn;
+    } else if (d->key == "turtle position") {
+      position = ConversionsOf(d->value);
+      if (!position) {
+        diags.Add(Warning(ref.file, line, d->valueColumn, int(d->value.size()),
+                          "this 'turtle position:' format has a conversion other than %f, %e "
+                          "or %g: no position is sent, so the program answers no ?E"));
+        position = std::vector<Conversion>{};
+      }
+    } else if (d->key == "communication type" || d->key == "verbose" ||
+               d->key == "remote host" || d->key == "strings only" ||
+               d->key == "binary data" || d->key == "turtle heading" ||
+               d->key == "turtle left" || d->key == "turtle up" ||
+               d->key == "turtle line width" || d->key == "turtle scale factor" ||
+               d->key == "following module") {
+      // How cpfg talks to the process, or turtle data that Sylva's built-in
+      // programs do not read (none of them uses more than the position).
+    } else if (d->key == "interpreted modules" || d->key == "when interpret") {
+      diags.Add(Warning(ref.file, line, keyCol, int(d->key.size()),
+                        "'" + d->key +
+                            ":' is read but not acted on: Sylva sends only ?E modules to "
+                            "the environment"));
+    } else {
+      diags.Add(Warning(ref.file, line, keyCol, int(d->key.size()),
+                        "unknown directive '" + d->key +
+                            "' in the environment file: ignored, as cpfg does"));
+    }
+  }
+  if (!executableLine) {
+    Diagnostic d = MakeError(SourceLoc{ref.file, 1, 0},
+                             "the environment file has no 'executable:' line: ?E is not "
+                             "answered");
+    d.severity = Severity::kWarning;
+    diags.Add(std::move(d));
+    return nullptr;
+  }
+  const auto args = Split(executable, " \t");
+  if (args.empty()) {
+    diags.Add(Warning(ref.file, *executableLine, executableColumn, 1,
+                      "'executable:' names no program: ?E is not answered"));
+    return nullptr;
+  }
+  const std::string program = BaseOf(args[0].first);
+  const int programCol = executableColumn + args[0].second;
+  Program kind;
+  if (program == "honda81") {
+    kind = Program::kHonda81;
+  } else if (program == "ecosystem") {
+    kind = Program::kEcosystem;
+  } else {
+    diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
+                      "the environment program '" + program +
+                          "' is not built into Sylva (it has honda81 and ecosystem): ?E is not "
+                          "answered, its parameters keep the values written in the grammar"));
+    return nullptr;
+  }
+  // The program's arguments: `-e FILE` (the .e itself), then its spec file.
+  std::string specFile;
+  int specCol = programCol;
+  for (size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i].first;
+    if (a == "-e" || a == "-k" || a == "-ext" || a == "-host") {
+      ++i;
+      continue;
+    }
+    if (a == "&" || a[0] == '-') continue;
+    specFile = a;
+    specCol = executableColumn + args[i].second;
+    break;
+  }
+  Honda81Def honda;
+  EcosystemDef eco;
+  if (specFile.empty()) {
+    diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
+                      program + " is given no specification file: it runs with its defaults"));
+  } else {
+    const std::string specPath = Join(ParentOf(ref.file), specFile);
+    auto spec = ReadText(specPath, readFile);
+    if (!spec) {
+      diags.Add(Warning(ref.file, *executableLine, specCol, int(specFile.size()),
+                        "cannot read " + program + "'s specification file " + specPath +
+                            ": it runs with its defaults" +
+                            (kind == Program::kHonda81 ? " (radius 0, 2D)" : " (2D, no vigor)")));
+    } else {
+      ReadSpec(kind, specPath, *spec, honda, eco, diags);
+    }
+  }
+  if (!position) {
+    diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
+                      "the environment file has no 'turtle position:' line, so cpfg sends no "
+                      "position and " +
+                          program + " answers no ?E"));
+    position = std::vector<Conversion>{};
+  } else if (position->size() < 3) {
+    diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
+                      "'turtle position:' sends " + std::to_string(position->size()) +
+                          " coordinates and " + program + " needs 3: it answers no ?E"));
+  }
+  return std::make_unique<CpfgProgramEnvironment>(kind, std::move(*position), honda, eco);
+}
+
+}  // namespace sylva::plant

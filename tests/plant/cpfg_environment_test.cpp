@@ -1,0 +1,247 @@
+// cpfg's environment programs built in (plant/density_environment.h) and
+// how a cpfg folder's .e and specifications files select them
+// (plant/cpfg_environment.h).
+#include "plant/cpfg_environment.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lsys/word.h"
+#include "plant/density_environment.h"
+#include "plant/plant.h"
+
+namespace sylva::plant {
+namespace {
+
+std::vector<double> Honda(const Honda81Def& def, const std::vector<Vec3>& at,
+                          const std::vector<std::vector<double>>& params) {
+  std::vector<DensityQuery> q;
+  for (size_t i = 0; i < at.size(); ++i) q.push_back(DensityQuery{at[i], params[i]});
+  return Honda81Answers(def, q);
+}
+
+std::vector<double> Eco(const EcosystemDef& def, const std::vector<Vec3>& at,
+                        const std::vector<std::vector<double>>& params) {
+  std::vector<DensityQuery> q;
+  for (size_t i = 0; i < at.size(); ++i) q.push_back(DensityQuery{at[i], params[i]});
+  return EcosystemAnswers(def, q);
+}
+
+using Answers = std::vector<double>;
+
+TEST(Honda81, EqualVigorsWithinTheRadiusBothStop) {
+  const Honda81Def def{1.0, true};
+  // 0 and 1 are 0.9 apart; 2 is 1.1 from 1 and 2.0 from 0.
+  EXPECT_EQ(Honda(def, {Vec3(0, 0, 0), Vec3(0.9, 0, 0), Vec3(2, 0, 0)}, {{1}, {1}, {1}}),
+            (Answers{0, 0, 1}));
+  // Exactly at the radius collides (<=).
+  EXPECT_EQ(Honda(def, {Vec3(0, 0, 0), Vec3(0, 1, 0)}, {{1}, {1}}), (Answers{0, 0}));
+}
+
+TEST(Honda81, TheHigherVigorGrowsAndGroupsDoNotMeet) {
+  const Honda81Def def{1.0, true};
+  EXPECT_EQ(Honda(def, {Vec3(0, 0, 0), Vec3(0.5, 0, 0)}, {{2}, {3}}), (Answers{0, 1}));
+  // Groups (the whole part of the second parameter) never collide.
+  EXPECT_EQ(Honda(def, {Vec3(0, 0, 0), Vec3(0.5, 0, 0)}, {{1, 1.7}, {1, 2.2}}), (Answers{1, 1}));
+  EXPECT_EQ(Honda(def, {Vec3(0, 0, 0), Vec3(0.5, 0, 0)}, {{1, 2.7}, {1, 2.2}}), (Answers{0, 0}));
+}
+
+TEST(Honda81, TwoDimensionsMeasureXAndZ) {
+  // 2D (the default) reads x and z: y, the height in cpfg, is left out.
+  const Honda81Def flat{1.0, false};
+  EXPECT_EQ(Honda(flat, {Vec3(0, 0, 0), Vec3(0, 50, 0.5)}, {{1}, {1}}), (Answers{0, 0}));
+  EXPECT_EQ(Honda(flat, {Vec3(0, 0, 0), Vec3(0, 0, 1.5)}, {{1}, {1}}), (Answers{1, 1}));
+  // Radius 0: only points in the same place collide.
+  const Honda81Def zero{0.0, true};
+  EXPECT_EQ(Honda(zero, {Vec3(1, 2, 3), Vec3(1, 2, 3), Vec3(1, 2, 3.001)}, {{1}, {1}, {1}}),
+            (Answers{0, 0, 1}));
+}
+
+TEST(Honda81, SweepAgreesWithAllPairsOnARandomCloud) {
+  // 400 points on a 20x20 grid jittered; the answer is checked against
+  // the rule applied to every pair.
+  std::vector<Vec3> at;
+  std::vector<std::vector<double>> params;
+  uint32_t s = 12345;
+  auto next = [&] { return (s = s * 1664525u + 1013904223u) / 4294967296.0; };
+  for (int i = 0; i < 400; ++i) {
+    at.emplace_back(i % 20 + next() * 0.8, next() * 10, i / 20 + next() * 0.8);
+    params.push_back({double(int(next() * 4)), double(int(next() * 2))});
+  }
+  const Honda81Def def{0.6, false};
+  const Answers got = Honda(def, at, params);
+  int zeros = 0;
+  for (size_t i = 0; i < at.size(); ++i) {
+    double expect = 1;
+    for (size_t j = 0; j < at.size(); ++j) {
+      const float dx = float(at[i].x()) - float(at[j].x());
+      const float dz = float(at[i].z()) - float(at[j].z());
+      if (i != j && params[i][1] == params[j][1] && params[i][0] <= params[j][0] &&
+          dx * dx + dz * dz <= 0.6f * 0.6f)
+        expect = 0;
+    }
+    EXPECT_EQ(got[i], expect) << "point " << i;
+    zeros += expect == 0;
+  }
+  EXPECT_GT(zeros, 20) << "the cloud should have collisions to test";
+}
+
+TEST(Ecosystem, SmallerDiscsUnderLargerOnesDie) {
+  const EcosystemDef def{};
+  // Radii 0.3 and 0.1, centres 0.35 apart (overlap: 0.35 <= 0.4): the
+  // small one reads 0. The third is alone.
+  EXPECT_EQ(Eco(def, {Vec3(0, 0, 0), Vec3(0.35, 7, 0), Vec3(3, 0, 0)}, {{0.3}, {0.1}, {0.2}}),
+            (Answers{1, 0, 1}));
+  // Equal radii: both die. Apart by more than the sum: both live.
+  EXPECT_EQ(Eco(def, {Vec3(0, 0, 0), Vec3(0, 0, 0.5)}, {{0.25}, {0.25}}), (Answers{0, 0}));
+  EXPECT_EQ(Eco(def, {Vec3(0, 0, 0), Vec3(0, 0, 0.51)}, {{0.25}, {0.25}}), (Answers{1, 1}));
+}
+
+TEST(Ecosystem, WithVigorARemovedDiscNoLongerDominates) {
+  // A chain a - b - c of overlapping discs (a and c apart): vigor 3, 2, 1.
+  // b is removed by a; c, visited after b, is not dominated by the removed b.
+  const EcosystemDef def{false, true};
+  const std::vector<Vec3> at{Vec3(0, 0, 0), Vec3(0.5, 0, 0), Vec3(1.0, 0, 0)};
+  EXPECT_EQ(Eco(def, at, {{0.3, 3}, {0.3, 2}, {0.3, 1}}), (Answers{1, 0, 1}));
+  // In the other order c is visited first, while b still stands: c dies,
+  // then b dies to a.
+  EXPECT_EQ(Eco(def, {at[2], at[1], at[0]}, {{0.3, 1}, {0.3, 2}, {0.3, 3}}), (Answers{0, 0, 1}));
+}
+
+// A cpfg object folder in memory.
+struct Folder {
+  std::map<std::string, std::string> files;
+  FileReader Reader() const {
+    return [files = files](const std::string& path) -> std::optional<std::string> {
+      auto it = files.find(path);
+      if (it == files.end()) return std::nullopt;
+      return it->second;
+    };
+  }
+};
+
+PlantResult Grow(const Folder& folder, const std::string& grammar, int steps) {
+  PlantSpec spec;
+  spec.path = "obj/t.l";
+  spec.text = grammar;
+  spec.readFile = folder.Reader();
+  spec.steps = steps;
+  spec.until = Stage::kWord;
+  return BuildPlant(spec);
+}
+
+std::string WordOf(const PlantResult& r) {
+  if (!r.plant) return "error:\n" + r.diagnostics.FormatAll();
+  return lsys::FormatWord(r.plant->word, r.plant->grammar.symbols);
+}
+
+// Two tips grow toward each other along y, each probing with ?E(1); they
+// stop when they come within the radius.
+const char* kTips =
+    "axiom: [A ?E(1)] f(5) | A ?E(1)\n"
+    "A > ?E(x) : x == 1 --> F(1) A\n"
+    "?E(x) --> ?E(1)\n";
+
+TEST(CpfgEnvironment, Honda81FromTheFoldersEFileStopsTipsThatMeet) {
+  Folder f;
+  f.files["obj/specifications"] = "t.l\nt.e\n*\nimage:\n\tgenerate:\n\t\tcpfg -e t.e t.l t.v\n";
+  f.files["obj/t.e"] =
+      "executable: honda81 -e t.e density.spec\n"
+      "communication type: files\n"
+      "turtle position:P:%f %f %f\n";
+  f.files["obj/density.spec"] = "radius: 1.5\n3d case: on\n";
+  // Tips at y = 0 and 5, then 1 and 4 (3 apart), then 2 and 3 (1 apart):
+  // both read 0 and grow no further.
+  PlantResult r = Grow(f, kTips, 4);
+  EXPECT_EQ(WordOf(r), "[F(1)F(1)A?E(0)]f(5)|F(1)F(1)A?E(0)");
+  EXPECT_EQ(r.diagnostics.FormatAll(), "");
+  // In 2D (x and z) the two tips on the y axis are in the same place.
+  f.files["obj/density.spec"] = "radius: 1.5\n";
+  EXPECT_EQ(WordOf(Grow(f, kTips, 4)), "[A?E(0)]f(5)|A?E(0)");
+}
+
+TEST(CpfgEnvironment, PositionsGoThroughTheFilesFormat) {
+  // Tips at x = 0.4 and -0.4, radius 0: through %.0f both are sent as 0
+  // (and -0), the same place, and collide; through %f they do not.
+  Folder f;
+  f.files["obj/t.e"] = "executable: honda81 -e t.e d.spec\nturtle position:%.0f %.0f %.0f\n";
+  f.files["obj/d.spec"] = "3d case: on\n";
+  const char* g =
+      "axiom: [@M(0.4,0,0) A ?E(1)] @M(-0.4,0,0) A ?E(1)\n"
+      "A > ?E(x) : x == 1 --> F(1) A\n"
+      "?E(x) --> ?E(1)\n";
+  EXPECT_EQ(WordOf(Grow(f, g, 1)), "[@M(0.4,0,0)A?E(0)]@M(-0.4,0,0)A?E(0)");
+  f.files["obj/t.e"] = "executable: honda81 -e t.e d.spec\nturtle position:%f %f %f\n";
+  EXPECT_EQ(WordOf(Grow(f, g, 1)), "[@M(0.4,0,0)F(1)A?E(1)]@M(-0.4,0,0)F(1)A?E(1)");
+}
+
+TEST(CpfgEnvironment, EcosystemThinsOverlappingPlants) {
+  Folder f;
+  f.files["obj/t.e"] = "executable: ecosystem -e t.e density.spec\nturtle position:%g %g %g\n";
+  f.files["obj/density.spec"] = "verbose: off\ngrid size: 128x128x1\n3d case: no\n";
+  // Plants of radius 0.3, 0.1 and 0.2 along x at 0, 0.35 and 3: the
+  // second overlaps the first, which is larger.
+  const char* g =
+      "axiom: [@M(0,0,0) P ?E(0.3)] [@M(0.35,0,0) P ?E(0.1)] [@M(3,0,0) P ?E(0.2)]\n";
+  EXPECT_EQ(WordOf(Grow(f, g, 0)),
+            "[@M(0,0,0)P?E(1)][@M(0.35,0,0)P?E(0)][@M(3,0,0)P?E(1)]");
+}
+
+std::string Warnings(const Folder& f, const std::string& grammar) {
+  PlantResult r = Grow(f, grammar, 1);
+  EXPECT_TRUE(r.plant) << r.diagnostics.FormatAll();
+  return r.diagnostics.FormatAll();
+}
+
+TEST(CpfgEnvironment, AProgramSylvaLacksIsNamedInAWarning) {
+  Folder f;
+  f.files["obj/t.e"] = "executable: chiba -e t.e light.spec\nturtle position:%g %g %g\n";
+  const std::string w = Warnings(f, kTips);
+  EXPECT_NE(w.find("obj/t.e:1:13: warning: the environment program 'chiba' is not built into "
+                   "Sylva"),
+            std::string::npos)
+      << w;
+  EXPECT_EQ(w.find("'environment:' statement"), std::string::npos) << w;
+}
+
+TEST(CpfgEnvironment, AMissingEFileNamedBySpecificationsIsAWarningThere) {
+  Folder f;
+  f.files["obj/specifications"] = "t.l\n*\n\t\tcpfg -m t.map -e tree.e t.l t.v\n";
+  const std::string w = Warnings(f, kTips);
+  EXPECT_NE(w.find("obj/specifications:3:20: warning: the environment file obj/tree.e named "
+                   "here cannot be read"),
+            std::string::npos)
+      << w;
+}
+
+TEST(CpfgEnvironment, SpecFileProblemsAreWarnedAndDefaultsKept) {
+  Folder f;
+  f.files["obj/t.e"] = "executable: honda81 -e t.e density.spec\nturtle position:%g %g\n";
+  std::string w = Warnings(f, kTips);
+  EXPECT_NE(w.find("cannot read honda81's specification file obj/density.spec"),
+            std::string::npos)
+      << w;
+  EXPECT_NE(w.find("'turtle position:' sends 2 coordinates and honda81 needs 3"),
+            std::string::npos)
+      << w;
+  f.files["obj/density.spec"] = "radius: 2\nspeed: 9\n";
+  w = Warnings(f, kTips);
+  EXPECT_NE(w.find("obj/density.spec:2:1: warning: unknown directive 'speed'"), std::string::npos)
+      << w;
+}
+
+TEST(CpfgEnvironment, NoQueryNoEnvironment) {
+  // A grammar without ?E reads nothing of the folder's .e file.
+  Folder f;
+  f.files["obj/t.e"] = "executable: chiba\n";
+  PlantResult r = Grow(f, "axiom: F A\nA --> F A\n", 2);
+  EXPECT_EQ(WordOf(r), "FFFA");
+  EXPECT_EQ(r.diagnostics.FormatAll(), "");
+}
+
+}  // namespace
+}  // namespace sylva::plant
