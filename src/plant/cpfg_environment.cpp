@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/atomic_file.h"
+#include "plant/clover_environment.h"
 #include "plant/density_environment.h"
 
 namespace sylva::plant {
@@ -160,31 +161,46 @@ double ThroughFormat(double x, const Conversion& c) {
   return std::strtod(buf, nullptr);
 }
 
-enum class Program { kHonda81, kEcosystem };
+enum class Program { kHonda81, kEcosystem, kClover };
 
-// Answers ?E as cpfg's program would: positions through the file's format,
-// then the program's rule.
-class CpfgProgramEnvironment final : public Environment {
+// Sends each query's position through the .e file's format (the first
+// coordinates; the rest are not sent) before the program reads it.
+class FormattedPositions final : public Environment {
  public:
-  CpfgProgramEnvironment(Program program, std::vector<Conversion> position, Honda81Def honda,
-                         EcosystemDef eco)
-      : program_(program), position_(std::move(position)), honda_(honda), eco_(eco) {}
+  FormattedPositions(std::unique_ptr<Environment> program, std::vector<Conversion> format)
+      : program_(std::move(program)), format_(std::move(format)) {}
+  Status Answer(std::span<EnvQuery> queries) override {
+    std::vector<EnvQuery> sent(queries.begin(), queries.end());
+    for (EnvQuery& q : sent) {
+      for (size_t c = 0; c < 3; ++c)
+        q.position[int(c)] = c < format_.size() ? ThroughFormat(q.position[int(c)], format_[c]) : 0;
+    }
+    return program_->Answer(sent);
+  }
+
+ private:
+  std::unique_ptr<Environment> program_;
+  std::vector<Conversion> format_;
+};
+
+// honda81 and ecosystem: both need x, y and z; with fewer coordinates sent
+// they store no query and answer nothing (as in cpfg).
+class DensityProgram final : public Environment {
+ public:
+  DensityProgram(Program program, int coordinates, Honda81Def honda, EcosystemDef eco)
+      : program_(program), coordinates_(coordinates), honda_(honda), eco_(eco) {}
 
   Status Answer(std::span<EnvQuery> queries) override {
-    // Both programs need x, y and z; with fewer coordinates in the format
-    // they store no query and answer nothing (as in cpfg).
-    if (position_.size() < 3) return {};
+    if (coordinates_ < 3) return {};
     std::vector<DensityQuery> in;
     std::vector<size_t> which;
     in.reserve(queries.size());
+    // ecosystem with `vigor: on` needs 2 parameters, the others 1.
+    const size_t need = program_ == Program::kEcosystem && eco_.vigor ? 2 : 1;
     for (size_t i = 0; i < queries.size(); ++i) {
       const EnvQuery& q = queries[i];
-      // ecosystem with `vigor: on` needs 2 parameters, the others 1.
-      const size_t need = program_ == Program::kEcosystem && eco_.vigor ? 2 : 1;
       if (q.params.size() < need) continue;
-      Vec3 p;
-      for (int c = 0; c < 3; ++c) p[c] = ThroughFormat(q.position[c], position_[size_t(c)]);
-      in.push_back(DensityQuery{p, {q.params.data(), q.params.size()}});
+      in.push_back(DensityQuery{q.position, {q.params.data(), q.params.size()}});
       which.push_back(i);
     }
     const std::vector<double> answers = program_ == Program::kHonda81
@@ -196,13 +212,13 @@ class CpfgProgramEnvironment final : public Environment {
 
  private:
   Program program_;
-  std::vector<Conversion> position_;
+  int coordinates_;
   Honda81Def honda_;
   EcosystemDef eco_;
 };
 
 // The spec file of honda81 or ecosystem: `keyword: value` lines.
-void ReadSpec(Program program, const std::string& path, const std::string& text,
+void ReadDensitySpec(Program program, const std::string& path, const std::string& text,
               Honda81Def& honda, EcosystemDef& eco, DiagnosticList& diags) {
   const char* name = program == Program::kHonda81 ? "honda81" : "ecosystem";
   for (const Line& line : LinesOf(text)) {
@@ -237,6 +253,84 @@ void ReadSpec(Program program, const std::string& path, const std::string& text,
                       std::string("unknown directive '") + d->key + "' in " + name +
                           "'s specification file: ignored, as " + name + " does"));
   }
+}
+
+// clover's spec file. False when the grid is too large to hold (then a
+// warning says so and ?E is not answered).
+bool ReadCloverSpec(const std::string& path, const std::string& text, const Reader& readFile,
+                    CloverDef& def, std::optional<CloverImage>& image, DiagnosticList& diags) {
+  std::optional<std::pair<Line, int>> imageAt;
+  std::string imageName;
+  for (const Line& line : LinesOf(text)) {
+    auto d = DirectiveOf(line.text);
+    if (!d) continue;
+    const int keyCol = int(line.text.find_first_not_of("\t:"));
+    const auto pair = Split(d->value, "x,; \t:");
+    const auto words = Split(d->value, ",; \t:");
+    const std::string first = words.empty() ? std::string() : words[0].first;
+    auto two = [&](auto& out, auto convert) {
+      if (pair.size() < 2) {
+        diags.Add(Warning(path, line, keyCol, int(d->key.size()),
+                          "clover's '" + d->key + ":' takes two numbers; ignored"));
+        return;
+      }
+      out[0] = convert(pair[0].first);
+      out[1] = convert(pair[1].first);
+    };
+    if (d->key == "grid size") {
+      two(def.size, [](const std::string& w) { return int(std::atof(w.c_str())); });
+    } else if (d->key == "grid position") {
+      two(def.pos, [](const std::string& w) { return float(std::atof(w.c_str())); });
+    } else if (d->key == "grid range") {
+      two(def.range, [](const std::string& w) { return float(std::atof(w.c_str())); });
+    } else if (d->key == "transmittance") {
+      def.transmittance = float(std::atof(first.c_str()));
+      if (def.transmittance == 0) def.transmittance = 0.0001f;  // as clover does
+    } else if (d->key == "input image") {
+      imageName = first;
+      imageAt = std::make_pair(line, d->valueColumn + (words.empty() ? 0 : words[0].second));
+    } else if (d->key == "remove old leaves") {
+      def.removeOldLeaves = first == "on" || first == "yes";
+    } else if (d->key == "z is up") {
+      if (first == "no" || first == "off") def.zIsUp = false;
+    } else if (d->key != "verbose") {
+      diags.Add(Warning(path, line, keyCol, int(d->key.size()),
+                        "unknown directive '" + d->key +
+                            "' in clover's specification file: ignored, as clover does"));
+    }
+  }
+  const Line specLine{1, {}};
+  if (def.size[0] < 1 || def.size[1] < 1 || double(def.size[0]) * def.size[1] > double(1 << 26) ||
+      !(def.range[0] != 0 && def.range[1] != 0)) {
+    diags.Add(Warning(path, specLine, 0, 1,
+                      "clover's grid of " + std::to_string(def.size[0]) + "x" +
+                          std::to_string(def.size[1]) +
+                          " cells over a range of zero or more than 2^26 cells cannot be held: "
+                          "?E is not answered"));
+    return false;
+  }
+  if (imageAt) {
+    const std::string imagePath = Join(ParentOf(path), imageName);
+    std::optional<std::string> bytes;
+    if (readFile) {
+      bytes = readFile(imagePath);
+    } else if (auto b = ReadFile(imagePath, size_t(256) << 20)) {
+      bytes = std::move(*b);
+    }
+    std::string why;
+    if (bytes) {
+      auto img = ReadCloverImage(*bytes, imagePath);
+      if (img) image = std::move(*img);
+      else why = img.error().message;
+    } else {
+      why = "cannot read " + imagePath;
+    }
+    if (!image) {
+      diags.Add(Warning(path, imageAt->first, imageAt->second, int(imageName.size()),
+                        why + ": clover's light is taken as full (255) everywhere"));
+    }
+  }
+  return true;
 }
 
 }  // namespace
@@ -354,11 +448,14 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
     kind = Program::kHonda81;
   } else if (program == "ecosystem") {
     kind = Program::kEcosystem;
+  } else if (program == "clover") {
+    kind = Program::kClover;
   } else {
     diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
                       "the environment program '" + program +
-                          "' is not built into Sylva (it has honda81 and ecosystem): ?E is not "
-                          "answered, its parameters keep the values written in the grammar"));
+                          "' is not built into Sylva (it has honda81, ecosystem and clover): ?E "
+                          "is not answered, its parameters keep the values written in the "
+                          "grammar"));
     return nullptr;
   }
   // The program's arguments: `-e FILE` (the .e itself), then its spec file.
@@ -375,35 +472,50 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
     specCol = executableColumn + args[i].second;
     break;
   }
+  const char* defaults = kind == Program::kHonda81     ? " (radius 0, 2D)"
+                         : kind == Program::kEcosystem ? " (2D, no vigor)"
+                                                       : " (a 2x2 grid from (-1, -1), full light)";
   Honda81Def honda;
   EcosystemDef eco;
+  CloverDef clover;
+  std::optional<CloverImage> image;
   if (specFile.empty()) {
     diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
-                      program + " is given no specification file: it runs with its defaults"));
+                      program + " is given no specification file: it runs with its defaults" +
+                          defaults));
   } else {
     const std::string specPath = Join(ParentOf(ref.file), specFile);
     auto spec = ReadText(specPath, readFile);
     if (!spec) {
       diags.Add(Warning(ref.file, *executableLine, specCol, int(specFile.size()),
                         "cannot read " + program + "'s specification file " + specPath +
-                            ": it runs with its defaults" +
-                            (kind == Program::kHonda81 ? " (radius 0, 2D)" : " (2D, no vigor)")));
+                            ": it runs with its defaults" + defaults));
+    } else if (kind == Program::kClover) {
+      if (!ReadCloverSpec(specPath, *spec, readFile, clover, image, diags)) return nullptr;
     } else {
-      ReadSpec(kind, specPath, *spec, honda, eco, diags);
+      ReadDensitySpec(kind, specPath, *spec, honda, eco, diags);
     }
   }
+  const int need = kind == Program::kClover && clover.zIsUp ? 2 : 3;
   if (!position) {
     diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
                       "the environment file has no 'turtle position:' line, so cpfg sends no "
                       "position and " +
                           program + " answers no ?E"));
     position = std::vector<Conversion>{};
-  } else if (position->size() < 3) {
+  } else if (int(position->size()) < need) {
     diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
                       "'turtle position:' sends " + std::to_string(position->size()) +
-                          " coordinates and " + program + " needs 3: it answers no ?E"));
+                          " coordinates and " + program + " needs " + std::to_string(need) +
+                          ": it answers no ?E"));
   }
-  return std::make_unique<CpfgProgramEnvironment>(kind, std::move(*position), honda, eco);
+  const int coordinates = int(position->size());
+  std::unique_ptr<Environment> env;
+  if (kind == Program::kClover)
+    env = std::make_unique<CloverEnvironment>(clover, image ? &*image : nullptr, coordinates);
+  else
+    env = std::make_unique<DensityProgram>(kind, coordinates, honda, eco);
+  return std::make_unique<FormattedPositions>(std::move(env), std::move(*position));
 }
 
 }  // namespace sylva::plant

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "lsys/word.h"
+#include "plant/clover_environment.h"
 #include "plant/density_environment.h"
 #include "plant/plant.h"
 
@@ -189,6 +190,127 @@ TEST(CpfgEnvironment, EcosystemThinsOverlappingPlants) {
       "axiom: [@M(0,0,0) P ?E(0.3)] [@M(0.35,0,0) P ?E(0.1)] [@M(3,0,0) P ?E(0.2)]\n";
   EXPECT_EQ(WordOf(Grow(f, g, 0)),
             "[@M(0,0,0)P?E(1)][@M(0.35,0,0)P?E(0)][@M(3,0,0)P?E(1)]");
+}
+
+// A 10 x 10 grid of unit cells from (0, 0), leaves letting half through.
+CloverDef UnitGrid() {
+  CloverDef def;
+  def.size[0] = def.size[1] = 10;
+  def.pos[0] = def.pos[1] = 0;
+  def.range[0] = def.range[1] = 10;
+  def.transmittance = 0.5f;
+  return def;
+}
+
+TEST(CloverEnvironment, LeavesShadeTheCellsOfTheirDisc) {
+  CloverEnvironment env(UnitGrid(), nullptr, 2);
+  // A leaf of area 4 pi (radius 2: 3 cells) at (5.5, 5.5), node (5, 5).
+  std::vector<double> leaf{1, 4 * M_PI}, under{1}, beside{1}, off{1}, two{0, 7};
+  std::vector<EnvQuery> q{
+      {Vec3(5.5, 5.5, 0), {}, leaf}, {Vec3(5.2, 5.9, 0), {}, under},
+      {Vec3(9.5, 5.5, 0), {}, beside}, {Vec3(-0.5, 5, 0), {}, off}, {Vec3(2.5, 5.5, 0), {}, two}};
+  ASSERT_TRUE(env.Answer(q).ok());
+  EXPECT_EQ(leaf, (std::vector<double>{1, 4 * M_PI})) << "a leaf is not answered";
+  EXPECT_EQ(under[0], 0.5);
+  EXPECT_EQ(beside[0], 1.0);  // 4 cells from the node: outside the disc
+  EXPECT_EQ(off[0], 0.0);     // off the grid
+  EXPECT_EQ(two[0], 0.5);     // (2, 5): 3 cells left of the node, on the ellipse
+  EXPECT_EQ(two[1], 0.0);     // the ratio (no image: 0)
+  // The disc: cells (dx, dy) in [-3, 3) with dx^2 + dy^2 <= 9.
+  EXPECT_EQ(env.Leaves(5, 5), 1);
+  EXPECT_EQ(env.Leaves(2, 5), 1);
+  EXPECT_EQ(env.Leaves(7, 7), 1);  // (2, 2): 8 <= 9
+  EXPECT_EQ(env.Leaves(8, 5), 0);  // dx = 3 is past the loop
+  EXPECT_EQ(env.Leaves(2, 4), 0);  // (-3, -1): 10 > 9
+  // Leaves stay from step to step: a second one doubles the shade; a
+  // removal (first parameter 2) takes one away.
+  std::vector<double> leaf2{1, 4 * M_PI}, q2{1};
+  std::vector<EnvQuery> step2{{Vec3(5.5, 5.5, 0), {}, leaf2}, {Vec3(5.5, 5.5, 0), {}, q2}};
+  ASSERT_TRUE(env.Answer(step2).ok());
+  EXPECT_EQ(q2[0], 0.25);
+  std::vector<double> gone{2, 4 * M_PI}, q3{1};
+  std::vector<EnvQuery> step3{{Vec3(5.5, 5.5, 0), {}, gone}, {Vec3(5.5, 5.5, 0), {}, q3}};
+  ASSERT_TRUE(env.Answer(step3).ok());
+  EXPECT_EQ(q3[0], 0.5);
+}
+
+// An SGI image, 8 bits, 3 channels; `rle` stores each row as one literal run.
+std::string Sgi(int w, int h, const std::vector<std::vector<uint8_t>>& rowsPerChannel, bool rle) {
+  std::string out(512, '\0');
+  auto put16 = [&](size_t at, uint32_t v) {
+    out[at] = char(v >> 8);
+    out[at + 1] = char(v & 255);
+  };
+  auto put32 = [&](size_t at, uint32_t v) {
+    for (int i = 0; i < 4; ++i) out[at + size_t(i)] = char((v >> (24 - 8 * i)) & 255);
+  };
+  put16(0, 474);
+  out[2] = char(rle ? 1 : 0);
+  out[3] = 1;
+  put16(4, 3);
+  put16(6, uint32_t(w));
+  put16(8, uint32_t(h));
+  put16(10, 3);
+  if (!rle) {
+    for (const auto& ch : rowsPerChannel) out.append(ch.begin(), ch.end());
+    return out;
+  }
+  const size_t rows = size_t(h) * 3, table = 512 + 8 * rows;
+  out.resize(table);
+  for (size_t k = 0; k < rows; ++k) {
+    const auto& ch = rowsPerChannel[k / size_t(h)];
+    const size_t y = k % size_t(h);
+    put32(512 + 4 * k, uint32_t(out.size()));
+    put32(512 + 4 * rows + 4 * k, uint32_t(w + 2));
+    out.push_back(char(0x80 | w));
+    out.append(ch.begin() + long(y) * w, ch.begin() + long(y + 1) * w);
+    out.push_back('\0');
+  }
+  return out;
+}
+
+TEST(CloverEnvironment, ReadsSgiImagesVerbatimAndRunLength) {
+  // 2 x 2; rows from the bottom. Red 10 20 / 30 40, green 50 60 / 70 80.
+  const std::vector<std::vector<uint8_t>> ch{{10, 20, 30, 40}, {50, 60, 70, 80}, {0, 0, 0, 0}};
+  for (bool rle : {false, true}) {
+    auto img = ReadCloverImage(Sgi(2, 2, ch, rle), "light.rgb");
+    ASSERT_TRUE(img) << img.error().message;
+    EXPECT_EQ(img->red, ch[0]) << "rle " << rle;
+    EXPECT_EQ(img->green, ch[1]) << "rle " << rle;
+  }
+  EXPECT_FALSE(ReadCloverImage(std::string(600, 'x'), "light.png"));
+  EXPECT_FALSE(ReadCloverImage(Sgi(2, 2, ch, false).substr(0, 517), "cut.rgb"));
+}
+
+TEST(CpfgEnvironment, CloverReadsItsSpecAndImage) {
+  Folder f;
+  f.files["obj/t.e"] = "executable: clover -e t.e t.spec\nturtle position:P:%g %g\n";
+  // A 2 x 2 grid over (0, 0)-(2, 2); the image's green is 255 on the left
+  // column and 51 on the right, its red 64 everywhere (ratio 0.5). ?E(0, r)
+  // asks for the light and the ratio. The leaf at (1.5, 1.5), of radius 0.4
+  // (1 cell), shades its cell (1, 1) and those left of and below it.
+  f.files["obj/t.spec"] =
+      "grid position: 0 0\ngrid range: 2x2\ngrid size: 2x2\ninput image: l.rgb\n"
+      "transmittance: 0.5\nverbose: off\n";
+  f.files["obj/l.rgb"] = Sgi(2, 2, {{64, 64, 64, 64}, {255, 51, 255, 51}, {0, 0, 0, 0}}, true);
+  const char* g =
+      "axiom: [@M(0.5,0.5,0) ?E(0,0)] [@M(0.5,1.5,0) ?E(0,0)] [@M(1.5,0.5,0) ?E(0,0)] "
+      "[@M(1.5,1.5,0) ?E(1,0.5)] [@M(1.5,1.5,0) ?E(0,0)]\n";
+  PlantResult r = Grow(f, g, 0);
+  EXPECT_EQ(WordOf(r),
+            "[@M(0.5,0.5,0)?E(1,0.5)][@M(0.5,1.5,0)?E(0.5,0.5)][@M(1.5,0.5,0)?E(0.1,0.5)]"
+            "[@M(1.5,1.5,0)?E(1,0.5)][@M(1.5,1.5,0)?E(0.1,0.5)]");
+  EXPECT_EQ(r.diagnostics.FormatAll(), "");
+  // Without the image: a warning at its name, and full light.
+  f.files.erase("obj/l.rgb");
+  r = Grow(f, g, 0);
+  EXPECT_EQ(WordOf(r),
+            "[@M(0.5,0.5,0)?E(1,0)][@M(0.5,1.5,0)?E(0.5,0)][@M(1.5,0.5,0)?E(0.5,0)]"
+            "[@M(1.5,1.5,0)?E(1,0.5)][@M(1.5,1.5,0)?E(0.5,0)]");
+  EXPECT_NE(r.diagnostics.FormatAll().find("obj/t.spec:4:14: warning: cannot read obj/l.rgb: "
+                                           "clover's light is taken as full (255) everywhere"),
+            std::string::npos)
+      << r.diagnostics.FormatAll();
 }
 
 std::string Warnings(const Folder& f, const std::string& grammar) {
