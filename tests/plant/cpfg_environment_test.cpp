@@ -10,10 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "core/atomic_file.h"
 #include "lsys/word.h"
 #include "plant/clover_environment.h"
 #include "plant/density_environment.h"
 #include "plant/plant.h"
+#include "plant/plant_test_util.h"
 
 namespace sylva::plant {
 namespace {
@@ -133,6 +135,12 @@ PlantResult Grow(const Folder& folder, const std::string& grammar, int steps) {
   spec.steps = steps;
   spec.until = Stage::kWord;
   return BuildPlant(spec);
+}
+
+size_t Count(const std::string& s, const std::string& what) {
+  size_t n = 0;
+  for (size_t i = s.find(what); i != std::string::npos; i = s.find(what, i + 1)) ++n;
+  return n;
 }
 
 std::string WordOf(const PlantResult& r) {
@@ -311,6 +319,40 @@ TEST(CpfgEnvironment, CloverReadsItsSpecAndImage) {
                                            "clover's light is taken as full (255) everywhere"),
             std::string::npos)
       << r.diagnostics.FormatAll();
+}
+
+TEST(CpfgEnvironment, BundledHexCollideGrowsASymmetricSnowflake) {
+  // grammars/cpfg/hex_collide.l names no environment; hex_collide.e beside
+  // it names honda81. Three arms grow alike: each top-level branch holds the
+  // same number of segments, which only holds if every collision is found.
+  PlantSpec spec;
+  spec.path = std::string(SYLVA_SOURCE_DIR) + "/grammars/cpfg/hex_collide.l";
+  spec.until = Stage::kWord;
+  PlantResult r = BuildPlant(spec);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
+  EXPECT_EQ(r.diagnostics.FormatAll(), "");
+  const std::string w = WordOf(r);
+  std::vector<int> perArm;
+  int depth = 0;
+  for (size_t i = 0; i < w.size(); ++i) {
+    if (w[i] == '[' && depth++ == 0) perArm.push_back(0);
+    if (w[i] == ']') --depth;
+    if (w.compare(i, 4, "F(1)") == 0 && !perArm.empty()) ++perArm.back();
+  }
+  EXPECT_EQ(perArm, (std::vector<int>{172, 172, 172}));
+  // Without its .e file nothing answers the probes, every one grows, and
+  // after n steps there are 3 + 9 + ... + 3^n = (3^(n+1) - 3) / 2 segments;
+  // with it, fewer.
+  spec.steps = 6;
+  const size_t withEnv = Count(WordOf(BuildPlant(spec)), "F(1)");
+  spec.readFile = [](const std::string& path) -> std::optional<std::string> {
+    if (path.size() > 2 && path.compare(path.size() - 2, 2, ".e") == 0) return std::nullopt;
+    auto text = ReadFile(path);
+    if (!text) return std::nullopt;
+    return std::move(*text);
+  };
+  EXPECT_EQ(Count(WordOf(BuildPlant(spec)), "F(1)"), (2187u - 3u) / 2u);
+  EXPECT_LT(withEnv, (2187u - 3u) / 2u);
 }
 
 std::string Warnings(const Folder& f, const std::string& grammar) {
