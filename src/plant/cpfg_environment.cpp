@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/atomic_file.h"
+#include "plant/chiba_environment.h"
 #include "plant/clover_environment.h"
 #include "plant/density_environment.h"
 
@@ -161,7 +162,7 @@ double ThroughFormat(double x, const Conversion& c) {
   return std::strtod(buf, nullptr);
 }
 
-enum class Program { kHonda81, kEcosystem, kClover };
+enum class Program { kHonda81, kEcosystem, kClover, kChiba };
 
 // Sends each query's position through the .e file's format (the first
 // coordinates; the rest are not sent) before the program reads it.
@@ -333,6 +334,53 @@ bool ReadCloverSpec(const std::string& path, const std::string& text, const Read
   return true;
 }
 
+// chiba's spec file.
+void ReadChibaSpec(const std::string& path, const std::string& text, ChibaDef& def,
+                   DiagnosticList& diags) {
+  for (const Line& line : LinesOf(text)) {
+    auto d = DirectiveOf(line.text);
+    if (!d) continue;
+    const int keyCol = int(line.text.find_first_not_of("\t:"));
+    const auto xs = Split(d->value, "x,; \t:");
+    const auto words = Split(d->value, ",; \t:");
+    const std::string first = words.empty() ? std::string() : words[0].first;
+    const std::string firstX = xs.empty() ? std::string() : xs[0].first;
+    auto number = [](const std::string& w) { return float(std::atof(w.c_str())); };
+    if (d->key == "grid size" || d->key == "verbose") {
+      // cpfg's acceleration grid (the answers do not depend on it); a log.
+    } else if (d->key == "lower to upper ratio") {
+      def.lowerToUpper = number(first);
+    } else if (d->key == "transmittance") {
+      def.transmittance = number(first);
+    } else if (d->key == "number of samples") {
+      def.samples = std::atoi(firstX.c_str());
+    } else if (d->key == "radius") {
+      def.radius = number(first);
+    } else if (d->key == "beam radius") {
+      def.beamRadius = number(first);
+    } else if (d->key == "source direction") {
+      if (def.sources.size() >= 100) {
+        diags.Add(Warning(path, line, keyCol, int(d->key.size()),
+                          "chiba takes at most 100 light sources; this one is ignored"));
+        continue;
+      }
+      ChibaDef::Source src;
+      src.dir[1] = 0;
+      for (size_t i = 0; i < 3 && i < words.size(); ++i) src.dir[i] = number(words[i].first);
+      if (words.size() > 3) src.intensity = number(words[3].first);
+      def.sources.push_back(src);
+    } else if (d->key == "estimate intersection area") {
+      def.estimateArea = firstX == "on";
+    } else if (d->key == "use CIE formula") {
+      def.cie = firstX == "yes";
+    } else {
+      diags.Add(Warning(path, line, keyCol, int(d->key.size()),
+                        "unknown directive '" + d->key +
+                            "' in chiba's specification file: ignored, as chiba does"));
+    }
+  }
+}
+
 }  // namespace
 
 std::optional<CpfgEnvironmentRef> FindCpfgEnvironment(const std::string& grammarPath,
@@ -450,10 +498,13 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
     kind = Program::kEcosystem;
   } else if (program == "clover") {
     kind = Program::kClover;
+  } else if (program == "chiba") {
+    kind = Program::kChiba;
   } else {
     diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
                       "the environment program '" + program +
-                          "' is not built into Sylva (it has honda81, ecosystem and clover): ?E "
+                          "' is not built into Sylva (it has honda81, ecosystem, clover and chiba): "
+                          "?E "
                           "is not answered, its parameters keep the values written in the "
                           "grammar"));
     return nullptr;
@@ -474,11 +525,14 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
   }
   const char* defaults = kind == Program::kHonda81     ? " (radius 0, 2D)"
                          : kind == Program::kEcosystem ? " (2D, no vigor)"
-                                                       : " (a 2x2 grid from (-1, -1), full light)";
+                         : kind == Program::kClover    ? " (a 2x2 grid from (-1, -1), full light)"
+                                                       : " (radius 25, transmittance 0.6, 32 sky "
+                                                         "samples)";
   Honda81Def honda;
   EcosystemDef eco;
   CloverDef clover;
   std::optional<CloverImage> image;
+  ChibaDef chiba;
   if (specFile.empty()) {
     diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
                       program + " is given no specification file: it runs with its defaults" +
@@ -492,6 +546,8 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
                             ": it runs with its defaults" + defaults));
     } else if (kind == Program::kClover) {
       if (!ReadCloverSpec(specPath, *spec, readFile, clover, image, diags)) return nullptr;
+    } else if (kind == Program::kChiba) {
+      ReadChibaSpec(specPath, *spec, chiba, diags);
     } else {
       ReadDensitySpec(kind, specPath, *spec, honda, eco, diags);
     }
@@ -513,6 +569,8 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
   std::unique_ptr<Environment> env;
   if (kind == Program::kClover)
     env = std::make_unique<CloverEnvironment>(clover, image ? &*image : nullptr, coordinates);
+  else if (kind == Program::kChiba)
+    env = std::make_unique<ChibaEnvironment>(chiba, coordinates);
   else
     env = std::make_unique<DensityProgram>(kind, coordinates, honda, eco);
   return std::make_unique<FormattedPositions>(std::move(env), std::move(*position));

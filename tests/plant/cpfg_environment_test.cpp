@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.h"
 #include "lsys/word.h"
+#include "plant/chiba_environment.h"
 #include "plant/clover_environment.h"
 #include "plant/density_environment.h"
 #include "plant/plant.h"
@@ -355,6 +356,87 @@ TEST(CpfgEnvironment, BundledHexCollideGrowsASymmetricSnowflake) {
   EXPECT_LT(withEnv, (2187u - 3u) / 2u);
 }
 
+TEST(ChibaEnvironment, SourcesAreNormalizedAndSkySamplesWeighted) {
+  ChibaDef def;
+  def.sources = {{{0, 100, 0}, 4}, {{40, 100, 0}, 3}, {{0, 60, 80}, 1}};
+  auto dirs = ChibaDirections(def);
+  ASSERT_EQ(dirs.size(), 3u);
+  EXPECT_FLOAT_EQ(dirs[0].intensity, 0.5f);
+  EXPECT_FLOAT_EQ(dirs[2].intensity, 0.125f);
+  EXPECT_FLOAT_EQ(dirs[2].dir[1], 0.6f);
+  EXPECT_FLOAT_EQ(dirs[2].dir[2], 0.8f);
+  // 20 samples: the next 8 * 4^k is 32, the octahedron subdivided once;
+  // 16 look up, 16 down, weighted 1 : 0.7.
+  ChibaDef sky;
+  dirs = ChibaDirections(sky);
+  ASSERT_EQ(dirs.size(), 32u);
+  int up = 0;
+  float total = 0;
+  for (const auto& d : dirs) {
+    EXPECT_NEAR(d.dir[0] * d.dir[0] + d.dir[1] * d.dir[1] + d.dir[2] * d.dir[2], 1.0f, 1e-6f);
+    up += d.dir[1] > 0;
+    total += d.intensity;
+    EXPECT_FLOAT_EQ(d.intensity, d.dir[1] > 0 ? 1 / 16.0f / 1.7f : 0.7f / 16.0f / 1.7f);
+  }
+  EXPECT_EQ(up, 16);
+  EXPECT_NEAR(total, 1.0f, 1e-6f);
+}
+
+TEST(ChibaEnvironment, ClustersTowardTheLightShadeByOverlappingArea) {
+  ChibaDef def;
+  def.sources = {{{0, 1, 0}, 1}};
+  def.transmittance = 0.25f;
+  def.estimateArea = true;
+  ChibaEnvironment env(def, 3);
+  // Unit clusters: one right above the first (full overlap), one above the
+  // third but shifted by 1 (lens of area 2 pi/3 - sqrt(3)/2).
+  std::vector<double> a{1, 0, 0, 0}, b{1}, c{1}, e{1};
+  std::vector<EnvQuery> q{{Vec3(0, 0, 0), {}, a}, {Vec3(0, 2, 0), {}, b},
+                          {Vec3(10, 0, 0), {}, c}, {Vec3(11, 2, 0), {}, e}};
+  ASSERT_TRUE(env.Answer(q).ok());
+  EXPECT_NEAR(a[0], 0.25, 1e-6);  // 1 - 0.75 * pi / pi
+  EXPECT_NEAR(a[2], 1.0, 1e-6) << "the brightest direction is the one source";
+  EXPECT_EQ(b[0], 1.0);           // nothing above it
+  const double lens = 2 * M_PI / 3 - std::sqrt(3.0) / 2;
+  EXPECT_NEAR(c[0], 1 - 0.75 * lens / M_PI, 1e-6);
+  EXPECT_EQ(e[0], 1.0);
+}
+
+TEST(ChibaEnvironment, WithoutAreaABallLetsThroughByChordLength) {
+  ChibaDef def;
+  def.sources = {{{0, 1, 0}, 1}};  // transmittance 0.6, beam radius 0
+  ChibaEnvironment env(def, 3);
+  // The ray up from (0, 0, 0) crosses the ball of radius 0.5 at (0, 3, 0)
+  // through its centre: a chord of 1 = its diameter, so 0.6^1. A ball off
+  // to the side at distance 0.4 of the ray: chord 2 sqrt(0.25 - 0.16) = 0.6.
+  std::vector<double> a{1}, b{0.5}, c{1}, d{0.5};
+  std::vector<EnvQuery> q{{Vec3(0, 0, 0), {}, a}, {Vec3(0, 3, 0), {}, b},
+                          {Vec3(5, 0, 0), {}, c}, {Vec3(5.4, 3, 0), {}, d}};
+  ASSERT_TRUE(env.Answer(q).ok());
+  EXPECT_NEAR(a[0], 0.6, 1e-6);
+  EXPECT_NEAR(c[0], std::pow(0.6, 0.6), 1e-6);
+  EXPECT_EQ(b[0], 1.0);
+  // ?E with 2 or 3 parameters is not a cluster: not answered, casts nothing.
+  std::vector<double> two{7, 7}, lone{1};
+  std::vector<EnvQuery> q2{{Vec3(0, 0, 0), {}, lone}, {Vec3(0, 1, 0), {}, two}};
+  ASSERT_TRUE(env.Answer(q2).ok());
+  EXPECT_EQ(two, (std::vector<double>{7, 7}));
+  EXPECT_EQ(lone[0], 1.0);
+}
+
+TEST(CpfgEnvironment, ChibaReadsItsSpecFile) {
+  Folder f;
+  f.files["obj/t.e"] = "executable: chiba -e t.e light.spec\nturtle position:P:%.4g %.4g %.4g\n";
+  f.files["obj/light.spec"] =
+      "grid size: 32x32x32\nverbose: off\ntransmittance: 0.25\nnumber of samples: 128\n"
+      "estimate intersection area: on\nsource direction:    0 100    0   4\n";
+  // Two clusters of radius 1 stacked 2 apart: the lower one gets a quarter.
+  const char* g = "axiom: [?E(1)] f(2) ?E(1)\n";
+  PlantResult r = Grow(f, g, 0);
+  EXPECT_EQ(WordOf(r), "[?E(0.25)]f(2)?E(1)");
+  EXPECT_EQ(r.diagnostics.FormatAll(), "");
+}
+
 std::string Warnings(const Folder& f, const std::string& grammar) {
   PlantResult r = Grow(f, grammar, 1);
   EXPECT_TRUE(r.plant) << r.diagnostics.FormatAll();
@@ -363,9 +445,9 @@ std::string Warnings(const Folder& f, const std::string& grammar) {
 
 TEST(CpfgEnvironment, AProgramSylvaLacksIsNamedInAWarning) {
   Folder f;
-  f.files["obj/t.e"] = "executable: chiba -e t.e light.spec\nturtle position:%g %g %g\n";
+  f.files["obj/t.e"] = "executable: soil -e t.e soil.spec\nturtle position:%g %g %g\n";
   const std::string w = Warnings(f, kTips);
-  EXPECT_NE(w.find("obj/t.e:1:13: warning: the environment program 'chiba' is not built into "
+  EXPECT_NE(w.find("obj/t.e:1:13: warning: the environment program 'soil' is not built into "
                    "Sylva"),
             std::string::npos)
       << w;
