@@ -1,6 +1,8 @@
 // The light environment (plant/light_grid.h): one Update() of the shadow
 // grid from N buds and N exposure queries, as a growing plant asks after
-// every derivation step; and a whole open L-system grown with it.
+// every derivation step; and a whole open L-system grown with it. Then
+// cpfg's environment programs built in (plant/density_environment.h,
+// plant/chiba_environment.h): one step's answers to N ?E modules.
 // Buds are spread in a crown: uniform in a sphere of radius 4 centred 5
 // above the ground, so that density, not only count, grows with N.
 #include <benchmark/benchmark.h>
@@ -8,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "plant/chiba_environment.h"
+#include "plant/density_environment.h"
 #include "plant/light_grid.h"
 #include "plant/plant.h"
 
@@ -73,6 +77,54 @@ void BM_GrowTwoTreesInLight(benchmark::State& state) {
   state.counters["modules"] = double(modules);
 }
 BENCHMARK(BM_GrowTwoTreesInLight)->Unit(benchmark::kMillisecond);
+
+// honda81 in 3D, radius 0.25, N points in the crown: one step's answers.
+void BM_Honda81Answers(benchmark::State& state) {
+  const std::vector<Vec3> pts = Crown(size_t(state.range(0)));
+  const double vigor = 1;
+  std::vector<plant::DensityQuery> q;
+  for (const Vec3& p : pts) q.push_back(plant::DensityQuery{p, {&vigor, 1}});
+  const plant::Honda81Def def{0.25, true};
+  double free = 0;
+  for (auto _ : state) {
+    const std::vector<double> a = plant::Honda81Answers(def, q);
+    free = 0;
+    for (double x : a) free += x;
+    benchmark::DoNotOptimize(free);
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * state.range(0));
+  state.counters["free"] = free / double(pts.size());
+}
+BENCHMARK(BM_Honda81Answers)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
+
+// chiba with two-trees' light.spec (9 sources, transmittance 0.25,
+// intersection areas), N clusters of radius 0.3 in the crown.
+void BM_ChibaAnswer(benchmark::State& state) {
+  const std::vector<Vec3> pts = Crown(size_t(state.range(0)));
+  plant::ChibaDef def;
+  def.transmittance = 0.25f;
+  def.estimateArea = true;
+  def.sources = {{{0, 100, 0}, 4},  {{40, 100, 0}, 3}, {{-40, 100, 0}, 3},
+                 {{0, 100, -40}, 3}, {{0, 100, 40}, 3}, {{80, 75, 0}, 2},
+                 {{-80, 75, 0}, 2},  {{0, 75, 80}, 2},  {{0, 75, -80}, 2}};
+  plant::ChibaEnvironment env(def, 3);
+  std::vector<double> params(pts.size());
+  double light = 0;
+  for (auto _ : state) {
+    std::vector<plant::EnvQuery> q;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      params[i] = 0.3;
+      q.push_back(plant::EnvQuery{pts[i], {}, {&params[i], 1}});
+    }
+    if (!env.Answer(q).ok()) state.SkipWithError("answer failed");
+    light = 0;
+    for (double x : params) light += x;
+    benchmark::DoNotOptimize(light);
+  }
+  state.SetItemsProcessed(int64_t(state.iterations()) * state.range(0));
+  state.counters["mean_light"] = light / double(pts.size());
+}
+BENCHMARK(BM_ChibaAnswer)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -4,6 +4,8 @@
 #include <array>
 #include <cmath>
 
+#include "plant/point_grid.h"
+
 namespace sylva::plant {
 namespace {
 
@@ -130,48 +132,79 @@ Status ChibaEnvironment::Answer(std::span<EnvQuery> queries) {
   }
   const float red = def_.transmittance;
   const float beam = def_.estimateArea ? 1.0f : def_.beamRadius;
-  for (size_t l = 0; l < clusters.size(); ++l) {
-    const Cluster& leaf = clusters[l];
-    float sum = 0;
-    float bright[3] = {0, 0, 0};
-    for (const ChibaDef::Source& s : dirs_) {
-      if (s.intensity == 0) continue;
+  const size_t n = clusters.size();
+  float maxRadius = 0, maxCoord = 0;
+  for (const Cluster& c : clusters) {
+    maxRadius = std::max(maxRadius, std::abs(c.radius));
+    for (float x : c.pos) maxCoord = std::max(maxCoord, std::abs(x));
+  }
+  // Farthest from a ray that a cluster can still shade it.
+  const double reach = double(maxRadius) * (def_.estimateArea ? 2.0 : 1.0 + std::abs(beam)) +
+                       1e-6 * double(maxCoord);
+  std::vector<float> sum(n, 0.0f), bright(3 * n, 0.0f), across(3 * n, 0.0f);
+  for (const ChibaDef::Source& s : dirs_) {
+    if (s.intensity == 0) continue;
+    // Only clusters near the ray across the light's direction can shade:
+    // bucket the centres by their place in a plane across it.
+    double u[3], v[3];
+    const double d[3] = {s.dir[0], s.dir[1], s.dir[2]};
+    const double a[3] = {std::abs(d[0]) < 0.9 ? 1.0 : 0.0, std::abs(d[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+    u[0] = a[1] * d[2] - a[2] * d[1];
+    u[1] = a[2] * d[0] - a[0] * d[2];
+    u[2] = a[0] * d[1] - a[1] * d[0];
+    const double ul = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (double& x : u) x /= ul;
+    v[0] = d[1] * u[2] - d[2] * u[1];
+    v[1] = d[2] * u[0] - d[0] * u[2];
+    v[2] = d[0] * u[1] - d[1] * u[0];
+    for (size_t i = 0; i < n; ++i) {
+      const auto& p = clusters[i].pos;
+      across[3 * i] = float(u[0] * p[0] + u[1] * p[1] + u[2] * p[2]);
+      across[3 * i + 1] = float(v[0] * p[0] + v[1] * p[1] + v[2] * p[2]);
+    }
+    const PointGrid grid(across, reach);
+    for (uint32_t l = 0; l < n; ++l) {
+      const Cluster& leaf = clusters[l];
       float reduction = 1;
-      for (size_t k = 0; k < clusters.size(); ++k) {
-        if (k == l) continue;
+      grid.ForNear(l, [&](uint32_t k) {
         const Cluster& other = clusters[k];
         float vec[3];
         for (int i = 0; i < 3; ++i) vec[i] = leaf.pos[size_t(i)] - other.pos[size_t(i)];
         const float aux = s.dir[0] * vec[0] + s.dir[1] * vec[1] + s.dir[2] * vec[2];
         const float vv = vec[0] * vec[0] + vec[1] * vec[1] + vec[2] * vec[2];
         if (def_.estimateArea) {
-          if (aux > 0) continue;  // the other cluster is farther from the light
+          if (aux > 0) return true;  // the other cluster is farther from the light
           const float d2 = vv - aux * aux;
-          const float reach = other.radius + leaf.radius;
-          if (!(d2 < reach * reach)) continue;
+          const float r = other.radius + leaf.radius;
+          if (!(d2 < r * r)) return true;
           const float r1 = std::max(other.radius, leaf.radius);
           const float r2 = std::min(other.radius, leaf.radius);
           const float area = LensArea(r1, r2, std::sqrt(std::max(0.0f, d2)));
           if (area > 0) reduction *= 1 - (1 - red) * area / leaf.area;
-        } else {
-          const float r = other.radius + leaf.radius * beam;
-          float disc = aux * aux - vv + r * r;
-          if (!(disc >= 0)) continue;
-          disc = std::sqrt(disc);
-          if (!(-aux + disc > 0)) continue;  // the ball is behind the start
-          const float len = -aux - disc >= 0 ? 2 * disc : -aux + disc;
-          if (len > 0)
-            reduction *= float(std::pow(double(red), len / (2.0 * (other.radius + beam * leaf.radius))));
+          return true;
         }
-      }
-      const float a = s.intensity * reduction;
-      sum += a;
-      for (int i = 0; i < 3; ++i) bright[i] += a * s.dir[i];
+        const float r = other.radius + leaf.radius * beam;
+        float disc = aux * aux - vv + r * r;
+        if (!(disc >= 0)) return true;
+        disc = std::sqrt(disc);
+        if (!(-aux + disc > 0)) return true;  // the ball is behind the start
+        const float len = -aux - disc >= 0 ? 2 * disc : -aux + disc;
+        if (len > 0)
+          reduction *=
+              float(std::pow(double(red), len / (2.0 * (other.radius + beam * leaf.radius))));
+        return true;
+      });
+      const float got = s.intensity * reduction;
+      sum[l] += got;
+      for (int i = 0; i < 3; ++i) bright[3 * l + size_t(i)] += got * s.dir[i];
     }
-    leaf.q->params[0] = sum;
-    if (leaf.q->params.size() >= 4) {
-      Normalize(bright);
-      for (int i = 0; i < 3; ++i) leaf.q->params[size_t(1 + i)] = bright[i];
+  }
+  for (size_t l = 0; l < n; ++l) {
+    EnvQuery& q = *clusters[l].q;
+    q.params[0] = sum[l];
+    if (q.params.size() >= 4) {
+      Normalize(&bright[3 * l]);
+      for (int i = 0; i < 3; ++i) q.params[size_t(1 + i)] = bright[3 * l + size_t(i)];
     }
   }
   return {};

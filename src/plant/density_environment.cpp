@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "plant/point_grid.h"
+
 namespace sylva::plant {
 namespace {
 
@@ -30,32 +32,16 @@ int64_t Group(std::span<const double> params) {
   return int64_t(std::clamp(std::trunc(v), -4e18, 4e18));
 }
 
-// Visits, for each point i, every j != i whose x lies within reach(i) +
-// reachAll of x_i (a superset of the pairs that can collide), through one
-// sort by x.
+// Visits, for each point i, every j != i that may lie within `reach` of
+// it (a superset of the pairs that can collide), until visit returns false.
 template <typename Fn>
-void ForNeighbours(const std::vector<Point>& pts, const std::vector<float>& reach, float reachAll,
-                   Fn&& visit) {
-  const size_t n = pts.size();
-  std::vector<uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](uint32_t a, uint32_t b) { return pts[a].p[0] < pts[b].p[0]; });
-  std::vector<float> xs(n);
-  for (size_t k = 0; k < n; ++k) xs[k] = pts[order[k]].p[0];
-  for (size_t k = 0; k < n; ++k) {
-    const uint32_t i = order[k];
-    // A little wider than the float test can accept (a product that
-    // underflows to 0 still collides).
-    const double r = (double(reach[i]) + double(reachAll)) * (1 + 1e-5) + 1e-20;
-    const double x = xs[k];
-    auto lo = std::lower_bound(xs.begin(), xs.end(), float(x - r));
-    auto hi = std::upper_bound(xs.begin(), xs.end(), float(x + r));
-    for (auto it = lo; it != hi; ++it) {
-      const uint32_t j = order[size_t(it - xs.begin())];
-      if (j != i) visit(i, j);
-    }
-  }
+void ForNeighbours(const std::vector<Point>& pts, float reach, Fn&& visit) {
+  std::vector<float> xyz;
+  xyz.reserve(pts.size() * 3);
+  for (const Point& p : pts) xyz.insert(xyz.end(), p.p, p.p + 3);
+  const PointGrid grid(xyz, double(reach));
+  for (uint32_t i = 0; i < pts.size(); ++i)
+    grid.ForNear(i, [&](uint32_t j) { return visit(i, j); });
 }
 
 }  // namespace
@@ -73,9 +59,10 @@ std::vector<double> Honda81Answers(const Honda81Def& def, std::span<const Densit
   const float radius = float(def.radius);
   const float radius2 = radius * radius;
   std::vector<double> answer(n, 1.0);
-  ForNeighbours(pts, std::vector<float>(n, std::abs(radius)), 0.0f, [&](uint32_t i, uint32_t j) {
+  ForNeighbours(pts, std::abs(radius), [&](uint32_t i, uint32_t j) {
     if (group[i] == group[j] && vigor[i] <= vigor[j] && Dist2(pts[i], pts[j]) <= radius2)
       answer[i] = 0.0;
+    return answer[i] != 0.0;  // one collision settles it
   });
   return answer;
 }
@@ -84,15 +71,14 @@ std::vector<double> EcosystemAnswers(const EcosystemDef& def,
                                      std::span<const DensityQuery> queries) {
   const size_t n = queries.size();
   std::vector<Point> pts(n);
-  std::vector<float> radius(n), reach(n), vigor(n, 1.0f);
+  std::vector<float> radius(n), vigor(n, 1.0f);
   std::vector<int64_t> group(n, 0);
   float maxReach = 0;
   for (size_t i = 0; i < n; ++i) {
     const auto params = queries[i].params;
     pts[i] = ProgramPoint(queries[i].position, def.is3d);
     radius[i] = float(params[0]);
-    reach[i] = std::abs(radius[i]);
-    maxReach = std::max(maxReach, reach[i]);
+    maxReach = std::max(maxReach, std::abs(radius[i]));
     if (def.vigor)
       vigor[i] = params.size() > 1 ? float(params[1]) : 1.0f;
     else
@@ -104,8 +90,9 @@ std::vector<double> EcosystemAnswers(const EcosystemDef& def,
   };
   std::vector<double> answer(n, 1.0);
   if (!def.vigor) {
-    ForNeighbours(pts, reach, maxReach, [&](uint32_t i, uint32_t j) {
+    ForNeighbours(pts, 2 * maxReach, [&](uint32_t i, uint32_t j) {
       if (group[i] == group[j] && radius[i] <= radius[j] && overlap(i, j)) answer[i] = 0.0;
+      return answer[i] != 0.0;
     });
     return answer;
   }
@@ -113,10 +100,11 @@ std::vector<double> EcosystemAnswers(const EcosystemDef& def,
   // the word no longer dominates. Gather each disc's candidates first, then
   // decide in word order.
   std::vector<std::vector<uint32_t>> near(n);
-  ForNeighbours(pts, reach, maxReach, [&](uint32_t i, uint32_t j) {
+  ForNeighbours(pts, 2 * maxReach, [&](uint32_t i, uint32_t j) {
     if (overlap(i, j) &&
         (vigor[i] < vigor[j] || (vigor[i] == vigor[j] && radius[i] < radius[j])))
       near[i].push_back(j);
+    return true;
   });
   std::vector<char> removed(n, 0);
   for (size_t i = 0; i < n; ++i) {

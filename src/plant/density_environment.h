@@ -26,8 +26,9 @@
 // which does not change the answers), `verbose:`.
 //
 // Both read positions as single-precision floats, as the programs do, so a
-// point exactly at the radius collides as it does in cpfg. The work is a
-// sweep along x: O(n log n + pairs closer than the reach in x).
+// point exactly at the radius collides as it does in cpfg. The pairs are
+// found through a uniform grid of cells one reach wide (plant/point_grid.h;
+// the programs use a grid too): O(n log n + pairs in neighbouring cells).
 #pragma once
 
 #include <cstdint>
