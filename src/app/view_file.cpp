@@ -75,7 +75,6 @@ constexpr Ignored kIgnored[] = {
     {"initial scale:", "@D scaling is not implemented"},
     {"scale multiplier:", "@D scaling is not implemented"},
     {"environment display:", kNotActed},
-    {"function set:", "cpfg function sets (.fset) are not read; name .func files with 'function:'"},
     {"curve:", "cpfg curve files are not read"},
     {"antialiasing:", "use render --supersample"},
     {"min zoom:", kNotActed},
@@ -131,7 +130,8 @@ std::vector<Line> Lines(const std::string& text) {
 
 class Reader {
  public:
-  Reader(ViewFile& v, const std::string& path) : v_(v), path_(path) {}
+  Reader(ViewFile& v, const std::string& path, bool checkFiles)
+      : v_(v), path_(path), checkFiles_(checkFiles) {}
 
   void Read(const app::Line& line);
 
@@ -196,6 +196,7 @@ class Reader {
 
   ViewFile& v_;
   std::string path_;
+  bool checkFiles_ = false;  // whether the files the lines name are looked for
   std::string current_;  // the line as read (comments blanked)
   int line_ = 0;
   std::string label_;
@@ -324,12 +325,15 @@ void Reader::Read(const app::Line& line) {
     Tropism();
   } else if (L == "surface:") {
     Surface();
-  } else if (L == "function:") {
+  } else if (L == "function:" || L == "function set:") {
     // `function: FILE.func [samples]`: func(1, x) is the first such line.
     // cpfg tabulates the curve at `samples` points; Sylva evaluates it
-    // (docs/cpfg.md), so the number is not needed.
+    // (docs/cpfg.md), so the number is not needed. `function set:
+    // FILE.fset`: the functions of a set, in order, each also by its name.
+    const bool set = L == "function set:";
     if (tokens_.empty()) {
-      Error(int(current_.size()) + 1, "expected 'function: FILE.func [samples]'");
+      Error(int(current_.size()) + 1, set ? "expected 'function set: FILE.fset'"
+                                          : "expected 'function: FILE.func [samples]'");
       return;
     }
     const fs::path file(tokens_[0].text);
@@ -340,7 +344,12 @@ void Reader::Read(const app::Line& line) {
     f.from = path_;
     f.line = line_;
     f.column = tokens_[0].column;
+    f.set = set;
     v_.functions.push_back(std::move(f));
+    if (set) {
+      ExtraValues(1);
+      return;
+    }
     if (tokens_.size() > 1) Number(1, "a number of samples");
     ExtraValues(2);
   } else {
@@ -453,6 +462,14 @@ void Reader::Surface() {
   ExtraValues(5);
   def.viewFile = path_;
   def.line = line_;
+  // A surface file that is not there (objects are often copied without
+  // them): the surface is not drawn, with a warning here; --strict fails.
+  std::error_code ec;
+  if (checkFiles_ && !fs::exists(def.file, ec)) {
+    def.missing = true;
+    Warn(tokens_[1].column, "surface '" + def.name + "' is not drawn: its file " + def.file +
+                                " does not exist");
+  }
   for (auto& old : v_.surfaces) {
     if (old.name == def.name) {
       Warn(tokens_[0].column, "surface '" + def.name + "' is named again: this line wins");
@@ -491,10 +508,10 @@ bool IsFile(const fs::path& p) {
 
 }  // namespace
 
-ViewFile ParseViewFile(const std::string& text, const std::string& path) {
+ViewFile ParseViewFile(const std::string& text, const std::string& path, bool checkFiles) {
   ViewFile v;
   v.path = path;
-  Reader r(v, path);
+  Reader r(v, path, checkFiles);
   for (const Line& line : Lines(text)) {
     r.Read(line);
     if (v.diagnostics.ErrorCount() >= kMaxViewErrors ||
@@ -569,7 +586,7 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
       v->diagnostics.Add(std::move(d));
       return v;
     }
-    *v = ParseViewFile(*text, viewPath.string());
+    *v = ParseViewFile(*text, viewPath.string(), /*checkFiles=*/true);
   }
   // Colours: NAME.mat, then NAME.map, beside the grammar, then beside the view file.
   std::vector<fs::path> stems;
@@ -629,6 +646,7 @@ void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec
   if (!view) return;
   spec.cpfgSurfaces = view->surfaces;
   spec.cpfgFunctions = view->functions;
+  spec.cpfgViewFile = view->path;
   spec.amendGrammar = [view](lsys::Grammar& g, DiagnosticList& diagnostics) {
     for (const Diagnostic& d : view->diagnostics.items) diagnostics.Add(d);
     if (!view->diagnostics.HasErrors()) ApplyViewFile(*view, g);

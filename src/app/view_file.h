@@ -54,13 +54,18 @@ struct ViewFile {
   std::string colorsPath;                       // the .map or .mat read
   std::vector<std::array<float, 3>> palette;    // sRGB 0..1 of each colour index
   std::vector<plant::CpfgSurfaceDef> surfaces;  // `surface: l leaf.s size s t`
-  // `function: FILE.func [samples]`, in order (func(1, x) the first).
+  // `function: FILE.func [samples]` and `function set: FILE.fset`, in order
+  // (func(1, x) the first).
   std::vector<lsys::ParseOptions::FunctionFile> functions;
   DiagnosticList diagnostics;  // warnings, and errors that stop the build
 };
 
-// Reads the text of a view file; `path` names it in diagnostics.
-ViewFile ParseViewFile(const std::string& text, const std::string& path);
+// Reads the text of a view file; `path` names it in diagnostics. With
+// checkFiles, a `surface:` file that does not exist is a warning at its
+// name ("surface 'c' is not drawn") and the surface draws nothing
+// (CpfgSurfaceDef::missing): a folder copied without one of its .s files
+// still opens; --strict makes it an error.
+ViewFile ParseViewFile(const std::string& text, const std::string& path, bool checkFiles = false);
 
 // 768 bytes of a .map: 256 sRGB colours. An error when shorter; a warning
 // (in `warnings`) when longer: only the first 768 bytes are colours.

@@ -91,6 +91,15 @@ Expected<CpfgFunction> CpfgFunction::Parse(const std::string& text, const std::s
     if (std::sscanf(line.c_str(), "fver %d %d", &major, &minor) != 2 || major != 1 || minor != 1)
       return FileError(path, number, "unsupported function file version (Sylva reads 'fver 1 1')");
     if (!next() || !starts("name:")) return FileError(path, number, "expected 'name:'");
+    {
+      // cpfg: the name up to its last '.' (a file name's suffix), blanks trimmed.
+      std::string n = line.substr(5);
+      const size_t b = n.find_first_not_of(" \t");
+      const size_t e = n.find_last_not_of(" \t");
+      n = b == std::string::npos ? std::string() : n.substr(b, e - b + 1);
+      if (const size_t dot = n.rfind('.'); dot != std::string::npos) n.resize(dot);
+      f.name_ = std::move(n);
+    }
     if (!next() || std::sscanf(line.c_str(), "samples: %d", &samples) != 1)
       return FileError(path, number, "expected 'samples: N'");
     if (!next()) return FileError(path, number, "expected 'points: N'");
@@ -138,6 +147,51 @@ Expected<CpfgFunction> CpfgFunction::Parse(const std::string& text, const std::s
     for (int i = 0; i < samples; ++i) f.samples_[size_t(i)] = f.Exact(double(i) / (samples - 1));
   }
   return f;
+}
+
+Expected<std::vector<CpfgFunction>> CpfgFunction::ParseSet(const std::string& text,
+                                                           const std::string& path) {
+  // The lines, and where each `fver` function starts.
+  std::vector<std::string> lines;
+  {
+    std::istringstream in(text);
+    std::string line;
+    while (std::getline(in, line)) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      lines.push_back(std::move(line));
+    }
+  }
+  int major = 0, minor = 0;
+  if (lines.empty() ||
+      std::sscanf(lines[0].c_str(), "funcgalleryver %d %d", &major, &minor) != 2)
+    return FileError(path, 1, "not a cpfg function set (expected 'funcgalleryver 1 1')");
+  if (major != 1 || minor != 1)
+    return FileError(path, 1, "unsupported function set version (Sylva reads 'funcgalleryver 1 1')");
+  long items = -1;
+  if (lines.size() < 2 || std::sscanf(lines[1].c_str(), "items: %ld", &items) != 1 || items < 0)
+    return FileError(path, 2, "expected 'items: N'");
+  std::vector<size_t> starts;
+  for (size_t i = 2; i < lines.size(); ++i)
+    if (lines[i].rfind("fver", 0) == 0) starts.push_back(i);
+  if (long(starts.size()) != items) {
+    return FileError(path, 2,
+                     "'items: " + std::to_string(items) + "' but the set has " +
+                         std::to_string(starts.size()) + " functions ('fver' lines)");
+  }
+  std::vector<CpfgFunction> set;
+  for (size_t k = 0; k < starts.size(); ++k) {
+    const size_t end = k + 1 < starts.size() ? starts[k + 1] : lines.size();
+    std::string one;
+    for (size_t i = starts[k]; i < end; ++i) one += lines[i] + "\n";
+    auto f = Parse(one, path);
+    if (!f) {
+      Diagnostic d = f.error();
+      d.loc.line += int(starts[k]);  // the line in the set
+      return d;
+    }
+    set.push_back(std::move(*f));
+  }
+  return set;
 }
 
 }  // namespace sylva::lsys

@@ -999,6 +999,7 @@ uint64_t SeedAfterStart(const Grammar& g, const DeriveOptions& options,
 
 // The global variables as the Start: block leaves them.
 Expected<std::vector<double>> StartGlobals(const Grammar& g, uint64_t seed) {
+  if (g.dataFiles) g.dataFiles->Reset();  // no data file open; Start: opens them
   std::vector<double> globals(g.globals.size(), 0.0);
   for (size_t k = 0; k < g.globalInitial.size() && k < globals.size(); ++k)
     globals[k] = g.globalInitial[k];

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "core/math.h"
+#include "lsys/cpfg_data_files.h"
 #include "lsys/cpfg_function.h"
 #include "lsys/expr_parser.h"
 
@@ -38,6 +39,10 @@ static bool Fail(EvalError* err, int column, const char* msg) {
     err->message = msg;
   }
   return false;
+}
+
+static bool Fail(EvalError* err, int column, const std::string& msg) {
+  return Fail(err, column, msg.c_str());
 }
 
 static bool Finite(double v, EvalError* err, int column, const char* what) {
@@ -279,6 +284,47 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
         if (!std::isfinite(v))
           return Fail(err, int(columns_[pc]), "assigned value is not a finite number (overflow)");
         (in.op == OpCode::kStore ? vars : globals)[in.arg] = v;
+        break;
+      }
+      case OpCode::kDup:
+        stack[sp] = stack[sp - 1];
+        ++sp;
+        break;
+      case OpCode::kPop:
+        --sp;
+        break;
+      case OpCode::kFopen: {
+        const double h = files_->Open(in.arg);
+        if (h == 0)
+          return Fail(err, int(columns_[pc]),
+                      "more than " + std::to_string(kMaxOpenDataFiles) +
+                          " files opened in one derivation (fopen in a loop?)");
+        stack[sp++] = h;
+        break;
+      }
+      case OpCode::kFclose:
+        files_->Close(stack[--sp]);
+        break;
+      case OpCode::kFscanf: {
+        const CpfgDataFiles::Call& call = files_->call(in.arg);
+        const int targets = int(call.element.size());
+        int slots = 1 + targets;
+        for (uint8_t e : call.element) slots += e;
+        const int base = sp - slots;
+        // The addresses' values, in order (an element's offset sits below it).
+        int at[kMaxScanValues];
+        double values[kMaxScanValues];
+        for (int k = 0, q = base + 1; k < targets; ++k, ++q) {
+          q += call.element[size_t(k)];
+          at[k] = q;
+          values[k] = stack[q];
+        }
+        int count = 0;
+        std::string why;
+        if (!files_->Scan(stack[base], in.arg, values, &count, &why))
+          return Fail(err, int(columns_[pc]), why);
+        for (int k = 0; k < targets; ++k) stack[at[k]] = values[k];
+        stack[base] = count;
         break;
       }
       case OpCode::kLoop:
@@ -1132,13 +1178,14 @@ class ExprCompiler {
     return true;
   }
 
-  // The grammar's function files, when the code calls func().
+  // The grammar's function files, when the code calls func(), and its
+  // data files, when it reads them.
   void TakeFunctions(Expr& e) const {
     for (const Instr& in : e.code_) {
-      if (in.op == OpCode::kFunc && scope_ && scope_->functions) {
-        e.funcs_ = *scope_->functions;
-        return;
-      }
+      if (in.op == OpCode::kFunc && scope_ && scope_->functions) e.funcs_ = *scope_->functions;
+      if ((in.op == OpCode::kFopen || in.op == OpCode::kFscanf || in.op == OpCode::kFclose) &&
+          scope_ && scope_->dataFiles)
+        e.files_ = *scope_->dataFiles;
     }
   }
   const ExprScope* scope_ = nullptr;
@@ -1315,6 +1362,24 @@ class ExprCompiler {
       Push(OpCode::kStoreGlobal, uint32_t(scope.srandSlot), col);
       return EndOfStatement(text, pos);
     }
+    if (name == "fscanf" && q < text.size() && text[q] == '(' && scope.dataFiles) {
+      if (!Fscanf(text, q, pos, scope, col)) return false;
+      Push(OpCode::kPop, 0, col);  // its count, unused
+      return EndOfStatement(text, pos);
+    }
+    if (name == "fclose" && q < text.size() && text[q] == '(' && scope.dataFiles &&
+        *scope.dataFiles && !(*scope.dataFiles)->empty()) {
+      // Closes a file opened for reading (other values: nothing, as cpfg).
+      *pos = q + 1;
+      if (!Expression(text, pos, scope)) return false;
+      SkipSpace(text, pos);
+      if (*pos >= text.size() || text[*pos] != ')')
+        return Err(int(*pos) + 1, "expected ')' after the file of 'fclose'");
+      ++*pos;
+      Push(OpCode::kFclose, 0, col);
+      if (scope.writesGlobal) *scope.writesGlobal = true;  // files are read in word order
+      return EndOfStatement(text, pos);
+    }
     if (q < text.size() && text[q] == '(' && scope.outputCalls &&
         (name == "printf" || name == "fprintf" || name == "fclose" || name == "fflush")) {
       // cpfg's output: read, checked for balance, and compiled to nothing.
@@ -1342,11 +1407,50 @@ class ExprCompiler {
     if (q >= text.size() || text[q] != '=' || (q + 1 < text.size() && text[q + 1] == '='))
       return Err(int(q) + 1, "expected '=' after '" + name + "' (an assignment)");
     *pos = q + 1;
-    // `f = fopen(NAME, "w")`: cpfg's output file, not opened (f is 0).
+    // `f = fopen(NAME, "r")`: a data file read (cpfg_data_files.h);
+    // `f = fopen(NAME, "w")`: cpfg's output file, not opened (f is 0);
+    // `n = fscanf(...)`: its count.
     size_t f = *pos;
     SkipSpace(text, &f);
     bool fopenCall = false;
-    if (compound == OpCode::kConst && scope.outputCalls && Keyword(text, f, "fopen")) {
+    if (compound == OpCode::kConst && scope.dataFiles && Keyword(text, f, "fopen")) {
+      size_t paren = f + 5;
+      SkipSpace(text, &paren);
+      if (paren < text.size() && text[paren] == '(') {
+        size_t a = paren + 1;
+        std::string file, mode;
+        int fileCol = 0, modeCol = 0;
+        if (!StringArg(text, &a, &file, &fileCol))
+          return Err(int(a) + 1, "expected the file name of 'fopen' in quotes");
+        SkipSpace(text, &a);
+        if (a >= text.size() || text[a] != ',') return Err(int(a) + 1, "expected ',' in 'fopen'");
+        ++a;
+        if (!StringArg(text, &a, &mode, &modeCol))
+          return Err(int(a) + 1, "expected the mode of 'fopen' in quotes (\"r\" or \"w\")");
+        SkipSpace(text, &a);
+        if (a >= text.size() || text[a] != ')') return Err(int(a) + 1, "expected ')' after 'fopen'");
+        if (!mode.empty() && mode[0] == 'r') {
+          uint32_t id = 0;
+          std::string why;
+          if (!(*scope.dataFiles)->Add(UnescapeC(file), &id, &why)) return Err(fileCol, why);
+          *pos = a + 1;
+          Push(OpCode::kFopen, id, int(f) + 1);
+          blockDepth = std::max(blockDepth, 1);
+          if (scope.writesGlobal) *scope.writesGlobal = true;  // files are read in word order
+          fopenCall = true;
+        }
+      }
+    }
+    if (!fopenCall && compound == OpCode::kConst && scope.dataFiles && Keyword(text, f, "fscanf")) {
+      size_t paren = f + 6;
+      SkipSpace(text, &paren);
+      if (paren < text.size() && text[paren] == '(') {
+        if (!Fscanf(text, paren, pos, scope, int(f) + 1)) return false;
+        fopenCall = true;
+      }
+    }
+    if (!fopenCall && compound == OpCode::kConst && scope.outputCalls &&
+        Keyword(text, f, "fopen")) {
       size_t paren = f + 5;
       SkipSpace(text, &paren);
       if (paren < text.size() && text[paren] == '(') {
@@ -1412,6 +1516,163 @@ class ExprCompiler {
     if (store == OpCode::kStoreGlobal && scope.writesGlobal) *scope.writesGlobal = true;
     Push(store, slot, col);
     return EndOfStatement(text, pos);
+  }
+
+  // A "string" at *pos (blanks before it skipped): its body as written
+  // (escapes kept) and the column of its opening quote; *pos past it.
+  bool StringArg(std::string_view text, size_t* pos, std::string* body, int* column) {
+    SkipSpace(text, pos);
+    if (*pos >= text.size() || text[*pos] != '"') return false;
+    *column = int(*pos) + 1;
+    size_t i = *pos + 1;
+    for (; i < text.size() && text[i] != '"'; ++i)
+      if (text[i] == '\\') ++i;
+    if (i >= text.size()) return false;
+    *body = std::string(text.substr(*pos + 1, i - *pos - 1));
+    *pos = i + 1;
+    return true;
+  }
+
+  // One sub-expression emitted while `onStack` values are on the stack.
+  bool ExpressionAbove(std::string_view text, size_t* pos, const ExprScope& scope, int onStack,
+                       int* maxDepth) {
+    const int saved = blockDepth;
+    blockDepth = 0;
+    if (!Expression(text, pos, scope)) return false;
+    *maxDepth = std::max(*maxDepth, onStack + blockDepth);
+    blockDepth = saved;
+    return true;
+  }
+
+  // `fscanf(FP, "FORMAT", &x, &a[i], ...)` from text[open] == '(' (*pos is
+  // set past its ')'): the handle, then each address's [offset and] value
+  // on the stack, kFscanf, and the stores; fscanf's count is left on the
+  // stack (cpfg_data_files.h).
+  bool Fscanf(std::string_view text, size_t open, size_t* pos, const ExprScope& scope, int col) {
+    int maxDepth = 0, onStack = 0;
+    *pos = open + 1;
+    if (!ExpressionAbove(text, pos, scope, 0, &maxDepth)) return false;
+    onStack = 1;
+    SkipSpace(text, pos);
+    if (*pos >= text.size() || text[*pos] != ',')
+      return Err(int(*pos) + 1, "expected ',' after the file of 'fscanf'");
+    ++*pos;
+    std::string body;
+    int formatCol = 0;
+    if (!StringArg(text, pos, &body, &formatCol))
+      return Err(int(*pos) + 1, "expected the format of 'fscanf' in quotes");
+    ScanFormat format;
+    std::string why;
+    if (!ParseScanFormat(UnescapeC(body), &format, &why))
+      return Err(formatCol, "fscanf: " + why, int(body.size()) + 2);
+    struct Target {
+      OpCode store;
+      uint32_t slot;
+      bool element;
+    };
+    std::vector<Target> targets;
+    for (;;) {
+      SkipSpace(text, pos);
+      if (*pos < text.size() && text[*pos] == ')') break;
+      if (*pos >= text.size() || text[*pos] != ',')
+        return Err(int(*pos) + 1, "expected ',' or ')' in 'fscanf'");
+      ++*pos;
+      SkipSpace(text, pos);
+      if (*pos >= text.size() || text[*pos] != '&')
+        return Err(int(*pos) + 1, "fscanf reads into variables: write '&name' or '&a[i]'");
+      ++*pos;
+      SkipSpace(text, pos);
+      const size_t s = *pos;
+      while (*pos < text.size() && IsIdent(text[*pos])) ++*pos;
+      const std::string name(text.substr(s, *pos - s));
+      const int tcol = int(s) + 1;
+      if (name.empty() || std::isdigit(static_cast<unsigned char>(name[0])))
+        return Err(tcol, "expected a variable name after '&'");
+      if (int(targets.size()) == kMaxScanValues)
+        return Err(tcol - 1, "fscanf assigns at most 10 values (cpfg's limit)");
+      size_t q = *pos;
+      SkipSpace(text, &q);
+      if (q < text.size() && text[q] == '[') {  // &a[i][j]
+        const ArrayShape* a = nullptr;
+        if (scope.arrays)
+          for (const ArrayShape& x : *scope.arrays)
+            if (x.name == name) a = &x;
+        if (!a)
+          return Err(tcol, "'" + name + "' is not an array (arrays are declared in 'define: { array " +
+                               name + "[n]; }')",
+                     int(name.size()));
+        Push(OpCode::kConst, 0, tcol);  // the offset, built one index at a time
+        ++onStack;
+        *pos = q;
+        for (uint32_t d : a->dims) {
+          SkipSpace(text, pos);
+          if (*pos >= text.size() || text[*pos] != '[')
+            return Err(int(*pos) + 1, "array '" + name + "' needs " +
+                                          std::to_string(a->dims.size()) +
+                                          (a->dims.size() == 1 ? " index" : " indices"));
+          ++*pos;
+          if (!ExpressionAbove(text, pos, scope, onStack, &maxDepth)) return false;
+          SkipSpace(text, pos);
+          if (*pos >= text.size() || text[*pos] != ']')
+            return Err(int(*pos) + 1, "expected ']' after an index of '" + name + "'");
+          ++*pos;
+          Push(OpCode::kIndex, d, tcol);
+        }
+        SkipSpace(text, pos);
+        if (*pos < text.size() && text[*pos] == '[')
+          return Err(int(*pos) + 1, "array '" + name + "' has " + std::to_string(a->dims.size()) +
+                                        (a->dims.size() == 1 ? " dimension" : " dimensions"));
+        Push(OpCode::kDup, 0, tcol);
+        Push(OpCode::kGlobalAt, a->base, tcol);
+        ++onStack;
+        maxDepth = std::max(maxDepth, onStack);
+        targets.push_back(Target{OpCode::kStoreGlobalAt, a->base, true});
+        continue;
+      }
+      uint32_t slot = 0;
+      OpCode load = OpCode::kFormal, store = OpCode::kStore;
+      bool found = Parser::FindVar(scope, name, &slot);
+      if (!found && scope.globals) {
+        for (size_t i = 0; i < scope.globals->size(); ++i) {
+          if ((*scope.globals)[i] == name) {
+            slot = uint32_t(i);
+            load = OpCode::kGlobal;
+            store = OpCode::kStoreGlobal;
+            found = true;
+          }
+        }
+      }
+      if (!found) {
+        if (!scope.locals)
+          return Err(tcol,
+                     "'" + name +
+                         "' is not a variable here (a global variable is one assigned in Start:, "
+                         "StartEach:, EndEach: or End:)",
+                     int(name.size()));
+        scope.locals->push_back(name);  // a new local, 0 until read
+        Parser::FindVar(scope, name, &slot);
+      }
+      Push(load, slot, tcol);
+      ++onStack;
+      maxDepth = std::max(maxDepth, onStack);
+      targets.push_back(Target{store, slot, false});
+    }
+    ++*pos;  // ')'
+    if (int(targets.size()) != format.assignments)
+      return Err(formatCol,
+                 "fscanf: the format assigns " + std::to_string(format.assignments) +
+                     (format.assignments == 1 ? " value" : " values") + " and " +
+                     std::to_string(targets.size()) +
+                     (targets.size() == 1 ? " address follows" : " addresses follow"),
+                 int(body.size()) + 2);
+    CpfgDataFiles::Call call;
+    call.format = std::move(format);
+    for (const Target& t : targets) call.element.push_back(t.element ? 1 : 0);
+    Push(OpCode::kFscanf, (*scope.dataFiles)->AddCall(std::move(call)), col);
+    for (size_t k = targets.size(); k-- > 0;) Push(targets[k].store, targets[k].slot, col);
+    blockDepth = std::max(blockDepth, maxDepth + 1);  // kDup
+    if (scope.writesGlobal) *scope.writesGlobal = true;  // files are read in word order
+    return true;
   }
 
   // `a[i][j] = expr;` (text[q] is the first '[').
@@ -1495,7 +1756,7 @@ bool IsStatementBlock(std::string_view text, size_t pos, std::string_view next) 
     size_t q = e;
     while (q < t.size() && (t[q] == ' ' || t[q] == '\t')) ++q;
     if ((word == "if" || word == "while" || word == "printf" || word == "fprintf" ||
-         word == "fclose" || word == "fflush") &&
+         word == "fclose" || word == "fflush" || word == "fscanf") &&
         q < t.size() && t[q] == '(')
       return true;
     if (word == "do" && (q >= t.size() || t[q] == '{' || q > e)) return true;

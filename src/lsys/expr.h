@@ -25,6 +25,7 @@
 namespace sylva::lsys {
 
 class CpfgFunction;
+class CpfgDataFiles;
 
 enum class OpCode : uint8_t {
   kConst,
@@ -83,6 +84,15 @@ enum class OpCode : uint8_t {
   kIndex,
   kGlobalAt,       // top = globals[arg + top]
   kStoreGlobalAt,  // value = pop, offset = pop: globals[arg + offset] = value
+  // cpfg's data files (lsys/cpfg_data_files.h), in statement blocks only.
+  kFopen,   // push a new handle reading data file arg
+  kFclose,  // pop a handle and close it
+  // fscanf call arg: below the top, the handle, then per address [its
+  // array offset] and its value; the values are replaced by what is read
+  // and the handle by fscanf's count, for the stores that follow.
+  kFscanf,
+  kDup,  // push a copy of the top
+  kPop,  // drop the top
 };
 
 // A `while` loop in a statement block that runs more often than this in one
@@ -149,6 +159,7 @@ class Expr {
   std::vector<Instr> code_;
   std::vector<uint32_t> columns_;  // per instruction: column of the operation, for errors
   std::vector<std::shared_ptr<const CpfgFunction>> funcs_;  // of kFunc: the grammar's functions
+  std::shared_ptr<CpfgDataFiles> files_;  // of kFopen, kFscanf, kFclose: the grammar's data files
 };
 
 }  // namespace sylva::lsys

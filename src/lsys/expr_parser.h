@@ -81,6 +81,10 @@ struct ExprScope {
   // to 0) and each is noted here, column and message, for the caller to warn
   // about. Null: they are errors.
   std::vector<ExprParseError>* outputCalls = nullptr;
+  // cpfg's data files (`fp = fopen(NAME, "r");`, `fscanf(fp, "%lf", &x);`,
+  // `fclose(fp);` in blocks): files are read into it when the block is
+  // parsed. Null: reading files is an error.
+  const std::shared_ptr<CpfgDataFiles>* dataFiles = nullptr;
   // cpfg function files, for `func(id, x)`: id 1 is the first.
   const std::vector<std::shared_ptr<const CpfgFunction>>* functions = nullptr;
   // cpfg arrays: `a[i][j]` in expressions, `a[i][j] = v;` in blocks.

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/diagnostic.h"
+#include "lsys/cpfg_data_files.h"
 #include "lsys/cpfg_function.h"
 #include "lsys/expr.h"
 #include "lsys/expr_parser.h"
@@ -198,6 +199,10 @@ struct Grammar {
   // cpfg function files (`functions: a.func b.func`), for func(id, x).
   std::vector<std::shared_ptr<const CpfgFunction>> functions;
   std::optional<Expr> startBlock, startEachBlock, endEachBlock, endBlock;
+  // cpfg data files the blocks read (`fopen(NAME, "r")`, `fscanf`), read
+  // when parsed; null when there are none. A derivation starts with none
+  // open; afterwards ShortReads() says where fscanf stopped early.
+  std::shared_ptr<CpfgDataFiles> dataFiles;
   // Some production assigns a global variable: its steps are then rewritten
   // left to right on one thread, as cpfg does, so the assignments happen in
   // word order.

@@ -189,6 +189,8 @@ class GrammarParser {
       ++diags_.droppedErrors;  // counted, so the report can say how many
       return;
     }
+    if (msg.rfind("func(id, x)", 0) == 0 && functionFilesFailed_) return;  // reported at the file
+    if (msg.rfind("func(id, x) needs cpfg function files", 0) == 0) msg += FunctionsHint();
     if (const Line::Expansion* e = l.ExpansionAt(col)) {
       msg += " (in the text of '#define " + e->name + "' at line " + std::to_string(e->defineLine) +
              ")";
@@ -268,6 +270,17 @@ class GrammarParser {
   std::optional<SymbolId> Intern(const Line& l, int col, const std::string& name, int arity);
   void JoinContinuations();
   void LoadOptionFunctions();
+  // Where Sylva looked for function files outside the grammar, for the
+  // error of a func() without any: the view file it read or looked for.
+  std::string FunctionsHint() const {
+    if (!opt_.viewFile.empty())
+      return "; the view file " + opt_.viewFile + " has no 'function:' or 'function set:' line";
+    if (files_.empty()) return "";
+    std::filesystem::path v(files_[0]);
+    v.replace_extension(".v");
+    return "; no view file was read (sylva looks for " + v.lexically_normal().string() +
+           ", or takes --view FILE)";
+  }
   void WarnAfterEnd(const Line& l);
   void Finish();
   void WarnUnmatchable();
@@ -309,6 +322,10 @@ class GrammarParser {
   std::unordered_map<std::string, TextMacro> textMacros_;
   std::unordered_set<std::string> usedConstants_;
   std::set<std::string> usedOverrides_;
+  // Names a function set defines as constants (cpfg's -DNAME=i): a #define
+  // or #undef of one in the grammar replaces it.
+  std::set<std::string> functionSetNames_;
+  bool functionFilesFailed_ = false;  // a view file's function file could not be read
   std::unordered_map<std::string, ArityUse> arityUse_;
   std::unordered_set<std::string> unsupportedWarned_;  // name + reason
   std::unordered_map<std::string, bool> isSurface_;
@@ -607,6 +624,23 @@ bool GrammarParser::ParseBlockAt(const Line& l, std::string_view view, size_t* p
   ExprScope withOutput = scope;
   std::vector<ExprParseError> calls;
   withOutput.outputCalls = &calls;
+  if (!g_.dataFiles) {
+    // cpfg's fopen(NAME, "r"): NAME relative to the grammar file's folder.
+    const size_t limit = kMaxDataFileBytes;
+    CpfgDataFiles::Reader reader = [this, limit](const std::string& path) -> Expected<std::string> {
+      if (opt_.readFile) {
+        auto text = opt_.readFile(path);
+        if (!text) return MakeError(SourceLoc{path, 0, 0}, "cannot read file");
+        if (text->size() > limit) return MakeError(SourceLoc{path, 0, 0}, "file is larger than the limit of 16 MiB");
+        return std::move(*text);
+      }
+      return ReadFile(path, limit);
+    };
+    g_.dataFiles = std::make_shared<CpfgDataFiles>(
+        std::filesystem::path(files_.empty() ? std::string() : files_[0]).parent_path().string(),
+        std::move(reader));
+  }
+  withOutput.dataFiles = &g_.dataFiles;
   ExprParseError err;
   if (!ParseBlock(view, pos, withOutput, out, &err)) {
     Error(l, err.column, err.message, err.length);
@@ -775,6 +809,8 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
   while (pos < t.size() && IsIdentChar(t[pos])) ++pos;
   std::string name = t.substr(s, pos - s);
   int col = int(s) + 1;
+  // The grammar's own #define of a function set's name replaces it.
+  if (functionSetNames_.erase(name)) g_.constants.erase(name);
   if (pos < t.size() && t[pos] == '(') {
     ParseMacro(l, name, col, pos);
     return;
@@ -921,6 +957,10 @@ void GrammarParser::ParseUndef(const Line& l, size_t after) {
     return;
   }
   const std::string name = t.substr(q, e - q);
+  if (functionSetNames_.erase(name)) {  // a function set's name, as a -D of cpfg's
+    g_.constants.erase(name);
+    return;
+  }
   if (textMacros_.erase(name)) {
     defines_.erase(name);
     return;
@@ -1513,8 +1553,28 @@ void GrammarParser::LoadOptionFunctions() {
     std::string why;
     auto text = Read(ff.file, &why);
     std::string problem;
+    const char* kind = ff.set ? "function set" : "function file";
     if (!text) {
-      problem = "cannot read function file '" + ff.file + "': " + why;
+      problem = std::string("cannot read ") + kind + " '" + ff.file + "': " + why;
+    } else if (ff.set) {
+      auto set = CpfgFunction::ParseSet(*text, ff.file);
+      if (!set) {
+        problem = "in function set " + ff.file + ":" + std::to_string(set.error().loc.line) + ": " +
+                  set.error().message;
+      } else {
+        for (CpfgFunction& f : *set) {
+          // cpfg's -DNAME=i for each function of the set (a name that is
+          // not an identifier cannot be written in a grammar: not defined).
+          const std::string name = f.name();
+          g_.functions.push_back(std::make_shared<const CpfgFunction>(std::move(f)));
+          if (name.empty() || !IsIdentStart(name[0]) ||
+              !std::all_of(name.begin(), name.end(), IsIdentChar))
+            continue;
+          g_.constants[name] = double(g_.functions.size());
+          functionSetNames_.insert(name);
+        }
+        continue;
+      }
     } else if (auto f = CpfgFunction::Parse(*text, ff.file); !f) {
       problem = "in function file " + ff.file + ":" + std::to_string(f.error().loc.line) + ": " +
                 f.error().message;
@@ -1522,8 +1582,10 @@ void GrammarParser::LoadOptionFunctions() {
       g_.functions.push_back(std::make_shared<const CpfgFunction>(std::move(f).value()));
       continue;
     }
+    // Every file that fails is reported; func() ids are then not checked
+    // (their numbers would be off), see Error().
     diags_.Add(MakeError(SourceLoc{ff.from, ff.line, ff.column}, problem));
-    return;
+    functionFilesFailed_ = true;
   }
 }
 
@@ -1785,6 +1847,26 @@ void GrammarParser::CollectGlobals() {
     const char* kw = MatchKeyword(t, p, &after);
     if (!kw || !IsGlobalBlockKeyword(kw)) continue;
     for (size_t i = after; i < t.size(); ++i) {
+      if (t[i] == '"') {  // a string (printf's, fscanf's format): skipped
+        for (++i; i < t.size() && t[i] != '"'; ++i)
+          if (t[i] == '\\') ++i;
+        continue;
+      }
+      // fscanf's `&name` assigns name (not `&&`, not an array's `&a[i]`).
+      if (t[i] == '&' && (i + 1 >= t.size() || t[i + 1] != '&') && (i == 0 || t[i - 1] != '&')) {
+        size_t b = i + 1;
+        while (b < t.size() && IsSpace(t[b])) ++b;
+        size_t e = b;
+        while (e < t.size() && IsIdentChar(t[e])) ++e;
+        size_t n = e;
+        while (n < t.size() && IsSpace(t[n])) ++n;
+        if (e > b && IsIdentStart(t[b]) && (n >= t.size() || t[n] != '[')) {
+          std::string name = t.substr(b, e - b);
+          if (std::find(g_.globals.begin(), g_.globals.end(), name) == g_.globals.end())
+            g_.globals.push_back(std::move(name));
+        }
+        continue;
+      }
       if (t[i] != '=') continue;
       if (i + 1 < t.size() && t[i + 1] == '=') {
         ++i;
@@ -2076,8 +2158,10 @@ void GrammarParser::JoinContinuations() {
       // `A(t) : t < 5` / `  {nt = t + 1;}` / `  --> ...`), or, after the
       // ':' of a condition, with any indented line (`A(x) : {...}` /
       // `  x < 5 -->`): without its arrow it is no production on its own.
+      // So does a line that starts with the ':' of the condition (vlab's
+      // soil3d: `?E(...)A(tl,l,o) > @v?P(x,y,z)` / `  : (nut>0) ...`).
       join = curArrow ? !hasArrow(l.text)
-                      : (startsWithArrow(l.text) || l.text[p] == '{' ||
+                      : (startsWithArrow(l.text) || l.text[p] == '{' || l.text[p] == ':' ||
                          FindTopLevel(out.back().text, 0, out.back().text.size(), ":") !=
                              std::string::npos);
     }
@@ -2606,6 +2690,7 @@ void GrammarParser::Finish() {
   for (int a = 1; a <= kMaxArity && !g_.subLsystems; ++a)
     g_.subLsystems = g_.symbols.Find("?", a).has_value();
   g_.cutSymbol = g_.symbols.Find("%", 0);
+  if (g_.dataFiles && g_.dataFiles->empty()) g_.dataFiles.reset();
   g_.axiom = std::move(axiom_);
   g_.axiomLoc = axiomLoc_;
 }
@@ -2622,9 +2707,10 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   std::vector<std::string> stack{std::filesystem::path(path).lexically_normal().string()};
   Preprocess(std::make_shared<const std::string>(text), path, 0, stack);
   JoinContinuations();
+  // Before the #defines are read: a function set defines names.
+  LoadOptionFunctions();
   Conditionals();
   CollectGlobals();
-  LoadOptionFunctions();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
   // module: declarations apply to the whole file, wherever they stand.

@@ -48,13 +48,21 @@ struct ParseOptions {
   // `function: FILE [samples]` lines), func(1, x) the first; used when the
   // grammar has no `functions:` statement of its own (which wins). `file`
   // is resolved; `from` and `line` locate the naming line for diagnostics.
+  // A function set (`function set: FILE.fset`, `set` true) gives all its
+  // functions, in order, and defines each one's name as its number, as
+  // cpfg's `-DNAME=i` does (a #define or #undef of the name in the grammar
+  // replaces it).
   struct FunctionFile {
     std::string file;
     std::string from;
     int line = 0;
     int column = 0;
+    bool set = false;
   };
   std::vector<FunctionFile> functionFiles;
+  // The cpfg view file read for this grammar (empty: none was found); the
+  // error of a func() without function files says where Sylva looked.
+  std::string viewFile;
   // The caller answers ?E itself (plant::PlantSpec::environment): no
   // warning that a grammar without `environment:` leaves ?E unanswered.
   bool environmentGiven = false;

@@ -48,6 +48,9 @@ struct CpfgSurfaceDef {
   int tPrecision = 0;
   std::string viewFile;  // where the line is, for diagnostics
   int line = 0;
+  // The file does not exist (the view file reader warned): `~l` draws
+  // nothing instead of failing.
+  bool missing = false;
 };
 
 // Reads a .s file's text into a mesh in the surface's own frame. Errors (a

@@ -200,6 +200,7 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
     if (cpfgEnv) popt.environmentGiven = true;  // its own warnings say what is answered
   }
   popt.functionFiles = spec.cpfgFunctions;
+  popt.viewFile = spec.cpfgViewFile;
   // `~lF`: cpfg's one-letter surface `l` then `F` when l.obj exists and lF.obj does not.
   SurfaceLibrary surfaces(spec.path, spec.surfacePath, spec.readFile);
   surfaces.Define(spec.cpfgSurfaces);
@@ -352,6 +353,9 @@ PlantResult Grower::Finish() && {
     p.interpreted = std::move(*w);
     p.time.interpret = MsSince(t0);
   }
+  // cpfg data files that fscanf read less of than its formats asked.
+  if (g.dataFiles)
+    for (Diagnostic& d : g.dataFiles->ShortReads()) r.diagnostics.Add(std::move(d));
   if (spec_.until >= Stage::kGeometry) {
     const auto t0 = Clock::now();
     auto geometry =

@@ -83,6 +83,8 @@ struct PlantSpec {
   // cpfg function files for func(id, x) when the grammar names none (a view
   // file's `function:` lines; lsys::ParseOptions::functionFiles).
   std::vector<lsys::ParseOptions::FunctionFile> cpfgFunctions;
+  // The view file those come from (lsys::ParseOptions::viewFile).
+  std::string cpfgViewFile;
   int threads = 0;  // derivation threads; 0: all hardware threads; at most 256
   // When set, derivation, interpretation and tessellation run on this pool
   // (the process's, core/parallel.h SharedPool; not owned) and `threads` is

@@ -74,6 +74,10 @@ void SurfaceLibrary::Define(const std::vector<CpfgSurfaceDef>& defs) {
 }
 
 Status SurfaceLibrary::LoadCpfg(const CpfgSurfaceDef& def) {
+  if (def.missing) {  // warned where the view file names it
+    meshes_.emplace(def.name, mesh::TriangleMesh());
+    return {};
+  }
   std::optional<std::string> text;
   if (readFile_) {
     text = readFile_(def.file);

@@ -254,6 +254,32 @@ TEST(ViewFile, FunctionLinesGiveFuncItsFilesInOrder) {
   EXPECT_NEAR(r.plant->word.params[0], 0.5, 0.003) << r.plant->word.params[0];  // y = 2x
 }
 
+TEST(ViewFile, AFunctionSetLineGivesFuncItsFunctionsByName) {
+  ViewFile v = ParseViewFile("function set: functions.fset\n", "/x/p.v");
+  EXPECT_TRUE(v.diagnostics.items.empty()) << Messages(v.diagnostics);
+  ASSERT_EQ(v.functions.size(), 1u);
+  EXPECT_TRUE(v.functions[0].set);
+  EXPECT_EQ(v.functions[0].file, "/x/functions.fset");
+  EXPECT_EQ(v.functions[0].column, 15);
+  // Through the plant: vlab's GettingStarted lychnis writes func(BR_ANGLE, t).
+  const std::string grammar = WriteFile("fs.l", "axiom: A(func(RISE, 0.25), func(2, 0.5))\n");
+  WriteFile("fs.v", "angle factor: 40\nfunction set: fs.fset\n");
+  WriteFile("fs.fset",
+            "funcgalleryver 1 1\nitems: 2\n"
+            "fver 1 1\nname: FLAT\nsamples: 100\nflip: off\npoints: 4\n0 1\n0.3 1\n0.6 1\n1 1\n"
+            "fver 1 1\nname: RISE\nsamples: 100\nflip: off\npoints: 4\n0 0\n0.333333 "
+            "0.666667\n0.666667 1.333333\n1 2\n");
+  plant::PlantSpec spec;
+  spec.path = grammar;
+  spec.until = plant::Stage::kWord;
+  AttachViewFile(LoadViewFiles(grammar, ""), spec);
+  plant::PlantResult r = plant::BuildPlant(spec);
+  ASSERT_TRUE(r.plant.has_value()) << r.diagnostics.FormatAll();
+  ASSERT_EQ(r.plant->word.params.size(), 2u);
+  EXPECT_NEAR(r.plant->word.params[0], 0.5, 0.003) << r.plant->word.params[0];  // RISE is 2
+  EXPECT_NEAR(r.plant->word.params[1], 1, 0.003) << r.plant->word.params[1];
+}
+
 TEST(ViewFile, TheTurtleDrawsWithTheViewFilesSettings) {
   const std::string grammar = WriteFile("vt.l", "axiom: F + F ; F ! F\n");
   WriteFile("vt.v",
@@ -309,6 +335,45 @@ TEST(ViewFile, StrictMakesItsWarningsErrorsAndViewNamesTheFile) {
   EXPECT_EQ(bad.code, 2) << bad.err;
   EXPECT_NE(bad.err.find("/dev/null: error: view file: is not a regular file"), std::string::npos)
       << bad.err;
+}
+
+TEST(ViewFile, ASurfaceFileThatIsNotThereWarnsAndDrawsNothing) {
+  // vlab objects copied without one of their .s files (lychnis' calyx.s):
+  // the plant opens, the surface is not drawn, the warning says which file.
+  const std::string grammar = WriteFile("vm.l", "axiom: F [~c(1)] F\n");
+  WriteFile("vm.v", "angle increment: 30\nsurface: c calyx_gone.s 2 3 3\n");
+  auto view = LoadViewFiles(grammar, "");
+  ASSERT_TRUE(view != nullptr);
+  const std::string all = Messages(view->diagnostics);
+  EXPECT_NE(all.find("2:12 warning: surface 'c' is not drawn: its file " +
+                     (Scratch() / "calyx_gone.s").lexically_normal().string() +
+                     " does not exist"),
+            std::string::npos)
+      << all;
+  ASSERT_EQ(view->surfaces.size(), 1u);
+  EXPECT_TRUE(view->surfaces[0].missing);
+  plant::PlantSpec spec;
+  spec.path = grammar;
+  spec.until = plant::Stage::kMesh;
+  AttachViewFile(view, spec);
+  plant::PlantResult r = plant::BuildPlant(spec);
+  ASSERT_TRUE(r.plant.has_value()) << r.diagnostics.FormatAll();
+  EXPECT_EQ(r.plant->geometry.surfaces.size(), 1u);
+  EXPECT_GT(r.plant->mesh.triangleCount(), 0u);  // the two F
+  EXPECT_EQ(r.diagnostics.ErrorCount(), 0u) << r.diagnostics.FormatAll();
+  // --strict makes the warning an error.
+  auto strict = RunSylva({"check", "--strict", grammar});
+  EXPECT_EQ(strict.code, 2) << strict.err;
+  EXPECT_NE(strict.err.find("vm.v:2:12: warning: surface 'c' is not drawn"), std::string::npos)
+      << strict.err;
+  // A surface file that exists but is malformed stays an error.
+  WriteFile("calyx_gone.s", "not a surface\n");
+  spec.amendGrammar = nullptr;
+  AttachViewFile(LoadViewFiles(grammar, ""), spec);
+  plant::PlantResult bad = plant::BuildPlant(spec);
+  EXPECT_FALSE(bad.plant.has_value());
+  EXPECT_GT(bad.diagnostics.ErrorCount(), 0u);
+  std::filesystem::remove(Scratch() / "calyx_gone.s");
 }
 
 }  // namespace

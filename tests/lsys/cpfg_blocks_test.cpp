@@ -213,9 +213,10 @@ TEST(CpfgBlocks, MalformedBlocksAreErrorsWithLocations) {
             "1:10 a statement block belongs in a production, not here");
   EXPECT_EQ(FirstError("axiom: A(1)\nA(x) : {sin(x);} * --> B(x)\n"),
             "2:9 a call 'sin(...)' as a statement is not supported (cpfg's printf, ...)");
-  EXPECT_EQ(FirstError("Start: {fp = fopen(\"data.txt\", \"r\");}\naxiom: A\n"),
-            "1:14 fopen for reading is not supported (cpfg's fopen with \"r\" and fscanf: Sylva "
-            "reads no data files from a grammar)");
+  // A data file that is not there (reading: cpfg_data_files_test.cpp).
+  EXPECT_EQ(FirstError("Start: {fp = fopen(\"no_such_data.txt\", \"r\");}\naxiom: A\n"),
+            "1:20 cannot read data file 'no_such_data.txt': cannot read file: No such file or "
+            "directory");
 }
 
 TEST(CpfgBlocks, OutputCallsAreReadAndWarnedOnceEach) {

@@ -106,6 +106,10 @@ ParseOptions Files() {
   opt.readFile = [](const std::string& path) -> std::optional<std::string> {
     if (path == "hump.func") return std::string(kHump);
     if (path == "line.func") return std::string(kLine);
+    if (path == "set.fset")  // a function set: hump, then the line, by name
+      return std::string("funcgalleryver 1 1\nitems: 2\n") + kHump +
+             "fver 1 1\nname: LINE.func\nsamples: 100\nflip: on\npoints: 4\n0 0\n"
+             "0.333333 0.333333\n0.666667 0.666667\n1 1\n";
     if (path == "sampled.func")
       return "fver 1 1\nname: s\nsamples: 3\nflip: off\npoints: 4\n0 0\n0.3 1\n0.7 1\n1 0\n";
     return std::nullopt;
@@ -190,7 +194,8 @@ TEST(CpfgFunctions, FuncErrorsAreLocated) {
   };
   EXPECT_EQ(first("axiom: A\nA --> B(func(1, 0.5))\n"),
             "2:9 func(id, x) needs cpfg function files: name them with 'functions: FILE.func "
-            "...' before the productions, or with 'function: FILE.func' lines in the view file");
+            "...' before the productions, or with 'function: FILE.func' lines in the view file; "
+            "no view file was read (sylva looks for c.v, or takes --view FILE)");
   EXPECT_EQ(first("functions: hump.func\naxiom: A\nA --> B(func(2, 0.5))\n"),
             "3:9 func(id, x): id must be a whole number from 1 to 1 (the files of 'functions:')");
   EXPECT_EQ(first("functions: hump.func missing.func\naxiom: A\n"),
@@ -200,6 +205,56 @@ TEST(CpfgFunctions, FuncErrorsAreLocated) {
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().loc.line, 7);
   EXPECT_EQ(bad.error().message, "expected a point 'x y'");
+}
+
+TEST(CpfgFunctions, AFunctionSetGivesItsFunctionsInOrderAndByName) {
+  // cpfg (generate.c, PreprocessLsystem) defines each name of the set as
+  // its number, the name cut at its last '.': func(LINE, x) is func(2, x).
+  ParseOptions opt = Files();
+  opt.functionFiles = {{"set.fset", "p.v", 7, 15, /*set=*/true}};
+  ParseResult r = ParseGrammarText(
+      "axiom: A(func(hump, 0.5), func(LINE, 0.25), func(2, 0.75), LINE)\n", "c.l", opt);
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  ASSERT_EQ(r.grammar->functions.size(), 2u);
+  auto w = Derive(*r.grammar, DeriveOptions{});
+  ASSERT_TRUE(w);
+  ASSERT_EQ(w->word.params.size(), 4u);
+  EXPECT_DOUBLE_EQ(w->word.params[0], 0.75);
+  EXPECT_NEAR(w->word.params[1], 0.25, 0.002) << w->word.params[1];  // samples: 100
+  EXPECT_NEAR(w->word.params[2], 0.75, 0.002) << w->word.params[2];
+  EXPECT_EQ(w->word.params[3], 2);
+  // As with cpp's -D, the grammar may #undef a name and define it again
+  // (vlab's fern-leaf: `#undef int_length` then `#define int_length(x) ...`).
+  ParseResult redefined = ParseGrammarText(
+      "#undef LINE\n#define LINE(x) (10 * func(2, x))\n#define hump 2\n"
+      "axiom: A(LINE(0.5), func(hump, 0.5))\n",
+      "c.l", opt);
+  ASSERT_TRUE(redefined.grammar) << redefined.diagnostics.FormatAll();
+  auto w2 = Derive(*redefined.grammar, DeriveOptions{});
+  ASSERT_TRUE(w2);
+  EXPECT_NEAR(w2->word.params[0], 5, 0.02) << w2->word.params[0];
+  EXPECT_NEAR(w2->word.params[1], 0.5, 0.002) << w2->word.params[1];  // the line, not the hump
+  // Errors: a set that cannot be read, at the view file's line; a malformed
+  // set, with the line in the set.
+  opt.functionFiles = {{"gone.fset", "p.v", 7, 15, true}};
+  ParseResult gone = ParseGrammarText("axiom: A\n", "c.l", opt);
+  ASSERT_FALSE(gone.grammar);
+  EXPECT_EQ(gone.diagnostics.items[0].loc.line, 7);
+  EXPECT_NE(gone.diagnostics.items[0].message.find("cannot read function set 'gone.fset'"),
+            std::string::npos)
+      << gone.diagnostics.FormatAll();
+  auto count = CpfgFunction::ParseSet(std::string("funcgalleryver 1 1\nitems: 3\n") + kHump, "s");
+  ASSERT_FALSE(count);
+  EXPECT_EQ(count.error().loc.line, 2);
+  EXPECT_EQ(count.error().message, "'items: 3' but the set has 1 functions ('fver' lines)");
+  auto point = CpfgFunction::ParseSet(
+      std::string("funcgalleryver 1 1\nitems: 2\n") + kHump +
+          "fver 1 1\nname: b\nsamples: 0\nflip: off\npoints: 4\n0 0\n1\n",
+      "s");
+  ASSERT_FALSE(point);
+  EXPECT_EQ(point.error().loc.line, 18);  // the 18th line of the set
+  EXPECT_EQ(point.error().message, "expected a point 'x y'");
+  EXPECT_FALSE(CpfgFunction::ParseSet(kHump, "s"));  // not a set
 }
 
 }  // namespace
