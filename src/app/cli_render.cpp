@@ -3,12 +3,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <ostream>
 
 #include "app/cli.h"
 #include "app/commands.h"
 #include "mesh/export.h"
+#include "plant/frames.h"
 #include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
@@ -72,18 +74,41 @@ void UseViewFileDirection(const ViewFile* view, ViewFlags& v) {
   }
 }
 
-// cpfg's `scale factor:` zooms the framed view.
+// A cpfg file (`.l`) without a view file is viewed as cpfg views it by
+// default (interpret.c, InitializeParameters): from viewpoint 0,0,1 toward
+// the origin, in parallel projection. Unless --camera says otherwise.
+bool UseCpfgDefaultView(const std::string& grammar, const ViewFile* view, ViewFlags& v) {
+  if (std::filesystem::path(grammar).extension() != ".l") return false;
+  if (view && !view->path.empty()) return false;
+  if (v.explicitCamera) return false;
+  v.explicitCamera = true;
+  v.cam[0] = v.cam[1] = v.cam[2] = 0;
+  return true;
+}
+
+// cpfg's `scale factor:` zooms the framed view; its `viewing angle:` is
+// the perspective's field of view (the camera moves back or forward so the
+// framed box keeps its size: the distance times tan(35/2) / tan(a/2)).
 void UseViewFileScale(const ViewFile* view, render::Camera& camera) {
+  if (view && view->viewingAngle && !camera.orthographic) {
+    const double a = *view->viewingAngle;
+    camera.distance *= std::tan(camera.fovY * kDegToRad / 2) / std::tan(a * kDegToRad / 2);
+    camera.fovY = a;
+  }
   if (!view || !view->scale) return;
-  camera.distance /= *view->scale;
-  camera.orthoHeight /= *view->scale;
+  if (camera.orthographic)
+    camera.orthoHeight /= *view->scale;  // the eye stays outside the plant
+  else
+    camera.distance /= *view->scale;
 }
 
 // The camera that frames the plant, or the one --camera gives. The box
 // comes from the geometry, before tessellation, so every detail (uniform
-// or screen-space) sees one view.
+// or screen-space) sees one view. Orthographic for 2D figures (`lines`)
+// and when a cpfg view file asks for a parallel projection.
 Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSpec& spec,
-                                     const ViewFlags& v, bool lines, mesh::Box* meshBox = nullptr) {
+                                     const ViewFlags& v, bool lines, bool orthographic,
+                                     mesh::Box* meshBox = nullptr) {
   Vec3 lo = p.geometry.boundsMin, hi = p.geometry.boundsMax;
   if (!lines) {
     auto box = plant::MeshBounds(p, spec);
@@ -97,7 +122,7 @@ Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSp
   const double aspect = double(v.width) / v.height;
   render::Camera camera =
       render::Camera::Frame(lo, hi, aspect, v.explicitCamera ? v.cam[0] : (lines ? 0 : 30),
-                            v.explicitCamera ? v.cam[1] : (lines ? 0 : 12), lines);
+                            v.explicitCamera ? v.cam[1] : (lines ? 0 : 12), orthographic);
   if (v.explicitCamera && v.cam[2] > 0) camera.distance = v.cam[2];
   return camera;
 }
@@ -135,6 +160,15 @@ render::Image Downsample(const render::Image& big, int k) {
     }
   }
   return out;
+}
+
+// Whether a geometry's widths are pixels and some are wider than the one
+// pixel of a line.
+bool WiderThanAPixel(const mesh::PlantGeometry& g) {
+  if (!g.widthInPixels) return false;
+  for (const mesh::Segment& s : g.segments)
+    if (std::max(s.radiusStart, s.radiusEnd) > 0.5f + 1e-4f) return true;
+  return false;
 }
 
 }  // namespace
@@ -190,21 +224,49 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   auto spec = SpecFrom(cmd.derive, err, &exit, &viewFile);
   if (!spec) return exit;
   UseViewFileDirection(viewFile.get(), v);
+  const bool cpfgDefaultView = UseCpfgDefaultView(cmd.derive.file, viewFile.get(), v);
   if (cmd.sides) spec->detail.sides = *cmd.sides;
   spec->until = plant::Stage::kGeometry;
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
+  if (viewFile && viewFile->overlay) {
+    // cpfg's animation file says to draw its frames over each other: the
+    // picture is their union (plant/frames.h). The grammar's warnings were
+    // reported above; this second pass reports its errors only.
+    DiagnosticList again;
+    auto frames = plant::DrawFrames(*spec, *viewFile->overlay, again);
+    if (!frames) return Report(frames.error(), err);
+    plant->geometry = std::move(*frames);
+  }
   const mesh::PlantGeometry* geometry = &plant->geometry;
   const mesh::Palette& palette = plant->palette;
   // 2D figures (all in the z = 0 plane, nothing but segments) draw as lines
-  // in an orthographic view from +Z; everything else as a lit mesh.
-  const bool lines = plant::IsLineFigure(*geometry);
+  // in an orthographic view from +Z; everything else as a lit mesh. A 2D
+  // figure whose widths are pixels (a cpfg view file's line style) draws
+  // (some wider than one) as ribbons of those widths, on white like the lines.
+  const bool figure = plant::IsLineFigure(*geometry);
+  const bool ribbons = figure && WiderThanAPixel(*geometry);
+  const bool lines = figure && !ribbons;
+  const bool parallel = figure || cpfgDefaultView || (viewFile && viewFile->parallel);
   render::LineBatch batch;
   mesh::Box bounds;
-  auto camera = FrameCamera(*plant, *spec, v, lines, &bounds);
+  auto camera = FrameCamera(*plant, *spec, v, figure, parallel, &bounds);
   if (!camera) return Report(camera.error(), err);
   if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
   const int W = v.width * K, H = v.height * K;
+  float widestPixels = 0;  // the widest pixel width, in rendered pixels
+  if (plant->geometry.widthInPixels) {
+    // Pixel widths are output pixels: K of the K-times larger image.
+    for (mesh::Segment& s : plant->geometry.segments) {
+      s.radiusStart *= float(K);
+      s.radiusEnd *= float(K);
+      widestPixels = std::max({widestPixels, 2 * s.radiusStart, 2 * s.radiusEnd});
+    }
+  }
+  // The key light (the shadow caster): toward cpfg's light when the view
+  // file gives one.
+  const Vec3 keyToward = viewFile && viewFile->lightToward ? *viewFile->lightToward
+                                                           : render::KeyLightDirection();
   if (lines) {
     draw::Lines figure = LinesOf(*plant);
     batch.points = std::move(figure.points);
@@ -212,14 +274,20 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   } else {
     // Screen-space detail unless --sides asks for uniform tubes; eps is in
     // output pixels, so K times as many in the K-times larger image.
-    if (!cmd.sides) {
+    if (!cmd.sides || geometry->widthInPixels) {
+      // Pixel widths need the view even at uniform detail (mesh/pixel_widths.h).
       spec->view = ViewOf(*camera, W, H, lodEps * K);
       // Shadows of what lies outside the view may fall inside it.
-      spec->view->shadowFrom = render::KeyLightDirection();
-      spec->view->shadowPlaneY = bounds.lo.y();
-      spec->view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(bounds);
+      if (!ribbons) {
+        spec->view->shadowFrom = keyToward;
+        spec->view->shadowPlaneY = bounds.lo.y();
+        spec->view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(bounds);
+      }
       // Twigs under a pixel fade as coverage lines (the renderer blends them).
       spec->view->coverage = true;
+      // A 2D figure's pixel-wide lines are flat ribbons, never tubes
+      // (ribbons are drawn under 3 eps of radius).
+      if (ribbons) spec->view->eps = std::max(spec->view->eps, 0.2 * widestPixels);
     }
     DiagnosticList warnings;
     Status s = plant::Tessellate(*plant, *spec, warnings);
@@ -241,15 +309,24 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (lines) {
     (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
     if (Status s = (*renderer)->SetLines(batch); !s.ok()) return Report(s.error(), err);
+  } else if (ribbons) {
+    (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
+    (*renderer)->SetShadows(false);
+    (*renderer)->SetMesh(*m, palette);
+    (*renderer)->SetWireframe(cmd.wireframe);
   } else {
     // The default scene: the plant on a ground plane, lit by the default
     // rig; the shadow map fitted to the whole plant, whatever was culled.
-    list = scene::DefaultScene(m, palette, bounds.lo, bounds.hi);
+    // No ground when the camera looks from below it (a cpfg view file's
+    // viewpoint under the plant): it would hide everything.
+    list = scene::DefaultScene(m, palette, bounds.lo, bounds.hi,
+                               scene::SeesGroundFromAbove(camera->Eye(), bounds.lo));
+    if (viewFile && viewFile->lightToward) list.lights[0].direction = -keyToward.cast<float>();
     list.wireframe = cmd.wireframe;
   }
   const double uploadMs = MsSince(t0);
   t0 = Clock::now();
-  if (lines) {
+  if (lines || ribbons) {
     (*renderer)->Draw(*camera);
   } else if (Status s = (*renderer)->Draw(list, *camera); !s.ok()) {
     return Report(s.error(), err);
@@ -265,7 +342,10 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   char line[256];
   std::snprintf(line, sizeof line, "%s: %dx%d, %s, %zu triangles, %zu lines (%s)\n",
                 cmd.output.c_str(), v.width, v.height,
-                lines ? "lines, orthographic" : "mesh, perspective", m->triangleCount(),
+                lines     ? "lines, orthographic"
+                : ribbons ? "pixel-wide ribbons, orthographic"
+                          : (parallel ? "mesh, orthographic" : "mesh, perspective"),
+                m->triangleCount(),
                 batch.points.size() / 2, (*context)->Renderer().c_str());
   err << line;
   if (cmd.stats) {
@@ -312,11 +392,13 @@ int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err)
   auto spec = SpecFrom(cmd.derive, err, &exit, &viewFile);
   if (!spec) return exit;
   UseViewFileDirection(viewFile.get(), v);
+  const bool cpfgDefaultView = UseCpfgDefaultView(cmd.derive.file, viewFile.get(), v);
   spec->until = plant::Stage::kGeometry;
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   // Framed as `sylva render` frames a mesh (never as a line figure).
-  auto camera = FrameCamera(*plant, *spec, v, false);
+  auto camera = FrameCamera(*plant, *spec, v, false,
+                            cpfgDefaultView || (viewFile && viewFile->parallel));
   if (!camera) return Report(camera.error(), err);
   if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
   spec->view = ViewOf(*camera, v.width, v.height, eps);

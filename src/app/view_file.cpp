@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "core/atomic_file.h"
+#include "lsys/deriver.h"
 
 namespace sylva::app {
 namespace {
@@ -33,7 +34,8 @@ struct Ignored {
 };
 
 constexpr std::string_view kLighting =
-    "lighting and shading: Sylva's renderer lights every plant with its own key and fill lights";
+    "shading: Sylva's renderer shades every plant with its own materials, fill and ambient "
+    "light (the key light takes the direction of 'light direction:' or the first 'light:')";
 constexpr std::string_view kSurfaces =
     "Sylva reads cpfg's .s surfaces from 'surface:', not line or triangle surfaces "
     "(docs/cpfg.md)";
@@ -43,12 +45,10 @@ constexpr Ignored kIgnored[] = {
     {"front distance:", "clipping planes: Sylva frames the plant"},
     {"back distance:", "clipping planes: Sylva frames the plant"},
     {"shade mode:", kLighting},
-    {"light direction:", kLighting},
     {"diffuse reflection:", kLighting},
     {"surface ambient:", kLighting},
     {"surface diffuse:", kLighting},
-    {"ambient light:", kLighting},
-    {"light:", kLighting},
+    {"ambient light:", "cpfg's OpenGL renderer does not use it either"},
     {"render mode:", kLighting},
     {"shadow map:", kLighting},
     {"line:", kSurfaces},
@@ -64,9 +64,7 @@ constexpr Ignored kIgnored[] = {
     {"blob:", kNotActed},
     {"torque:", "torque tropism is not implemented"},
     {"texture:", "textures are not implemented"},
-    {"line style:", "Sylva draws 2D figures as lines and 3D plants as tubes"},
     {"tapered lines:", "Sylva's tubes taper to the width of the next segment"},
-    {"viewing angle:", "Sylva's perspective uses a 35 degree field of view"},
     {"background scene:", kNotActed},
     {"interpretation step:", kNotActed},
     {"interpretation past %:", kNotActed},
@@ -134,6 +132,16 @@ class Reader {
       : v_(v), path_(path), checkFiles_(checkFiles) {}
 
   void Read(const app::Line& line);
+  // What the file says, with cpfg's defaults (InitializeParameters): line
+  // style pixel, width 1, parallel projection.
+  void Finish() {
+    if (!v_.width) v_.width = 1;
+    v_.widthInPixels = lineStyle_ != LineStyle::kWorld;
+    v_.parallel = parallel_;
+    // cpfg's OpenGL renderer: the `light:` lines, else one directional
+    // light toward `light direction:`.
+    v_.lightToward = firstLight_ ? firstLight_ : lightDirection_;
+  }
 
  private:
   // The values after the label: numbers and words split at blanks and
@@ -193,6 +201,7 @@ class Reader {
   }
   void Tropism();
   void Surface();
+  void Light();
 
   ViewFile& v_;
   std::string path_;
@@ -204,6 +213,11 @@ class Reader {
   std::vector<Token> tokens_;
   std::set<std::string> warned_;
   bool tropismSeen_ = false;
+  enum class LineStyle { kUnset, kPixel, kWorld };
+  LineStyle lineStyle_ = LineStyle::kUnset;
+  bool parallel_ = true;
+  std::optional<Vec3> lightDirection_, firstLight_;
+  int lights_ = 0;
 };
 
 void Reader::Read(const app::Line& line) {
@@ -276,10 +290,17 @@ void Reader::Read(const app::Line& line) {
       else
         v_.width = *x;
     }
-    // `pixels`, `polygons`, `cylinder`: how cpfg draws lines; Sylva draws
-    // tubes (lines for 2D figures) of this width in world units.
-    ExtraValues(
-        tokens_.size() > 1 && std::isalpha(static_cast<unsigned char>(tokens_[1].text[0])) ? 2 : 1);
+    // cpfg (interpret.c, ReadViewData): a word after the width starting
+    // with `p` makes it pixels, with `s` a cylinder; otherwise (nothing
+    // after the number, or another word) polygons: world units. cpfg looks
+    // at the first letter only, so its `polygons` would be pixels too;
+    // Sylva reads `po...` as the polygons the word names.
+    const bool word =
+        tokens_.size() > 1 && std::isalpha(static_cast<unsigned char>(tokens_[1].text[0]));
+    const bool pixels =
+        word && tokens_[1].text[0] == 'p' && tokens_[1].text.rfind("po", 0) != 0;
+    lineStyle_ = pixels ? LineStyle::kPixel : LineStyle::kWorld;
+    ExtraValues(word ? 2 : 1);
   } else if (L == "line width increment:") {
     if (auto x = Number(0, "a width")) v_.widthIncrement = *x;
     ExtraValues(1);
@@ -295,6 +316,15 @@ void Reader::Read(const app::Line& line) {
       // 0: cpfg reads it as 1
     }
     ExtraValues(1);
+  } else if (L == "viewing angle:") {
+    // cpfg: the vertical field of view of the perspective projection.
+    if (auto x = Number(0, "an angle in degrees")) {
+      if (*x > 0 && *x < 180)
+        v_.viewingAngle = *x;
+      else
+        Error(tokens_[0].column, "'viewing angle:' must be between 0 and 180 degrees");
+    }
+    ExtraValues(1);
   } else if (L == "twist:") {
     if (auto x = Number(0, "an angle")) {
       if (*x != 0) NotActed("a twisted view (the camera's up is +Y)");
@@ -306,8 +336,34 @@ void Reader::Read(const app::Line& line) {
       if (*x != 0) NotActed("depth cueing is not implemented");
     }
   } else if (L == "projection:") {
-    if (tokens_.empty() || tokens_[0].text.rfind("perspective", 0) != 0)
-      NotActed("Sylva draws 3D plants in perspective (2D figures in parallel projection)");
+    // cpfg: `parallel...` or `perspective...`; anything else is parallel
+    // with a warning.
+    if (tokens_.empty()) {
+      Error(int(current_.size()) + 1, "expected 'parallel' or 'perspective'");
+    } else if (tokens_[0].text.rfind("perspective", 0) == 0) {
+      parallel_ = false;
+    } else {
+      parallel_ = true;
+      if (tokens_[0].text.rfind("parallel", 0) != 0)
+        Warn(tokens_[0].column,
+             "unknown projection '" + tokens_[0].text + "': parallel, as cpfg assumes");
+    }
+    ExtraValues(1);
+  } else if (L == "line style:") {
+    // cpfg: pixel, polygon, cylinder, or their numbers 1, 2, 3.
+    const std::string w = tokens_.empty() ? "" : tokens_[0].text;
+    if (w == "pixel" || w == "1") {
+      lineStyle_ = LineStyle::kPixel;
+    } else if (w == "polygon" || w == "cylinder" || w == "2" || w == "3") {
+      lineStyle_ = LineStyle::kWorld;
+    } else {
+      // cpfg keeps the line style it had (interpret.c ReadViewData).
+      Warn(tokens_.empty() ? int(current_.size()) + 1 : tokens_[0].column,
+           "'line style:' is 'pixel', 'polygon' or 'cylinder', not '" +
+               (tokens_.empty() ? std::string() : tokens_[0].text) +
+               "': the line style stays as it was, as in cpfg");
+    }
+    ExtraValues(1);
   } else if (L == "tropism direction:") {
     if (auto p = Vector(0, "x,y,z")) {
       // 0,0,0: no direction, so no bending (as in cpfg, whose tropism is
@@ -321,6 +377,18 @@ void Reader::Read(const app::Line& line) {
   } else if (L == "elasticity increment:") {
     if (auto x = Number(0, "an elasticity")) v_.elasticityIncrement = *x;
     ExtraValues(1);
+  } else if (L == "light direction:") {
+    // cpfg: the direction toward the light (normalised); its OpenGL
+    // renderer makes it a directional light when no `light:` line is given.
+    if (auto d = Vector(0, "x,y,z")) {
+      if (d->norm() == 0)
+        Error(tokens_[0].column, "the light direction must not be 0,0,0");
+      else
+        lightDirection_ = d->normalized();
+    }
+    ExtraValues(3);
+  } else if (L == "light:") {
+    Light();
   } else if (L == "tropism:") {
     Tropism();
   } else if (L == "surface:") {
@@ -421,6 +489,69 @@ void Reader::Tropism() {
   }
   v_.tropism = dir->normalized();
   v_.elasticity = elasticity * intensity;
+}
+
+// `light: V: x y z  D: r g b ...` (cpfg's irisGL.c read_light): an OpenGL
+// light, V a direction toward it, O a position; A, D, S colours, P a
+// spot, T attenuation. Sylva takes the direction of the first light (O
+// seen from the origin) for its key light; the rest warns.
+void Reader::Light() {
+  ++lights_;
+  if (lights_ == 2) {
+    Warn(labelColumn_,
+         "a second 'light:': Sylva draws with one key light (the first 'light:'), its own fill "
+         "and ambient: this one is not used");
+  }
+  std::optional<Vec3> toward;
+  std::string ignored;
+  for (size_t k = 0; k < tokens_.size();) {
+    std::string t = tokens_[k].text;
+    const int column = tokens_[k].column;
+    // The letter, bare or with a colon and maybe the first value attached.
+    const char c = t[0];
+    if (!std::strchr("ADSOVPT", c) || (t.size() > 1 && t[1] != ':')) {
+      Error(column, "expected A, D, S, O, V, P or T in 'light:', not '" + t + "'");
+      return;
+    }
+    const size_t values = c == 'P' ? 5 : 3;
+    std::vector<Token> rest;
+    if (t.size() > 2) rest.push_back({t.substr(2), column + 2});
+    size_t next = k + 1;
+    while (rest.size() < values && next < tokens_.size()) rest.push_back(tokens_[next++]);
+    std::vector<double> x;
+    for (const Token& r : rest) {
+      char* end = nullptr;
+      const double v = std::strtod(r.text.c_str(), &end);
+      if (end != r.text.c_str() + r.text.size() || !std::isfinite(v)) {
+        Error(r.column, "expected a number after '" + std::string(1, c) + "', not '" + r.text + "'");
+        return;
+      }
+      x.push_back(v);
+    }
+    if (x.size() < values) {
+      Error(int(current_.size()) + 1, std::string("expected ") + std::to_string(values) +
+                                          " numbers after '" + std::string(1, c) + "'");
+      return;
+    }
+    if (c == 'V' || c == 'O') {
+      const Vec3 d(x[0], x[1], x[2]);
+      if (d.norm() == 0) {
+        Error(column, "the light's direction or position must not be 0,0,0");
+        return;
+      }
+      toward = d.normalized();
+    } else if (ignored.find(c) == std::string::npos) {
+      ignored += (ignored.empty() ? "" : ", ") + std::string(1, c);
+    }
+    k = next;
+  }
+  if (lights_ == 1) {
+    if (toward) firstLight_ = toward;
+    if (!ignored.empty())
+      Warn(labelColumn_, "'light:': Sylva uses the light's direction (V, or O seen from the "
+                         "origin) for its key light; " +
+                             ignored + " (colours, spot, attenuation) ignored");
+  }
 }
 
 // `surface: l leaf.s size [s-precision t-precision]` (cpfg's
@@ -524,6 +655,7 @@ ViewFile ParseViewFile(const std::string& text, const std::string& path, bool ch
       break;
     }
   }
+  r.Finish();
   return v;
 }
 
@@ -588,6 +720,19 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
     }
     *v = ParseViewFile(*text, viewPath.string(), /*checkFiles=*/true);
   }
+  // cpfg's animation file beside the grammar (only its overlaid frames
+  // change a still picture).
+  if (!grammarPath.empty()) {
+    const fs::path a = fs::path(grammarPath).replace_extension(".a");
+    if (IsFile(a)) {
+      auto text = ReadRegular(a.string(), kMaxViewBytes);
+      if (!text) {
+        v->diagnostics.Add(text.error());
+        return v;
+      }
+      ParseAnimationFile(*text, a.string(), *v);
+    }
+  }
   // Colours: NAME.mat, then NAME.map, beside the grammar, then beside the view file.
   std::vector<fs::path> stems;
   if (!grammarPath.empty()) stems.push_back(fs::path(grammarPath));
@@ -613,8 +758,72 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
       return v;
     }
   }
-  if (v->path.empty() && v->colorsPath.empty()) return nullptr;
+  if (v->path.empty() && v->colorsPath.empty() && v->animationPath.empty()) return nullptr;
   return v;
+}
+
+void ParseAnimationFile(const std::string& text, const std::string& path, ViewFile& view) {
+  view.animationPath = path;
+  // Only an overlay (clear between frames: off) changes a still picture:
+  // the frame numbers are read, and checked, for it alone.
+  struct Value {
+    std::string text;
+    int line = 0, column = 0;
+  };
+  std::optional<Value> clear, first, last, step;
+  for (const Line& line : Lines(text)) {
+    const std::string& s = line.text;
+    const size_t colon = s.find(':');
+    if (colon == std::string::npos) continue;
+    std::string label;
+    for (size_t k = 0; k < colon; ++k) {
+      const char c = s[k];
+      if (c == ' ' || c == '\t') {
+        if (!label.empty() && label.back() != ' ') label += ' ';
+      } else {
+        label += c;
+      }
+    }
+    while (!label.empty() && label.back() == ' ') label.pop_back();
+    const size_t v0 = s.find_first_not_of(" \t", colon + 1);
+    Value value;
+    value.line = line.number;
+    value.column = v0 == std::string::npos ? int(s.size()) + 1 : int(v0) + 1;
+    if (v0 != std::string::npos) value.text = s.substr(v0, s.find_first_of(" \t", v0) - v0);
+    if (label == "clear between frames") clear = value;
+    if (label == "first frame") first = value;
+    if (label == "last frame") last = value;
+    if (label == "step") step = value;
+  }
+  if (!clear || clear->text.rfind("off", 0) != 0) return;
+  auto number = [&](const std::optional<Value>& v, const char* label, int lo, int fallback,
+                    int* out) {
+    if (!v) {
+      *out = fallback;
+      return true;
+    }
+    char* end = nullptr;
+    const long x = std::strtol(v->text.c_str(), &end, 10);
+    if (v->text.empty() || *end != '\0' || x < lo || x > lsys::kMaxDerivationLengthForDerive) {
+      Diagnostic d;
+      d.loc.file = path;
+      d.loc.line = v->line;
+      d.loc.column = v->column;
+      d.message = std::string("'") + label + ":' expects a whole number from " +
+                  std::to_string(lo) + " to " +
+                  std::to_string(lsys::kMaxDerivationLengthForDerive) + ", not '" + v->text + "'";
+      view.diagnostics.Add(std::move(d));
+      return false;
+    }
+    *out = int(x);
+    return true;
+  };
+  plant::FrameRange frames;
+  // cpfg's `last frame: -1`: up to the derivation length.
+  if (number(first, "first frame", 0, 0, &frames.first) &&
+      number(last, "last frame", -1, -1, &frames.last) &&
+      number(step, "step", 1, 1, &frames.step))
+    view.overlay = frames;
 }
 
 void ApplyViewFile(const ViewFile& v, lsys::Grammar& g) {
@@ -644,6 +853,7 @@ void ApplyViewFile(const ViewFile& v, lsys::Grammar& g) {
 
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec) {
   if (!view) return;
+  spec.draw.widthInPixels = view->widthInPixels;
   spec.cpfgSurfaces = view->surfaces;
   spec.cpfgFunctions = view->functions;
   spec.cpfgViewFile = view->path;

@@ -32,6 +32,7 @@
 #include "core/math.h"
 #include "lsys/grammar.h"
 #include "lsys/parser.h"
+#include "plant/frames.h"
 #include "plant/plant.h"
 
 namespace sylva::app {
@@ -51,6 +52,28 @@ struct ViewFile {
   std::optional<Vec3> viewpoint;                // `viewpoint:` (the eye)
   std::optional<Vec3> target;                   // `view reference point:`
   std::optional<double> scale;                  // `scale factor:` (> 0)
+  std::optional<double> viewingAngle;           // `viewing angle:` (degrees, 0..180): perspective
+  // cpfg's line style: widths in pixels on the screen (`initial line
+  // width: 2 pixels`, `line style: pixel`, or neither: cpfg's default,
+  // with a width of 1), not in world units (`initial line width: 0.1`,
+  // `... 0.1 s`, `line style: polygon` or `cylinder`). False without a
+  // view file.
+  bool widthInPixels = false;
+  // cpfg's projection: parallel (`projection: parallel`, and cpfg's
+  // default when the line is missing) or perspective. False without a
+  // view file.
+  bool parallel = false;
+  // Unit direction toward cpfg's light: the first `light:` line's V (or
+  // its O position seen from the origin), else `light direction:`; it
+  // turns the key light of `sylva render`.
+  std::optional<Vec3> lightToward;
+  // cpfg's animation file NAME.a beside the grammar, when it says `clear
+  // between frames: off`: cpfg's picture is then the frames from `first
+  // frame:` to `last frame:` (every `step:`) drawn over each other
+  // (plant/frames.h). Its other lines are playback settings that do not
+  // change a still picture, and are not read.
+  std::string animationPath;
+  std::optional<plant::FrameRange> overlay;
   std::string colorsPath;                       // the .map or .mat read
   std::vector<std::array<float, 3>> palette;    // sRGB 0..1 of each colour index
   std::vector<plant::CpfgSurfaceDef> surfaces;  // `surface: l leaf.s size s t`
@@ -82,9 +105,13 @@ Expected<std::vector<std::array<float, 3>>> ParseMaterials(const std::string& by
 // The view file and colours of the grammar at `grammarPath`: `explicitView`
 // when not empty (an error when it cannot be read), else NAME.v beside the
 // grammar if it exists; NAME.mat or NAME.map beside the grammar or the view
-// file. nullptr when there is none of them.
+// file; NAME.a beside the grammar. nullptr when there is none of them.
 std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
                                               const std::string& explicitView);
+
+// Reads an animation file's text into view.animationPath and view.overlay
+// (errors and warnings to view.diagnostics).
+void ParseAnimationFile(const std::string& text, const std::string& path, ViewFile& view);
 
 // Puts what the view file says into the grammar (its header values, read
 // as the turtle's defaults).

@@ -66,6 +66,10 @@ struct PlantGeometry {
   uint32_t branchCount = 0;
   Vec3 boundsMin{0, 0, 0}, boundsMax{0, 0, 0};  // of every point drawn or visited
   bool planar = true;  // every point lies in the z = 0 plane (ABOP's 2D figures)
+  // Segment radii are pixels on screen, not world units: a cpfg view file's
+  // line style `pixels` (`initial line width: 2 pixels`). The tessellator
+  // turns them into world radii for its view (mesh/pixel_widths.h).
+  bool widthInPixels = false;
 
   // Problems that do not stop the drawing (an unmatched `}`, a polygon with
   // fewer than 3 vertices), each naming the module.

@@ -9,6 +9,7 @@
 #include "core/assert.h"
 #include "core/memory.h"
 #include "core/parallel.h"
+#include "mesh/pixel_widths.h"
 #include "mesh/screen_detail.h"
 
 namespace sylva::mesh {
@@ -589,6 +590,16 @@ Status StreamMesh(const MeshStream& stream, const PlantGeometry& g, const Chains
 Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, TriangleMesh& out,
                   TessellateStats* stats) {
   const ScreenView* view = options.view ? &*options.view : nullptr;
+  if (g.widthInPixels) {
+    // cpfg's pixel widths: world radii for this view (mesh/pixel_widths.h).
+    if (!view && stats) {
+      stats->warnings.push_back(
+          "the widths are pixels (the view file's line style) and this mesh has no view: a "
+          "pixel is drawn as 1/" +
+          std::to_string(int(kNominalPixels)) + " of the plant's largest extent");
+    }
+    return Tessellate(ResolvePixelWidths(g, view), options, out, stats);
+  }
   auto detailFor = [&](const Vec3& c, double r) {
     if (view) return SidesForPixelRadius(r * PixelsPerUnit(*view, c), view->eps);
     return ClampSides(options.detailFn ? options.detailFn(c, r).sides : options.detail.sides);
@@ -910,17 +921,19 @@ Box TessellatedBounds(const PlantGeometry& g,
                       const std::unordered_map<std::string, TriangleMesh>* surfaces) {
   Box box;
   // A tube is the hull of its end discs: a disc of radius r across the
-  // unit axis t reaches r sqrt(1 - t_k^2) along axis k.
+  // unit axis t reaches r sqrt(1 - t_k^2) along axis k. Radii in pixels
+  // (widthInPixels) are nothing in world units: the axis alone.
+  const float radiusUnit = g.widthInPixels ? 0.0f : 1.0f;
   for (const Segment& s : g.segments) {
     const Vec3 d = s.end - s.start;
     const double len = d.norm();
     if (!(len > 1e-12)) continue;
     const Vec3 t = d / len;
     const Vec3 reach = (Vec3::Ones() - t.cwiseProduct(t)).cwiseMax(0.0).cwiseSqrt();
-    box.Add(s.start - reach * s.radiusStart);
-    box.Add(s.start + reach * s.radiusStart);
-    box.Add(s.end - reach * s.radiusEnd);
-    box.Add(s.end + reach * s.radiusEnd);
+    box.Add(s.start - reach * (s.radiusStart * radiusUnit));
+    box.Add(s.start + reach * (s.radiusStart * radiusUnit));
+    box.Add(s.end - reach * (s.radiusEnd * radiusUnit));
+    box.Add(s.end + reach * (s.radiusEnd * radiusUnit));
   }
   for (const Sphere& s : g.spheres) {
     Box b;

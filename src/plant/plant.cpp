@@ -38,7 +38,7 @@ void AddWarnings(const std::vector<std::string>& warnings, const std::string& pa
 // `width scale:`, say so and name the fix.
 void WarnAboutPixelWidths(const lsys::Grammar& g, const mesh::PlantGeometry& geometry,
                           DiagnosticList& out) {
-  if (g.widthScale != 1 || geometry.segments.size() < 4) return;
+  if (g.widthScale != 1 || geometry.widthInPixels || geometry.segments.size() < 4) return;
   size_t fat = 0;
   for (const mesh::Segment& s : geometry.segments) {
     const double diameter = 2.0 * std::max(s.radiusStart, s.radiusEnd);

@@ -61,7 +61,8 @@ std::shared_ptr<mesh::TriangleMesh> GroundMesh(double cx, double y, double cz, d
 }  // namespace
 
 draw::DrawList DefaultScene(std::shared_ptr<const mesh::TriangleMesh> plant,
-                            const mesh::Palette& palette, const Vec3& lo, const Vec3& hi) {
+                            const mesh::Palette& palette, const Vec3& lo, const Vec3& hi,
+                            bool ground) {
   draw::DrawList list;
   list.lights = draw::DefaultLights();
   list.background = mesh::Srgb(0.94f, 0.95f, 0.96f);
@@ -71,6 +72,7 @@ draw::DrawList DefaultScene(std::shared_ptr<const mesh::TriangleMesh> plant,
   p.palette = palette;
   p.instances.emplace_back();
   p.name = "plant";
+  if (!ground) return list;
 
   const double radius = std::max(0.5 * (hi - lo).norm(), 1e-3);
   draw::MeshDraw& g = list.meshes.emplace_back();

@@ -21,9 +21,16 @@ namespace sylva::scene {
 
 // `lo`..`hi`: the whole plant's box, before any culling; the ground lies at
 // lo.y and the shadow map covers the box (draw::DrawList::shadowBounds), so
-// every view of one plant gets the same shadows.
+// every view of one plant gets the same shadows. `ground` false: no ground
+// (a camera below it, such as a cpfg view file looking up into a crown,
+// would see only its underside).
 draw::DrawList DefaultScene(std::shared_ptr<const mesh::TriangleMesh> plant,
-                            const mesh::Palette& palette, const Vec3& lo, const Vec3& hi);
+                            const mesh::Palette& palette, const Vec3& lo, const Vec3& hi,
+                            bool ground = true);
+
+// Whether a camera at `eye` sees the default ground of a plant whose box
+// starts at lo.y from above (eye.y >= lo.y).
+inline bool SeesGroundFromAbove(const Vec3& eye, const Vec3& lo) { return eye.y() >= lo.y(); }
 
 // The ground's colour near the plant (linear); toward its rim it turns to
 // what the default lights make of the background colour.

@@ -780,14 +780,17 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           break;
         case Op::kDisc:
         case Op::kCircle: {
-          // @o(d): in the plane of H and L, facing -U (the viewer of a 2D
-          // figure, which cpfg draws facing the screen); @c(d): across the
-          // heading, facing H. d defaults to the width.
+          // As cpfg draws them (irisGL.c): @c(d) (iGlCircle3D) in the
+          // turtle's frame, local x = L, y = H, z = U, a circle in the
+          // local xy plane: the plane of H and L, facing U; @o(d)
+          // (iGlCircle2D: circf at the turtle's x, y) in the world's xy
+          // plane, facing +z, the screen of a 2D figure. d defaults to
+          // the width.
           const double d = (np ? p[0] : t.width) * def.widthScale;
           if (op == Op::kDisc) {
-            AddDisc(t.pos, t.frame.heading, t.frame.left, d, t.color, uint32_t(i), g);
+            AddDisc(t.pos, Vec3(1, 0, 0), Vec3(0, 1, 0), d, t.color, uint32_t(i), g);
           } else {
-            AddDisc(t.pos, t.frame.up, t.frame.left, d, t.color, uint32_t(i), g);
+            AddDisc(t.pos, t.frame.left, t.frame.heading, d, t.color, uint32_t(i), g);
           }
           break;
         }
@@ -908,6 +911,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   g.boundsMin = lo;
   g.boundsMax = hi;
   g.planar = planar;
+  g.widthInPixels = options.widthInPixels;
   g.branchCount = uint32_t(branchParent.size());
   return {};
 }

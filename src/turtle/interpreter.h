@@ -21,9 +21,9 @@
 // f, the frame turns about H x T by e |H x T|.
 //
 // cpfg's commands (its manual, and vlab's blackbox.c):
-//   @o(d)  a disc of diameter d (default: the width) in the plane of H and L,
-//          facing -U: a polygon of 24 vertices
-//   @c(d)  the same across the heading (the plane of L and U), facing H
+//   @o(d)  a disc of diameter d (default: the width) in the world's xy
+//          plane, facing +z (cpfg's 2D circle): a polygon of 24 vertices
+//   @c(d)  the same in the plane of H and L, facing U (cpfg's 3D circle)
 //   @v     roll to vertical: the same as $
 //   @Gs @Gc(n) @Ge(n)  a generalized cylinder: a tube along the cubic
 //          Hermite curve through the turtle's positions at @Gs, each @Gc and
@@ -91,6 +91,9 @@ struct DrawOptions {
   // vertices, spheres, surfaces); counted before anything is allocated. A
   // segment takes 112 bytes: 2^24 of them, 1.75 GiB.
   uint64_t maxPrimitives = uint64_t(1) << 24;
+  // The widths are pixels on screen (cpfg's line style `pixels`): copied
+  // to PlantGeometry::widthInPixels.
+  bool widthInPixels = false;
 };
 
 // Coordinates, widths and scales the turtle may produce: beyond this, float

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "app/cli_test_util.h"
@@ -53,6 +54,70 @@ TEST(ViewFile, ReadsWhatTheTurtleUses) {
   EXPECT_EQ(ParseViewFile("angle factor: 16\n", "p.v").angle.value_or(-1), 22.5);
 }
 
+TEST(ViewFile, LineStyleAndProjectionAsCpfgReadsThem) {
+  // cpfg (interpret.c ReadViewData, InitializeParameters): widths are
+  // pixels unless the width line says otherwise, 1 by default; the
+  // projection is parallel unless it says perspective.
+  ViewFile none = ParseViewFile("angle increment: 30\n", "p.v");
+  EXPECT_TRUE(none.widthInPixels);
+  EXPECT_EQ(none.width.value_or(-1), 1);
+  EXPECT_TRUE(none.parallel);
+  ViewFile px = ParseViewFile("initial line width: 2 pixels\nprojection: parallel\n", "p.v");
+  EXPECT_TRUE(px.diagnostics.items.empty()) << Messages(px.diagnostics);
+  EXPECT_TRUE(px.widthInPixels);
+  EXPECT_EQ(px.width.value_or(-1), 2);
+  EXPECT_TRUE(px.parallel);
+  for (const char* world : {"initial line width: 0.1\n", "initial line width: 0.1 s\n",
+                            "initial line width: 0.3 polygons\n",
+                            "initial line width: 3 pixels\nline style: cylinder\n"}) {
+    ViewFile w = ParseViewFile(world, "p.v");
+    EXPECT_TRUE(w.diagnostics.items.empty()) << world << Messages(w.diagnostics);
+    EXPECT_FALSE(w.widthInPixels) << world;
+  }
+  ViewFile persp = ParseViewFile("projection: perspective\nline style: pixel\n", "p.v");
+  EXPECT_TRUE(persp.diagnostics.items.empty()) << Messages(persp.diagnostics);
+  EXPECT_FALSE(persp.parallel);
+  EXPECT_TRUE(persp.widthInPixels);
+  ViewFile odd = ParseViewFile("projection: fisheye\nline style: wavy\n", "p.v");
+  const std::string all = Messages(odd.diagnostics);
+  EXPECT_NE(all.find("1:13 warning: unknown projection 'fisheye': parallel"), std::string::npos)
+      << all;
+  EXPECT_NE(all.find("2:13 warning: 'line style:' is 'pixel', 'polygon' or 'cylinder', not 'wavy'"),
+            std::string::npos)
+      << all;
+  EXPECT_TRUE(odd.parallel);
+}
+
+TEST(ViewFile, LightsGiveTheKeyLightItsDirection) {
+  // cpfg's OpenGL renderer (irisGL.c read_light, set_gl_lights): the
+  // `light:` lines, else a directional light toward `light direction:`.
+  ViewFile dir = ParseViewFile("light direction: 0,2,0\n", "p.v");
+  EXPECT_TRUE(dir.diagnostics.items.empty()) << Messages(dir.diagnostics);
+  ASSERT_TRUE(dir.lightToward.has_value());
+  EXPECT_LT((*dir.lightToward - Vec3(0, 1, 0)).norm(), 1e-15);
+  ViewFile first = ParseViewFile(
+      "light direction: 1,0,0\nlight: O:400 500 300\nlight: V: 0 0 1 D: 1 1 1\n", "p.v");
+  ASSERT_TRUE(first.lightToward.has_value());
+  EXPECT_LT((*first.lightToward - Vec3(400, 500, 300).normalized()).norm(), 1e-12);
+  const std::string all = Messages(first.diagnostics);
+  ASSERT_EQ(first.diagnostics.items.size(), 1u) << all;
+  EXPECT_NE(all.find("3:1 warning: a second 'light:'"), std::string::npos) << all;
+  ViewFile colours = ParseViewFile("light: V:1 1 0 A: 0.2 0.2 0.2 D:1 1 1\n", "p.v");
+  const std::string c = Messages(colours.diagnostics);
+  EXPECT_NE(c.find("1:1 warning: 'light:': Sylva uses the light's direction"), std::string::npos)
+      << c;
+  EXPECT_NE(c.find("A, D (colours"), std::string::npos) << c;
+  ASSERT_TRUE(colours.lightToward.has_value());
+  EXPECT_NEAR(colours.lightToward->x(), std::sqrt(0.5), 1e-12);
+  ViewFile bad = ParseViewFile("light: Q 1 2 3\nlight direction: 0,0,0\n", "p.v");
+  const std::string b = Messages(bad.diagnostics);
+  EXPECT_NE(b.find("1:8 error: expected A, D, S, O, V, P or T in 'light:', not 'Q'"),
+            std::string::npos)
+      << b;
+  EXPECT_NE(b.find("2:18 error: the light direction must not be 0,0,0"), std::string::npos) << b;
+  EXPECT_FALSE(ParseViewFile("angle factor: 8\n", "p.v").lightToward.has_value());
+}
+
 TEST(ViewFile, TropismLettersMayCarryAColonAndAnAttachedValue) {
   // As vlab's published view files write them.
   ViewFile v = ParseViewFile("tropism: T: 0.0 -1.0 0.0  A:0 E: 0.3\n", "p.v");
@@ -72,8 +137,8 @@ TEST(ViewFile, TropismLettersMayCarryAColonAndAnAttachedValue) {
 
 TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
   ViewFile v = ParseViewFile(
-      "twist: 0\nz buffer: on\nprojection: perspective\n"  // as Sylva draws: silent
-      "light direction: 1,1,1\n"
+      "twist: 0\nz buffer: on\nprojection: perspective\n"  // acted on or as Sylva draws: silent
+      "shade mode: 3\n"
       "  tsurface: l leaf.s 1\n"
       "tsurface: k flower.s 1\n"
       "#include \"more.v\"\n"
@@ -84,7 +149,7 @@ TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
   ASSERT_EQ(v.diagnostics.items.size(), 5u) << all;
   EXPECT_EQ(v.diagnostics.HasErrors(), false) << all;
   EXPECT_EQ(v.diagnostics.items[0].loc.line, 4) << all;
-  EXPECT_NE(all.find("4:1 warning: 'light direction:' is read but not acted on"), std::string::npos)
+  EXPECT_NE(all.find("4:1 warning: 'shade mode:' is read but not acted on"), std::string::npos)
       << all;
   EXPECT_NE(all.find("5:3 warning: 'tsurface:' is read but not acted on"), std::string::npos)
       << all;

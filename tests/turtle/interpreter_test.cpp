@@ -379,17 +379,33 @@ TEST(Turtle, DiscLiesInTheHeadingLeftPlaneFacingMinusUp) {
   EXPECT_TRUE(d.geometry.segments.size() == 1u);
 }
 
-TEST(Turtle, CircleLiesAcrossTheHeadingWithTheWidthAsDefaultDiameter) {
+TEST(Turtle, DiscFacesTheScreenWhateverTheTurtlesFrame) {
+  // cpfg's @o is a 2D circle (irisGL.c iGlCircle2D): in the world's xy
+  // plane even after the turtle pitched and rolled.
+  Drawn d = Draw("axiom: F &(60) /(35) F @o(2)\n");
+  ASSERT_EQ(d.geometry.polygons.size(), 1u);
+  const auto& v = d.geometry.polygons[0].vertices;
+  const Vec3 centre = d.geometry.segments.back().end;
+  for (const Vec3& p : v) {
+    EXPECT_NEAR((p - centre).norm(), 1.0, 1e-12) << Str(p);
+    EXPECT_NEAR(p.z(), centre.z(), 1e-12) << Str(p);
+  }
+  EXPECT_VEC_NEAR(NewellNormal(v), Vec3(0, 0, 1), 1e-12);
+}
+
+TEST(Turtle, CircleLiesInTheHeadingLeftPlaneWithTheWidthAsDefaultDiameter) {
+  // cpfg's @c (irisGL.c iGlCircle3D) maps its circle's x, y, z to the
+  // turtle's L, H, U: it lies in the plane of H and L, facing U. After
+  // &(90) H = (0,0,-1), L = (-1,0,0), U = (0,-1,0): the plane y = 1.
   Drawn d = Draw("width: 0.4\naxiom: F &(90) @c\n");
   ASSERT_EQ(d.geometry.polygons.size(), 1u);
   const auto& v = d.geometry.polygons[0].vertices;
   ASSERT_EQ(v.size(), 24u);
-  // After &(90) H = (0,0,-1): the disc lies in the plane z = 0 through (0,1,0).
   for (const Vec3& p : v) {
     EXPECT_NEAR((p - Vec3(0, 1, 0)).norm(), 0.2, 1e-12) << Str(p);
-    EXPECT_NEAR(p.z(), 0.0, 1e-12) << Str(p);
+    EXPECT_NEAR(p.y(), 1.0, 1e-12) << Str(p);
   }
-  EXPECT_VEC_NEAR(NewellNormal(v), Vec3(0, 0, -1), 1e-12);  // H
+  EXPECT_VEC_NEAR(NewellNormal(v), Vec3(0, -1, 0), 1e-12);  // U
 }
 
 TEST(Turtle, RollToVerticalIsDollar) {
