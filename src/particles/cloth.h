@@ -91,7 +91,8 @@ struct ClothDef {
   double windFriction = 0;  // c_f, along the triangle, 0..1e6
   std::vector<int> pinned;  // particle indices (row * columns + column), each 0..columns * rows - 1
   // Long-range attachments: tethers from every particle to its two nearest
-  // pins, at their rest distance (XPBD only).
+  // pins, at their rest distance (XPBD only: the implicit solver ignores
+  // them).
   bool longRangeAttachments = true;
   // Self-collision: two particles that were farther apart than `thickness`
   // at rest are kept at least that far apart, m, 0..1e12 (0: off). A sheet
@@ -110,13 +111,13 @@ struct ClothDef {
   double implicitDamping = 0.02;    // N s/m along each spring, 0..1e12
   int implicitSubsteps = 1;         // backward-Euler steps per Step, 1..10000
   // Strain limiting after each implicit step (Provot 1995): structural
-  // constraints stretched more than this fraction, and tethers (with
-  // longRangeAttachments) longer than their rest distance by it, are
-  // shortened to it, Gauss-Seidel colour by colour, up to
-  // `implicitStrainIterations` passes or until none is; the velocities
+  // constraints stretched more than this fraction are shortened (to 80 %
+  // of it), on coarser grids of the cloth first and then on its own links
+  // (see LimitStrain in cloth.cpp), in cycles until a pass finds none past
+  // the limit, at most `implicitStrainIterations` cycles; the velocities
   // take the correction. 0..1e6; 0 = off.
   double implicitStrainLimit = 0.1;
-  int implicitStrainIterations = 20;  // 1..100000
+  int implicitStrainIterations = 200;  // cycles, 1..100000
   int cgIterations = 20;              // 1..100000
 };
 
@@ -188,6 +189,10 @@ class Cloth {
   SolveStats lastSolve() const { return implicit_ ? implicit_->lastSolve() : SolveStats{}; }
   // Largest relative stretch of a structural constraint, (len - rest) / rest.
   double MaxStretch() const;
+  // The strain limiter's cycles in the last implicit substep (0: none ran);
+  // implicitStrainIterations means it stopped at the bound, and a link may
+  // still be past the limit (MaxStretch says by how much).
+  int lastStrainCycles() const { return lastStrainCycles_; }
 
  private:
   explicit Cloth(const ClothDef& def);
@@ -195,13 +200,27 @@ class Cloth {
   Status StepImplicit(double dt, const Vec3& gravity, const Vec3& wind);
   // Strain limiting of the implicit state after a step of h seconds.
   void LimitStrain(std::vector<Vec3>& x, std::vector<Vec3>& v, double h);
+  // The limiter's levels from the current inverse masses (pins).
+  void BuildStrainLimiter();
   struct StrainLink {  // 40 bytes
     uint32_t a, b;
     double max2, target;    // (limit rest)^2, the length a stretched link goes back to
     double shareA, shareB;  // w_a / (w_a + w_b), w_b / (w_a + w_b)
   };
-  std::vector<StrainLink> strainLinks_;
-  std::vector<Vec3> strainX0_;
+  // A coarse grid of the cloth: the particles of some columns and rows,
+  // linked to their neighbours on it.
+  struct StrainLevel {
+    std::vector<StrainLink> links;
+    // Each column's coarse column at or before it (its index in `columns`)
+    // and its fraction of the way to the next; the same for rows.
+    std::vector<int> columns, rows, columnBelow, rowBelow;
+    std::vector<double> columnFraction, rowFraction;
+  };
+  // Coarsest first; the last is the cloth's own structural links.
+  std::vector<StrainLevel> strainLevels_;
+  bool strainBuilt_ = false;
+  std::vector<Vec3> strainX0_, strainLevelX0_;
+  int lastStrainCycles_ = 0;
   Status StepXpbd(double dt, const Vec3& gravity, const Vec3& wind);
   // Colliders and self-collision on the XPBD substep's positions.
   void ContactsXpbd(ThreadPool* pool);

@@ -128,28 +128,59 @@ TEST(ClothImplicit, LargeStepsStayStableWithPinsFixed) {
   EXPECT_LT(lowest, -0.9) << "the cloth hangs";
 }
 
+// A k x k, 1 kg, 1 m cloth hanging from its top corners in a 2 m/s wind,
+// 30 implicit steps of 1/10 s: the largest structural stretch after any
+// step, and the most strain-limiter cycles a step took.
+struct Peak {
+  double stretch = 0;
+  int cycles = 0;
+};
+Peak HangAtATenthOfASecond(int k, double strainLimit) {
+  ClothDef def;
+  def.columns = def.rows = k;
+  def.solver = ClothSolver::kImplicit;
+  def.pinned = {0, k - 1};
+  def.implicitStrainLimit = strainLimit;
+  auto cloth = testing::Made(Cloth::Create(def));
+  Peak peak;
+  for (int i = 0; i < 30; ++i) {
+    EXPECT_OK(cloth->Step(0.1, Vec3(0, -9.81, 0), Vec3(0, 0, 2)));
+    peak.stretch = std::max(peak.stretch, cloth->MaxStretch());
+    peak.cycles = std::max(peak.cycles, cloth->lastStrainCycles());
+  }
+  return peak;
+}
+
 // Steps of 1/10 s: one linearised backward-Euler step is far from the
 // nonlinear solution and the springs stretch (a 32 x 32 cloth falling from
-// two corners peaked at 23 %, a 100 x 100 one at 880 %); strain limiting
-// holds the 32 x 32 one to 10 % (docs/particles.md gives the larger ones'
-// figures), and XPBD with 60 substeps holds even the 100 x 100 one to 5 %.
+// two corners peaks at 23 %, a 100 x 100 one at 880 %); strain limiting on
+// coarser grids and then the cloth's own holds each to 10 %.
 TEST(ClothImplicit, StrainLimitingHoldsTenPercentAtATenthOfASecond) {
-  double peak[2];
-  for (int limit = 0; limit < 2; ++limit) {
-    ClothDef def;
-    def.columns = def.rows = 32;
-    def.solver = ClothSolver::kImplicit;
-    def.pinned = {0, 31};
-    def.implicitStrainLimit = limit ? 0.1 : 0;
-    auto cloth = testing::Made(Cloth::Create(def));
-    peak[limit] = 0;
-    for (int i = 0; i < 30; ++i) {
-      ASSERT_OK(cloth->Step(0.1, Vec3(0, -9.81, 0), Vec3(0, 0, 2)));
-      peak[limit] = std::max(peak[limit], cloth->MaxStretch());
-    }
+  const Peak free = HangAtATenthOfASecond(32, 0);
+  EXPECT_GT(free.stretch, 0.2) << "32 x 32 without strain limiting: peak " << free.stretch;
+  EXPECT_EQ(free.cycles, 0);
+  for (int k : {32, 64}) {
+    const Peak held = HangAtATenthOfASecond(k, 0.1);
+    EXPECT_LE(held.stretch, 0.1 + 1e-9)
+        << k << " x " << k << ": peak stretch " << held.stretch << " (" << held.cycles
+        << " cycles at most)";
+    EXPECT_LT(held.cycles, ClothDef().implicitStrainIterations) << k << " x " << k;
   }
-  EXPECT_GT(peak[0], 0.2) << "without strain limiting";
-  EXPECT_LE(peak[1], 0.1 + 1e-9) << "with strain limiting";
+}
+
+// The same for 100 x 100 (about 2.5 s of a Release build): before the
+// coarse grids, Gauss-Seidel passes on the links alone let it peak at 33 %
+// with 20 passes and 18 % with 1,000.
+TEST(ClothImplicit, StrainLimitingHoldsTenPercentOnA100x100SheetAtATenthOfASecond) {
+  const Peak held = HangAtATenthOfASecond(100, 0.1);
+  EXPECT_LE(held.stretch, 0.1 + 1e-9)
+      << "100 x 100: peak stretch " << held.stretch << " (" << held.cycles << " cycles at most)";
+  EXPECT_LT(held.cycles, ClothDef().implicitStrainIterations);
+}
+
+// XPBD at the same frame step with 60 substeps of 1/600 s holds even the
+// 100 x 100 cloth to 5 %.
+TEST(Cloth, SixtySubstepsHoldA100x100SheetToFivePercentAtATenthOfASecond) {
   ClothDef def;
   def.columns = def.rows = 100;
   def.pinned = {0, 99};
@@ -160,7 +191,7 @@ TEST(ClothImplicit, StrainLimitingHoldsTenPercentAtATenthOfASecond) {
     ASSERT_OK(cloth->Step(0.1, Vec3(0, -9.81, 0), Vec3(0, 0, 2)));
     xpbd = std::max(xpbd, cloth->MaxStretch());
   }
-  EXPECT_LT(xpbd, 0.05) << "XPBD, 100 x 100, 60 substeps of 1/600 s";
+  EXPECT_LT(xpbd, 0.05) << "XPBD, 100 x 100, 60 substeps of 1/600 s: peak " << xpbd;
 }
 
 TEST(ClothImplicit, ConjugateGradientsConvergeWhenGivenTheIterations) {
