@@ -11,10 +11,11 @@
 // cpfg runs the program as a separate process and sends it, after each
 // step, every ?E module with the turtle state the file asks for; the
 // program's answers fill the modules' parameters. Sylva has no such
-// processes: it builds in the programs that vlab's objects use most
-// (plant/density_environment.h: honda81, ecosystem, ecosystemR) and
+// processes: it builds in the programs that vlab's objects use (honda81
+// and ecosystem: plant/density_environment.h; clover:
+// plant/clover_environment.h; chiba: plant/chiba_environment.h) and
 // answers ?E the same way, reading the program's own spec file. A program
-// Sylva lacks (chiba, clover, soil, MonteCarlo, ...) is a warning at the
+// Sylva lacks (soil, ecosystemR, MonteCarlo, ...) is a warning at the
 // `executable:` line that names it, and ?E keeps its parameters.
 //
 // The positions go through the file's `turtle position:` format as cpfg's

@@ -18,6 +18,9 @@
 //          shadow-propagation grid (Palubicki et al. 2009), 0..1.
 //   terrain (plant/ground_environment.h): the ground's height and normal
 //          under the query (a scene's terrain, or the plane y = 0).
+// Without `environment:`, a grammar in a cpfg object folder is answered by
+// the environment program its .e file names (plant/cpfg_environment.h:
+// honda81, ecosystem, clover, chiba built in).
 // GL-free; units are the grammar's.
 #pragma once
 

@@ -437,6 +437,22 @@ TEST(CpfgEnvironment, ChibaReadsItsSpecFile) {
   EXPECT_EQ(r.diagnostics.FormatAll(), "");
 }
 
+TEST(CpfgEnvironment, TheCpfgLineNamingTheGrammarChoosesTheEFile) {
+  // specifications' cpfg line for another grammar (a control panel) is
+  // passed over; LSspecifications' line for this one names far.e.
+  Folder f;
+  f.files["obj/specifications"] = "image:\n\tcpfg -e panel.e panel.l\n";
+  f.files["obj/LSspecifications"] = "cpfg -m t.map -e far.e t.l t.v t.a\nauto run: on\n";
+  f.files["obj/panel.e"] = "executable: soil\n";
+  f.files["obj/far.e"] = "executable: honda81 -e far.e d.spec\nturtle position:%f %f %f\n";
+  f.files["obj/d.spec"] = "radius: 1.5\n3d case: on\n";
+  EXPECT_EQ(WordOf(Grow(f, kTips, 4)), "[F(1)F(1)A?E(0)]f(5)|F(1)F(1)A?E(0)");
+  // With neither naming it, NAME.e beside the grammar is used.
+  f.files.erase("obj/LSspecifications");
+  f.files["obj/t.e"] = f.files["obj/far.e"];
+  EXPECT_EQ(WordOf(Grow(f, kTips, 4)), "[F(1)F(1)A?E(0)]f(5)|F(1)F(1)A?E(0)");
+}
+
 std::string Warnings(const Folder& f, const std::string& grammar) {
   PlantResult r = Grow(f, grammar, 1);
   EXPECT_TRUE(r.plant) << r.diagnostics.FormatAll();
