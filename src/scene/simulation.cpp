@@ -1231,8 +1231,18 @@ Expected<std::unique_ptr<Simulation>> Simulation::Create(const Scene& scene,
     m.flocks.push_back(std::move(flock));
   }
   if (Status s = m.PlaceCentres(); !s.ok()) return s.error();
-  for (auto& ps : m.systems)
+  for (auto& ps : m.systems) {
     if (Status s = m.AddClothColliders(*ps); !s.ok()) return s.error();
+    // A particle that sticks is pinned where it touched: on a sheet that
+    // moves on, it stays behind in the air.
+    for (const ParticleSystem::ClothCollider& cc : ps->clothColliders) {
+      if (cc.def->stick)
+        diags.Add(Warn(cc.def->loc, "stick=\"true\" with the cloth '" + m.cloths[cc.cloth].def->id +
+                                        "': a particle that lands on it stays where it landed "
+                                        "while the sheet moves on (it does not ride with the "
+                                        "cloth)"));
+    }
+  }
   // A cloth colliding with another cloth: the other sheet's triangles, now
   // and before each step, kept a quarter of this sheet's cell away (a sheet
   // has two sides: a vertex resting on the surface itself would pass).
