@@ -122,7 +122,7 @@ struct ClothDef {
   // take the correction. 0..1e6; 0 = off.
   double implicitStrainLimit = 0.1;
   int implicitStrainIterations = 200;  // cycles, 1..100000
-  int cgIterations = 20;              // 1..100000
+  int cgIterations = 20;               // 1..100000
 };
 
 // The first field of `def` outside its range, or ok.

@@ -330,8 +330,8 @@ TEST(SceneSimulation, SelfCollidingParticlesDoNotOverlapWhereOthersPassThroughEa
   EXPECT_EQ(without.n, 150u);
   EXPECT_EQ(with.overlaps, 0u) << "with <self-collide>: closest centres " << with.closest
                                << " m apart, radius " << r;
-  EXPECT_GT(without.overlaps, 100u) << "without <self-collide>: closest centres "
-                                    << without.closest;
+  EXPECT_GT(without.overlaps, 100u)
+      << "without <self-collide>: closest centres " << without.closest;
   EXPECT_LT(without.highest, r + 1e-3) << "without <self-collide> every ball lies on the ground";
   EXPECT_GT(with.closest, without.closest) << "with <self-collide>: closest " << with.closest;
 }
@@ -357,9 +357,9 @@ TEST(SceneSimulation, ParticlesStuckToAClothStayWhereTheyLandedAndTheSceneWarns)
   ASSERT_TRUE(run);
   bool warned = false;
   for (const Diagnostic& d : warnings.items)
-    warned = warned || (d.severity == Severity::kWarning &&
-                        d.message.find("stays where it landed") != std::string::npos &&
-                        d.loc.line == 9);
+    warned =
+        warned || (d.severity == Severity::kWarning &&
+                   d.message.find("stays where it landed") != std::string::npos && d.loc.line == 9);
   EXPECT_TRUE(warned) << warnings.FormatAll();
   ASSERT_TRUE(run->sim->AdvanceTo(1.0).ok());
   double sheetHigh = -HUGE_VAL, hailLow = HUGE_VAL, hailHigh = -HUGE_VAL, fastest = 0;
