@@ -580,7 +580,7 @@ void Cloth::BuildStrainLimiter() {
     for (int r = 0; r < nr; ++r)
       if (r % stride == 0 || r == nr - 1 || pinRow[size_t(r)]) level.rows.push_back(r);
     const size_t count = level.columns.size() * level.rows.size();
-    if (2 * count > nodes) break;  // many pins: no coarser than the grid below
+    if (4 * count > 3 * nodes) break;  // many pins: hardly coarser than the grid below
     nodes = count;
     for (int r : level.rows)
       for (size_t k = 0; k + 1 < level.columns.size(); ++k)

@@ -16,6 +16,7 @@
 #include <optional>
 #include <ostream>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "core/assert.h"
 #include "core/rng.h"
@@ -320,6 +321,19 @@ struct ParticleSystem {
     const CollideDef* def;
   };
   std::vector<ClothCollider> clothColliders;
+  // Particles stuck to a cloth (a <collide stick="true"> naming it): each
+  // rides on the triangle it touched, at its barycentric coordinates and
+  // its height along the triangle's normal, moved with the sheet after the
+  // sheet steps (the particle system keeps it pinned).
+  struct Rider {
+    uint32_t id;
+    size_t cloth;
+    uint32_t triangle;
+    double b1, b2;  // barycentric coordinates of corners 1 and 2
+    double height;  // along the unit normal, m
+  };
+  std::vector<Rider> riders;
+  std::unordered_set<uint32_t> pinnedSeen;  // immovable particles already looked at
   // <springs>: the library's Springs, which System::RemoveDead renumbers
   // (a spring follows its particles; one with a dead end goes).
   const SpringsDef* springsDef = nullptr;
@@ -504,6 +518,10 @@ struct Simulation::Impl {
   // added to the system now and rebuilt from the sheet before every step.
   Status AddClothColliders(ParticleSystem& ps);
   Status RefreshClothColliders(ParticleSystem& ps);
+  // Particles of `ps` stuck to a cloth since the last call become riders.
+  void CatchRiders(ParticleSystem& ps);
+  // Riders follow their triangles, after the cloths stepped h seconds.
+  void MoveRiders();
   std::shared_ptr<const particles::TriangleBvh> BvhOf(const std::string& id);
   Status Emit(ParticleSystem& ps, double h);
   Status Step();
@@ -696,6 +714,99 @@ Status Simulation::Impl::PlaceCentres() {
   return {};
 }
 
+// The point of triangle (a, b, c) nearest p, as barycentric coordinates
+// of b and c (Ericson, "Real-Time Collision Detection", 5.1.5).
+static std::pair<double, double> NearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                                   const Vec3& c) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {0, 0};
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {1, 0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return {d1 / (d1 - d3), 0};
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {0, 1};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return {0, d2 / (d2 - d6)};
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {1 - w, w};
+  }
+  const double denom = 1 / (va + vb + vc);
+  return {vb * denom, vc * denom};
+}
+
+void Simulation::Impl::CatchRiders(ParticleSystem& ps) {
+  bool sticky = false;
+  for (const ParticleSystem::ClothCollider& cc : ps.clothColliders) sticky |= cc.def->stick;
+  if (!sticky) return;
+  const ParticleState& st = ps.system->state;
+  for (size_t i = 0; i < st.size(); ++i) {
+    if (st.invMass[i] != 0 || !ps.pinnedSeen.insert(st.id[i]).second) continue;
+    // The nearest triangle of a sticky cloth, where the sheets are now (the
+    // colliders' positions: the cloths step after the particles).
+    const Vec3 x = st.position[i];
+    double best = HUGE_VAL;
+    ParticleSystem::Rider rider{};
+    for (const ParticleSystem::ClothCollider& cc : ps.clothColliders) {
+      if (!cc.def->stick) continue;
+      const particles::Cloth& cloth = *cloths[cc.cloth].cloth;
+      const std::vector<Vec3>& v = cloth.positions();
+      const auto& tris = cloth.triangles();
+      for (size_t k = 0; k < tris.size(); ++k) {
+        const Vec3 &a = v[tris[k][0]], &b = v[tris[k][1]], &c = v[tris[k][2]];
+        // A corner farther than the triangle's longest edge and the best so
+        // far: no point of the triangle is nearer.
+        const double reach =
+            std::sqrt(std::max({(b - a).squaredNorm(), (c - a).squaredNorm()})) + best;
+        if ((x - a).squaredNorm() > reach * reach) continue;
+        const auto [b1, b2] = NearestOnTriangle(x, a, b, c);
+        const Vec3 q = a + b1 * (b - a) + b2 * (c - a);
+        const double d = (x - q).norm();
+        if (d >= best) continue;
+        const Vec3 n = (b - a).cross(c - a);
+        const double area2 = n.norm();
+        if (!(area2 > 0)) continue;
+        best = d;
+        rider = {st.id[i], cc.cloth, uint32_t(k), b1, b2, (x - q).dot(n / area2)};
+      }
+    }
+    // Stuck where a sticky cloth's collider stopped it: its centre at its
+    // radius from the sheet (anything farther stuck to something else).
+    if (best <= double(st.radius[i]) + 1e-6) ps.riders.push_back(rider);
+  }
+}
+
+void Simulation::Impl::MoveRiders() {
+  for (auto& ps : systems) {
+    if (ps->riders.empty()) continue;
+    ParticleState& st = ps->system->state;
+    size_t kept = 0;
+    for (const ParticleSystem::Rider& r : ps->riders) {
+      // Ids grow with births and RemoveDead keeps the order: a search.
+      const auto it = std::lower_bound(st.id.begin(), st.id.end(), r.id);
+      if (it == st.id.end() || *it != r.id) continue;  // died
+      const size_t i = size_t(it - st.id.begin());
+      const particles::Cloth& cloth = *cloths[r.cloth].cloth;
+      const auto& t = cloth.triangles()[r.triangle];
+      const Vec3 &a = cloth.positions()[t[0]], &b = cloth.positions()[t[1]],
+                 &c = cloth.positions()[t[2]];
+      const Vec3 n = (b - a).cross(c - a);
+      const double area2 = n.norm();
+      Vec3 x = a + r.b1 * (b - a) + r.b2 * (c - a);
+      if (area2 > 0) x += (r.height / area2) * n;
+      st.velocity[i] = (x - st.position[i]) / h;
+      st.position[i] = x;
+      ps->riders[kept++] = r;
+    }
+    ps->riders.resize(kept);
+  }
+}
+
 Status Simulation::Impl::Step() {
   for (Centre& c : centres)
     if (c.follow) *c.at = c.follow();
@@ -716,6 +827,7 @@ Status Simulation::Impl::Step() {
         d.message = "<particles> at t = " + std::to_string(time) + " s: " + d.message;
         return d;
       }
+      CatchRiders(*ps);
     }
     // Deaths: secondary bursts where they happen, then removal.
     ParticleState& st = ps->system->state;
@@ -773,6 +885,7 @@ Status Simulation::Impl::Step() {
       return d;
     }
   }
+  MoveRiders();
   for (Flock& f : flocks) {
     if (Status s = f.system->Step(h, particles::Integrator::kSymplecticEuler); !s.ok()) {
       Diagnostic d = s.error();

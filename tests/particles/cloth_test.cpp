@@ -18,7 +18,8 @@ namespace {
 // the extension of a spring of stiffness 1/alpha under their weight.
 TEST(Cloth, HangingMassSettlesAtTheExtensionOfItsCompliance) {
   const double alpha = 1e-3, g = 9.81;
-  for (int iterations : {1, 5, 50}) {
+  const int settings[][2] = {{1, 20}, {5, 20}, {50, 20}, {5, 7}};  // iterations, substeps
+  for (const auto& [iterations, substeps] : settings) {
     ClothDef def;
     def.columns = 2;
     def.rows = 2;
@@ -29,7 +30,7 @@ TEST(Cloth, HangingMassSettlesAtTheExtensionOfItsCompliance) {
     def.shearCompliance = 1e9;  // effectively absent
     def.bendCompliance = 1e9;
     def.windDrag = 0;
-    def.substeps = 20;
+    def.substeps = substeps;
     def.iterations = iterations;
     def.damping = 2.0;
     def.longRangeAttachments = false;  // tethers would cap the extension at rest
@@ -42,7 +43,8 @@ TEST(Cloth, HangingMassSettlesAtTheExtensionOfItsCompliance) {
     const double extension = -cloth.positions()[2].y() - 1.0;
     const double want = 1.0 * g * alpha;
     EXPECT_NEAR(extension, want, 0.01 * want)
-        << iterations << " iterations: extension " << extension << ", want m g alpha = " << want;
+        << iterations << " iterations, " << substeps << " substeps: extension " << extension
+        << ", want m g alpha = " << want;
   }
 }
 
@@ -161,9 +163,8 @@ TEST(ClothImplicit, StrainLimitingHoldsTenPercentAtATenthOfASecond) {
   EXPECT_EQ(free.cycles, 0);
   for (int k : {32, 64}) {
     const Peak held = HangAtATenthOfASecond(k, 0.1);
-    EXPECT_LE(held.stretch, 0.1 + 1e-9)
-        << k << " x " << k << ": peak stretch " << held.stretch << " (" << held.cycles
-        << " cycles at most)";
+    EXPECT_LE(held.stretch, 0.1 + 1e-9) << k << " x " << k << ": peak stretch " << held.stretch
+                                        << " (" << held.cycles << " cycles at most)";
     EXPECT_LT(held.cycles, ClothDef().implicitStrainIterations) << k << " x " << k;
   }
 }
@@ -176,6 +177,26 @@ TEST(ClothImplicit, StrainLimitingHoldsTenPercentOnA100x100SheetAtATenthOfASecon
   EXPECT_LE(held.stretch, 0.1 + 1e-9)
       << "100 x 100: peak stretch " << held.stretch << " (" << held.cycles << " cycles at most)";
   EXPECT_LT(held.cycles, ClothDef().implicitStrainIterations);
+}
+
+// A ribbon two particles wide and 100 long, hanging from its top two:
+// the coarse grids coarsen its rows alone.
+TEST(ClothImplicit, StrainLimitingHoldsANarrowRibbonAtATenthOfASecond) {
+  ClothDef def;
+  def.columns = 2;
+  def.rows = 100;
+  def.u = Vec3(0.02, 0, 0);
+  def.v = Vec3(0, -1, 0);
+  def.mass = 0.04;
+  def.solver = ClothSolver::kImplicit;
+  def.pinned = {0, 1};
+  auto cloth = testing::Made(Cloth::Create(def));
+  double peak = 0;
+  for (int i = 0; i < 30; ++i) {
+    ASSERT_OK(cloth->Step(0.1, Vec3(0, -9.81, 0), Vec3(0, 0, 2)));
+    peak = std::max(peak, cloth->MaxStretch());
+  }
+  EXPECT_LE(peak, 0.1 + 1e-9) << "2 x 100 ribbon: peak stretch " << peak;
 }
 
 // XPBD at the same frame step with 60 substeps of 1/600 s holds even the
@@ -390,6 +411,27 @@ TEST(Cloth, WindDragLiftAndFrictionMatchTheirClosedForms) {
       }
     }
   }
+}
+
+// Compliance 0 is inextensible only in the limit: more substeps and more
+// iterations stiffen it. A 30 x 30 cloth hanging from two corners without
+// tethers, after 2 s of 1/60 s frames.
+TEST(Cloth, MoreSubstepsAndIterationsStretchLess) {
+  const int settings[][2] = {{10, 1}, {20, 4}, {40, 4}};
+  double stretch[3];
+  for (int k = 0; k < 3; ++k) {
+    ClothDef def;
+    def.columns = def.rows = 30;
+    def.pinned = {0, 29};
+    def.longRangeAttachments = false;
+    def.substeps = settings[k][0];
+    def.iterations = settings[k][1];
+    auto cloth = testing::Made(Cloth::Create(def));
+    for (int i = 0; i < 120; ++i) ASSERT_OK(cloth->Step(1.0 / 60, Vec3(0, -9.81, 0)));
+    stretch[k] = cloth->MaxStretch();
+  }
+  EXPECT_GT(stretch[0], 2 * stretch[1]) << "10 x 1: " << stretch[0] << ", 20 x 4: " << stretch[1];
+  EXPECT_GT(stretch[1], 1.5 * stretch[2]) << "20 x 4: " << stretch[1] << ", 40 x 4: " << stretch[2];
 }
 
 TEST(Cloth, TethersKeepAHangingClothFromStretching) {

@@ -157,6 +157,28 @@ TEST(Cloth, StepReportsBadStepsBadFieldsAndNonFiniteParticles) {
   }
 }
 
+// A failure inside the implicit solve (here a wind field that is not
+// finite, which makes the right-hand side NaN) comes back from Cloth::Step
+// with the frame and the substep, and the cloth refuses further frames; XPBD
+// reports the same field as a non-finite particle.
+TEST(Cloth, ImplicitSolveFailuresAreReportedWithTheFrame) {
+  for (ClothSolver solver : {ClothSolver::kXPBD, ClothSolver::kImplicit}) {
+    const bool implicit = solver == ClothSolver::kImplicit;
+    const std::string ctx = implicit ? "implicit" : "XPBD";
+    auto cloth = testing::Made(Cloth::Create(SmallCloth(solver)));
+    const Vec3 g(0, -9.81, 0);
+    for (int i = 0; i < 2; ++i) ASSERT_OK(cloth->Step(1.0 / 60, g));
+    const Status st = cloth->StepInWindField(
+        1.0 / 60, g, [](const Vec3& x) { return x.x() > 0.5 ? Vec3(0, 0, kNaN) : Vec3::Zero(); });
+    if (implicit) {
+      ExpectError(st, {"cloth: frame 2, implicit substep 0", "not finite"}, ctx);
+    } else {
+      ExpectError(st, {"frame 2", "not finite"}, ctx);
+    }
+    EXPECT_FALSE(cloth->Step(1.0 / 60, g).ok()) << ctx << ": a faulted cloth steps again";
+  }
+}
+
 TEST(Emitter, EmitReportsBadStepsAndCountsThatOverflow) {
   EmitterDef def;
   def.rate = 1e9;  // the largest rate: 1e10 particles in 10 s would overflow the count

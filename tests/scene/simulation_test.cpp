@@ -287,6 +287,98 @@ TEST(SceneSimulation, ParticlesRideAFallingCloth) {
                             << " (the sheet's lowest point is at " << sheetLow << ")";
 }
 
+// A scene's <self-collide>: 150 balls of radius 5 cm dropped in a clump
+// onto the ground. With it they push one another apart and no two centres
+// come closer than a diameter (less 10 %); the same scene without it lets
+// them fall through one another onto the ground, where they overlap.
+TEST(SceneSimulation, SelfCollidingParticlesDoNotOverlapWhereOthersPassThroughEachOther) {
+  const double r = 0.05;
+  struct Outcome {
+    size_t n = 0, overlaps = 0;
+    double closest = HUGE_VAL, highest = -HUGE_VAL;
+  };
+  auto drop = [&](bool selfCollide) {
+    Outcome o;
+    auto run = Start(std::string(R"(<scene version="1">
+      <particles id="balls" max="150">
+        <emitter shape="box" at="0 0.6 0" size="0.4 0.8 0.4" burst="150" speed="0"
+                 lifetime="100" radius="0.05"/>
+        <gravity/>
+        <collide with="ground" restitution="0" friction="0.5"/>)") +
+                     (selfCollide ? R"(<self-collide restitution="0"/>)" : "") + R"(
+      </particles>
+    </scene>)");
+    EXPECT_TRUE(run);
+    if (!run) return o;
+    EXPECT_TRUE(run->sim->AdvanceTo(2.0).ok());
+    std::vector<Vec3> x;
+    for (const Row& row : Rows(*run->sim))
+      if (row.system == "balls") x.push_back(row.x);
+    o.n = x.size();
+    for (size_t i = 0; i < x.size(); ++i) {
+      o.highest = std::max(o.highest, x[i].y());
+      for (size_t j = i + 1; j < x.size(); ++j) {
+        const double d = (x[i] - x[j]).norm();
+        o.closest = std::min(o.closest, d);
+        o.overlaps += d < 0.9 * 2 * r;
+      }
+    }
+    return o;
+  };
+  const Outcome with = drop(true), without = drop(false);
+  EXPECT_EQ(with.n, 150u);
+  EXPECT_EQ(without.n, 150u);
+  EXPECT_EQ(with.overlaps, 0u) << "with <self-collide>: closest centres " << with.closest
+                               << " m apart, radius " << r;
+  EXPECT_GT(without.overlaps, 100u)
+      << "without <self-collide>: closest centres " << without.closest;
+  EXPECT_LT(without.highest, r + 1e-3) << "without <self-collide> every ball lies on the ground";
+  EXPECT_GT(with.closest, without.closest) << "with <self-collide>: closest " << with.closest;
+}
+
+// stick="true" with a cloth: a particle rides on the triangle it touched.
+// Hail thrown up at a falling sheet sticks to its underside and falls with
+// it (it stayed in the air where it landed, with a warning, before).
+TEST(SceneSimulation, ParticlesStuckToAClothRideWithIt) {
+  DiagnosticList warnings;
+  auto run = Start(R"(<scene version="1">
+    <cloth id="sheet" size="2 2" resolution="10 10" position="-1 3 1" rotate="90 0 0"
+           pin="none">
+      <gravity/>
+    </cloth>
+    <particles id="hail" max="20">
+      <emitter shape="box" at="0 2.6 0" size="1 0 1" burst="20" direction="0 1 0" speed="4"
+               lifetime="100" radius="0.02"/>
+      <collide with="sheet" stick="true"/>
+    </particles>
+  </scene>)",
+                   1, &warnings);
+  ASSERT_TRUE(run);
+  EXPECT_EQ(warnings.items.size(), 0u) << warnings.FormatAll();
+  ASSERT_TRUE(run->sim->AdvanceTo(1.0).ok());
+  std::vector<Vec3> sheet;
+  std::vector<Row> hail;
+  for (const Row& r : Rows(*run->sim)) {
+    if (r.system == "sheet") sheet.push_back(r.x);
+    if (r.system == "hail") hail.push_back(r);
+  }
+  ASSERT_EQ(hail.size(), 20u);
+  double sheetHigh = -HUGE_VAL, farthest = 0, slowest = HUGE_VAL;
+  for (const Vec3& p : sheet) sheetHigh = std::max(sheetHigh, p.y());
+  for (const Row& r : hail) {
+    // Its distance from the sheet: from the nearest vertex, at most half a
+    // cell's diagonal (0.16 m) and the radius.
+    double nearest = HUGE_VAL;
+    for (const Vec3& p : sheet) nearest = std::min(nearest, (r.x - p).norm());
+    farthest = std::max(farthest, nearest);
+    slowest = std::min(slowest, r.v.norm());
+  }
+  // Free fall for 1 s: the sheet is 4.9 m lower, falling at 9.8 m/s.
+  EXPECT_LT(sheetHigh, 0.0) << "the sheet did not fall";
+  EXPECT_LT(farthest, 0.16 + 0.02) << "a hailstone left the sheet (m from its nearest vertex)";
+  EXPECT_GT(slowest, 5.0) << "a hailstone does not fall with the sheet (m/s)";
+}
+
 TEST(SceneSimulation, AClothLandsOnAnotherCloth) {
   // A hammock (a sheet turned 90 degrees about x, so it lies flat and
   // extends toward -z from its position; pinned at its four corners at
