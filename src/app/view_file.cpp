@@ -770,7 +770,7 @@ void ParseAnimationFile(const std::string& text, const std::string& path, ViewFi
     std::string text;
     int line = 0, column = 0;
   };
-  std::optional<Value> clear, first, last, step;
+  std::optional<Value> clear, doubleBuffer, first, last, step;
   for (const Line& line : Lines(text)) {
     const std::string& s = line.text;
     const size_t colon = s.find(':');
@@ -791,11 +791,16 @@ void ParseAnimationFile(const std::string& text, const std::string& path, ViewFi
     value.column = v0 == std::string::npos ? int(s.size()) + 1 : int(v0) + 1;
     if (v0 != std::string::npos) value.text = s.substr(v0, s.find_first_of(" \t", v0) - v0);
     if (label == "clear between frames") clear = value;
+    if (label == "double buffer") doubleBuffer = value;
     if (label == "first frame") first = value;
     if (label == "last frame") last = value;
     if (label == "step") step = value;
   }
+  // With double buffering each of the two buffers keeps every second
+  // frame: an artefact of the swap (vlab's growing sunflower and gaillardia
+  // ask for it and show the last frame), not a picture built of frames.
   if (!clear || clear->text.rfind("off", 0) != 0) return;
+  if (!doubleBuffer || doubleBuffer->text.rfind("off", 0) != 0) return;
   auto number = [&](const std::optional<Value>& v, const char* label, int lo, int fallback,
                     int* out) {
     if (!v) {

@@ -68,9 +68,9 @@ struct ViewFile {
   // turns the key light of `sylva render`.
   std::optional<Vec3> lightToward;
   // cpfg's animation file NAME.a beside the grammar, when it says `clear
-  // between frames: off`: cpfg's picture is then the frames from `first
-  // frame:` to `last frame:` (every `step:`) drawn over each other
-  // (plant/frames.h). Its other lines are playback settings that do not
+  // between frames: off` and `double buffer: off`: cpfg's picture is then
+  // the frames from `first frame:` to `last frame:` (every `step:`) drawn
+  // over each other (plant/frames.h). Its other lines are playback settings that do not
   // change a still picture, and are not read.
   std::string animationPath;
   std::optional<plant::FrameRange> overlay;

@@ -155,6 +155,10 @@ struct CylinderShape {
 struct CpfgState {
   double elasticity = 0;  // tropism susceptibility (cpfg: elasticity), @Ts @Ti @Td change it
   int32_t cylinder = -1;  // the open generalized cylinder (@Gs), or -1
+  // In a branch opened inside a generalized cylinder: that cylinder, whose
+  // last control point starts the branch's first @Gc/@Ge piece (cpfg's `[`
+  // pushes the turtle with its open cylinder); -1: none.
+  int32_t branchFrom = -1;
   CylinderShape shape;
   double scale = 1;  // sub-L-system scale (cpfg: scale_factor) of steps, widths, surfaces
 };
@@ -683,7 +687,11 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           t.depth = uint16_t(std::min<int>(t.depth + 1, 65535));
           if constexpr (kCpfg) {
             xstack.push_back(x);
-            x.cylinder = -1;  // a branch draws its own segments; `]` resumes the cylinder
+            // A branch draws its own segments; its first @Gc/@Ge continues
+            // the cylinder from the last control point before the `[`
+            // (nested branches inherit that); `]` resumes the cylinder.
+            if (x.cylinder >= 0) x.branchFrom = x.cylinder;
+            x.cylinder = -1;
           }
           break;
         case Op::kPop:
@@ -798,6 +806,14 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kGcPoint:
         case Op::kGcEnd: {
           const ControlPoint here{t.pos, t.frame.heading, t.frame.left, t.width, t.color, x.shape};
+          if (x.cylinder < 0 && x.branchFrom >= 0 && op != Op::kGcStart) {
+            // The branch's first piece starts where its parent cylinder was.
+            const ControlPoint from = cylinders[size_t(x.branchFrom)].last;
+            branchParent.push_back(t.branch);
+            x.cylinder = int32_t(cylinders.size());
+            cylinders.push_back({from, uint32_t(branchParent.size() - 1)});
+          }
+          x.branchFrom = -1;
           if (x.cylinder < 0) {
             if (op == Op::kGcEnd) break;  // nothing open: nothing to end
             branchParent.push_back(t.branch);

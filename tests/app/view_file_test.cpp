@@ -118,6 +118,37 @@ TEST(ViewFile, LightsGiveTheKeyLightItsDirection) {
   EXPECT_FALSE(ParseViewFile("angle factor: 8\n", "p.v").lightToward.has_value());
 }
 
+TEST(ViewFile, AnimationFilesOverlayFramesOnlyWithoutClearingOrDoubleBuffering) {
+  ViewFile natica;
+  ParseAnimationFile(
+      "double buffer: off\nclear between frames: off\nfirst frame: 0\nlast frame: 1500\n"
+      "step: 1\nframe numbers: consecutive\n",
+      "rd.a", natica);
+  EXPECT_TRUE(natica.diagnostics.items.empty()) << Messages(natica.diagnostics);
+  ASSERT_TRUE(natica.overlay.has_value());
+  EXPECT_EQ(natica.overlay->first, 0);
+  EXPECT_EQ(natica.overlay->last, 1500);
+  EXPECT_EQ(natica.overlay->step, 1);
+  ViewFile toEnd;
+  ParseAnimationFile("double buffer: off\nclear between frames: off\nlast frame: -1\n", "a.a",
+                     toEnd);
+  ASSERT_TRUE(toEnd.overlay.has_value());
+  EXPECT_EQ(toEnd.overlay->last, -1);
+  for (const char* still : {"double buffer: on\nclear between frames: off\nlast frame: -1\n",
+                            "double buffer: off\nclear between frames: on\nlast frame: x\n",
+                            "last frame: 5\n"}) {
+    ViewFile v;
+    ParseAnimationFile(still, "a.a", v);
+    EXPECT_FALSE(v.overlay.has_value()) << still;
+    EXPECT_TRUE(v.diagnostics.items.empty()) << still << Messages(v.diagnostics);
+  }
+  ViewFile bad;
+  ParseAnimationFile("double buffer: off\nclear between frames: off\nstep: 0\n", "a.a", bad);
+  EXPECT_FALSE(bad.overlay.has_value());
+  const std::string all = Messages(bad.diagnostics);
+  EXPECT_NE(all.find("3:7 error: 'step:' expects a whole number from 1"), std::string::npos) << all;
+}
+
 TEST(ViewFile, TropismLettersMayCarryAColonAndAnAttachedValue) {
   // As vlab's published view files write them.
   ViewFile v = ParseViewFile("tropism: T: 0.0 -1.0 0.0  A:0 E: 0.3\n", "p.v");

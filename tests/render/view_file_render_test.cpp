@@ -47,6 +47,89 @@ double DrawnAspect(const std::string& png) {
   return double(x1 - x0 + 1) / double(y1 - y0 + 1);
 }
 
+// The pixels of a PNG (RGBA), with its size; empty when it cannot be read.
+struct Png {
+  int w = 0, h = 0;
+  std::vector<unsigned char> px;
+  const unsigned char* At(int x, int y) const { return &px[4 * (size_t(y) * size_t(w) + size_t(x))]; }
+};
+Png Load(const std::string& png) {
+  Png p;
+  int n = 0;
+  unsigned char* data = stbi_load(png.c_str(), &p.w, &p.h, &n, 4);
+  if (!data) return p;
+  p.px.assign(data, data + size_t(p.w) * size_t(p.h) * 4);
+  stbi_image_free(data);
+  return p;
+}
+
+int Render(const std::string& grammar, const std::string& png, const std::string& size,
+           std::string* errors) {
+  std::ostringstream out, err;
+  const int code = RunCliWithGraphics({"render", grammar, "-o", png, "--size", size}, out, err);
+  *errors = err.str();
+  return code;
+}
+
+TEST(ViewFile, PixelWidthsAreThatManyPixelsOnScreen) {
+  // A vertical line of cpfg's `5 pixels` (a 2D figure: ribbons on white):
+  // the middle row crosses 5 drawn pixels, give or take the edges' blend.
+  const std::string grammar = WriteFile("px.l", "axiom: F(10)\n");
+  WriteFile("px.v", "initial line width: 5 pixels\n");
+  const std::string png = (Scratch() / "px.png").string();
+  std::string err;
+  ASSERT_EQ(Render(grammar, png, "120x120", &err), 0) << err;
+  const Png p = Load(png);
+  ASSERT_GT(p.w, 0);
+  double covered = 0;  // darkness summed across the row, in pixels
+  for (int x = 0; x < p.w; ++x) {
+    const unsigned char* c = p.At(x, p.h / 2);
+    covered += 1.0 - (c[0] + c[1] + c[2]) / (3.0 * 255.0);
+  }
+  // The line's colour is not black: its darkness over a pixel is below 1.
+  int dark = 0;
+  for (int x = 0; x < p.w; ++x) {
+    const unsigned char* c = p.At(x, p.h / 2);
+    if (c[0] + c[1] + c[2] < 3 * 200) ++dark;
+  }
+  EXPECT_GE(dark, 4) << "pixels of the line in the middle row (darkness " << covered << ")";
+  EXPECT_LE(dark, 6) << "pixels of the line in the middle row (darkness " << covered << ")";
+  std::filesystem::remove(Scratch() / "px.v");
+}
+
+TEST(ViewFile, ACameraBelowThePlantSeesItWithoutTheGround) {
+  // terminalia's view: from under the crown looking up. With the default
+  // ground in between, the picture was the ground's dark underside.
+  // A trunk 15 to the side of a flat whorl, as terminalia's tree.l draws
+  // (main at 8ca261c: 0 background pixels of 19,200; without the ground
+  // 19,008).
+  const std::string grammar = WriteFile(
+      "below.l",
+      "axiom: [-(90)f(15)+(90)f(-2)F(4)] F(1) [&(90) F(3)] [^(90) F(3)] [+(90) F(3)] "
+      "[-(90) F(3)]\n");
+  WriteFile("below.v",
+            "initial line width: 0.1\nviewpoint: 1.1,-60,0\nview reference point: 1.1,0,0\n"
+            "projection: perspective\n");
+  const std::string png = (Scratch() / "below.png").string();
+  std::string err;
+  ASSERT_EQ(Render(grammar, png, "160x120", &err), 0) << err;
+  const Png p = Load(png);
+  ASSERT_GT(p.w, 0);
+  int dark = 0, background = 0;
+  for (int y = 0; y < p.h; ++y) {
+    for (int x = 0; x < p.w; ++x) {
+      const unsigned char* c = p.At(x, y);
+      const int sum = c[0] + c[1] + c[2];
+      if (sum < 3 * 90) ++dark;
+      if (sum > 3 * 225) ++background;
+    }
+  }
+  const int all = p.w * p.h;
+  EXPECT_GT(background, all / 2) << "light background pixels of " << all;
+  EXPECT_GT(dark + (all - background), 10) << "the plant draws something";
+  std::filesystem::remove(Scratch() / "below.v");
+}
+
 TEST(ViewFile, RenderLooksFromTheViewpointUnlessCameraIsGiven) {
   // An L in the z = 0 plane: as wide as tall from +Z (cpfg's default
   // viewpoint), a vertical line from +X.

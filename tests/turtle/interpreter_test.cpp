@@ -497,6 +497,26 @@ TEST(Turtle, GeneralizedCylinderIsOneTubeAndBranchesDrawOnTheirOwn) {
   EXPECT_EQ(tube->mesh.triangleCount(), steps->mesh.triangleCount());
 }
 
+TEST(Turtle, BranchOfAGeneralizedCylinderContinuesItFromItsLastControlPoint) {
+  // cpfg's `[` pushes the turtle with its open cylinder: the branch's first
+  // @Gc draws the piece from the last control point before the `[` (here
+  // @Gs at the origin), as vlab's cooksonia and horneophyton branch. Its
+  // f only moves; `]` resumes the parent, whose @Ge ends at (0, 1, 0).
+  Drawn d = Draw("axiom: @Gs [-(90) f(2) @Gc(4)] f @Ge(2)\n");
+  ASSERT_EQ(d.geometry.segments.size(), 6u);
+  EXPECT_VEC_NEAR(d.geometry.segments[0].start, Vec3(0, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.segments[3].end, Vec3(2, 0, 0), 1e-12);  // the branch's @Gc
+  EXPECT_NE(d.geometry.segments[0].branch, d.geometry.segments[4].branch);
+  EXPECT_VEC_NEAR(d.geometry.segments[5].end, Vec3(0, 1, 0), 1e-12);
+  // Nested branches inherit the start; a branch without @Gc draws its F.
+  Drawn n = Draw("axiom: @Gs [[+ f @Ge(1)]] [-F] F @Ge(1)\n");
+  ASSERT_EQ(n.geometry.segments.size(), 3u);
+  EXPECT_VEC_NEAR(n.geometry.segments[0].start, Vec3(0, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(n.geometry.segments[0].end, Vec3(-1, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(n.geometry.segments[1].end, Vec3(1, 0, 0), 1e-12);  // [-F] as before
+  EXPECT_VEC_NEAR(n.geometry.segments[2].end, Vec3(0, 1, 0), 1e-12);
+}
+
 TEST(Turtle, GeneralizedCylinderLeftOpenWarnsAndHugeRingCountsStopEarly) {
   Drawn d = Draw("axiom: @Gs F @Gc(2) F\n");
   EXPECT_EQ(d.geometry.segments.size(), 2u);
