@@ -279,11 +279,6 @@ void Reader::Read(const app::Line& line) {
     // tubes (lines for 2D figures) of this width in world units.
     ExtraValues(
         tokens_.size() > 1 && std::isalpha(static_cast<unsigned char>(tokens_[1].text[0])) ? 2 : 1);
-    if (tokens_.size() > 1 && tokens_[1].text == "pixels")
-      Warn(tokens_[1].column,
-           "cpfg draws this width and the widths of '!' and '#' in pixels; Sylva draws them in "
-           "world units (a width of 1 is as wide as an internode of length 1 is long): add "
-           "'width scale: 0.015' (say) to the .l file to draw them thin");
   } else if (L == "line width increment:") {
     if (auto x = Number(0, "a width")) v_.widthIncrement = *x;
     ExtraValues(1);

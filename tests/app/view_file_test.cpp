@@ -53,17 +53,6 @@ TEST(ViewFile, ReadsWhatTheTurtleUses) {
   EXPECT_EQ(ParseViewFile("angle factor: 16\n", "p.v").angle.value_or(-1), 22.5);
 }
 
-TEST(ViewFile, WidthsInPixelsWarn) {
-  // sfplant plant.v: cpfg's line widths in pixels are drawn as world units.
-  ViewFile v = ParseViewFile("initial line width: 2.0 pixels\n", "p.v");
-  EXPECT_EQ(v.width.value_or(-1), 2.0);
-  EXPECT_NE(Messages(v.diagnostics).find("1:25 warning: cpfg draws this width and the widths of "
-                                         "'!' and '#' in pixels"),
-            std::string::npos)
-      << Messages(v.diagnostics);
-  EXPECT_TRUE(ParseViewFile("initial line width: 2.0 polygons\n", "p.v").diagnostics.items.empty());
-}
-
 TEST(ViewFile, TropismLettersMayCarryAColonAndAnAttachedValue) {
   // As vlab's published view files write them.
   ViewFile v = ParseViewFile("tropism: T: 0.0 -1.0 0.0  A:0 E: 0.3\n", "p.v");
