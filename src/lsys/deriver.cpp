@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -136,6 +137,15 @@ struct Scratch {
   PodBuffer<uint32_t> match;   // bracket partners
 };
 
+// The seed that cpfg's srand(seed) last set, or `seed` while it has not
+// been called (its hidden global is NaN until then).
+uint64_t SrandSeed(const Grammar& g, const double* globals, uint64_t seed) {
+  if (g.srandGlobal < 0 || !globals) return seed;
+  const double v = globals[size_t(g.srandGlobal)];
+  if (!(std::abs(v) < 9e18)) return seed;
+  return uint64_t(int64_t(std::trunc(v)));
+}
+
 // One parallel rewriting pass of one section over a word.
 class Pass {
  public:
@@ -154,6 +164,7 @@ class Pass {
         choice_(scratch.choice),
         match_(scratch.match),
         globals_(globals) {
+    reseeds_ = g.reseeds && globals != nullptr;
     for (const auto& p : sec.productions) {
       maxFormals_ = std::max<size_t>(maxFormals_, size_t(p.formalCount) + p.localCount);
       needsMatch_ |= p.HasContext();
@@ -183,8 +194,9 @@ class Pass {
         pi.index = idx;
         auto kind = [&](const std::vector<FormalModule>& ctx) -> uint8_t {
           if (ctx.empty()) return 0;
-          if (ctx.size() == 1 && g.symbols.arity(ctx[0].symbol) == 0 &&
-              ctx[0].symbol != kOpenBracket && ctx[0].symbol != kCloseBracket)
+          if (ctx.size() == 1 && ctx[0].symbol != kRestOfBranch &&
+              g.symbols.arity(ctx[0].symbol) == 0 && ctx[0].symbol != kOpenBracket &&
+              ctx[0].symbol != kCloseBracket)
             return 1;
           return 2;
         };
@@ -270,6 +282,12 @@ class Pass {
   const StaticTable& table_;
   ThreadPool& pool_;
   uint64_t seed_, purpose_, step_;
+  // srand outside Start: (Grammar::reseeds): the seed each module of the
+  // input is rewritten with, as srand left it when the module came up (the
+  // pass then runs in word order on one chunk).
+  bool reseeds_ = false;
+  std::vector<uint64_t> moduleSeed_;
+  uint64_t SeedOf(size_t i) const { return reseeds_ ? moduleSeed_[i] : seed_; }
   int stepForMessages_;
   uint64_t maxModules_;
   size_t maxFormals_ = 0;
@@ -563,7 +581,7 @@ int Pass::MatchBlocks(const Production& q, size_t i, double* formals, RandomStre
 
 bool Pass::Stash(const Production& p, size_t i, double* vars, Chunk& c) {
   const Successor& s = p.successor;
-  RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2 + 1, 0};
+  RandomStream rng{SeedOf(i), purpose_, step_, uint64_t(i) * 2 + 1, 0};
   const auto& arities = g_.symbols.arities();
   size_t e = 0, b = 0;
   EvalError err;
@@ -591,7 +609,7 @@ bool Pass::Rebind(uint32_t index, const WordView& w, size_t i, double* vars, Chu
   const SymbolId sym = w.symbols[i];
   const ProdInfo* pi = infos_.data() + infoStart_[sym];
   while (pi->index != index) ++pi;
-  RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2, 1};
+  RandomStream rng{SeedOf(i), purpose_, step_, uint64_t(i) * 2, 1};
   const double* pp = w.paramStart ? w.params + w.paramStart[i] : nullptr;
   size_t prev = kNotLooked, next = kNotLooked;
   return Matches(*pi, w, i, pp, g_.symbols.arity(sym), vars, prev, next, rng, c) >= 0;
@@ -662,7 +680,7 @@ bool Pass::Choose(const WordView& w, size_t i, double* formals, uint32_t* choice
   const SymbolId sym = w.symbols[i];
   const ProdInfo* first = infos_.data() + infoStart_[sym];
   const ProdInfo* last = infos_.data() + infoStart_[sym + 1];
-  RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2, 0};
+  RandomStream rng{SeedOf(i), purpose_, step_, uint64_t(i) * 2, 0};
   const double* pp = w.paramStart ? w.params + w.paramStart[i] : nullptr;
   const int arity = g_.symbols.arity(sym);
   // Context neighbours, looked up once and shared by every production.
@@ -769,7 +787,7 @@ void Pass::Write(const WordView& w, const Word& in, Word& out, Chunk& c, bool ou
         if (!p.right.empty()) MatchRight(p, w, i, NextInContext(w, i + 1), formals.data());
       }
     }
-    RandomStream rng{seed_, purpose_, step_, uint64_t(i) * 2 + 1, 0};
+    RandomStream rng{SeedOf(i), purpose_, step_, uint64_t(i) * 2 + 1, 0};
     size_t e = 0;
     for (SymbolId x : s.symbols) {
       osym[o] = x;
@@ -851,6 +869,7 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
     if (Status st = ComputeOwners(in); !st.ok()) return st;
   }
   choice_.ResizeUninitialized(n);
+  if (reseeds_) moduleSeed_.resize(n);
   const auto& arities = g_.symbols.arities();
   // Compiled twice: only grammars with predecessors of several modules pay
   // for the check of modules a match took.
@@ -874,6 +893,7 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
         }
       }
       const SymbolId sym = w.symbols[i];
+      if (reseeds_) moduleSeed_[i] = SrandSeed(g_, globals_, seed_);
       uint32_t ch = symChoice[sym];
       if (ch == kDynamic) {
         if (const ContextTable* t = tables_[sym].get()) {
@@ -978,6 +998,7 @@ bool ContainsSymbol(const Word& w, SymbolId s) {
 Status RunGlobalBlock(const Grammar& g, const std::optional<Expr>& block, const char* name,
                       uint64_t seed, uint64_t step, std::vector<double>& globals) {
   if (!block) return {};
+  if (g.reseeds) seed = SrandSeed(g, globals.data(), seed);
   RandomStream rng{seed, kGlobalBlockDraws, step, 0, 0};
   EvalError err;
   if (block->Exec(nullptr, globals.data(), rng, &err)) return {};
@@ -995,6 +1016,14 @@ uint64_t SeedAfterStart(const Grammar& g, const DeriveOptions& options,
   const double v = globals[size_t(g.srandGlobal)];
   if (!(std::abs(v) < 9e18)) return seed;  // NaN: srand was not called
   return uint64_t(int64_t(std::trunc(v)));
+}
+
+// cpfg's stop(v): a value other than 1 in its hidden global (NaN: not
+// called; 1 is cpfg's "run on").
+bool StopCalled(const Grammar& g, const std::vector<double>& globals) {
+  if (g.stopGlobal < 0) return false;
+  const double v = globals[size_t(g.stopGlobal)];
+  return !std::isnan(v) && v != 1;
 }
 
 // The global variables as the Start: block leaves them.
@@ -1073,6 +1102,7 @@ struct Derivation::State {
   std::vector<double> globals;  // the grammar's global variables
   int step = 0;
   bool fixedPoint = false;
+  bool stopped = false;  // cpfg's stop(v), v not 1, was called
   std::vector<StepStats> stats;
 };
 
@@ -1088,6 +1118,10 @@ Expected<Derivation> Derivation::Start(const Grammar& g, const DeriveOptions& op
   if (!globals) return globals.error();
   state->globals = std::move(globals).value();
   state->seed = SeedAfterStart(g, options, state->globals, state->seed);
+  // A --seed given wins over srand in Start:; a later srand still reseeds.
+  if (options.seed && g.srandGlobal >= 0)
+    state->globals[size_t(g.srandGlobal)] = std::numeric_limits<double>::quiet_NaN();
+  state->stopped = StopCalled(g, state->globals);
   auto axiom = BuildAxiom(g, state->seed, state->globals.data());
   if (!axiom) return axiom.error();
   state->word = std::move(axiom).value();
@@ -1137,6 +1171,7 @@ Status Derivation::Step() {
     // between steps breaks this: MutableWord() clears it.)
     if (!changed && s.g.decomposition.empty() && !s.g.usesRandom && s.g.globals.empty())
       s.fixedPoint = true;
+    s.stopped = s.stopped || StopCalled(s.g, s.globals);
   }
   s.step = step;
   s.stats.push_back(
@@ -1146,6 +1181,9 @@ Status Derivation::Step() {
 
 int Derivation::step() const {
   return state_->step;
+}
+bool Derivation::stopped() const {
+  return state_->stopped;
 }
 const Word& Derivation::word() const {
   return state_->word;
@@ -1199,7 +1237,7 @@ Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
   }
   auto derivation = Derivation::Start(g, options);
   if (!derivation) return derivation.error();
-  while (derivation->step() < steps) {
+  while (derivation->step() < steps && !derivation->stopped()) {
     if (Status s = derivation->Step(); !s.ok()) return s.error();
     if (options.progress) options.progress(derivation->step(), steps, derivation->word().size());
   }

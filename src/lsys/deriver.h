@@ -93,6 +93,10 @@ class Derivation {
   Status Step();
 
   int step() const;  // steps taken; 0 after Start
+  // cpfg's `stop(v);` with v other than 1 was called (in Start: or in the
+  // last step): as cpfg's animation halts there, Derive() takes no further
+  // step, nor do the plant library's growers.
+  bool stopped() const;
   const Word& word() const;
   // The word, for a caller that fills query parameters between steps.
   Word& MutableWord();

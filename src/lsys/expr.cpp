@@ -1350,16 +1350,16 @@ class ExprCompiler {
     size_t q = e;
     SkipSpace(text, &q);
     if (q < text.size() && text[q] == '[') return ElementAssignment(text, pos, scope, name, col, q);
-    if (name == "srand" && q < text.size() && text[q] == '(') {
-      if (scope.srandSlot < 0)
-        return Err(col,
-                   "srand(seed) is read only in the Start: block, where it sets the seed (Sylva "
-                   "draws each module's random numbers from the seed, step and position, so "
-                   "there is no sequence to reseed later)",
-                   5);
-      *pos = q;  // `srand(x)`: x is stored as the seed
+    if ((name == "srand" || name == "stop") && q < text.size() && text[q] == '(') {
+      // cpfg's srand(seed) (reseed) and stop(v) (v other than 1 stops the
+      // derivation): v is stored in a hidden global the derivation reads.
+      const int slot = name == "srand" ? scope.srandSlot : scope.stopSlot;
+      if (slot < 0)
+        return Err(col, "'" + name + "(...)' belongs in a statement block", int(name.size()));
+      *pos = q;
       if (!Expression(text, pos, scope)) return false;
-      Push(OpCode::kStoreGlobal, uint32_t(scope.srandSlot), col);
+      Push(OpCode::kStoreGlobal, uint32_t(slot), col);
+      if (scope.writesGlobal) *scope.writesGlobal = true;  // in word order, as cpfg
       return EndOfStatement(text, pos);
     }
     if (name == "fscanf" && q < text.size() && text[q] == '(' && scope.dataFiles) {
@@ -1756,7 +1756,8 @@ bool IsStatementBlock(std::string_view text, size_t pos, std::string_view next) 
     size_t q = e;
     while (q < t.size() && (t[q] == ' ' || t[q] == '\t')) ++q;
     if ((word == "if" || word == "while" || word == "printf" || word == "fprintf" ||
-         word == "fclose" || word == "fflush" || word == "fscanf") &&
+         word == "fclose" || word == "fflush" || word == "fscanf" || word == "srand" ||
+         word == "stop") &&
         q < t.size() && t[q] == '(')
       return true;
     if (word == "do" && (q >= t.size() || t[q] == '{' || q > e)) return true;

@@ -89,9 +89,14 @@ struct ExprScope {
   const std::vector<std::shared_ptr<const CpfgFunction>>* functions = nullptr;
   // cpfg arrays: `a[i][j]` in expressions, `a[i][j] = v;` in blocks.
   const std::vector<ArrayShape>* arrays = nullptr;
-  // The global slot `srand(seed);` stores to (the Start: block only; -1:
-  // srand is an error here).
+  // The hidden global slot `srand(seed);` stores to (-1: srand is an error
+  // here). The derivation draws random numbers from that seed once it is
+  // set (Grammar::srandGlobal).
   int srandSlot = -1;
+  // The hidden global slot `stop(v);` stores v to (-1: stop is an error
+  // here): v other than 1 ends the derivation after the step
+  // (Grammar::stopGlobal).
+  int stopSlot = -1;
 };
 
 // Parses one expression starting at text[pos]; stops before the first
@@ -114,7 +119,9 @@ bool ParseBlock(std::string_view text, size_t* pos, const ExprScope& scope, Expr
 // Whether the '{' at text[pos] starts a statement block rather than a
 // polygon: the text after it (or, when nothing follows it on the line, the
 // text of `next`) starts with a statement: `NAME =`, `NAME op=`, `if (`,
-// `while (`, `do`, or it is `{ }` with only spaces or a `;` inside.
+// `while (`, `do`, a call of cpfg's `printf`, `fprintf`, `fclose`,
+// `fflush`, `srand` or `stop`, or it is `{ }` with only spaces or a `;`
+// inside.
 bool IsStatementBlock(std::string_view text, size_t pos, std::string_view next = {});
 
 }  // namespace sylva::lsys

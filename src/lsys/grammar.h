@@ -46,6 +46,12 @@ struct Successor {
   std::vector<Block> blocks;
 };
 
+// cpfg's `=` in a right context (`A > [B=]C`): it stands for the rest of
+// the current branch, up to the `]` that closes it (cpfg `generate.c`,
+// RconDiff/skipright). It is no module of the word: a right context's
+// FormalModule::symbol holds this value for it (symbol ids end at 65534).
+inline constexpr SymbolId kRestOfBranch = 0xFFFF;
+
 // Brackets a right context may nest (`A > [[[B]]]` is 3); deeper is a parse
 // error.
 inline constexpr int kMaxRightContextNesting = 64;
@@ -192,10 +198,22 @@ struct Grammar {
   // cpfg arrays (`define: { array a[3]; }`): elements are globals
   // [base, base + size), named "a[0]", ... in `globals`.
   std::vector<ArrayShape> arrays;
-  // The hidden global that `srand(seed);` in Start: sets (-1: none); after
-  // Start: a finite value there is the derivation's seed, as `seed:` (a
-  // --seed given to the command still wins).
+  // The hidden global that `srand(seed);` sets (-1: none; NaN until
+  // called). After Start: a finite value there is the derivation's seed, as
+  // `seed:` (a --seed given to the command still wins over Start:'s srand).
   int srandGlobal = -1;
+  // srand is called outside Start: (a production, StartEach:, ...): each
+  // module's random numbers are then drawn from the value the hidden global
+  // holds when the module is rewritten (in word order), a global block's
+  // from the value when it runs.
+  bool reseeds = false;
+  // The hidden global that cpfg's `stop(v);` sets (-1: none; NaN until
+  // called): a value other than 1 at the end of a step ends the derivation
+  // there (Derivation::stopped).
+  int stopGlobal = -1;
+  // Text parameters of modules (cpfg's `@L("label")`), in file order: a
+  // text's value as a parameter is its index here.
+  std::vector<std::string> strings;
   // cpfg function files (`functions: a.func b.func`), for func(id, x).
   std::vector<std::shared_ptr<const CpfgFunction>> functions;
   std::optional<Expr> startBlock, startEachBlock, endEachBlock, endBlock;

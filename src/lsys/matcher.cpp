@@ -42,6 +42,23 @@ bool MatchLeft(const Production& p, const WordView& w, size_t prev, double* form
   return true;
 }
 
+// The position of the `]` that closes the branch holding position j (j
+// itself when it is that `]`), or w.size: cpfg's skipright.
+static size_t EndOfBranch(const WordView& w, size_t j) {
+  while (j < w.size) {
+    const SymbolId s = w.symbols[j];
+    if (s == kCloseBracket) return j;
+    if (s == kOpenBracket) {
+      const uint32_t m = w.bracketMatch[j];
+      if (m == kNoMatch) return w.size;
+      j = size_t(m) + 1;
+      continue;
+    }
+    ++j;
+  }
+  return w.size;
+}
+
 bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, double* formals) {
   // The parser rejects right contexts nested deeper than this.
   static constexpr int kMaxNesting = kMaxRightContextNesting;
@@ -51,10 +68,21 @@ bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, d
   bool first = true;
   const size_t n = w.size;
   for (const FormalModule& fm : p.right) {
+    if (fm.symbol == kRestOfBranch) {  // cpfg's `=`: up to the `]` of this branch
+      if (depth > 0) {
+        const uint32_t m = w.bracketMatch[opened[depth - 1]];
+        if (m == kNoMatch) return false;
+        j = size_t(m);
+      } else {
+        j = EndOfBranch(w, j);
+      }
+      first = false;
+      continue;
+    }
     if (fm.symbol == kOpenBracket) {
-      while (j < n && w.symbols[j] != kOpenBracket && w.symbols[j] != kCloseBracket &&
-             w.skip[w.symbols[j]])
-        ++j;
+      // Ignored modules first (an ignored `[` too: it then never matches,
+      // as in cpfg).
+      while (j < n && w.skip[w.symbols[j]]) ++j;
       if (j >= n || w.symbols[j] != kOpenBracket || depth == kMaxNesting) return false;
       opened[depth++] = uint32_t(j);
       ++j;
@@ -62,10 +90,15 @@ bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, d
       continue;
     }
     if (fm.symbol == kCloseBracket) {
-      if (depth == 0) return false;
-      const uint32_t m = w.bracketMatch[opened[--depth]];
-      if (m == kNoMatch) return false;
-      j = size_t(m) + 1;
+      if (depth == 0) {  // out of the predecessor's branch, into its parent
+        const size_t e = EndOfBranch(w, j);
+        if (e >= n) return false;
+        j = e + 1;
+      } else {
+        const uint32_t m = w.bracketMatch[opened[--depth]];
+        if (m == kNoMatch) return false;
+        j = size_t(m) + 1;
+      }
       first = false;
       continue;
     }

@@ -6,10 +6,16 @@
 // table), and an enclosing `[` is stepped out of, to the parent. The right
 // context is read forwards along the same branch: sibling branches that the
 // context does not name are skipped whole; a `[` in the context descends
-// into a branch; a `]` in the context skips the rest of that branch; the
-// word's `]` ends the current branch, and the right context never crosses
-// it. Symbols flagged in `skip` (ignore:/consider:) are passed over. Both
-// matchers bind the context modules' parameters into the formal slots.
+// into a branch; a `]` in the context skips the rest of that branch (one
+// without its `[` leaves the predecessor's branch into its parent, as in
+// cpfg); cpfg's `=` (kRestOfBranch) skips to the `]` that ends the current
+// branch; otherwise the word's `]` ends the current branch, and the right
+// context does not cross it. Symbols flagged in `skip` (ignore:/consider:)
+// are passed over. The right context checks `skip` before the brackets, as
+// cpfg's RconDiff: an ignored `[` or `]` is passed over like any module
+// (the context then reads into and out of branches); the left context
+// always follows the branching (cpfg's LconDiff). Both matchers bind the
+// context modules' parameters into the formal slots.
 #pragma once
 
 #include <cstdint>
@@ -67,6 +73,10 @@ inline size_t NextInContext(const WordView& w, size_t j) {
   for (;;) {
     if (j >= w.size) return kNoPosition;
     const SymbolId s = w.symbols[j];
+    if (w.skip[s]) {  // ignored (a bracket too, when ignore: names it)
+      ++j;
+      continue;
+    }
     if (s == kOpenBracket) {  // a sibling branch the context does not name
       const uint32_t m = w.bracketMatch[j];
       if (m == kNoMatch) return kNoPosition;
@@ -74,10 +84,6 @@ inline size_t NextInContext(const WordView& w, size_t j) {
       continue;
     }
     if (s == kCloseBracket) return kNoPosition;  // end of this branch
-    if (w.skip[s]) {
-      ++j;
-      continue;
-    }
     return j;
   }
 }

@@ -96,8 +96,14 @@ bool IsIdentChar(char c) {
   return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
 }
 
-// Single-character module names besides letters and digits.
-constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_;,#";
+// `maximum depth:` of a decomposition or interpretation section.
+constexpr int kMaxSectionDepth = 100000;
+
+// Single-character module names besides letters and digits. cpfg's lexer
+// (`lsys_input.l`, `symbol`) takes any character but `<>:*`, blanks and
+// parentheses as a module; Sylva reads `~`, `@` and `?` as the start of
+// longer names and leaves out `"` (a string in parameters).
+constexpr std::string_view kModuleChars = "+-&^\\/|$[]!'{.}%_;,#=`";
 
 // cpfg's @ commands, longest first where they share a prefix.
 constexpr std::string_view kAtCommands[] = {
@@ -226,6 +232,7 @@ class GrammarParser {
   void ParseFunctions(const Line& l, size_t after, size_t end);
   void ParseArrays(const Line& l, size_t after, size_t end);
   void CollectGlobals();
+  void HiddenGlobalSlots(const std::string& t, size_t from, bool start, ExprScope* scope);
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
                       size_t lhsEnd);
   void ParseMacro(const Line& l, const std::string& name, int col, size_t pos);
@@ -685,7 +692,29 @@ bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const
       for (;;) {
         Expr e;
         ExprParseError err;
-        if (!ParseExpr(view, &pos, scope, &e, &err)) {
+        while (pos < end && IsSpace(t[pos])) ++pos;
+        if (pos < end && t[pos] == '"') {
+          // cpfg's text parameter (`@L("%.0f", n)`, a label): its value is
+          // the string's number in the file, as cpfg's global string index.
+          const size_t s0 = pos;
+          for (++pos; pos < end && t[pos] != '"'; ++pos)
+            if (t[pos] == '\\') ++pos;
+          if (pos >= end) {
+            Error(l, int(s0) + 1, "unclosed '\"' in parameters of '" + name + "'");
+            return false;
+          }
+          ++pos;
+          const std::string text = t.substr(s0 + 1, pos - s0 - 2);
+          auto it = std::find(g_.strings.begin(), g_.strings.end(), text);
+          const double index = double(it - g_.strings.begin());
+          if (it == g_.strings.end()) g_.strings.push_back(text);
+          e = Expr::Constant(index);
+          if (unsupportedWarned_.insert(name + "\x01string").second && name != "@L")
+            Warn(Loc(l, int(s0) + 1), OriginalAt(l, int(s0) + 1),
+                 "a text parameter of '" + name + "' is read as the number of the text (" +
+                     std::to_string(int(index)) + "), as cpfg does",
+                 int(pos - s0));
+        } else if (!ParseExpr(view, &pos, scope, &e, &err)) {
           Error(l, err.column, err.message, err.length);
           return false;
         }
@@ -1195,16 +1224,12 @@ void GrammarParser::ParseContextNames(const Line& l, size_t after, size_t end, b
       ++p;
       continue;
     }
-    int c = int(p) + 1;
     std::string name;
     if (!LexName(l, p, end, &name)) return;
-    if (name == "[" || name == "]") {
-      // cpfg files list the brackets in `consider:` so that context
-      // matching sees the branching; Sylva's matcher always does.
-      if (!ignore) continue;
-      Error(l, c, "brackets cannot be ignored: they give the branching structure");
-      return;
-    }
+    // Brackets too: as in cpfg, an ignored `[` or `]` (or one that
+    // `consider:` does not name) is passed over by right contexts, which
+    // then read into and out of branches; left contexts always follow the
+    // branching (matcher.h).
     (ignore ? ignoreNames_ : considerNames_).insert(name);
   }
   return;
@@ -1655,16 +1680,7 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
   scope.functions = &g_.functions;
   scope.globals = &g_.globals;
   scope.arrays = &g_.arrays;
-  if (k == "start" && t.find("srand", after) != std::string::npos) {
-    // srand(seed) there sets the seed: a hidden global holds it.
-    if (g_.srandGlobal < 0) {
-      g_.srandGlobal = int(g_.globals.size());
-      g_.globals.push_back("srand()");
-      g_.globalInitial.resize(g_.globals.size(), 0.0);
-      g_.globalInitial.back() = std::numeric_limits<double>::quiet_NaN();  // not called
-    }
-    scope.srandSlot = g_.srandGlobal;
-  }
+  HiddenGlobalSlots(t, after, k == "start", &scope);
   std::string_view view(t.data(), end);
   size_t pos = after;
   Expr block;
@@ -1675,6 +1691,38 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
     return;
   }
   *slot = std::move(block);
+}
+
+// cpfg's srand(seed) and stop(v) in a block of line text t (from `from`
+// on): each stores its value in a hidden global, made at its first use, NaN
+// until called. srand in Start: sets the derivation's seed; anywhere else
+// it reseeds the derivation from there on (Grammar::reseeds).
+void GrammarParser::HiddenGlobalSlots(const std::string& t, size_t from, bool start,
+                                      ExprScope* scope) {
+  auto slot = [&](const char* name, int* index) {
+    if (*index < 0) {
+      *index = int(g_.globals.size());
+      g_.globals.push_back(name);
+      g_.globalInitial.resize(g_.globals.size(), 0.0);
+      g_.globalInitial.back() = std::numeric_limits<double>::quiet_NaN();  // not called
+    }
+    return *index;
+  };
+  // `name (` as a word of its own.
+  auto calls = [&](std::string_view name) {
+    for (size_t i = t.find(name, from); i != std::string::npos; i = t.find(name, i + 1)) {
+      if (i > 0 && IsIdentChar(t[i - 1])) continue;
+      size_t q = i + name.size();
+      while (q < t.size() && IsSpace(t[q])) ++q;
+      if (q < t.size() && t[q] == '(') return true;
+    }
+    return false;
+  };
+  if (calls("srand")) {
+    scope->srandSlot = slot("srand()", &g_.srandGlobal);
+    if (!start) g_.reseeds = true;
+  }
+  if (calls("stop")) scope->stopSlot = slot("stop()", &g_.stopGlobal);
 }
 
 // cpfg's `define: { array a[3], b[2][2] = {1, 2, 3, 4}; array c[4]; }`:
@@ -1935,8 +1983,11 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
     }
     double v;
     if (!ParseConstExpr(l, after, end, &v)) return true;
-    if (v != std::floor(v) || v < 1 || v > 1000) {
-      Error(l, int(after) + 1, "maximum depth must be a whole number from 1 to 1000");
+    // cpfg's decompositions run thousands deep (self-thinning: 15000, a
+    // module that makes one plant a pass); passes stop when nothing changes.
+    if (v != std::floor(v) || v < 1 || v > kMaxSectionDepth) {
+      Error(l, int(after) + 1,
+            "maximum depth must be a whole number from 1 to " + std::to_string(kMaxSectionDepth));
       return true;
     }
     section_->maxDepth = int(v);
@@ -2051,6 +2102,17 @@ static size_t FindWeightColon(const std::string& t, size_t from, size_t to) {
   return std::string::npos;
 }
 
+// `array NAME` from p on, blanks first: cpfg's `define: { array a[3],`
+// whose block goes on over the next lines.
+static bool StartsArrayDefinition(const std::string& t, size_t p) {
+  while (p < t.size() && IsSpace(t[p])) ++p;
+  if (t.compare(p, 5, "array") != 0) return false;
+  p += 5;
+  if (p >= t.size() || !IsSpace(t[p])) return false;
+  while (p < t.size() && IsSpace(t[p])) ++p;
+  return p < t.size() && IsIdentStart(t[p]);
+}
+
 // The depth of statement-block braces at the end of `t`, from `depth` at
 // its start: a `{` opens a block when it follows a ':' and ends its line
 // (a pre-condition, `Start: {`) or starts a statement (IsStatementBlock; `next` is the text
@@ -2064,6 +2126,7 @@ static int BlockDepth(const std::string& t, int depth, std::string_view next) {
       depth += c == '{' ? 1 : (c == '}' ? -1 : 0);
     } else if (c == '{' &&
                ((prev == ':' && t.find_first_not_of(" \t\r", i + 1) == std::string::npos) ||
+                (prev == ':' && StartsArrayDefinition(t, i + 1)) ||
                 IsStatementBlock(t, i, next))) {
       depth = 1;
     }
@@ -2264,11 +2327,32 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   const Formal& pf = (*pred)[0];
   // cpfg's strict predecessor may be several modules (`A B --> C`), matched
   // on consecutive modules of the word.
+  // Brackets may be part of it in balanced pairs (cpfg's
+  // `[f(y)-f(z)P(r,s)?E(x)] --> ...` rewrites a whole branch), matched
+  // module for module like the rest; the successor is balanced too, so
+  // the word stays balanced.
+  std::vector<int> openAt;
   for (const Formal& f : *pred) {
-    if (f.name == "[" || f.name == "]" || f.name == "%") {
-      Error(l, f.column, "'" + f.name + "' cannot be rewritten");
+    if (f.name == "%") {
+      Error(l, f.column, "'%' cannot be rewritten");
       return;
     }
+    if (f.name == "[") openAt.push_back(f.column);
+    if (f.name == "]") {
+      if (openAt.empty()) {
+        Error(l, f.column,
+              "']' cannot be rewritten without its '[': a predecessor holds brackets only in "
+              "balanced pairs");
+        return;
+      }
+      openAt.pop_back();
+    }
+  }
+  if (!openAt.empty()) {
+    Error(l, openAt.back(),
+          "'[' cannot be rewritten without its ']': a predecessor holds brackets only in "
+          "balanced pairs");
+    return;
   }
   if (!bind(pf, &p.pred)) return;
   for (size_t k = 1; k < pred->size(); ++k) {
@@ -2280,13 +2364,24 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     std::vector<int> cols;
     for (const auto& f : *right) {
       FormalModule fm;
-      if (!bind(f, &fm)) return;
+      if (f.name == "=" && !f.wildcard) {
+        // cpfg's `=`: the rest of the current branch (`A > [B=]C`).
+        if (!f.params.empty()) {
+          Error(l, f.column, "'=' in a right context (the rest of the branch) takes no parameters");
+          return;
+        }
+        fm.symbol = kRestOfBranch;
+      } else if (!bind(f, &fm)) {
+        return;
+      }
       p.right.push_back(fm);
       cols.push_back(f.column);
     }
+    // As in cpfg, a right context need not be balanced: a `]` without its
+    // `[` leaves the branch of the predecessor (`A > B]C`), a `[` without
+    // its `]` ends the context inside that branch.
     std::vector<SymbolId> syms;
     for (auto& fm : p.right) syms.push_back(fm.symbol);
-    if (!CheckBrackets(l, syms, cols, "right context")) return;
     int depth = 0;
     for (size_t k = 0; k < syms.size(); ++k) {
       depth += syms[k] == kOpenBracket ? 1 : (syms[k] == kCloseBracket ? -1 : 0);
@@ -2309,6 +2404,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   scope.locals = &locals;
   scope.globals = &g_.globals;
   scope.writesGlobal = &writesGlobal;
+  HiddenGlobalSlots(t, pos, false, &scope);
   if (condAt != std::string::npos && !ParseCondition(l, p, scope, condAt, lhsEnd)) return;
 
   // RHS: SUCCESSOR [: WEIGHT]
@@ -2546,7 +2642,7 @@ void GrammarParser::BeginLsystem(const Line& l, int col, size_t after, size_t en
 std::vector<uint8_t> GrammarParser::SkipTable(const ContextNames& c) const {
   const size_t nsym = g_.symbols.size();
   std::vector<uint8_t> skip(nsym, 0);
-  for (size_t s = 2; s < nsym; ++s) {
+  for (size_t s = 0; s < nsym; ++s) {
     const std::string& name = g_.symbols.name(SymbolId(s));
     if (c.haveConsider) skip[s] = !c.consider.count(name);
     if (c.haveIgnore && c.ignore.count(name)) skip[s] = 1;

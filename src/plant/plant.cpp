@@ -304,6 +304,10 @@ Status Grower::AnswerQueries() {
   return plant::AnswerQueries(queries_, word, drawn, *geometry, environment_);
 }
 
+bool Grower::done() const {
+  return step() >= steps() || (derivation_ && derivation_->stopped());
+}
+
 Status Grower::Step() {
   SYLVA_ASSERT(derivation_.has_value());
   const auto t0 = Clock::now();

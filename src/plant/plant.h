@@ -194,7 +194,8 @@ class Grower {
   Status Step();  // one derivation step; an error ends the growth
   int step() const;
   int steps() const;  // the length asked for (spec.steps or the grammar's)
-  bool done() const { return step() >= steps(); }
+  // The length is reached, or the grammar called cpfg's stop(v), v not 1.
+  bool done() const;
 
   const lsys::Grammar& grammar() const { return *grammar_; }
   const lsys::Word& word() const;

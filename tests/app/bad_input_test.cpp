@@ -70,7 +70,8 @@ std::vector<BadCase> Cases() {
       {"bracket_in_left_context", "axiom: F\n[ < F --> G\n", "2:1",
        "not allowed in a left context"},
       {"rewriting_a_bracket", "axiom: F\n] --> F\n", "2:1", "cannot be rewritten"},
-      {"unbalanced_right_context", "axiom: AB\nA > [B --> C\n", "2:5", "unbalanced '['"},
+      // (An unbalanced right context is cpfg's: `A > [B` and `A > B]C` read.)
+      {"star_inside_right_context", "axiom: AB\nA > B * --> C\n", "2:7", "'*' stands alone"},
       {"second_axiom", "axiom: F\naxiom: G\n", "2:1", "second axiom"},
       {"short_tropism", "tropism: 0 1 0\naxiom: F\n", "1:10", "four numbers"},
       {"negative_weight", "axiom: F\nF --> G : -1\n", "2:11", "negative probability weight"},

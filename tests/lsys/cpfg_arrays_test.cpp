@@ -87,14 +87,5 @@ TEST(CpfgSrand, InStartItSetsTheSeedLikeSeedStatement) {
   EXPECT_EQ(DeriveText("Start: { srand(42); }\n" + rules, 1, o), DeriveText(rules, 1, o));
 }
 
-TEST(CpfgSrand, ElsewhereItIsAnErrorWithItsLocation) {
-  EXPECT_EQ(FirstError("axiom: A\nA : { srand(3); } * --> B\n")
-                .rfind("2:7 srand(seed) is read only in the Start: block", 0),
-            0u);
-  EXPECT_EQ(FirstError("StartEach: { srand(3); }\naxiom: A\n")
-                .rfind("1:14 srand(seed) is read only in the Start: block", 0),
-            0u);
-}
-
 }  // namespace
 }  // namespace sylva::lsys

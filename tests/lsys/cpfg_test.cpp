@@ -85,11 +85,6 @@ TEST(Cpfg, BracketsInConsiderAreAcceptedAndKeepTheBranching) {
   EXPECT_EQ(DeriveText("consider: [ ] A\naxiom: A B [C] A\nA < A --> D\n", 1), "AB[C]D");
   // Without the consider: list B stands between them.
   EXPECT_EQ(DeriveText("axiom: A B [C] A\nA < A --> D\n", 1), "AB[C]A");
-  ParseResult r = ParseGrammarText("ignore: [ +\naxiom: A\n", "c.l", {});
-  EXPECT_FALSE(r.grammar);
-  EXPECT_NE(r.diagnostics.FormatAll().find("c.l:1:9: error: brackets cannot be ignored"),
-            std::string::npos)
-      << r.diagnostics.FormatAll();
 }
 
 TEST(Cpfg, QueryModulesWarnOnlyWhereTheyAreNotAnswered) {
