@@ -148,6 +148,7 @@ int RunSimulate(const SimulateCommand& cmd, std::ostream& out, std::ostream& err
     }
   }
   if (progress) err << "\n";
+  err << sim->warnings().FormatAll();
   if (!cmd.dump.empty()) {
     std::ostringstream csv;
     sim->WriteCsv(csv);

@@ -53,11 +53,15 @@ class NeighbourGrid {
   // a loop over all particles in this order reuses the cache.
   const std::vector<uint32_t>& order() const { return order_; }
   const std::vector<Vec3>& sortedPositions() const { return sorted_; }
+  // Calls visit(from, to) for the 9 ranges of slot order that hold the 27
+  // cells around p (every particle within a cell size of p is in one; a
+  // range may hold farther ones), in the same order whatever the thread
+  // count.
+  template <typename Fn>
+  void ForEachCandidateRange(const Vec3& p, Fn&& visit) const;
 
  private:
   uint32_t Slot(int64_t cx, int64_t cy, int64_t cz) const;
-  template <typename Fn>
-  void ForEachCandidateRange(const Vec3& p, Fn&& visit) const;
   // The cell coordinate of c (Build and queries must agree exactly).
   int64_t CellOf(double c) const;
   double cell_ = 1, invCell_ = 1;

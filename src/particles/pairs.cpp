@@ -9,10 +9,22 @@
 // plus twice the largest displacement of the step, so a pair moving fast
 // toward each other is found however far it travels (the cost grows with
 // the fastest particle's step). The contact keeps the normal at the time
-// of impact and the relative normal speed before the solve.
+// of impact and its target speed (from the relative normal speed before
+// the solve).
+//
+// Layout (pairs.h). The work runs in the grid's slot order: each
+// particle's data is copied there once a step, so neighbours are near in
+// memory, and written back at the end. One walk of the grid finds the
+// contacts: the candidates of the 9 row ranges are screened by distance
+// without a branch into a small buffer, and each particle's contacts are
+// appended to its chunk's array (kPairChunk particles a chunk, the unit of
+// parallel work), so no counting pass is needed. The velocity passes take
+// the positive part of an impulse without a branch (its sign changes from
+// pass to pass: a branch on it was mispredicted often enough to cost half
+// the pass).
 //
 // Response, in two kinds of passes over each particle's own list of
-// contacts (CSR, in the grid's order: the same whatever the thread count):
+// contacts (in the grid's order: the same whatever the thread count):
 //   velocity  a contact whose approach is faster than the step's forces
 //             could give (a collision) must leave at e times that speed; a
 //             slower one (resting) must not approach; the impulse summed
@@ -25,7 +37,9 @@
 //             equal masses). A step with no resting contact (a gas) goes
 //             on past the fixed passes until every collision meets its
 //             target, so at e = 1 it keeps its energy (the impulses' work is
-//             zero when each contact leaves at the speed it came in); a
+//             zero when each contact leaves at the speed it came in; a
+//             step that reaches System::pairMaxPasses first returns a
+//             warning, PairPassesWarning); a
 //             pair overlapping at the start of the step bounces there only
 //             when the step's forces changed neither velocity (free flight:
 //             a collision the step before missed). After the passes a
@@ -43,10 +57,16 @@
 //
 // References: Mirtich, "Timewarp rigid body simulation" (swept spheres);
 // Müller et al., "Position based dynamics" (2007), Jacobi projection.
+#include "particles/pairs.h"
+
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
-#include "particles/grid.h"
+#include "particles/def_check.h"
 #include "particles/system.h"
 
 namespace sylva::particles {
@@ -56,11 +76,13 @@ namespace {
 constexpr int kVelocityPasses = 16;
 // A step whose contacts are all collisions (no resting contact: a gas) is
 // solved on past kVelocityPasses until every target speed is met within
-// kConverged of the step's fastest approach, or this many passes.
-constexpr int kMaxVelocityPasses = 1024;
+// kConverged of the step's fastest approach, or System::pairMaxPasses.
 constexpr double kConverged = 1e-12;
 constexpr int kPositionPasses = 4;
 constexpr double kRestFraction = 0.5;
+// Candidates of one particle gathered before their contacts are computed:
+// the distance screen runs without a branch a candidate.
+constexpr uint32_t kCandidates = 64;
 
 // The first t in [0, 1] where |d0 + t dd| = R, or -1; 0 when |d0| < R.
 double TimeOfImpact(const Vec3& d0, const Vec3& dd, double R) {
@@ -75,6 +97,16 @@ double TimeOfImpact(const Vec3& d0, const Vec3& dd, double R) {
   return t <= 1 ? t : -1;
 }
 
+// max(x, 0) without a branch (a contact's impulse sign changes from pass to
+// pass: a branch on it is mispredicted often). NaN gives 0, as std::max(0, x).
+inline double PositivePart(double x) {
+#if defined(__SSE2__)
+  return _mm_cvtsd_f64(_mm_max_sd(_mm_set_sd(x), _mm_setzero_pd()));
+#else
+  return x > 0 ? x : 0;
+#endif
+}
+
 // fn(begin, end) over ranges of [0, n), on the pool if there is one.
 template <typename Fn>
 void Ranges(ThreadPool* pool, size_t n, Fn&& fn) {
@@ -85,236 +117,311 @@ void Ranges(ThreadPool* pool, size_t n, Fn&& fn) {
   ForRanges(pool, n, BalancedGrain(pool, n, 256, 4096), fn);
 }
 
+// fn(c) for every chunk c < chunks, on the pool if there is one.
+template <typename Fn>
+void Chunks(ThreadPool* pool, size_t chunks, Fn&& fn) {
+  if (!pool || chunks < 2) {
+    for (size_t c = 0; c < chunks; ++c) fn(c);
+    return;
+  }
+  pool->ParallelFor(chunks, fn);
+}
+
 }  // namespace
 
 void System::ParticleCollisions(double h) {
+  PairWork& pw = *pairWork_;
+  pw.passes = 0;
+  pw.gas = false;
+  pw.converged = true;
+  pw.residual = pw.tolerance = 0;
   const size_t n = state.size();
   if (n < 2) return;
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
-  const Vec3* X0 = pairX0_.data();
-  const Vec3* V0 = pairV0_.data();
-  const double* w = state.invMass.data();
+  const Vec3* X0 = pw.x0.data();
+  const Vec3* V0 = pw.v0.data();
   auto radius = [&](size_t i) {
     return state.radius[i] > 0 ? double(state.radius[i]) : pairRadius_;
   };
-  double maxR = 0, maxMove = 0;
-  pairMove_.resize(n);
+  double maxR = 0, maxMove2 = 0;
   for (size_t i = 0; i < n; ++i) {
     maxR = std::max(maxR, radius(i));
-    pairMove_[i] = (X[i] - X0[i]).norm();
-    maxMove = std::max(maxMove, pairMove_[i]);
+    maxMove2 = std::max(maxMove2, (X[i] - X0[i]).squaredNorm());
   }
+  const double maxMove = std::sqrt(maxMove2);
   if (!(maxMove <= 1e12)) return;  // an explosion: the fault scan reports it
   const double reach = 2 * maxR + 2 * maxMove;
-  // With a copy of the start positions in slot order: every particle
-  // queries, and reads its candidates contiguously.
-  pairGrid_->Build(X0, n, reach, pool_, true);
-
-  // Contacts, particle by particle: count, offsets, fill.
-  auto find = [&](size_t i, auto&& emit) {
-    pairGrid_->ForEachNeighbour(X0, i, reach, [&](size_t j) {
-      if (w[i] + w[j] == 0) return;
-      const double R = radius(i) + radius(j);
-      const Vec3 d0 = X0[i] - X0[j];
-      // Too far apart for their two steps to meet.
-      const double meet = R + pairMove_[i] + pairMove_[j];
-      if (d0.squaredNorm() > meet * meet) return;
-      const Vec3 dd = (X[i] - X0[i]) - (X[j] - X0[j]);
-      const double t = TimeOfImpact(d0, dd, R);
-      if (t < 0) return;
-      const Vec3 d = d0 + t * dd;
-      const double len = d.norm();
-      if (!(len > 0)) return;  // coincident centres: no direction
-      emit(j, t, Vec3(d / len), R);
-    });
-  };
-  pairStart_.assign(n + 1, 0);
+  // With a copy of the start positions in slot order; from here every
+  // array is in that order.
+  pw.grid.Build(X0, n, reach, pool_, true);
+  const uint32_t* order = pw.grid.order().data();
+  const Vec3* x0 = pw.grid.sortedPositions().data();
+  for (auto* a : {&pw.x, &pw.d, &pw.v, &pw.dv, &pw.scratch}) a->resize(n);
+  for (auto* a : {&pw.w, &pw.r, &pw.move, &pw.first}) a->resize(n);
+  pw.begin.resize(n);
+  pw.end.resize(n);
+  pw.free.resize(n);
+  pw.resting.resize(n);
+  Vec3 *x = pw.x.data(), *d = pw.d.data(), *v = pw.v.data(), *dv = pw.dv.data();
+  double *w = pw.w.data(), *r = pw.r.data(), *move = pw.move.data(), *first = pw.first.data();
+  uint32_t *begin = pw.begin.data(), *end = pw.end.data();
+  uint8_t *freeFlight = pw.free.data(), *resting = pw.resting.data();
   Ranges(pool_, n, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      uint32_t c = 0;
-      find(i, [&](size_t, double, const Vec3&, double) { ++c; });
-      pairStart_[i + 1] = c;
+    for (size_t p = b; p < e; ++p) {
+      const size_t i = order[p];
+      x[p] = X[i];
+      d[p] = X[i] - X0[i];
+      v[p] = V[i];
+      dv[p] = V[i] - V0[i];
+      w[p] = state.invMass[i];
+      r[p] = radius(i);
+      move[p] = d[p].norm();
+      freeFlight[p] = V[i] == V0[i];
     }
   });
-  for (size_t i = 0; i < n; ++i) pairStart_[i + 1] += pairStart_[i];
-  const size_t total = pairStart_[n];
-  if (total == 0) return;
-  pairs_.resize(total);
-  Ranges(pool_, n, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      size_t k = pairStart_[i];
-      find(i, [&](size_t j, double t, const Vec3& nrm, double R) {
-        PairContact& c = pairs_[k++];
-        c.j = uint32_t(j);
-        c.t = t;
-        c.n = nrm;
-        c.R = R;
-        c.vn0 = nrm.dot(V[i] - V[j]);
-        // Speed the step's forces gave toward each other: a slower approach
-        // is resting contact.
-        const double gained = std::max(0.0, -nrm.dot((V[i] - V0[i]) - (V[j] - V0[j])));
+
+  // Contacts, in one walk of the grid: each particle of a chunk appends
+  // its contacts to the chunk's array.
+  const size_t chunks = (n + kPairChunk - 1) / kPairChunk;
+  if (pw.chunks.size() < chunks) pw.chunks.resize(chunks);
+  const double r2 = reach * reach;
+  Chunks(pool_, chunks, [&](size_t c) {
+    PairChunk& ch = pw.chunks[c];
+    ch.contacts.clear();
+    ch.speed = 0;
+    ch.resting = false;
+    // Particle p's contacts among the candidates cand[0, m).
+    auto contacts = [&](size_t p, const uint32_t* cand, uint32_t m) {
+      const Vec3 xp = x0[p];
+      for (uint32_t a = 0; a < m; ++a) {
+        const uint32_t q = cand[a];
+        if (w[p] + w[q] == 0) continue;
+        const double R = r[p] + r[q];
+        const Vec3 d0 = xp - x0[q];
+        // Too far apart for their two steps to meet.
+        const double meet = R + move[p] + move[q];
+        if (d0.squaredNorm() > meet * meet) continue;
+        const Vec3 dd = d[p] - d[q];
+        const double t = TimeOfImpact(d0, dd, R);
+        if (t < 0) continue;
+        const Vec3 dc = d0 + t * dd;
+        const double len = dc.norm();
+        if (!(len > 0)) continue;  // coincident centres: no direction
+        const Vec3 nrm = dc / len;
+        const double vn0 = nrm.dot(v[p] - v[q]);
+        // Speed the step's forces gave toward each other: a slower
+        // approach is resting contact.
+        const double gained = std::max(0.0, -nrm.dot(dv[p] - dv[q]));
         // A pair touching already at the start is in resting contact (what
         // a pile's passes leave of pushes and pops must not bounce), unless
         // the step's forces changed neither velocity: in free flight the
         // overlap is a collision the step before missed (a ball sent on by
         // one contact into another within that step), and it bounces.
-        const bool free = V[i] == V0[i] && V[j] == V0[j];
-        c.bounce = (t > 0 || free) && c.vn0 < -2 * gained - 1e-12;
-        c.impulse = 0;
-      });
-    }
-  });
-  auto factor = [&](size_t i, uint32_t j) {
-    const uint32_t ci = pairStart_[i + 1] - pairStart_[i];
-    const uint32_t cj = pairStart_[j + 1] - pairStart_[j];
-    return 1.0 / double(std::max(ci, cj));
-  };
-
-  // Each contact's target speed and sharing factor, once.
-  Ranges(pool_, n, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      for (uint32_t k = pairStart_[i]; k < pairStart_[i + 1]; ++k) {
-        PairContact& c = pairs_[k];
-        c.target = c.bounce ? -pairRestitution_ * c.vn0 : 0;
-        c.k = w[i] > 0 ? factor(i, c.j) / (w[i] + w[c.j]) : 0;
+        const bool bounce =
+            (t > 0 || (freeFlight[p] && freeFlight[q])) && vn0 < -2 * gained - 1e-12;
+        ch.contacts.push_back({nrm, 0.0, bounce ? -pairRestitution_ * vn0 : 0.0, 0.0, q, bounce});
+        ch.speed = std::max(ch.speed, std::abs(vn0));
+        resting[p] |= !bounce;
+        first[p] = std::min(first[p], t);
       }
+    };
+    const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
+    for (size_t p = pb; p < pe; ++p) {
+      first[p] = 1;
+      resting[p] = 0;
+      begin[p] = uint32_t(ch.contacts.size());
+      // The candidates: the grid's ranges, screened by distance without a
+      // branch, kCandidates at a time.
+      uint32_t from[27], to[27];
+      int ranges = 0;
+      pw.grid.ForEachCandidateRange(x0[p], [&](uint32_t f, uint32_t t) {
+        from[ranges] = f;
+        to[ranges] = t;
+        ++ranges;
+      });
+      const Vec3* const sx = x0;  // locals: the loop keeps them in registers
+      const double reach2 = r2;
+      const double px = sx[p].x(), py = sx[p].y(), pz = sx[p].z();
+      uint32_t cand[kCandidates];
+      uint32_t m = 0;
+      for (int g = 0; g < ranges; ++g) {
+        for (uint32_t k = from[g]; k < to[g]; ++k) {
+          const double dx = sx[k].x() - px, dy = sx[k].y() - py, dz = sx[k].z() - pz;
+          cand[m] = k;
+          m += uint32_t(dx * dx + dy * dy + dz * dz <= reach2) & uint32_t(k != p);
+          if (m == kCandidates) {
+            contacts(p, cand, m);
+            m = 0;
+          }
+        }
+      }
+      contacts(p, cand, m);
+      end[p] = uint32_t(ch.contacts.size());
+      ch.resting |= resting[p] != 0;
     }
   });
-
-  // From here pairMove_ holds what the step's forces changed each
-  // velocity by (|v - v0| before the solve), for the rest test at the end.
-  Ranges(pool_, n, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) pairMove_[i] = (V[i] - V0[i]).norm();
-  });
+  double speed = 0;
+  bool anyResting = false;
+  size_t total = 0;
+  for (size_t c = 0; c < chunks; ++c) {
+    speed = std::max(speed, pw.chunks[c].speed);
+    anyResting |= pw.chunks[c].resting;
+    total += pw.chunks[c].contacts.size();
+  }
+  if (total == 0) return;
 
   // Velocity passes (Jacobi), kVelocityPasses; where no contact of the
   // step is resting, on while a collision contact is off its target by more
   // than kConverged of the step's largest approach speed, up to
-  // kMaxVelocityPasses (a pile keeps its fixed passes: converging them
-  // costs 15x and does not settle it). Each
-  // particle records the largest residual of its bounce contacts; their
-  // maximum is the same whatever the thread count (a max does not depend
-  // on the order).
-  pairV_.assign(V.begin(), V.end());
-  pairScratch_.resize(n);
-  pairResidual_.resize(n);
-  double speed = 0;
-  bool resting = false;
-  for (size_t k = 0; k < total; ++k) {
-    speed = std::max(speed, std::abs(pairs_[k].vn0));
-    resting |= !pairs_[k].bounce;
-  }
-  const double tolerance = kConverged * speed;
-  const int passes = resting ? kVelocityPasses : kMaxVelocityPasses;
+  // pairMaxPasses (a pile keeps its fixed passes: converging them costs 15x
+  // and does not settle it). Each chunk records the largest residual of its
+  // bounce contacts; their maximum is the same whatever the thread count
+  // (a max does not depend on the order). The first pass also computes
+  // each contact's sharing factor.
+  pw.gas = !anyResting;
+  pw.tolerance = kConverged * speed;
+  const int passes = pw.gas ? std::max(pairMaxPasses, kVelocityPasses) : kVelocityPasses;
   for (int pass = 0; pass < passes; ++pass) {
-    Ranges(pool_, n, [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) {
-        Vec3 dv = Vec3::Zero();
-        double residual = 0;
-        if (w[i] > 0) {
-          for (uint32_t k = pairStart_[i]; k < pairStart_[i + 1]; ++k) {
-            PairContact& c = pairs_[k];
-            const double vn = c.n.dot(pairV_[i] - pairV_[c.j]);
+    const Vec3* vin = pw.v.data();
+    Vec3* vout = pw.scratch.data();
+    Chunks(pool_, chunks, [&](size_t c) {
+      PairChunk& ch = pw.chunks[c];
+      PairContact* cs = ch.contacts.data();
+      double worst = 0;
+      const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
+      for (size_t p = pb; p < pe; ++p) {
+        Vec3 sum = Vec3::Zero();
+        if (w[p] > 0) {
+          const Vec3 vp = vin[p];
+          if (pass == 0) {
+            for (uint32_t k = begin[p]; k < end[p]; ++k) {
+              const uint32_t q = cs[k].j;
+              const double f = 1.0 / double(std::max(end[p] - begin[p], end[q] - begin[q]));
+              cs[k].k = f / (w[p] + w[q]);
+            }
+          }
+          for (uint32_t k = begin[p]; k < end[p]; ++k) {
+            PairContact& ct = cs[k];
+            const double vn = ct.n.dot(vp - vin[ct.j]);
             // Off target: a pushing contact (impulse > 0) must meet its
             // target speed; one that does not push must not fall short.
-            if (c.bounce)
-              residual = std::max(
-                  residual, c.impulse > 0 ? std::abs(c.target - vn) : std::max(0.0, c.target - vn));
+            if (pw.gas)
+              worst = std::max(
+                  worst, ct.impulse > 0 ? std::abs(ct.target - vn) : std::max(0.0, ct.target - vn));
             // The impulse toward the target, its sum over the passes kept
             // at 0 or more (contacts push, never pull). Both particles of a
             // pair compute the same numbers.
-            const double acc = std::max(0.0, c.impulse + (c.target - vn) * c.k);
-            const double J = acc - c.impulse;
-            c.impulse = acc;
-            dv += (J * w[i]) * c.n;
+            const double acc = PositivePart(ct.impulse + (ct.target - vn) * ct.k);
+            const double J = acc - ct.impulse;
+            ct.impulse = acc;
+            sum += J * ct.n;
           }
         }
-        pairResidual_[i] = residual;
-        pairScratch_[i] = pairV_[i] + dv;
+        vout[p] = vin[p] + w[p] * sum;
       }
+      ch.residual = worst;
     });
     // The residuals were those of the velocities before this pass: met,
     // the pass changed nothing that matters; keep its result all the same.
-    std::swap(pairV_, pairScratch_);
-    if (pass + 1 >= kVelocityPasses) {
+    std::swap(pw.v, pw.scratch);
+    v = pw.v.data();
+    pw.passes = pass + 1;
+    if (pw.gas && pass + 1 >= kVelocityPasses) {
       double worst = 0;
-      for (size_t i = 0; i < n; ++i) worst = std::max(worst, pairResidual_[i]);
-      if (worst <= tolerance) break;
+      for (size_t c = 0; c < chunks; ++c) worst = std::max(worst, pw.chunks[c].residual);
+      pw.residual = worst;
+      if (worst <= pw.tolerance) break;
     }
   }
-  // New velocities; positions follow them over the rest of the step after
+  pw.converged = !pw.gas || pw.residual <= pw.tolerance;
+  // Positions follow the new velocities over the rest of the step after
   // the first contact.
-  Ranges(pool_, n, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      if (pairStart_[i + 1] == pairStart_[i] || w[i] == 0) continue;
-      double first = 1;
-      for (uint32_t k = pairStart_[i]; k < pairStart_[i + 1]; ++k)
-        first = std::min(first, pairs_[k].t);
-      X[i] += ((1 - first) * h) * (pairV_[i] - V[i]);
-      V[i] = pairV_[i];
+  Ranges(pool_, n, [&](size_t b, size_t e2) {
+    for (size_t p = b; p < e2; ++p) {
+      if (end[p] == begin[p] || w[p] == 0) continue;
+      const size_t i = order[p];
+      x[p] += ((1 - first[p]) * h) * (v[p] - V[i]);
     }
   });
 
   // Position passes (Jacobi): the remaining overlap along each normal.
   const double rh = h;
   for (int pass = 0; pass < kPositionPasses; ++pass) {
-    Ranges(pool_, n, [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) {
+    const Vec3* xin = pw.x.data();
+    Vec3* xout = pw.scratch.data();
+    Chunks(pool_, chunks, [&](size_t c) {
+      const PairContact* cs = pw.chunks[c].contacts.data();
+      const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
+      for (size_t p = pb; p < pe; ++p) {
+        if (w[p] == 0 || end[p] == begin[p]) {
+          xout[p] = xin[p];
+          continue;
+        }
         Vec3 dx = Vec3::Zero();
-        if (w[i] > 0) {
-          for (uint32_t k = pairStart_[i]; k < pairStart_[i + 1]; ++k) {
-            const PairContact& c = pairs_[k];
-            const double gap = c.n.dot(X[i] - X[c.j]) - c.R;
-            if (gap >= 0) continue;
-            dx -= (gap * w[i] / (w[i] + w[c.j]) * factor(i, c.j)) * c.n;
+        for (uint32_t k = begin[p]; k < end[p]; ++k) {
+          const PairContact& ct = cs[k];
+          const double gap = ct.n.dot(xin[p] - xin[ct.j]) - (r[p] + r[ct.j]);
+          if (gap < 0) dx -= (gap * w[p] * ct.k) * ct.n;
+        }
+        Vec3 xp = xin[p] + dx;
+        Vec3 vp = v[p];
+        // Out of the half-space colliders again (where a moving one ends
+        // the step), without velocity into them.
+        for (const Collider& col : colliders_) {
+          const Vec3 shift = rh * col.velocity;
+          Vec3 sp, sn;
+          if (col.Project(xp - shift, &sp, &sn, r[p])) {
+            xp = sp + shift;
+            const double vn = (vp - col.velocity).dot(sn);
+            if (vn < 0) vp -= vn * sn;
           }
         }
-        Vec3 x = X[i] + dx;
-        Vec3 v = V[i];
-        if (w[i] > 0 && pairStart_[i + 1] > pairStart_[i]) {
-          // Out of the half-space colliders again (where a moving one ends
-          // the step), without velocity into them.
-          for (const Collider& col : colliders_) {
-            const Vec3 shift = rh * col.velocity;
-            Vec3 sp, sn;
-            if (col.Project(x - shift, &sp, &sn, radius(i))) {
-              x = sp + shift;
-              const double vn = (v - col.velocity).dot(sn);
-              if (vn < 0) v -= vn * sn;
-            }
-          }
-        }
-        pairScratch_[i] = x;
-        pairV_[i] = v;
+        xout[p] = xp;
+        v[p] = vp;
       }
     });
-    // Every particle read X of the pass before; now the new positions.
-    Ranges(pool_, n, [&](size_t b, size_t e) {
-      for (size_t i = b; i < e; ++i) {
-        X[i] = pairScratch_[i];
-        V[i] = pairV_[i];
-      }
-    });
+    // Every particle read the positions of the pass before.
+    std::swap(pw.x, pw.scratch);
+    x = pw.x.data();
   }
   // A particle in resting contact takes the velocity of its displacement
   // over the step (position-based dynamics): what the passes left of the
   // forces' push into its neighbours does not build up from step to step,
-  // and a pile comes to rest.
-  Ranges(pool_, n, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      if (w[i] == 0) continue;
-      bool resting = false;
-      for (uint32_t k = pairStart_[i]; k < pairStart_[i + 1]; ++k) resting |= !pairs_[k].bounce;
-      if (!resting) continue;
-      V[i] = (X[i] - X0[i]) * (1 / h);
-      // At rest: a particle in resting contact that moved over the step at
-      // less than half the speed its forces alone gave it in the step is
-      // held by its neighbours; its velocity is zeroed, so what the passes
-      // leave of the forces' push does not make a pile jitter.
-      if (V[i].norm() < kRestFraction * pairMove_[i]) V[i] = Vec3::Zero();
+  // and a pile comes to rest. At rest: a particle in resting contact that
+  // moved over the step at less than half the speed its forces alone gave
+  // it in the step is held by its neighbours; its velocity is zeroed, so
+  // what the passes leave of the forces' push does not make a pile jitter.
+  // Then the particles with contacts take their new state.
+  Ranges(pool_, n, [&](size_t b, size_t e2) {
+    for (size_t p = b; p < e2; ++p) {
+      if (w[p] == 0 || end[p] == begin[p]) continue;
+      const size_t i = order[p];
+      Vec3 vp = v[p];
+      if (resting[p]) {
+        vp = (x[p] - x0[p]) * (1 / h);
+        if (vp.norm() < kRestFraction * dv[p].norm()) vp = Vec3::Zero();
+      }
+      X[i] = x[p];
+      V[i] = vp;
     }
   });
+}
+
+Status System::PairPassesWarning(const char* what) const {
+  const PairWork& pw = *pairWork_;
+  Diagnostic d = MakeError(
+      {}, "particles: " + std::string(what) + " step " + std::to_string(state.step) +
+              " (from t = " + check::Num(state.time) +
+              " s): the particle collisions did not converge in " + std::to_string(pw.passes) +
+              " velocity passes (System.pairMaxPasses): a collision is still " +
+              check::Num(pw.residual) + " m/s off its target speed (tolerance " +
+              check::Num(pw.tolerance) +
+              " m/s); the step kept what the passes gave, so an elastic gas does not keep its "
+              "energy exactly; raise pairMaxPasses or take smaller steps");
+  d.severity = Severity::kWarning;
+  d.kind = ErrorKind::kRuntime;
+  return d;
 }
 
 }  // namespace sylva::particles

@@ -11,6 +11,7 @@
 
 #include "particles/def_check.h"
 #include "particles/grid.h"
+#include "particles/pairs.h"
 
 namespace sylva::particles {
 namespace {
@@ -405,7 +406,7 @@ Status System::EnableParticleCollisions(double radius, double restitution) {
   SYLVA_CHECK_OK(check::Range("System.EnableParticleCollisions restitution", restitution, 0, 1));
   pairRadius_ = radius;
   pairRestitution_ = restitution;
-  if (!pairGrid_) pairGrid_ = std::make_unique<NeighbourGrid>();
+  if (!pairWork_) pairWork_ = std::make_unique<PairWork>();
   return {};
 }
 
@@ -537,6 +538,7 @@ Status System::CheckStep(const char* what, double h) {
   SYLVA_CHECK_OK(Range("System.maxMagnitude", maxMagnitude, 1e-300, 1e300));
   SYLVA_CHECK_OK(Range("System.cgTolerance", cgTolerance, 0, 1));
   SYLVA_CHECK_OK(Range("System.cgMaxIterations", cgMaxIterations, 1, 1e7));
+  SYLVA_CHECK_OK(Range("System.pairMaxPasses", pairMaxPasses, 16, 1e7));
   for (const auto& f : forces_) SYLVA_CHECK_OK(f->Check(state));
   SYLVA_CHECK_OK(CheckMasses(
       "System.Step", &state.massRecord, state.size(), [&](size_t i) { return state.mass[i]; },
@@ -618,6 +620,7 @@ Status System::Step(double h, Integrator integrator) {
   MoveColliders(h);
   state.time = time;
   Status status = CheckFaults("in");
+  if (status.ok() && pairRadius_ > 0 && !pairWork_->converged) status = PairPassesWarning("in");
   time += h;
   ++steps;
   return status;
@@ -803,8 +806,8 @@ Status System::NonFiniteSolve(const char* what, const Vec3* a, int iteration) {
 }
 
 void System::SavePairStart() {
-  pairX0_.assign(state.position.begin(), state.position.end());
-  pairV0_.assign(state.velocity.begin(), state.velocity.end());
+  pairWork_->x0.assign(state.position.begin(), state.position.end());
+  pairWork_->v0.assign(state.velocity.begin(), state.velocity.end());
 }
 
 // Dormand & Prince (1980) RK5(4)7M.
@@ -848,6 +851,7 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
   const double tEnd = time + dt;
   double h = adaptiveStep_ > 0 ? std::min(adaptiveStep_, dt) : dt;
   int calls = 0;
+  std::optional<Diagnostic> warning;  // the first substep whose gas contacts did not converge
   while (time < tEnd && tEnd - time > 1e-14 * std::max(1.0, std::abs(tEnd))) {
     if (++calls > opt.maxSteps) {
       Diagnostic d = MakeError({}, "particles: adaptive RK45 needed more than " +
@@ -923,6 +927,8 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
       MoveColliders(h);
       state.time = time;
       Status s = CheckFaults("in adaptive");
+      if (s.ok() && pairRadius_ > 0 && !pairWork_->converged && !warning)
+        warning = PairPassesWarning("in adaptive").error();
       time += h;
       ++steps;
       ++st.accepted;
@@ -944,6 +950,7 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
   }
   adaptiveStep_ = h;
   st.lastStep = h;
+  if (warning) return *warning;
   return {};
 }
 

@@ -25,6 +25,12 @@
 // particle id; the system then refuses to step again. Implicit Euler also
 // reports a system that is not positive definite (nothing moves; a smaller
 // step may succeed).
+//
+// Warnings. A step whose particle collisions (EnableParticleCollisions)
+// form a gas that did not converge within pairMaxPasses velocity passes
+// returns a Diagnostic of severity kWarning naming the step: the step was
+// taken and the system steps on (a Status that is not ok: check
+// error().severity).
 #pragma once
 
 #include <array>
@@ -46,6 +52,7 @@
 namespace sylva::particles {
 
 class NeighbourGrid;
+struct PairWork;
 
 struct ParticleState {
   // hot
@@ -309,6 +316,11 @@ class System {
   // Implicit Euler's CG: stop at this relative residual or iteration count.
   double cgTolerance = 1e-10;
   int cgMaxIterations = 200;
+  // Particle collisions: the most velocity passes a step with no resting
+  // contact (a gas) runs to meet every collision's target speed
+  // (pairs.cpp), 16..1e7; a step that reaches it keeps what the passes
+  // gave and returns a warning.
+  int pairMaxPasses = 1024;
 
   // 0 = every hardware thread. Starts a pool of the system's own.
   void SetThreads(int threads);
@@ -399,6 +411,8 @@ class System {
   // Moves every moving collider by h times its velocity (after a step).
   void MoveColliders(double h);
   Status CheckFaults(const char* what);
+  // The warning of a step whose gas contacts reached pairMaxPasses (pairs.cpp).
+  Status PairPassesWarning(const char* what) const;
   Status CheckStep(const char* what, double h);
 
   // Hands the pool to every force (before a step) or takes it back.
@@ -416,24 +430,7 @@ class System {
   ThreadPool* pool_ = nullptr;  // pools_.pool(): the pool in use (own or shared), null: serial
   bool hasNonLocal_ = false;
   double pairRadius_ = 0, pairRestitution_ = 1;
-  std::unique_ptr<NeighbourGrid> pairGrid_;
-  // The pair contacts of a step (pairs.cpp): 88 bytes each.
-  struct PairContact {
-    Vec3 n;          // unit, from the other particle toward this one, at impact
-    double t;        // time of impact, fraction of the step
-    double R;        // the two radii
-    double vn0;      // relative normal speed before the solve (negative: approaching)
-    double impulse;  // summed over the velocity passes (N s times the inverse mass sum's unit)
-    double target;   // relative normal speed the velocity passes aim for
-    double k;        // the pair's sharing factor over its inverse mass sum
-    uint32_t j;      // the other particle
-    bool bounce;     // faster than the step's forces: leaves at e times vn0
-  };
-  std::vector<Vec3> pairX0_, pairV0_, pairV_, pairScratch_;
-  std::vector<double> pairMove_;      // each particle's displacement over the step
-  std::vector<double> pairResidual_;  // each particle's largest bounce residual in a pass
-  std::vector<uint32_t> pairStart_;   // particle i's contacts: [start[i], start[i + 1])
-  std::vector<PairContact> pairs_;
+  std::unique_ptr<PairWork> pairWork_;  // pairs.h: the pair contacts' arrays
   FaultLatch faults_;
   SolveStats solve_;
   double adaptiveStep_ = 0;

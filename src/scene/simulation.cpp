@@ -307,6 +307,7 @@ struct ParticleSystem {
   };
   std::vector<Death> onDeath;
   uint64_t dropped = 0;  // births refused at `max`
+  bool warned = false;   // a step's warning is in Impl::warnings (the first only)
   std::unique_ptr<WindGrid> windGrid = std::make_unique<WindGrid>();
   std::shared_ptr<const mesh::TriangleMesh> drawMesh;  // as="mesh"
   // Leaves (draw as="mesh" with spin): orientation by particle id.
@@ -479,6 +480,7 @@ struct Simulation::Impl {
   double h = 1.0 / 120;
   double time = 0;
   uint64_t steps = 0;
+  DiagnosticList warnings;  // of steps taken (Simulation::warnings)
   Wind wind;
   bool hasWind = false;
   std::vector<std::unique_ptr<ParticleSystem>> systems;
@@ -825,7 +827,11 @@ Status Simulation::Impl::Step() {
         Diagnostic d = s.error();
         d.loc = ps->def->loc;
         d.message = "<particles> at t = " + std::to_string(time) + " s: " + d.message;
-        return d;
+        // A warning: the step was taken (particle collisions that did not
+        // converge); the first of each system is kept, and the run goes on.
+        if (d.severity != Severity::kWarning) return d;
+        if (!ps->warned) warnings.Add(std::move(d));
+        ps->warned = true;
       }
       CatchRiders(*ps);
     }
@@ -906,6 +912,9 @@ double Simulation::time() const {
 }
 double Simulation::stepLength() const {
   return impl_->h;
+}
+const DiagnosticList& Simulation::warnings() const {
+  return impl_->warnings;
 }
 
 Status Simulation::AdvanceTo(double t) {

@@ -55,6 +55,10 @@ class Simulation {
   // failed step is an error naming the element and the time; more than
   // kMaxStepsPerAdvance steps is an input error before any step.
   [[nodiscard]] Status AdvanceTo(double t);
+  // Warnings of steps taken (a particle system's collisions that did not
+  // converge in a step: System::pairMaxPasses), the first of each element,
+  // with its location; the simulation went on.
+  const DiagnosticList& warnings() const;
   // Particles as sprites, lines or instanced meshes; cloth as meshes; boids
   // as instanced meshes.
   void AddToDrawList(draw::DrawList& list) const;

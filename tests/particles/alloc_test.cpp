@@ -124,6 +124,33 @@ TEST(ParticleAllocations, BulkStepAllocatesNothing) {
   }
 }
 
+// Particle collisions (pairs.cpp): a pile of 1,000 balls resting in a box
+// under gravity, every ball in contact. Each chunk's contact array keeps
+// its capacity, so once the pile has settled (no chunk holds more contacts
+// than it has held before) a step allocates nothing.
+TEST(ParticleAllocations, ParticleCollisionsAllocateNothingAtRest) {
+  for (int threads : {1, 2}) {
+    System s(threads);
+    s.AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
+    ASSERT_OK(s.AddCollider(
+        Collider::Box(Vec3(-0.5, 0, -0.5), Vec3(0.5, 10, 0.5), true).Restitution(0.3)));
+    for (int y = 0; y < 10; ++y)
+      for (int z = 0; z < 10; ++z)
+        for (int x = 0; x < 10; ++x) {
+          s.state.Add(Vec3(-0.45 + 0.1 * x, 0.05 + 0.1 * y, -0.45 + 0.1 * z), Vec3::Zero());
+          s.state.radius.back() = 0.05f;
+        }
+    ASSERT_OK(s.EnableParticleCollisions(0.05, 0.3));
+    for (int k = 0; k < 60; ++k) STEP_OK(s, 1.0 / 60, Integrator::kSymplecticEuler);
+    Status st;
+    const uint64_t n = Allocations([&] {
+      for (int k = 0; k < 10; ++k) st = s.Step(1.0 / 60, Integrator::kSymplecticEuler);
+    });
+    ASSERT_TRUE(st.ok()) << st.error().message;
+    EXPECT_EQ(n, 0u) << "allocations in 10 steps of a resting pile on " << threads << " threads";
+  }
+}
+
 // The counter sees allocations at all (the test above could not pass by
 // counting nothing).
 TEST(ParticleAllocations, CounterCounts) {

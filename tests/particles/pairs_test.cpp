@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <string>
 
 #include "helpers.h"
 #include "particles/system.h"
@@ -97,6 +98,63 @@ TEST(PairContacts, APileOf2880BallsComesToRest) {
   EXPECT_LT(speed, 0.05) << "the fastest ball still moves at " << speed << " m/s after 5 s";
   EXPECT_LT(drift, 0.05) << "a ball moved " << drift << " m between 4 s and 5 s";
   EXPECT_GE(lowest, 0.05 - 1e-9) << "a centre came down to y = " << lowest;
+}
+
+// A step with no resting contact (a gas) runs its velocity passes until
+// every collision meets its target speed, up to System::pairMaxPasses. The
+// 2,000-ball gas of ParticleCollisions.GasConservesMomentumAndElasticEnergy
+// needs more than 16 in some steps: with the limit at 16 those steps return
+// a warning naming the step (the step is taken, the system steps on), and
+// with the default limit none does.
+TEST(PairContacts, AGasStepThatReachesThePassLimitIsReported) {
+  auto gas = [](System& s) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1);
+    while (s.state.size() < 2000) {
+      const Vec3 p(u(rng), u(rng), u(rng));
+      bool apart = true;
+      for (const Vec3& q : s.state.position) apart &= (p - q).norm() > 0.06;
+      if (apart) s.state.Add(p, Vec3(u(rng), u(rng), u(rng)), 1 + 0.5 * u(rng));
+    }
+    EXPECT_OK(s.EnableParticleCollisions(0.03, 1.0));
+  };
+  System limited;
+  gas(limited);
+  limited.pairMaxPasses = 16;
+  int warnings = 0, errors = 0;
+  std::string first;
+  for (int i = 0; i < 50; ++i) {
+    Status st = limited.Step(0.005, Integrator::kSymplecticEuler);
+    if (st.ok()) continue;
+    if (st.error().severity != Severity::kWarning) {
+      ++errors;
+      ADD_FAILURE() << st.error().message;
+      continue;
+    }
+    if (warnings++ == 0) {
+      first = st.error().message;
+      EXPECT_NE(first.find("in step " + std::to_string(i) + " "), std::string::npos) << first;
+    }
+  }
+  EXPECT_GT(warnings, 0) << "no step of the gas reached 16 passes";
+  EXPECT_EQ(errors, 0);
+  EXPECT_EQ(limited.steps, 50u) << "every step is taken, warning or not";
+  EXPECT_NE(first.find("did not converge in 16 velocity passes"), std::string::npos) << first;
+
+  System full;
+  gas(full);
+  for (int i = 0; i < 50; ++i) {
+    Status st = full.Step(0.005, Integrator::kSymplecticEuler);
+    ASSERT_TRUE(st.ok()) << "step " << i << ": " << st.error().message;
+  }
+
+  System bad;
+  gas(bad);
+  bad.pairMaxPasses = 15;
+  Status st = bad.Step(0.005, Integrator::kSymplecticEuler);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("System.pairMaxPasses 15"), std::string::npos)
+      << st.error().message;
 }
 
 }  // namespace
