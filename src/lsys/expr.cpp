@@ -1756,7 +1756,7 @@ bool IsStatementBlock(std::string_view text, size_t pos, std::string_view next) 
     size_t q = e;
     while (q < t.size() && (t[q] == ' ' || t[q] == '\t')) ++q;
     if ((word == "if" || word == "while" || word == "printf" || word == "fprintf" ||
-         word == "fclose" || word == "fflush" || word == "fscanf") &&
+         word == "fclose" || word == "fflush" || word == "fscanf" || word == "srand") &&
         q < t.size() && t[q] == '(')
       return true;
     if (word == "do" && (q >= t.size() || t[q] == '{' || q > e)) return true;

@@ -196,5 +196,15 @@ TEST(CpfgDataFiles, NamesAreRelativeToTheGrammarAndHostileFilesAreClearErrors) {
       << errorFor("big.dat");
 }
 
+TEST(CpfgDataFiles, BlocksThatStartWithFscanfOrSrandGoOnOverLines) {
+  // vlab's paintbrush.field: `Start: {srand(1);` / `\tdx0 =` / `\tfunc(...);` / `}`.
+  EXPECT_EQ(Word(ParseWith("Start: {srand(3);\n\tx =\n\t2;\n}\naxiom: A(x)\n", {})), "A(2)");
+  EXPECT_EQ(Word(ParseWith("Start: {fp = fopen(\"n.dat\", \"r\");}\naxiom: A\n"
+                           "A : {fscanf(fp, \"%lf\",\n   &x);} * --> B(x)\n",
+                           {{"/obj/n.dat", "7"}}),
+                 1),
+            "B(7)");
+}
+
 }  // namespace
 }  // namespace sylva::lsys
