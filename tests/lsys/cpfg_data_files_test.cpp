@@ -152,6 +152,9 @@ TEST(CpfgDataFiles, FormatsAndAddressesAreCheckedWhenParsed) {
             "1:54 fscanf reads into variables: write '&name' or '&a[i]'");
   EXPECT_EQ(err("fscanf(fp, \"%lf\", &a[0]);"),
             "1:55 'a' is not an array (arrays are declared in 'define: { array a[n]; }')");
+  EXPECT_EQ(err("if (fscanf(fp, \"%lf\", &y) == 1) x = 2;"),
+            "1:40 'fscanf(...)' is read in a statement block as a statement ('fscanf(...);') or an "
+            "assignment ('x = fscanf(...);'), not inside an expression");
   // A file that is not there: an error at its name, which says where it looked.
   EXPECT_EQ(FirstError(ParseWith("Start: { fp = fopen(\"gone.dat\", \"r\"); }\naxiom: A\n", files)),
             "1:21 cannot read data file '/obj/gone.dat': cannot read file");
