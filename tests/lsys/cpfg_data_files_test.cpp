@@ -7,12 +7,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <string>
 
 #include "../scratch_dir.h"
+#include "lsys/cpfg_data_files.h"
 #include "lsys/parser.h"
 #include "lsys_test_util.h"
 
@@ -207,6 +209,45 @@ TEST(CpfgDataFiles, BlocksThatStartWithFscanfOrSrandGoOnOverLines) {
                            {{"/obj/n.dat", "7"}}),
                  1),
             "B(7)");
+}
+
+TEST(CpfgDataFiles, ScanAgreesWithTheCLibrarysScanf) {
+  // Differential: the C library's sscanf on the same text and format gives
+  // the same count and values (fscanf differs from sscanf only at EOF,
+  // where both return -1 before the first conversion).
+  const char* formats[] = {"%lf",     "%lf %lf",  "x=%lf",   "%*s %lf", "%3lf%lf",
+                           " %lf,%lf", "%lf\n%lf", "%*c%lf",  "a %lf",   "%2lf %*3c%lf"};
+  const char* inputs[] = {"1 2",  "x=3.5",   "abc 4",  "12345 6", "  -1e3,7", "",
+                          "   ",  "1,\n 2", "x= 2",   "a\t9",    "0x1p3 4", ".5e1 -.25",
+                          "1e",   "+7 x",    "12 34"};
+  int compared = 0;
+  for (const char* f : formats) {
+    ScanFormat fmt;
+    std::string why;
+    ASSERT_TRUE(ParseScanFormat(f, &fmt, &why)) << f << ": " << why;
+    ASSERT_LE(fmt.assignments, 2);
+    for (const char* in : inputs) {
+      CpfgDataFiles files("", [in](const std::string&) -> Expected<std::string> {
+        return std::string(in);
+      });
+      uint32_t id = 0;
+      ASSERT_TRUE(files.Add("d", &id, &why)) << why;
+      CpfgDataFiles::Call call;
+      call.format = fmt;
+      call.element.assign(size_t(fmt.assignments), 0);
+      const uint32_t c = files.AddCall(call);
+      double mine[2] = {-7, -7}, theirs[2] = {-7, -7};
+      int count = 0;
+      ASSERT_TRUE(files.Scan(files.Open(id), c, mine, &count, &why)) << f << " on " << in << ": "
+                                                                     << why;
+      const int expected = std::sscanf(in, f, &theirs[0], &theirs[1]);
+      EXPECT_EQ(count, expected) << "format '" << f << "' on '" << in << "'";
+      for (int k = 0; k < fmt.assignments; ++k)
+        EXPECT_EQ(mine[k], theirs[k]) << "format '" << f << "' on '" << in << "', value " << k;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 150);
 }
 
 }  // namespace
