@@ -25,6 +25,52 @@ std::string Shown(char c) {
   return std::string("'") + c + "'";
 }
 
+// How many characters of t[p, p + room) scanf takes for a number: the
+// longest run that can begin one (sign, digits, '.', exponent with its
+// sign, 0x, inf, nan), as glibc's scanf reads it before converting (it
+// takes `1e` of `1e,` and converts it to 1: it cannot push back more than
+// one character).
+size_t NumberPrefix(const std::string& t, size_t p, size_t room, bool real, int base) {
+  const size_t end = p + room;
+  size_t q = p;
+  auto at = [&](size_t i) { return i < end ? t[i] : '\0'; };
+  auto lower = [](char c) { return char(std::tolower(static_cast<unsigned char>(c))); };
+  if (at(q) == '+' || at(q) == '-') ++q;
+  if (real) {
+    for (const char* word : {"infinity", "inf", "nan"}) {
+      size_t k = 0;
+      while (word[k] && lower(at(q + k)) == word[k]) ++k;
+      if (!word[k]) return q + k - p;
+    }
+  }
+  bool hex = base == 16;
+  if ((base == 16 || base == 0 || real) && at(q) == '0' && lower(at(q + 1)) == 'x' &&
+      std::isxdigit(static_cast<unsigned char>(at(q + 2)))) {  // 0x, with a digit in the width
+    q += 2;
+    hex = true;
+  } else if (base == 0 && at(q) == '0') {
+    base = 8;
+  }
+  auto digit = [&](char c) {
+    if (hex) return std::isxdigit(static_cast<unsigned char>(c)) != 0;
+    if (base == 8) return c >= '0' && c <= '7';
+    return std::isdigit(static_cast<unsigned char>(c)) != 0;
+  };
+  while (digit(at(q))) ++q;
+  if (!real) return q - p;
+  if (at(q) == '.') {
+    ++q;
+    while (digit(at(q))) ++q;
+  }
+  const char e = lower(at(q));
+  if ((!hex && e == 'e') || (hex && e == 'p')) {
+    ++q;
+    if (at(q) == '+' || at(q) == '-') ++q;
+    while (std::isdigit(static_cast<unsigned char>(at(q)))) ++q;
+  }
+  return q - p;
+}
+
 }  // namespace
 
 std::string UnescapeC(std::string_view body) {
@@ -205,7 +251,7 @@ bool CpfgDataFiles::Scan(double handle, uint32_t callIndex, double* values, int*
   const std::string& t = file.text;
   const ScanFormat& fmt = calls_[callIndex].format;
   size_t p = h.pos;
-  int assigned = 0, conversions = 0;
+  int assigned = 0;
   bool inputFailure = false;
   std::string stopped;  // empty: the whole format was read
   auto skipBlanks = [&] {
@@ -241,41 +287,37 @@ bool CpfgDataFiles::Scan(double handle, uint32_t callIndex, double* values, int*
       size_t n = 0;
       while (n < room && (d.kind == Kind::kChars || !IsBlank(t[p + n]))) ++n;
       p += n;
-      ++conversions;
       continue;
     }
-    // A number: strtod/strtoll on the text (NUL-terminated) or, with a
-    // width, on a copy of that many characters.
-    std::string limited;
-    const char* s = t.c_str() + p;
-    if (d.width > 0) {
-      limited.assign(t, p, room);
-      s = limited.c_str();
-    }
+    // A number: the characters scanf takes for one, converted by
+    // strtod/strtoll (which must use at least one of them).
+    const size_t taken = NumberPrefix(t, p, room, d.kind == Kind::kReal, d.base);
+    const std::string text = t.substr(p, taken);
     char* end = nullptr;
     double v = 0;
     if (d.kind == Kind::kReal) {
-      v = std::strtod(s, &end);
+      v = std::strtod(text.c_str(), &end);
     } else {
-      v = double(std::strtoll(s, &end, d.base));
+      v = double(std::strtoll(text.c_str(), &end, d.base));
     }
-    if (end == s) {
+    if (taken == 0 || end == text.c_str()) {
+      p += taken;
       stopped = "at line " + lineAt(p) + ": the format expects a number, the file has " +
-                Shown(t[p]);
+                (p < t.size() ? Shown(t[p]) : std::string("its end"));
       break;
     }
     if (!std::isfinite(v)) {
-      *why = "fscanf read a number that is not finite ('" +
-             t.substr(p, size_t(end - s) > 40 ? 40 : size_t(end - s)) + "') at line " + lineAt(p) +
-             " of " + file.path;
+      *why = "fscanf read a number that is not finite ('" + text.substr(0, 40) + "') at line " +
+             lineAt(p) + " of " + file.path;
       return false;
     }
-    p += size_t(end - s);
-    ++conversions;
+    p += taken;
     if (d.assign) values[assigned++] = v;
   }
   h.pos = p;
-  *count = inputFailure && conversions == 0 ? -1 : assigned;
+  // glibc's rule (cpfg's C library): EOF when the input ends before any
+  // value was assigned.
+  *count = inputFailure && assigned == 0 ? -1 : assigned;
   if (!stopped.empty()) {
     if (file.shortReads++ == 0) file.firstShort = stopped;
   }

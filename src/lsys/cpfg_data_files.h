@@ -17,7 +17,9 @@
 // open (the Start: block opens them again). The format is read when the
 // grammar is parsed:
 //   blanks (space, \t, \n...)  skip any blanks in the input, none included
-//   %lf %f %le %e %lg %g %E %G %a   a number (strtod), blanks before it skipped
+//   %lf %f %le %e %lg %g %E %G %a   a number, blanks before it skipped: the
+//                                   characters glibc's scanf takes for one
+//                                   (`1e` of `1e,`), converted by strtod
 //   %d %i %u %ld %x %o ...          a whole number, stored as a double
 //   %*... (any of those, or %*s %*c) read and not assigned
 //   %%                              a '%' after blanks
@@ -109,7 +111,8 @@ class CpfgDataFiles {
   // fclose of a file it could not open only prints a message).
   void Close(double handle);
   // fscanf: values[k] holds the k-th address's value and receives what is
-  // read; *count is C's result (the values assigned, or -1 for EOF). False
+  // read; *count is C's result (the values assigned, or -1 when the input
+  // ends before any is: glibc's rule). False
   // and *why when the handle is no open file or a value is not finite.
   bool Scan(double handle, uint32_t call, double* values, int* count, std::string* why);
 

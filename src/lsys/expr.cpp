@@ -873,6 +873,12 @@ class Parser {
       if (name == f.name) fn = &f;
     }
     if (!fn) {
+      if (name == "fscanf" || name == "fopen" || name == "fclose")
+        return Error(col,
+                     "'" + name + "(...)' is read in a statement block as a statement ('" + name +
+                         "(...);') or an assignment ('x = " + name +
+                         "(...);'), not inside an expression",
+                     len);
       for (std::string_view c : kCpfgFunctions) {
         if (name == c)
           return Error(col, "cpfg function '" + name + "' is not supported by Sylva", len);

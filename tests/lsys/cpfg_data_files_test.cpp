@@ -7,12 +7,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <string>
 
 #include "../scratch_dir.h"
+#include "lsys/cpfg_data_files.h"
 #include "lsys/parser.h"
 #include "lsys_test_util.h"
 
@@ -152,6 +154,9 @@ TEST(CpfgDataFiles, FormatsAndAddressesAreCheckedWhenParsed) {
             "1:54 fscanf reads into variables: write '&name' or '&a[i]'");
   EXPECT_EQ(err("fscanf(fp, \"%lf\", &a[0]);"),
             "1:55 'a' is not an array (arrays are declared in 'define: { array a[n]; }')");
+  EXPECT_EQ(err("if (fscanf(fp, \"%lf\", &y) == 1) x = 2;"),
+            "1:40 'fscanf(...)' is read in a statement block as a statement ('fscanf(...);') or an "
+            "assignment ('x = fscanf(...);'), not inside an expression");
   // A file that is not there: an error at its name, which says where it looked.
   EXPECT_EQ(FirstError(ParseWith("Start: { fp = fopen(\"gone.dat\", \"r\"); }\naxiom: A\n", files)),
             "1:21 cannot read data file '/obj/gone.dat': cannot read file");
@@ -194,6 +199,55 @@ TEST(CpfgDataFiles, NamesAreRelativeToTheGrammarAndHostileFilesAreClearErrors) {
   }
   EXPECT_NE(errorFor("big.dat").find("larger than the limit of 16 MiB"), std::string::npos)
       << errorFor("big.dat");
+}
+
+TEST(CpfgDataFiles, BlocksThatStartWithFscanfOrSrandGoOnOverLines) {
+  // vlab's paintbrush.field: `Start: {srand(1);` / `\tdx0 =` / `\tfunc(...);` / `}`.
+  EXPECT_EQ(Word(ParseWith("Start: {srand(3);\n\tx =\n\t2;\n}\naxiom: A(x)\n", {})), "A(2)");
+  EXPECT_EQ(Word(ParseWith("Start: {fp = fopen(\"n.dat\", \"r\");}\naxiom: A\n"
+                           "A : {fscanf(fp, \"%lf\",\n   &x);} * --> B(x)\n",
+                           {{"/obj/n.dat", "7"}}),
+                 1),
+            "B(7)");
+}
+
+TEST(CpfgDataFiles, ScanAgreesWithTheCLibrarysScanf) {
+  // Differential: the C library's sscanf on the same text and format gives
+  // the same count and values (fscanf differs from sscanf only at EOF,
+  // where both return -1 before the first conversion).
+  const char* formats[] = {"%lf",     "%lf %lf",  "x=%lf",   "%*s %lf", "%3lf%lf",
+                           " %lf,%lf", "%lf\n%lf", "%*c%lf",  "a %lf",   "%2lf %*3c%lf"};
+  const char* inputs[] = {"1 2",  "x=3.5",   "abc 4",  "12345 6", "  -1e3,7", "",
+                          "   ",  "1,\n 2", "x= 2",   "a\t9",    "0x1p3 4", ".5e1 -.25",
+                          "1e",   "+7 x",    "12 34"};
+  int compared = 0;
+  for (const char* f : formats) {
+    ScanFormat fmt;
+    std::string why;
+    ASSERT_TRUE(ParseScanFormat(f, &fmt, &why)) << f << ": " << why;
+    ASSERT_LE(fmt.assignments, 2);
+    for (const char* in : inputs) {
+      CpfgDataFiles files("", [in](const std::string&) -> Expected<std::string> {
+        return std::string(in);
+      });
+      uint32_t id = 0;
+      ASSERT_TRUE(files.Add("d", &id, &why)) << why;
+      CpfgDataFiles::Call call;
+      call.format = fmt;
+      call.element.assign(size_t(fmt.assignments), 0);
+      const uint32_t c = files.AddCall(call);
+      double mine[2] = {-7, -7}, theirs[2] = {-7, -7};
+      int count = 0;
+      ASSERT_TRUE(files.Scan(files.Open(id), c, mine, &count, &why)) << f << " on " << in << ": "
+                                                                     << why;
+      const int expected = std::sscanf(in, f, &theirs[0], &theirs[1]);
+      EXPECT_EQ(count, expected) << "format '" << f << "' on '" << in << "'";
+      for (int k = 0; k < fmt.assignments; ++k)
+        EXPECT_EQ(mine[k], theirs[k]) << "format '" << f << "' on '" << in << "', value " << k;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 150);
 }
 
 }  // namespace

@@ -176,6 +176,33 @@ TEST(Plant, FilesComeThroughTheReaderWhenOneIsGiven) {
   EXPECT_GE(r.plant->mesh.triangleCount(), 1u + 4 * 2 * 8);
 }
 
+TEST(Plant, ADataFileReadShortIsAWarningNamingTheFile) {
+  // cpfg's fscanf at the end of its data file leaves the variables as they
+  // were (C's rule); the plant says so after the derivation.
+  std::map<std::string, std::string> files{
+      {"mem/p.l",
+       "Start: { fp = fopen(\"len.dat\", \"r\"); i = 0;\n"
+       "  while (i < 3) { fscanf(fp, \"%lf\", &len); i = i + 1; } }\n"
+       "axiom: F(len)\n"},
+      {"mem/len.dat", "2\n"},
+  };
+  PlantSpec spec;
+  spec.path = "mem/p.l";
+  spec.until = Stage::kWord;
+  spec.readFile = [&](const std::string& path) -> std::optional<std::string> {
+    auto it = files.find(path);
+    if (it == files.end()) return std::nullopt;
+    return it->second;
+  };
+  PlantResult r = BuildPlant(spec);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
+  EXPECT_EQ(Text(*r.plant, r.plant->word), "F(2)");
+  const std::string all = r.diagnostics.FormatAll();
+  EXPECT_NE(all.find("mem/len.dat: warning: fscanf stopped before the end of its format 2 times"),
+            std::string::npos)
+      << all;
+}
+
 TEST(SurfaceLibrary, CallerFoldersComeFirstThenTheGrammarsThenTheBundledOnes) {
   TempDir dir;
   fs::create_directories(dir.path / "mine");
