@@ -121,12 +121,11 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
   float* const olds[6] = {old[0], old[1], old[2], old[3], old[4], old[5]};
   alignas(32) uint8_t flags[kChunk];
   uint8_t done[kChunk];
-  uint16_t idx[kChunk];
+  uint16_t idx[kChunk + 4];
   // The vector path for resting contact: one static plane that bounces.
   std::optional<kernels::PlaneRest> floorRest;
-  if (kernel_ == kernels::Kernel::kAvx && colliders_.size() == 1 &&
-      colliders_[0].kind == Collider::Kind::kPlane && !colliders_[0].moving() &&
-      colliders_[0].response == Response::kBounce) {
+  if (restLanes_ > 0 && colliders_.size() == 1 && colliders_[0].kind == Collider::Kind::kPlane &&
+      !colliders_[0].moving() && colliders_[0].response == Response::kBounce) {
     const Collider& f = colliders_[0];
     floorRest = kernels::PlaneRest{{f.normal.x(), f.normal.y(), f.normal.z()},
                                    {f.point.x(), f.point.y(), f.point.z()},
@@ -135,43 +134,56 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
                                    faults_.limit2()};
   }
   const kernels::PlaneRest* floor = floorRest ? &*floorRest : nullptr;
+  // A lone static plane lists its candidates directly.
+  const Collider* plane = colliders_.size() == 1 && colliders_[0].kind == Collider::Kind::kPlane &&
+                                  !colliders_[0].moving()
+                              ? &colliders_[0]
+                              : nullptr;
   for (size_t c = begin; c < end; c += kChunk) {
     const size_t ce = std::min(end, c + kChunk), m = ce - c;
     if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds)) faults_.Flag();
     if (colliders_.empty()) continue;
-    std::memset(flags, 0, m);
-    for (const Collider& col : colliders_) {
-      if (col.kind == Collider::Kind::kPlane && !col.moving()) {
-        kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a,
-                                     s.radius.data(), c, ce, flags);
-        continue;
-      }
-      // Any other collider (a moving one: the path in its frame at the start
-      // of the step).
-      const Vec3 shift = h * col.velocity;
-      for (size_t j = 0; j < m; ++j) {
-        flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
-                               double(s.radius[c + j]));
-      }
-    }
-    // The candidates, in order; eight flags at a time (most particles touch
-    // nothing).
     size_t count = 0;
-    for (size_t j = 0; j < m; ++j) {
-      if (j % 8 == 0 && j + 8 <= m) {
-        uint64_t word;
-        std::memcpy(&word, flags + j, 8);
-        if (word == 0) {
-          j += 7;
+    if (plane) {
+      count = kernels::BulkPlaneCandidateList(kernel_, plane->normal.data(), plane->point.data(), a,
+                                              s.radius.data(), c, ce, idx);
+    } else {
+      std::memset(flags, 0, m);
+      for (const Collider& col : colliders_) {
+        if (col.kind == Collider::Kind::kPlane && !col.moving()) {
+          kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a,
+                                       s.radius.data(), c, ce, flags);
           continue;
         }
+        // Any other collider (a moving one: the path in its frame at the
+        // start of the step).
+        const Vec3 shift = h * col.velocity;
+        for (size_t j = 0; j < m; ++j) {
+          flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
+                                 double(s.radius[c + j]));
+        }
       }
-      if (flags[j] && s.invMass[c + j] != 0) idx[count++] = uint16_t(j);
+      // The candidates, in order; eight flags at a time (most particles
+      // touch nothing).
+      for (size_t j = 0; j < m; ++j) {
+        if (j % 8 == 0 && j + 8 <= m) {
+          uint64_t word;
+          std::memcpy(&word, flags + j, 8);
+          if (word == 0) {
+            j += 7;
+            continue;
+          }
+        }
+        if (flags[j] && s.invMass[c + j] != 0) idx[count++] = uint16_t(j);
+      }
     }
-    // A lone static floor: its resting contacts four at a time (the same
-    // bits as the path below).
-    std::memset(done, 0, count);
-    if (floor) kernels::BulkRestOnPlane(*floor, a, s.radius.data(), olds, c, idx, count, done);
+    // A lone static floor: its resting contacts four or eight at a time
+    // (the same bits as the path below).
+    if (floor) {
+      kernels::BulkRestOnPlane(restLanes_, *floor, a, s.radius.data(), olds, c, idx, count, done);
+    } else {
+      std::memset(done, 0, count);
+    }
     for (size_t k = 0; k < count; ++k) {
       if (done[k]) continue;
       const size_t j = idx[k], i = c + j;

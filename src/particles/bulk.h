@@ -27,6 +27,7 @@
 // give the same bits (kernels.h).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdint>
@@ -145,9 +146,14 @@ class BulkSystem {
   uint64_t Hash() const;
 
   // Chooses the vector kernel (tests compare AVX with its scalar twin).
-  // AVX only where the processor has it.
-  void SetKernel(kernels::Kernel k) {
+  // AVX only where the processor has it. restLanes: the lanes of the
+  // resting-floor kernel with AVX (4, or 8 where the processor has AVX-512;
+  // 0: the widest it runs).
+  void SetKernel(kernels::Kernel k, int restLanes = 0) {
     kernel_ = k == kernels::Kernel::kAvx ? kernels::Best() : kernels::Kernel::kScalar;
+    restLanes_ = kernel_ == kernels::Kernel::kScalar ? 0
+                 : restLanes == 0                    ? kernels::RestLanes()
+                                                     : std::min(restLanes, kernels::RestLanes());
   }
 
  private:
@@ -157,6 +163,7 @@ class BulkSystem {
   std::vector<Collider> colliders_;
   PoolChoice pools_;
   kernels::Kernel kernel_ = kernels::Best();
+  int restLanes_ = kernels::RestLanes();
   FaultLatch faults_;
 };
 

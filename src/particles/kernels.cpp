@@ -2,6 +2,7 @@
 
 #include <immintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -183,6 +184,41 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   return i;
 }
 
+// The same test, listing the movable candidates' indices (relative to
+// `first`) instead of flagging them.
+[[gnu::target("avx")]] size_t PlaneListAvx(const double* n, const double* p, const BulkArrays& a,
+                                           const float* radius, size_t& i, size_t e, size_t first,
+                                           uint16_t* idx) {
+  // The lanes of a four-bit mask as packed 16-bit offsets, and their count.
+  static constexpr uint64_t kOffsets[16] = {
+      0x0, 0x0,     0x1,     0x10000,     0x2,     0x20000,     0x20001,     0x200010000,
+      0x3, 0x30000, 0x30001, 0x300010000, 0x30002, 0x300020000, 0x300020001, 0x3000200010000};
+  const __m256d n0 = _mm256_set1_pd(n[0]), n1 = _mm256_set1_pd(n[1]), n2 = _mm256_set1_pd(n[2]);
+  const __m256d p0 = _mm256_set1_pd(p[0]), p1 = _mm256_set1_pd(p[1]), p2 = _mm256_set1_pd(p[2]);
+  size_t count = 0;
+  for (; i + 4 <= e; i += 4) {
+    const __m256d b0 = _mm256_cvtps_pd(_mm_loadu_ps(a.px + i));
+    const __m256d b1 = _mm256_cvtps_pd(_mm_loadu_ps(a.py + i));
+    const __m256d b2 = _mm256_cvtps_pd(_mm_loadu_ps(a.pz + i));
+    const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, _mm256_sub_pd(b0, p0)),
+                                                  _mm256_mul_pd(n1, _mm256_sub_pd(b1, p1))),
+                                    _mm256_mul_pd(n2, _mm256_sub_pd(b2, p2)));
+    const __m256d r = _mm256_cvtps_pd(_mm_loadu_ps(radius + i));
+    const int below = _mm256_movemask_pd(_mm256_cmp_pd(d, r, _CMP_LT_OQ));
+    if (!below) continue;
+    const int movable =
+        _mm_movemask_ps(_mm_cmp_ps(_mm_loadu_ps(a.invMass + i), _mm_setzero_ps(), _CMP_NEQ_UQ));
+    const int mask = below & movable;
+    // Four offsets at once (idx has room for four past the last), the
+    // lanes kept packed.
+    const uint64_t base = 0x0001000100010001ull * uint64_t(i - first);
+    const uint64_t lanes = kOffsets[mask] + base;
+    std::memcpy(idx + count, &lanes, 8);
+    count += size_t(__builtin_popcount(unsigned(mask)));
+  }
+  return count;
+}
+
 // (n0 y0 + n1 y1) + n2 y2, Eigen's order for a Vec3 dot product.
 [[gnu::target("avx")]] inline __m256d Dot3(const __m256d n[3], __m256d y0, __m256d y1, __m256d y2) {
   return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n[0], y0), _mm256_mul_pd(n[1], y1)),
@@ -235,19 +271,17 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
       v[c] = load(now[3 + c]);
     }
     const __m256d r = load(radius + begin);
-    __m256d dv[3], A[3], u[3], xp[3], ap[3];
+    __m256d dv[3], A[3], u[3], ap[3];
     for (int c = 0; c < 3; ++c) {
       dv[c] = _mm256_sub_pd(v[c], va[c]);
       A[c] = _mm256_mul_pd(h, dv[c]);
       u[c] = _mm256_sub_pd(_mm256_sub_pd(x[c], a[c]), _mm256_mul_pd(half, A[c]));
-      xp[c] = _mm256_sub_pd(x[c], p[c]);
       ap[c] = _mm256_sub_pd(a[c], p[c]);
     }
-    // The plane's contact at the start: d1 < 0 (a contact), d0 <= 0 (s = 0).
-    const __m256d d1 = _mm256_sub_pd(Dot3(n, xp[0], xp[1], xp[2]), r);
+    // The plane's contact at the start (a candidate ends the step inside:
+    // d1 < 0): d0 <= 0 (s = 0).
     const __m256d d0 = _mm256_sub_pd(Dot3(n, ap[0], ap[1], ap[2]), r);
-    __m256d ok =
-        _mm256_and_pd(_mm256_cmp_pd(d1, zero, _CMP_LT_OQ), _mm256_cmp_pd(d0, zero, _CMP_LE_OQ));
+    __m256d ok = _mm256_cmp_pd(d0, zero, _CMP_LE_OQ);
     __m256d point[3], px[3];
     for (int c = 0; c < 3; ++c) {
       point[c] = _mm256_sub_pd(a[c], _mm256_mul_pd(d0, n[c]));
@@ -288,18 +322,18 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     ok = _mm256_and_pd(
         ok, _mm256_cmp_pd(_mm256_sub_pd(Dot3(n, x1p[0], x1p[1], x1p[2]), r), zero, _CMP_GE_OQ));
     // Rounded to floats on the plane's side: a rounding's displacement,
-    // doubled, must not cross it (else RoundOutside's push is needed).
+    // doubled, must not cross it (else RoundOutside's push is needed). A
+    // rounding that changes nothing passes too: its doubled point is x1
+    // itself, on the plane's side by the test above.
     __m128 xf[3];
     __m256d rx[3], by[3];
-    __m256d same = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
     for (int c = 0; c < 3; ++c) {
       xf[c] = _mm256_cvtpd_ps(x1[c]);
       rx[c] = _mm256_cvtps_pd(xf[c]);
-      same = _mm256_and_pd(same, _mm256_cmp_pd(rx[c], x1[c], _CMP_EQ_OQ));
       by[c] = _mm256_sub_pd(_mm256_add_pd(rx[c], _mm256_sub_pd(rx[c], x1[c])), p[c]);
     }
     const __m256d db = _mm256_sub_pd(Dot3(n, by[0], by[1], by[2]), r);
-    ok = _mm256_and_pd(ok, _mm256_or_pd(same, _mm256_cmp_pd(db, zero, _CMP_GE_OQ)));
+    ok = _mm256_and_pd(ok, _mm256_cmp_pd(db, zero, _CMP_GE_OQ));
     // Within the magnitude limit.
     const __m256d xx =
         _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(rx[0], rx[0]), _mm256_mul_pd(rx[1], rx[1])),
@@ -334,6 +368,231 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     }
   }
 }
+
+// --- The same resting kernel on eight lanes (AVX-512 F, DQ and VL) ---
+
+#define SYLVA_AVX512 gnu::target("avx512f,avx512dq,avx512vl,bmi2")
+// GCC 12's AVX-512 conversions start from _mm512_undefined_*(), which
+// -Wmaybe-uninitialized reports once inlined.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+
+// (n0 y0 + n1 y1) + n2 y2 on eight lanes.
+[[SYLVA_AVX512]] inline __m512d Dot3(const __m512d n[3], __m512d y0, __m512d y1, __m512d y2) {
+  return _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(n[0], y0), _mm512_mul_pd(n[1], y1)),
+                       _mm512_mul_pd(n[2], y2));
+}
+
+[[SYLVA_AVX512]] inline __m512d Abs(__m512d x) {
+  return _mm512_andnot_pd(_mm512_set1_pd(-0.0), x);
+}
+
+[[SYLVA_AVX512]] inline __m512d Neg(__m512d x) {
+  return _mm512_xor_pd(x, _mm512_set1_pd(-0.0));
+}
+
+// std::max(a, b), as Max above.
+[[SYLVA_AVX512]] inline __m512d Max(__m512d a, __m512d b) {
+  return _mm512_max_pd(b, a);
+}
+
+// Where eight candidates' values are: one run of consecutive indices (one
+// load), or two windows of 16 floats, from j[0] and from the first lane
+// past the first window (two masked loads and a permutation; stores expand
+// back into the windows: a run's end and the next run's start), or
+// scattered.
+struct Lanes8 {
+  size_t j[8];
+  size_t j0, jB;  // the windows' starts
+  int nA;         // lanes in the first window (a prefix: the indices increase)
+  bool run, window;
+  __m512i perm;                // lane l takes position j[l] - j0, or 16 + j[l] - jB
+  __m512i shift;               // lane l takes lane l + nA (the second window's lanes first)
+  __mmask16 validA, validB;    // the positions up to each window's last lane
+  __mmask16 placedA, placedB;  // the positions of the distinct lanes
+};
+
+[[SYLVA_AVX512]] inline __m512d Load8(const float* base, const Lanes8& g) {
+  if (g.run) return _mm512_cvtps_pd(_mm256_loadu_ps(base + g.j0));
+  if (g.window) {
+    const __m512 wa = _mm512_maskz_loadu_ps(g.validA, base + g.j0);
+    const __m512 wb = _mm512_maskz_loadu_ps(g.validB, base + g.jB);
+    return _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_permutex2var_ps(wa, g.perm, wb)));
+  }
+  const size_t* j = g.j;
+  return _mm512_cvtps_pd(_mm256_set_ps(base[j[7]], base[j[6]], base[j[5]], base[j[4]], base[j[3]],
+                                       base[j[2]], base[j[1]], base[j[0]]));
+}
+
+// Lanes `mask` of v (the order of Load8) to their places.
+[[SYLVA_AVX512]] inline void Store8(float* base, const Lanes8& g, unsigned mask, __m256 v) {
+  const __m512 w = _mm512_castps256_ps512(v);
+  const unsigned maskA = mask & ((1u << g.nA) - 1);
+  if (maskA) {
+    _mm512_mask_storeu_ps(base + g.j0, __mmask16(_pdep_u32(maskA, g.placedA)),
+                          _mm512_maskz_expand_ps(g.placedA, w));
+  }
+  if (mask >> g.nA) {
+    _mm512_mask_storeu_ps(base + g.jB, __mmask16(_pdep_u32(mask >> g.nA, g.placedB)),
+                          _mm512_maskz_expand_ps(g.placedB, _mm512_permutexvar_ps(g.shift, w)));
+  }
+}
+
+[[SYLVA_AVX512]] void RestOnPlaneAvx512(const PlaneRest& q, const BulkArrays& ar,
+                                        const float* radius, const float* const* old, size_t begin,
+                                        const uint16_t* idx, size_t count, uint8_t* done) {
+  const __m512d n[3] = {_mm512_set1_pd(q.n[0]), _mm512_set1_pd(q.n[1]), _mm512_set1_pd(q.n[2])};
+  const __m512d p[3] = {_mm512_set1_pd(q.p[0]), _mm512_set1_pd(q.p[1]), _mm512_set1_pd(q.p[2])};
+  const __m512d h = _mm512_set1_pd(q.h), mh = _mm512_set1_pd(-q.h), half = _mm512_set1_pd(0.5);
+  const __m512d mu = _mm512_set1_pd(q.friction), zero = _mm512_setzero_pd();
+  const __m512d one = _mm512_set1_pd(1.0), tiny = _mm512_set1_pd(1e-300);
+  const __m512d tol = _mm512_set1_pd(1e-12), mtol = _mm512_set1_pd(-1e-12);
+  const __m512d limit2 = _mm512_set1_pd(q.limit2);
+  const float* const now[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
+                               ar.vx + begin, ar.vy + begin, ar.vz + begin};
+  float* const to[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
+                        ar.vx + begin, ar.vy + begin, ar.vz + begin};
+  for (size_t k0 = 0; k0 < count; k0 += 8) {
+    // Eight lanes, the last repeated past the end; a run of consecutive
+    // ones (the common case) needs only its first.
+    Lanes8 g;
+    const size_t lanes = std::min(size_t(8), count - k0);
+    g.j0 = idx[k0];
+    g.run = lanes == 8 && idx[k0 + 7] == g.j0 + 7;
+    g.window = false;
+    if (!g.run) {
+      for (size_t l = 0; l < 8; ++l) g.j[l] = idx[k0 + std::min(l, lanes - 1)];
+      int nA = 1;
+      while (nA < 8 && g.j[nA] - g.j0 < 16) ++nA;
+      g.nA = nA;
+      g.jB = nA < 8 ? g.j[nA] : g.j0;
+      g.window = g.j[7] - g.jB < 16;
+    }
+    if (g.window) {
+      alignas(64) int32_t perm[16] = {}, shift[16] = {};
+      g.placedA = g.placedB = 0;
+      for (int l = 0; l < 8; ++l) {
+        const bool inA = l < g.nA;
+        const int at = int(g.j[l] - (inA ? g.j0 : g.jB));
+        perm[l] = inA ? at : 16 + at;
+        (inA ? g.placedA : g.placedB) |= __mmask16(1u << at);
+        shift[l] = (l + g.nA) & 15;
+      }
+      g.perm = _mm512_load_si512(perm);
+      g.shift = _mm512_load_si512(shift);
+      g.validA = __mmask16((2u << (g.j[g.nA - 1] - g.j0)) - 1);
+      g.validB = g.nA < 8 ? __mmask16((2u << (g.j[7] - g.jB)) - 1) : __mmask16(0);
+    }
+    __m512d a[3], va[3], x[3], v[3];
+    for (int c = 0; c < 3; ++c) {
+      a[c] = Load8(old[c], g);
+      va[c] = Load8(old[3 + c], g);
+      x[c] = Load8(now[c], g);
+      v[c] = Load8(now[3 + c], g);
+    }
+    const __m512d r = Load8(radius + begin, g);
+    __m512d dv[3], A[3], u[3], ap[3];
+    for (int c = 0; c < 3; ++c) {
+      dv[c] = _mm512_sub_pd(v[c], va[c]);
+      A[c] = _mm512_mul_pd(h, dv[c]);
+      u[c] = _mm512_sub_pd(_mm512_sub_pd(x[c], a[c]), _mm512_mul_pd(half, A[c]));
+      ap[c] = _mm512_sub_pd(a[c], p[c]);
+    }
+    // The plane's contact at the start (a candidate ends the step inside:
+    // d1 < 0): d0 <= 0 (s = 0).
+    const __m512d d0 = _mm512_sub_pd(Dot3(n, ap[0], ap[1], ap[2]), r);
+    __mmask8 ok = _mm512_cmp_pd_mask(d0, zero, _CMP_LE_OQ);
+    __m512d point[3], px[3];
+    for (int c = 0; c < 3; ++c) {
+      point[c] = _mm512_sub_pd(a[c], _mm512_mul_pd(d0, n[c]));
+      px[c] = _mm512_sub_pd(point[c], x[c]);
+    }
+    // Not a graze (sliding along the plane within rounding).
+    const __m512d xmax = Max(one, Max(Max(Abs(x[0]), Abs(x[1])), Abs(x[2])));
+    const __m512d umax = Max(tiny, Max(Max(Abs(u[0]), Abs(u[1])), Abs(u[2])));
+    const __m512d un = Dot3(n, u[0], u[1], u[2]);
+    const __mmask8 slides =
+        _mm512_cmp_pd_mask(Dot3(n, px[0], px[1], px[2]), _mm512_mul_pd(tol, xmax), _CMP_LE_OQ) &
+        _mm512_cmp_pd_mask(un, _mm512_mul_pd(mtol, umax), _CMP_GE_OQ);
+    ok &= ~slides;
+    // Resting: no faster toward the plane than the step's forces made it.
+    const __m512d gained = Max(zero, _mm512_mul_pd(mh, Dot3(n, dv[0], dv[1], dv[2])));
+    ok &= ~_mm512_cmp_pd_mask(Neg(un), gained, _CMP_GT_OQ);
+    // The response.
+    const __m512d en = Dot3(n, v[0], v[1], v[2]);
+    const __m512d jn = Max(zero, Neg(en));
+    __m512d vt[3];
+    for (int c = 0; c < 3; ++c) vt[c] = _mm512_sub_pd(v[c], _mm512_mul_pd(en, n[c]));
+    const __m512d change = _mm512_mul_pd(mu, jn);
+    const __m512d len = _mm512_sqrt_pd(
+        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(vt[0], vt[0]), _mm512_mul_pd(vt[1], vt[1])),
+                      _mm512_mul_pd(vt[2], vt[2])));
+    const __mmask8 stops = _mm512_cmp_pd_mask(len, change, _CMP_LE_OQ);
+    const __m512d keep = _mm512_sub_pd(one, _mm512_div_pd(change, len));
+    const __m512d up = Max(en, zero);
+    __m512d out[3], x1[3], x1p[3];
+    for (int c = 0; c < 3; ++c) {
+      const __m512d f = _mm512_mask_blend_pd(stops, _mm512_mul_pd(vt[c], keep), zero);
+      out[c] = _mm512_add_pd(f, _mm512_mul_pd(up, n[c]));
+      x1[c] = _mm512_add_pd(point[c], _mm512_mul_pd(h, out[c]));
+      x1p[c] = _mm512_sub_pd(x1[c], p[c]);
+    }
+    // Ends on the plane: no second contact, nothing to project.
+    ok &= _mm512_cmp_pd_mask(_mm512_sub_pd(Dot3(n, x1p[0], x1p[1], x1p[2]), r), zero, _CMP_GE_OQ);
+    // Rounded to floats on the plane's side: a rounding's displacement,
+    // doubled, must not cross it. (A rounding that changes nothing passes
+    // here too: its doubled displacement is 0, the test above.)
+    __m256 xf[3];
+    __m512d rx[3], by[3];
+    for (int c = 0; c < 3; ++c) {
+      xf[c] = _mm512_cvtpd_ps(x1[c]);
+      rx[c] = _mm512_cvtps_pd(xf[c]);
+      by[c] = _mm512_sub_pd(_mm512_add_pd(rx[c], _mm512_sub_pd(rx[c], x1[c])), p[c]);
+    }
+    const __m512d db = _mm512_sub_pd(Dot3(n, by[0], by[1], by[2]), r);
+    ok &= _mm512_cmp_pd_mask(db, zero, _CMP_GE_OQ);
+    // Within the magnitude limit.
+    const __m512d xx =
+        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(rx[0], rx[0]), _mm512_mul_pd(rx[1], rx[1])),
+                      _mm512_mul_pd(rx[2], rx[2]));
+    const __m512d vv =
+        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(out[0], out[0]), _mm512_mul_pd(out[1], out[1])),
+                      _mm512_mul_pd(out[2], out[2]));
+    ok &= _mm512_cmp_pd_mask(_mm512_add_pd(xx, vv), limit2, _CMP_LE_OQ);
+    const unsigned mask = unsigned(ok) & ((1u << lanes) - 1);
+    const __m256 values[6] = {xf[0],
+                              xf[1],
+                              xf[2],
+                              _mm512_cvtpd_ps(out[0]),
+                              _mm512_cvtpd_ps(out[1]),
+                              _mm512_cvtpd_ps(out[2])};
+    if (lanes == 8) {
+      const uint64_t bytes = _pdep_u64(mask, 0x0101010101010101ull);  // a byte a lane
+      std::memcpy(done + k0, &bytes, 8);
+    } else {
+      for (size_t l = 0; l < lanes; ++l) done[k0 + l] = (mask >> l) & 1;
+    }
+    if (g.run) {
+      if (mask == 0xff) {
+        for (int c = 0; c < 6; ++c) _mm256_storeu_ps(to[c] + g.j0, values[c]);
+      } else {
+        for (int c = 0; c < 6; ++c) _mm256_mask_storeu_ps(to[c] + g.j0, __mmask8(mask), values[c]);
+      }
+    } else if (g.window) {
+      for (int c = 0; c < 6; ++c) Store8(to[c], g, mask, values[c]);
+    } else {
+      alignas(32) float fx[6][8];
+      for (int c = 0; c < 6; ++c) _mm256_store_ps(fx[c], values[c]);
+      for (size_t l = 0; l < lanes; ++l) {
+        if (!((mask >> l) & 1)) continue;
+        for (int c = 0; c < 6; ++c) to[c][g.j[l]] = fx[c][l];
+      }
+    }
+  }
+}
+
+#pragma GCC diagnostic pop
+#undef SYLVA_AVX512
 
 }  // namespace
 
@@ -385,9 +644,33 @@ void BulkPlaneCandidates(Kernel kernel, const double* n, const double* p, const 
   }
 }
 
-void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radius,
+int RestLanes() {
+  static const int lanes = Best() != Kernel::kAvx ? 0
+                           : (__builtin_cpu_init(), __builtin_cpu_supports("avx512f") &&
+                                                        __builtin_cpu_supports("avx512dq") &&
+                                                        __builtin_cpu_supports("avx512vl") &&
+                                                        __builtin_cpu_supports("bmi2"))
+                               ? 8
+                               : 4;
+  return lanes;
+}
+
+size_t BulkPlaneCandidateList(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
+                              const float* radius, size_t begin, size_t end, uint16_t* idx) {
+  size_t i = begin, count = 0;
+  if (kernel == Kernel::kAvx) count = PlaneListAvx(n, p, a, radius, i, end, begin, idx);
+  for (; i < end; ++i) {
+    const double d = (n[0] * (double(a.px[i]) - p[0]) + n[1] * (double(a.py[i]) - p[1])) +
+                     n[2] * (double(a.pz[i]) - p[2]);
+    if (d < double(radius[i]) && a.invMass[i] != 0) idx[count++] = uint16_t(i - begin);
+  }
+  return count;
+}
+
+void BulkRestOnPlane(int lanes, const PlaneRest& q, const BulkArrays& a, const float* radius,
                      const float* const* old, size_t begin, const uint16_t* idx, size_t count,
                      uint8_t* done) {
+  if (lanes == 8) return RestOnPlaneAvx512(q, a, radius, old, begin, idx, count, done);
   RestOnPlaneAvx(q, a, radius, old, begin, idx, count, done);
 }
 

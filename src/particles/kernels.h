@@ -101,6 +101,13 @@ bool BulkAdvance(Kernel kernel, const BulkParams& q, const BulkArrays& a, size_t
 void BulkPlaneCandidates(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
                          const float* radius, size_t begin, size_t end, uint8_t* flags);
 
+// The same test, for a scene whose only collider is that plane: writes the
+// indices (i - begin) of the particles of [begin, end) it flags that are
+// movable (inverse mass not 0), in order, to idx (room for end - begin + 4:
+// four lanes are written at a time) and returns their count.
+size_t BulkPlaneCandidateList(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
+                              const float* radius, size_t begin, size_t end, uint16_t* idx);
+
 // Resting contact on a single static plane (the bulk step's floor), four
 // particles at a time in double precision: the operations, in the same order,
 // that RespondToContacts (its fast path for one resting contact at the start
@@ -119,11 +126,16 @@ struct PlaneRest {
   double friction, h, limit2;
 };
 // For the candidates idx[0..count) (indices into [begin, begin + kChunk) of
-// the arrays; `old` holds the step's start state by chunk index as in
-// BulkAdvance): writes the particles it resolves into the arrays and sets
-// done[k] to 1 for them, 0 for the rest. AVX only (callers test Best()).
-void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radius,
+// the arrays, increasing, each a movable particle that ends the step inside
+// the plane: the plane's candidates; `old` holds the step's start state by
+// chunk index as in BulkAdvance): writes the particles it resolves into the arrays and
+// sets done[k] to 1 for them, 0 for the rest. `lanes`: 4 (AVX) or 8
+// (AVX-512), the same bits; at most RestLanes().
+void BulkRestOnPlane(int lanes, const PlaneRest& q, const BulkArrays& a, const float* radius,
                      const float* const* old, size_t begin, const uint16_t* idx, size_t count,
                      uint8_t* done);
+// The widest BulkRestOnPlane this processor runs: 8 lanes with AVX-512 (F,
+// DQ, VL) and BMI2, 4 with AVX, 0 without AVX (no vector path).
+int RestLanes();
 
 }  // namespace sylva::particles::kernels

@@ -107,41 +107,52 @@ TEST(Bulk, AvxKernelMatchesTheScalarKernelBitForBit) {
 TEST(Bulk, RestingFloorKernelMatchesTheScalarPathBitForBit) {
   if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
   // A lone tilted floor with friction (the vector path for resting contact):
-  // a quarter resting on it, the rest falling onto it, balls of three radii,
-  // a ragged count, immovable lanes, and a slow and a fast friction regime.
-  for (double mu : {0.3, 5.0}) {
-    BulkSystem avx, scalar;
-    const Vec3 n = Vec3(0.1, 1, -0.05).normalized();
-    for (BulkSystem* b : {&avx, &scalar}) {
-      Fill(b->state, 1003, 13, true);
-      for (size_t i = 0; i < b->state.size(); ++i) {
-        b->state.radius[i] = i % 3 == 0 ? 0.0f : i % 3 == 1 ? 0.01f : 0.1f;
-        // Onto the floor (through (0, -1, 0)) at its radius, those marked resting.
-        if (i % 4 == 0) {
-          const Vec3 p = b->state.position(i);
-          b->state.SetPosition(i, p - (n.dot(p - Vec3(0, -1, 0)) - b->state.radius[i]) * n);
+  // a third resting on it in runs, in every other and every fourth place
+  // (the kernel's loads: one run of consecutive lanes, a window of 16, or
+  // scattered lanes), the rest falling onto it, balls of three radii, a
+  // ragged count, immovable lanes, and a slow and a fast friction regime.
+  // Both widths of the kernel: 4 lanes (AVX) and, where the processor has
+  // AVX-512, 8.
+  std::vector<int> widths = {4};
+  if (kernels::RestLanes() == 8) widths.push_back(8);
+  for (int lanes : widths) {
+    for (double mu : {0.3, 5.0}) {
+      BulkSystem avx, scalar;
+      const Vec3 n = Vec3(0.1, 1, -0.05).normalized();
+      for (BulkSystem* b : {&avx, &scalar}) {
+        Fill(b->state, 1003, 13, true);
+        for (size_t i = 0; i < b->state.size(); ++i) {
+          b->state.radius[i] = i % 3 == 0 ? 0.0f : i % 3 == 1 ? 0.01f : 0.1f;
+          // Onto the floor (through (0, -1, 0)) at its radius, those marked resting.
+          const size_t k = i % 200;
+          if (k < 40 ? true : k < 100 ? i % 2 == 0 : i % 4 == 0) {
+            const Vec3 p = b->state.position(i);
+            b->state.SetPosition(i, p - (n.dot(p - Vec3(0, -1, 0)) - b->state.radius[i]) * n);
+          }
         }
+        b->fields.gravity = Vec3(0, -kG, 0);
+        b->fields.linearDrag = 0.1;
+        EXPECT_OK(b->AddCollider(Collider::Plane(Vec3(0, -1, 0), n).Restitution(0.5).Friction(mu)));
       }
-      b->fields.gravity = Vec3(0, -kG, 0);
-      b->fields.linearDrag = 0.1;
-      EXPECT_OK(b->AddCollider(Collider::Plane(Vec3(0, -1, 0), n).Restitution(0.5).Friction(mu)));
+      avx.SetKernel(kernels::Kernel::kAvx, lanes);
+      scalar.SetKernel(kernels::Kernel::kScalar);
+      for (int k = 0; k < 240; ++k) {
+        BULK_STEP_OK(avx, 1.0 / 240);
+        BULK_STEP_OK(scalar, 1.0 / 240);
+        ASSERT_EQ(avx.Hash(), scalar.Hash())
+            << lanes << " lanes, mu " << mu << ": states differ after step " << k;
+      }
+      // Most of them ended resting on the floor (what the vector path serves).
+      int onFloor = 0;
+      for (size_t i = 0; i < avx.state.size(); ++i) {
+        if (avx.state.invMass[i] == 0) continue;  // pinned where it was put
+        const double d = n.dot(avx.state.position(i) - Vec3(0, -1, 0)) - avx.state.radius[i];
+        onFloor += d < 1e-5;
+        // Within rounding of the tilted plane's projection (both paths).
+        ASSERT_GE(d, -1e-12) << "particle " << i << " below the floor by " << -d << " m";
+      }
+      EXPECT_GT(onFloor, 250) << "mu " << mu << ": particles on the floor: " << onFloor;
     }
-    scalar.SetKernel(kernels::Kernel::kScalar);
-    for (int k = 0; k < 240; ++k) {
-      BULK_STEP_OK(avx, 1.0 / 240);
-      BULK_STEP_OK(scalar, 1.0 / 240);
-      ASSERT_EQ(avx.Hash(), scalar.Hash()) << "mu " << mu << ": states differ after step " << k;
-    }
-    // Most of them ended resting on the floor (what the vector path serves).
-    int onFloor = 0;
-    for (size_t i = 0; i < avx.state.size(); ++i) {
-      if (avx.state.invMass[i] == 0) continue;  // pinned where it was put
-      const double d = n.dot(avx.state.position(i) - Vec3(0, -1, 0)) - avx.state.radius[i];
-      onFloor += d < 1e-5;
-      // Within rounding of the tilted plane's projection (both paths).
-      ASSERT_GE(d, -1e-12) << "particle " << i << " below the floor by " << -d << " m";
-    }
-    EXPECT_GT(onFloor, 250) << "mu " << mu << ": particles on the floor: " << onFloor;
   }
 }
 
