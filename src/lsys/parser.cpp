@@ -99,6 +99,18 @@ bool IsIdentChar(char c) {
 // `maximum depth:` of a decomposition or interpretation section.
 constexpr int kMaxSectionDepth = 100000;
 
+// A line whose first text (at p) is `#` is a preprocessor directive only
+// when a name, a number or the end of the line follows the `#` (and blanks):
+// cpfg's preprocessor (vlab's cccp, handle_directive) passes any other line,
+// such as a continued successor that begins with the width module `#(0.06)`,
+// through as text.
+bool StartsDirective(const std::string& t, size_t p) {
+  if (p >= t.size() || t[p] != '#') return false;
+  size_t q = p + 1;
+  while (q < t.size() && IsSpace(t[q])) ++q;
+  return q >= t.size() || IsIdentStart(t[q]) || std::isdigit(static_cast<unsigned char>(t[q]));
+}
+
 // Single-character module names besides letters and digits. cpfg's lexer
 // (`lsys_input.l`, `symbol`) takes any character but `<>:*`, blanks and
 // parentheses as a module; Sylva reads `~`, `@` and `?` as the start of
@@ -865,7 +877,9 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
   while (end > pos && IsSpace(t[end - 1])) --end;
   {
     // Not an expression (it does not parse, names what is not a constant,
-    // or goes on after one): text, substituted where the name is used.
+    // or goes on after one), or one that draws random numbers (`nran(80,
+    // 4)`: cpfg's preprocessor pastes the text, so each use draws anew):
+    // text, substituted where the name is used.
     ExprScope scope{&g_.constants, nullptr, nullptr, &macros_};
     scope.functions = &g_.functions;
     std::string_view view(t.data(), end);
@@ -874,7 +888,7 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     size_t q = pos;
     bool isExpr = ParseExpr(view, &q, scope, &e, &err);
     while (isExpr && q < end && IsSpace(t[q])) ++q;
-    if ((!isExpr && !err.evaluation) || (isExpr && q < end)) {
+    if ((!isExpr && !err.evaluation) || (isExpr && q < end) || (isExpr && !e.IsConstant())) {
       TextMacro m;
       m.body = t.substr(pos, end - pos);
       AddTextMacro(l, name, col, std::move(m));
@@ -1441,7 +1455,7 @@ void GrammarParser::Conditionals() {
     size_t p = 0;
     while (p < t.size() && IsSpace(t[p])) ++p;
     *pos = p;
-    if (p >= t.size() || t[p] != '#') return std::string();
+    if (!StartsDirective(t, p)) return std::string();
     size_t q = p + 1;
     while (q < t.size() && IsSpace(t[q])) ++q;
     size_t e = q;
@@ -2160,7 +2174,7 @@ void GrammarParser::JoinContinuations() {
   auto isProduction = [&](const Line& l) {
     const size_t p = firstText(l.text);
     size_t after = 0;
-    return p < l.text.size() && l.text[p] != '#' && !MatchKeyword(l.text, p, &after);
+    return p < l.text.size() && !StartsDirective(l.text, p) && !MatchKeyword(l.text, p, &after);
   };
   auto isAxiom = [&](const Line& l) {
     size_t after = 0;
@@ -2222,9 +2236,12 @@ void GrammarParser::JoinContinuations() {
       // ':' of a condition, with any indented line (`A(x) : {...}` /
       // `  x < 5 -->`): without its arrow it is no production on its own.
       // So does a line that starts with the ':' of the condition (vlab's
-      // soil3d: `?E(...)A(tl,l,o) > @v?P(x,y,z)` / `  : (nut>0) ...`).
+      // soil3d: `?E(...)A(tl,l,o) > @v?P(x,y,z)` / `  : (nut>0) ...`), and
+      // any indented line without an arrow: a context continued on the next
+      // line (ShootRoot's `N > [I(...)]` / `  [I(...)] : ...`).
       join = curArrow ? !hasArrow(l.text)
                       : (startsWithArrow(l.text) || l.text[p] == '{' || l.text[p] == ':' ||
+                         !hasArrow(l.text) ||
                          FindTopLevel(out.back().text, 0, out.back().text.size(), ":") !=
                              std::string::npos);
     }
@@ -2542,7 +2559,7 @@ void GrammarParser::ParseLine(const Line& l) {
   if (t.compare(pos, 7, "#define") == 0 && (pos + 7 >= t.size() || IsSpace(t[pos + 7]))) {
     return;  // read by Conditionals()
   }
-  if (t[pos] == '#') {
+  if (StartsDirective(t, pos)) {
     size_t e = pos + 1;
     while (e < t.size() && IsIdentChar(t[e])) ++e;
     Error(l, int(pos) + 1, "unknown directive '" + t.substr(pos, e - pos) + "'", int(e - pos));
@@ -2572,6 +2589,19 @@ void GrammarParser::ParseLine(const Line& l) {
     }
     Error(l, int(open) + 1, "unclosed '{': the statement block has no '}'");
     return;
+  }
+  {
+    // cpfg's `ring lsystem` statement (Ring/ring.l): the word is a ring.
+    std::string words;
+    for (size_t i = pos; i < t.size(); ++i)
+      if (!IsSpace(t[i])) words += char(std::tolower(static_cast<unsigned char>(t[i])));
+    if (words == "ringlsystem") {
+      Error(l, int(pos) + 1,
+            "'ring lsystem' is not supported by Sylva (cpfg: the word is a ring, its last "
+            "module the left neighbour of its first in context matching)",
+            int(t.size() - pos));
+      return;
+    }
   }
   size_t e = pos;
   while (e < t.size() && (IsIdentChar(t[e]) || t[e] == ' ')) ++e;
