@@ -2204,10 +2204,22 @@ void GrammarParser::JoinContinuations() {
   bool continued = false;  // out.back() ended with a backslash
   bool curArrow = false;   // out.back() has a `->` (kept, not rescanned: linear time)
   int blocks = 0;          // statement blocks open at the end of out.back()
+  // The next line with text of the same file, for each line: a `{` at the
+  // end of a line opens a statement block when a statement follows, even
+  // after blank and comment-only lines (Ridley: `A(s,a) : s<L {` / `// ...`
+  // / `rho = ...;`).
+  std::vector<size_t> nextWithText(lines_.size() + 1, lines_.size());
+  for (size_t k = lines_.size(); k-- > 0;) {
+    const bool hasText = firstText(lines_[k].text) < lines_[k].text.size();
+    nextWithText[k] = hasText ? k : nextWithText[k + 1];
+  }
   for (size_t i = 0; i < lines_.size(); ++i) {
     Line& l = lines_[i];
     const Line* next = i + 1 < lines_.size() ? &lines_[i + 1] : nullptr;
-    const std::string_view nextText = next ? std::string_view(next->text) : std::string_view();
+    const size_t nt = nextWithText[i + 1];
+    const std::string_view nextText = nt < lines_.size() && lines_[nt].file == l.file
+                                          ? std::string_view(lines_[nt].text)
+                                          : std::string_view();
     const size_t p = firstText(l.text);
     const bool blank = p >= l.text.size();
     if (blocks > 0 && out.back().file == l.file) {
@@ -2782,6 +2794,26 @@ void GrammarParser::Finish() {
            "its parameters keep the values written in the grammar",
            2);
       break;
+    }
+  }
+  // cpfg (interpret.c, 's'): when a grammar has a `?` module (it then runs
+  // its environment pass), s(x, y) and s(x, y, z) get the turtle's position,
+  // an older form of ?P. Sylva reads `s` as a plain module: said once.
+  {
+    bool queries = false, positionS = false;
+    for (size_t s = 0; s < g_.symbols.size(); ++s) {
+      const std::string& name = g_.symbols.name(SymbolId(s));
+      const int arity = g_.symbols.arity(SymbolId(s));
+      queries |= !name.empty() && name[0] == '?';
+      positionS |= name == "s" && (arity == 2 || arity == 3);
+    }
+    auto it = g_.symbolLoc.find("s");
+    if (queries && positionS && it != g_.symbolLoc.end()) {
+      Warn(it->second.loc, g_.SourceLine(it->second.loc),
+           "module 's' with 2 or 3 parameters: in a grammar with '?' modules cpfg fills them "
+           "with the turtle's position (an older form of ?P); Sylva reads 's' as a plain module "
+           "and leaves them as written (use ?P)",
+           1);
     }
   }
 

@@ -129,5 +129,24 @@ TEST(CpfgUnsupported, RingLsystemAndCurveFunctionsSayWhatTheyAreWhereTheyAre) {
       << curve;
 }
 
+TEST(CpfgLines, StatementBlockOpenedBeforeCommentLines) {
+  // Ridley/spiral.l: `A(s,a) : s<L {` then comment-only lines, then the
+  // statements, the block's `}` and the arrow lines below.
+  EXPECT_EQ(testing::DeriveText("axiom: A(1)\nA(s) : s<3 {   // go on\n\t\t// comment\n\n"
+                                "\tt = s + 1;\n\t} --> B(t)\n",
+                                1),
+            "B(2)");
+}
+
+TEST(CpfgSymbols, PositionModuleSWarnsInAGrammarWithQueries) {
+  // cpfg's environment pass fills s(x, y[, z]) with the turtle's position.
+  auto w = Diagnostics("axiom: F s(0,0) ?P(0,0)\n");
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0].rfind("1:10 module 's' with 2 or 3 parameters: in a grammar with '?' modules", 0),
+            0u)
+      << w[0];
+  EXPECT_TRUE(Diagnostics("axiom: F s(0,0)\n").empty());
+}
+
 }  // namespace
 }  // namespace sylva::lsys
