@@ -9,6 +9,7 @@
 #include <set>
 #include <string_view>
 
+#include "app/cpfg_specifications.h"
 #include "core/atomic_file.h"
 #include "lsys/deriver.h"
 
@@ -704,11 +705,56 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
                                               const std::string& explicitView) {
   auto v = std::make_shared<ViewFile>();
   fs::path viewPath;
+  // Colour files named by the object's cpfg command (`-M x.mat`, `-m x.map`).
+  std::vector<std::pair<fs::path, bool>> named;  // path, is a material file
   if (!explicitView.empty()) {
     viewPath = explicitView;
   } else if (!grammarPath.empty()) {
     fs::path beside = fs::path(grammarPath).replace_extension(".v");
-    if (IsFile(beside)) viewPath = beside;
+    if (IsFile(beside)) {
+      viewPath = beside;
+    } else {
+      // No NAME.v: the files the cpfg command of vlab's `specifications` names.
+      auto command = CpfgCommandFor(grammarPath);
+      if (!command) {
+        Diagnostic d = command.error();
+        d.severity = Severity::kWarning;
+        d.message += "; its files are not used";
+        v->diagnostics.Add(std::move(d));
+      } else if (command->has_value()) {
+        const CpfgCommand& c = **command;
+        const fs::path dir = fs::path(grammarPath).parent_path();
+        auto warn = [&](std::string message) {
+          Diagnostic d;
+          d.severity = Severity::kWarning;
+          d.loc = c.loc;
+          d.message = std::move(message);
+          v->diagnostics.Add(std::move(d));
+        };
+        if (!c.view.empty()) {
+          if (IsFile(dir / c.view)) {
+            viewPath = dir / c.view;
+          } else {
+            warn("the cpfg command names the view file '" + c.view +
+                 "', which is not in the object's folder: drawn without a view file");
+          }
+        }
+        auto add = [&](const std::string& f, bool material) {
+          if (f.empty()) return;
+          if (IsFile(dir / f)) {
+            named.emplace_back(dir / f, material);
+          } else {
+            warn("the cpfg command names the " +
+                 std::string(material ? "material file '" : "colour map '") + f +
+                 "', which is not in the object's folder");
+          }
+        };
+        add(c.materialWins ? c.material : c.colormap, c.materialWins);
+        add(c.materialWins ? c.colormap : c.material, !c.materialWins);
+        for (const std::string& o : c.unknownOptions)
+          warn("the cpfg command's option '" + o + "' is not one cpfg has: ignored");
+      }
+    }
   }
   if (!viewPath.empty()) {
     auto text = ReadRegular(viewPath.string(), kMaxViewBytes);
@@ -718,7 +764,11 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
       v->diagnostics.Add(std::move(d));
       return v;
     }
+    DiagnosticList before = std::move(v->diagnostics);
     *v = ParseViewFile(*text, viewPath.string(), /*checkFiles=*/true);
+    before.items.insert(before.items.end(), v->diagnostics.items.begin(),
+                        v->diagnostics.items.end());
+    v->diagnostics.items = std::move(before.items);
   }
   // cpfg's animation file beside the grammar (only its overlaid frames
   // change a still picture).
@@ -733,32 +783,36 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
       ParseAnimationFile(*text, a.string(), *v);
     }
   }
-  // Colours: NAME.mat, then NAME.map, beside the grammar, then beside the view file.
+  // Colours: the command's files, then NAME.mat and NAME.map beside the
+  // grammar, then beside the view file.
+  std::vector<std::pair<fs::path, bool>> candidates = named;
   std::vector<fs::path> stems;
   if (!grammarPath.empty()) stems.push_back(fs::path(grammarPath));
   if (!viewPath.empty()) stems.push_back(viewPath);
   for (const fs::path& stem : stems) {
-    for (const char* ext : {".mat", ".map"}) {
-      fs::path candidate = fs::path(stem).replace_extension(ext);
-      if (!IsFile(candidate)) continue;
-      auto bytes = ReadRegular(candidate.string(), kMaxColorBytes);
-      if (!bytes) {
-        v->diagnostics.Add(bytes.error());
-        return v;
-      }
-      auto colors = std::string(ext) == ".mat"
-                        ? ParseMaterials(*bytes, candidate.string())
-                        : ParseColormap(*bytes, candidate.string(), v->diagnostics);
-      if (!colors) {
-        v->diagnostics.Add(colors.error());
-        return v;
-      }
-      v->colorsPath = candidate.string();
-      v->palette = std::move(*colors);
+    candidates.emplace_back(fs::path(stem).replace_extension(".mat"), true);
+    candidates.emplace_back(fs::path(stem).replace_extension(".map"), false);
+  }
+  for (const auto& [candidate, material] : candidates) {
+    if (!IsFile(candidate)) continue;
+    auto bytes = ReadRegular(candidate.string(), kMaxColorBytes);
+    if (!bytes) {
+      v->diagnostics.Add(bytes.error());
       return v;
     }
+    auto colors = material ? ParseMaterials(*bytes, candidate.string())
+                           : ParseColormap(*bytes, candidate.string(), v->diagnostics);
+    if (!colors) {
+      v->diagnostics.Add(colors.error());
+      return v;
+    }
+    v->colorsPath = candidate.string();
+    v->palette = std::move(*colors);
+    return v;
   }
-  if (v->path.empty() && v->colorsPath.empty() && v->animationPath.empty()) return nullptr;
+  if (v->path.empty() && v->colorsPath.empty() && v->animationPath.empty() &&
+      v->diagnostics.items.empty())
+    return nullptr;
   return v;
 }
 

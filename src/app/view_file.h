@@ -104,8 +104,12 @@ Expected<std::vector<std::array<float, 3>>> ParseMaterials(const std::string& by
 
 // The view file and colours of the grammar at `grammarPath`: `explicitView`
 // when not empty (an error when it cannot be read), else NAME.v beside the
-// grammar if it exists; NAME.mat or NAME.map beside the grammar or the view
-// file; NAME.a beside the grammar. nullptr when there is none of them.
+// grammar if it exists, else the view file the object's cpfg command names
+// in vlab's `specifications` beside the grammar (app/cpfg_specifications.h;
+// `cpfg -M materials.mat lamp.l view.v`), whose -M/-m colour files then come
+// first; then NAME.mat or NAME.map beside the grammar or the view file;
+// NAME.a beside the grammar. A file the command names that is missing is a
+// warning. nullptr when there is none of them and nothing to say.
 std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
                                               const std::string& explicitView);
 

@@ -880,6 +880,15 @@ class Parser {
                          "(...);'), not inside an expression",
                      len);
       for (std::string_view c : kCpfgFunctions) {
+        if (name == c && name.rfind("curve", 0) == 0) {
+          // cpfg curveXYZc.cpp: the curves are the view file's `curve:` files.
+          return Error(col,
+                       "cpfg function '" + name +
+                           "' is not supported by Sylva: it reads the curve of a view file's "
+                           "'curve:' line (curveX/Y/Z(id, t): a coordinate of its point at t from 0 "
+                           "to 1; curveGAL(id): the curve's length)",
+                       len);
+        }
         if (name == c)
           return Error(col, "cpfg function '" + name + "' is not supported by Sylva", len);
       }

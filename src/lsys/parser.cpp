@@ -99,6 +99,18 @@ bool IsIdentChar(char c) {
 // `maximum depth:` of a decomposition or interpretation section.
 constexpr int kMaxSectionDepth = 100000;
 
+// A line whose first text (at p) is `#` is a preprocessor directive only
+// when a name, a number or the end of the line follows the `#` (and blanks):
+// cpfg's preprocessor (vlab's cccp, handle_directive) passes any other line,
+// such as a continued successor that begins with the width module `#(0.06)`,
+// through as text.
+bool StartsDirective(const std::string& t, size_t p) {
+  if (p >= t.size() || t[p] != '#') return false;
+  size_t q = p + 1;
+  while (q < t.size() && IsSpace(t[q])) ++q;
+  return q >= t.size() || IsIdentStart(t[q]) || std::isdigit(static_cast<unsigned char>(t[q]));
+}
+
 // Single-character module names besides letters and digits. cpfg's lexer
 // (`lsys_input.l`, `symbol`) takes any character but `<>:*`, blanks and
 // parentheses as a module; Sylva reads `~`, `@` and `?` as the start of
@@ -865,7 +877,9 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
   while (end > pos && IsSpace(t[end - 1])) --end;
   {
     // Not an expression (it does not parse, names what is not a constant,
-    // or goes on after one): text, substituted where the name is used.
+    // or goes on after one), or one that draws random numbers (`nran(80,
+    // 4)`: cpfg's preprocessor pastes the text, so each use draws anew):
+    // text, substituted where the name is used.
     ExprScope scope{&g_.constants, nullptr, nullptr, &macros_};
     scope.functions = &g_.functions;
     std::string_view view(t.data(), end);
@@ -874,7 +888,7 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     size_t q = pos;
     bool isExpr = ParseExpr(view, &q, scope, &e, &err);
     while (isExpr && q < end && IsSpace(t[q])) ++q;
-    if ((!isExpr && !err.evaluation) || (isExpr && q < end)) {
+    if ((!isExpr && !err.evaluation) || (isExpr && q < end) || (isExpr && !e.IsConstant())) {
       TextMacro m;
       m.body = t.substr(pos, end - pos);
       AddTextMacro(l, name, col, std::move(m));
@@ -1441,7 +1455,7 @@ void GrammarParser::Conditionals() {
     size_t p = 0;
     while (p < t.size() && IsSpace(t[p])) ++p;
     *pos = p;
-    if (p >= t.size() || t[p] != '#') return std::string();
+    if (!StartsDirective(t, p)) return std::string();
     size_t q = p + 1;
     while (q < t.size() && IsSpace(t[q])) ++q;
     size_t e = q;
@@ -2160,7 +2174,7 @@ void GrammarParser::JoinContinuations() {
   auto isProduction = [&](const Line& l) {
     const size_t p = firstText(l.text);
     size_t after = 0;
-    return p < l.text.size() && l.text[p] != '#' && !MatchKeyword(l.text, p, &after);
+    return p < l.text.size() && !StartsDirective(l.text, p) && !MatchKeyword(l.text, p, &after);
   };
   auto isAxiom = [&](const Line& l) {
     size_t after = 0;
@@ -2190,10 +2204,22 @@ void GrammarParser::JoinContinuations() {
   bool continued = false;  // out.back() ended with a backslash
   bool curArrow = false;   // out.back() has a `->` (kept, not rescanned: linear time)
   int blocks = 0;          // statement blocks open at the end of out.back()
+  // The next line with text of the same file, for each line: a `{` at the
+  // end of a line opens a statement block when a statement follows, even
+  // after blank and comment-only lines (Ridley: `A(s,a) : s<L {` / `// ...`
+  // / `rho = ...;`).
+  std::vector<size_t> nextWithText(lines_.size() + 1, lines_.size());
+  for (size_t k = lines_.size(); k-- > 0;) {
+    const bool hasText = firstText(lines_[k].text) < lines_[k].text.size();
+    nextWithText[k] = hasText ? k : nextWithText[k + 1];
+  }
   for (size_t i = 0; i < lines_.size(); ++i) {
     Line& l = lines_[i];
     const Line* next = i + 1 < lines_.size() ? &lines_[i + 1] : nullptr;
-    const std::string_view nextText = next ? std::string_view(next->text) : std::string_view();
+    const size_t nt = nextWithText[i + 1];
+    const std::string_view nextText = nt < lines_.size() && lines_[nt].file == l.file
+                                          ? std::string_view(lines_[nt].text)
+                                          : std::string_view();
     const size_t p = firstText(l.text);
     const bool blank = p >= l.text.size();
     if (blocks > 0 && out.back().file == l.file) {
@@ -2222,9 +2248,12 @@ void GrammarParser::JoinContinuations() {
       // ':' of a condition, with any indented line (`A(x) : {...}` /
       // `  x < 5 -->`): without its arrow it is no production on its own.
       // So does a line that starts with the ':' of the condition (vlab's
-      // soil3d: `?E(...)A(tl,l,o) > @v?P(x,y,z)` / `  : (nut>0) ...`).
+      // soil3d: `?E(...)A(tl,l,o) > @v?P(x,y,z)` / `  : (nut>0) ...`), and
+      // any indented line without an arrow: a context continued on the next
+      // line (ShootRoot's `N > [I(...)]` / `  [I(...)] : ...`).
       join = curArrow ? !hasArrow(l.text)
                       : (startsWithArrow(l.text) || l.text[p] == '{' || l.text[p] == ':' ||
+                         !hasArrow(l.text) ||
                          FindTopLevel(out.back().text, 0, out.back().text.size(), ":") !=
                              std::string::npos);
     }
@@ -2542,7 +2571,7 @@ void GrammarParser::ParseLine(const Line& l) {
   if (t.compare(pos, 7, "#define") == 0 && (pos + 7 >= t.size() || IsSpace(t[pos + 7]))) {
     return;  // read by Conditionals()
   }
-  if (t[pos] == '#') {
+  if (StartsDirective(t, pos)) {
     size_t e = pos + 1;
     while (e < t.size() && IsIdentChar(t[e])) ++e;
     Error(l, int(pos) + 1, "unknown directive '" + t.substr(pos, e - pos) + "'", int(e - pos));
@@ -2572,6 +2601,19 @@ void GrammarParser::ParseLine(const Line& l) {
     }
     Error(l, int(open) + 1, "unclosed '{': the statement block has no '}'");
     return;
+  }
+  {
+    // cpfg's `ring lsystem` statement (Ring/ring.l): the word is a ring.
+    std::string words;
+    for (size_t i = pos; i < t.size(); ++i)
+      if (!IsSpace(t[i])) words += char(std::tolower(static_cast<unsigned char>(t[i])));
+    if (words == "ringlsystem") {
+      Error(l, int(pos) + 1,
+            "'ring lsystem' is not supported by Sylva (cpfg: the word is a ring, its last "
+            "module the left neighbour of its first in context matching)",
+            int(t.size() - pos));
+      return;
+    }
   }
   size_t e = pos;
   while (e < t.size() && (IsIdentChar(t[e]) || t[e] == ' ')) ++e;
@@ -2752,6 +2794,26 @@ void GrammarParser::Finish() {
            "its parameters keep the values written in the grammar",
            2);
       break;
+    }
+  }
+  // cpfg (interpret.c, 's'): when a grammar has a `?` module (it then runs
+  // its environment pass), s(x, y) and s(x, y, z) get the turtle's position,
+  // an older form of ?P. Sylva reads `s` as a plain module: said once.
+  {
+    bool queries = false, positionS = false;
+    for (size_t s = 0; s < g_.symbols.size(); ++s) {
+      const std::string& name = g_.symbols.name(SymbolId(s));
+      const int arity = g_.symbols.arity(SymbolId(s));
+      queries |= !name.empty() && name[0] == '?';
+      positionS |= name == "s" && (arity == 2 || arity == 3);
+    }
+    auto it = g_.symbolLoc.find("s");
+    if (queries && positionS && it != g_.symbolLoc.end()) {
+      Warn(it->second.loc, g_.SourceLine(it->second.loc),
+           "module 's' with 2 or 3 parameters: in a grammar with '?' modules cpfg fills them "
+           "with the turtle's position (an older form of ?P); Sylva reads 's' as a plain module "
+           "and leaves them as written (use ?P)",
+           1);
     }
   }
 

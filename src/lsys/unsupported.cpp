@@ -84,6 +84,18 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
     }
     return "'" + std::string(name) + "' is not a command Sylva knows: it does nothing";
   }
+  if (name == "_" && arity > 1) {
+    return "'_' (cpfg: set the tropism elasticity) uses 1 parameter; the other " +
+           std::to_string(arity - 1) + " are ignored";
+  }
+  if ((name == "{" || name == "}") && arity > 0) {
+    // cpfg interpret.c: `{(n)` and `}(n)` with n != 0 start and end a spline
+    // (its older generalized cylinder, general.c InitializeSpline).
+    return "'" + std::string(name) +
+           "' with a parameter: cpfg draws a polygon when it is 0 and otherwise a spline "
+           "generalized cylinder (the older form of @Gs ... @Ge), which Sylva does not "
+           "implement: with a parameter other than 0 it does nothing";
+  }
   if (name == "$" && arity > 0) {
     // Some files write $(id, scale) for the start of a sub-L-system; cpfg's
     // source (generate.c CheckPred, interpret.c UpdateCurrentLsystem) starts

@@ -49,6 +49,7 @@ enum class Op : uint8_t {
   kTropismSet,   // @Ts
   kTropismUp,    // @Ti
   kTropismDown,  // @Td
+  kElasticity,   // _ (cpfg: elasticity of the tropism)
   kTwistForce,   // @Tf
   kGcTangent,    // @Gt
   kGcRadius,     // @Gr
@@ -102,6 +103,8 @@ Op OpFor(const std::string& name) {
         return Op::kVertex;
       case '}':
         return Op::kPolygonEnd;
+      case '_':
+        return Op::kElasticity;
       default:
         return Op::kNone;
     }
@@ -274,6 +277,7 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   if (g.tropism) {
     d.tropism = Vec3(g.tropism->x, g.tropism->y, g.tropism->z);
     d.susceptibility = g.tropism->susceptibility;
+    d.tropismGiven = true;
   }
   d.initialColor = g.initialColor;
   d.colorIncrement = g.colorIncrement;
@@ -562,14 +566,19 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   SinCos sincos;
   double defSin, defCos;
   sincos.Get(def.angle, &defSin, &defCos);
-  bool changesTropism = false, drawsCylinders = false;
+  bool changesTropism = false, drawsCylinders = false, underscore = false;
   for (Op op : ops) {
-    changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp || op == Op::kTropismDown;
+    underscore |= op == Op::kElasticity;
+    changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp ||
+                      op == Op::kTropismDown || op == Op::kElasticity;
     drawsCylinders |= op == Op::kGcStart || op == Op::kGcPoint || op == Op::kGcEnd ||
                       op == Op::kGcTangent || op == Op::kGcRadius;
   }
   const bool cpfgState = changesTropism || drawsCylinders || def.subLsystems;
   const bool tropism = def.susceptibility != 0 || changesTropism;
+  // cpfg's `_` bends toward the view file's `tropism direction:`, which is
+  // up (0, 1, 0) when the file gives none (interpret.c InitializeParameters).
+  const Vec3 tropismDir = underscore && !def.tropismGiven ? Vec3(0, 1, 0) : def.tropism;
   Vec3 lo = t.pos, hi = t.pos;
   bool planar = true;
   const size_t n = word.size();
@@ -640,7 +649,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
             sg.module = uint32_t(i);
             g.segments.push_back(sg);
           }
-          if (tropism && ApplyTropism(def.tropism, x.elasticity, t.frame)) ++turnsSinceOrtho;
+          if (tropism && ApplyTropism(tropismDir, x.elasticity, t.frame)) ++turnsSinceOrtho;
           break;
         }
         case Op::kTurnLeft:
@@ -740,6 +749,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
                                 : std::clamp(t.color - colorStep, 0, 65535));
           break;
         case Op::kPolygonBegin: {
+          if (np && p[0] != 0) break;  // cpfg: a spline cylinder, not drawn (warned)
           Polygon poly;
           poly.color = t.color;
           poly.module = uint32_t(i);
@@ -750,6 +760,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           if (!openPolygons.empty()) openPolygons.back().vertices.push_back(t.pos);
           break;
         case Op::kPolygonEnd:
+          if (np && p[0] != 0) break;
           ClosePolygon(openPolygons, i, g);
           break;
         case Op::kSurface: {
@@ -850,6 +861,11 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           if (op == Op::kTropismDown) x.elasticity -= v;
           break;
         }
+        case Op::kElasticity:
+          // _(e) sets the elasticity to e, _ adds the elasticity increment
+          // (cpfg interpret.c, '_'; the view file's `elasticity increment:`).
+          x.elasticity = np ? p[0] : x.elasticity + def.elasticityIncrement;
+          break;
         case Op::kTwistForce:
           // @Tf: cpfg records the frame so its next cylinder does not twist;
           // Sylva's tubes follow rotation-minimizing frames and never twist.

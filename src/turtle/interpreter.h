@@ -38,6 +38,8 @@
 //          the plane (t, radius) with tangent l (cos a, sin a) arriving at a
 //          control point and l2 (cos a2, sin a2) leaving it (2 values: both);
 //          @Gr(k), k != 0, multiplies their radius parts by the chord
+//   _(e) _  set the elasticity to e, or add the elasticity increment
+//          (cpfg's old tropism; the same one tropism as @Ts)
 //   @Ts(i, e) @Ti(i, d) @Td(i, d)  set, raise and lower the tropism
 //          susceptibility e (cpfg's elasticity) of the turtle (kept by [ ]);
 //          i must be 1
@@ -72,6 +74,7 @@ struct TurtleDef {
   double widthIncrement = 0;  // > 0: ! and # subtract and add it (cpfg); 0: the factor
   double widthScale = 1;      // drawn diameter = width x widthScale
   Vec3 tropism{0, -1, 0};
+  bool tropismGiven = false;  // the grammar or view file names it; else cpfg's `_` bends up (0,1,0)
   double susceptibility = 0;       // 0: no tropism (until @Ts, @Ti or @Td changes it)
   double elasticityIncrement = 0;  // @Ti and @Td without a value add and subtract it
   int initialColor = 0;            // colour index the turtle starts with

@@ -553,6 +553,39 @@ TEST(Turtle, TropismElasticitySetRaisedAndLoweredPerBranch) {
   EXPECT_NE(other.geometry.warnings[0].find("tropism other than 1"), std::string::npos);
 }
 
+TEST(Turtle, UnderscoreSetsOrAddsTheElasticityAsCpfgDoes) {
+  // cpfg interpret.c, '_': `_(e)` sets the elasticity to e, `_` adds the
+  // view file's elasticity increment; the change ends at the branch's `]`.
+  DrawOptions opt;
+  opt.recordModules = true;
+  auto end = [&](const std::string& text) {
+    Drawn d = Draw(text, 0, opt);
+    return d.geometry.modulePosition.empty() ? Vec3(1e9, 0, 0) : d.geometry.modulePosition.back();
+  };
+  const Vec3 want = end("tropism: 0 -1 0 0.2\naxiom: +(60) F F F\n");
+  const Vec3 straight = end("axiom: +(60) F F F\n");
+  EXPECT_GT((want - straight).norm(), 0.1) << Str(want);
+  EXPECT_VEC_NEAR(end("tropism: 0 -1 0 0\naxiom: _(0.2) +(60) F F F\n"), want, 1e-12);
+  EXPECT_VEC_NEAR(end("tropism: 0 -1 0 0.2\naxiom: [_(0)] +(60) F F F\n"), want, 1e-12);
+  EXPECT_VEC_NEAR(end("tropism: 0 -1 0 0.2\naxiom: _(0) +(60) F F F\n"), straight, 1e-12);
+
+  // `_` without a parameter: the increment, twice.
+  auto p = testing::PlantFromText("tropism: 0 -1 0 0\naxiom: _ _ +(60) F F F\n", 0,
+                                  plant::Stage::kInterpreted);
+  ASSERT_TRUE(p.has_value());
+  TurtleDef def = TurtleDefFrom(p->grammar);
+  def.elasticityIncrement = 0.1;
+  auto g = Interpret(p->DrawnWord(), p->grammar.symbols, def, opt);
+  ASSERT_TRUE(g.ok());
+  EXPECT_VEC_NEAR(g->modulePosition.back(), want, 1e-12);
+
+  // With no tropism direction, cpfg's old tropism points up (0, 1, 0):
+  // `_(0.2)` bends a turtle heading left-and-up toward +Y, as `tropism:
+  // 0 1 0 0.2` does.
+  EXPECT_VEC_NEAR(end("axiom: _(0.2) +(60) F F F\n"),
+                  end("tropism: 0 1 0 0.2\naxiom: +(60) F F F\n"), 1e-12);
+}
+
 TEST(Turtle, TwistForceChangesNothing) {
   const Frame a = FinalFrame("&(30)/(40)F@Tf F");
   const Frame b = FinalFrame("&(30)/(40)F F");
