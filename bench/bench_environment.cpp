@@ -104,7 +104,7 @@ void BM_ChibaAnswer(benchmark::State& state) {
   plant::ChibaDef def;
   def.transmittance = 0.25f;
   def.estimateArea = true;
-  def.sources = {{{0, 100, 0}, 4},  {{40, 100, 0}, 3}, {{-40, 100, 0}, 3},
+  def.sources = {{{0, 100, 0}, 4},   {{40, 100, 0}, 3}, {{-40, 100, 0}, 3},
                  {{0, 100, -40}, 3}, {{0, 100, 40}, 3}, {{80, 75, 0}, 2},
                  {{-80, 75, 0}, 2},  {{0, 75, 80}, 2},  {{0, 75, -80}, 2}};
   plant::ChibaEnvironment env(def, 3);

@@ -265,8 +265,8 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   }
   // The key light (the shadow caster): toward cpfg's light when the view
   // file gives one.
-  const Vec3 keyToward = viewFile && viewFile->lightToward ? *viewFile->lightToward
-                                                           : render::KeyLightDirection();
+  const Vec3 keyToward =
+      viewFile && viewFile->lightToward ? *viewFile->lightToward : render::KeyLightDirection();
   if (lines) {
     draw::Lines figure = LinesOf(*plant);
     batch.points = std::move(figure.points);
@@ -345,8 +345,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
                 lines     ? "lines, orthographic"
                 : ribbons ? "pixel-wide ribbons, orthographic"
                           : (parallel ? "mesh, orthographic" : "mesh, perspective"),
-                m->triangleCount(),
-                batch.points.size() / 2, (*context)->Renderer().c_str());
+                m->triangleCount(), batch.points.size() / 2, (*context)->Renderer().c_str());
   err << line;
   if (cmd.stats) {
     const plant::Timings& t = plant->time;
@@ -397,8 +396,8 @@ int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err)
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   // Framed as `sylva render` frames a mesh (never as a line figure).
-  auto camera = FrameCamera(*plant, *spec, v, false,
-                            cpfgDefaultView || (viewFile && viewFile->parallel));
+  auto camera =
+      FrameCamera(*plant, *spec, v, false, cpfgDefaultView || (viewFile && viewFile->parallel));
   if (!camera) return Report(camera.error(), err);
   if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
   spec->view = ViewOf(*camera, v.width, v.height, eps);

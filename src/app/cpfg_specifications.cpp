@@ -46,16 +46,17 @@ std::vector<Word> Words(std::string_view s, int column0) {
 // `cpfg` or `cpfg` and a version (`cpfg3.2`), as the program's name.
 bool IsCpfg(const std::string& w) {
   if (w.rfind("cpfg", 0) != 0) return false;
-  return std::all_of(w.begin() + 4, w.end(),
-                     [](char c) { return std::isdigit(static_cast<unsigned char>(c)) || c == '.'; });
+  return std::all_of(w.begin() + 4, w.end(), [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) || c == '.';
+  });
 }
 
 // cpfg's image and string output options (-rgb FILE, -str FILE, ...): each
 // takes a file name.
 bool IsOutputOption(const std::string& o) {
-  static constexpr std::string_view kOutputs[] = {"rgb", "ras", "tga", "ray", "ps",  "str",
-                                                  "strb", "gls", "vv", "iv",  "obj", "png",
-                                                  "bmp", "jpg", "tif", "tiff", "pdf", "eps"};
+  static constexpr std::string_view kOutputs[] = {"rgb",  "ras", "tga", "ray",  "ps",  "str",
+                                                  "strb", "gls", "vv",  "iv",   "obj", "png",
+                                                  "bmp",  "jpg", "tif", "tiff", "pdf", "eps"};
   for (std::string_view x : kOutputs)
     if (o.compare(1, std::string::npos, x) == 0) return true;
   return false;

@@ -32,14 +32,14 @@
 namespace sylva::app {
 
 struct CpfgCommand {
-  SourceLoc loc;            // the specifications file, line and column of `cpfg`
-  std::string lsystem;      // the first file name (the .l)
-  std::string view;         // the second (the .v); empty when there is none
-  std::string animation;    // the third (the .a); empty when there is none
-  std::string colormap;     // -m FILE or -m1 FILE (else the lowest -mN)
-  std::string material;     // -M FILE or -M1 FILE (else the lowest -MN)
+  SourceLoc loc;              // the specifications file, line and column of `cpfg`
+  std::string lsystem;        // the first file name (the .l)
+  std::string view;           // the second (the .v); empty when there is none
+  std::string animation;      // the third (the .a); empty when there is none
+  std::string colormap;       // -m FILE or -m1 FILE (else the lowest -mN)
+  std::string material;       // -M FILE or -M1 FILE (else the lowest -MN)
   bool materialWins = false;  // -M came after the last -m (cpfg: the later wins)
-  std::string environment;  // -e FILE
+  std::string environment;    // -e FILE
   // Options cpfg does not have (cpfg itself stops with its usage message).
   std::vector<std::string> unknownOptions;
 };

@@ -207,7 +207,7 @@ class Reader {
   ViewFile& v_;
   std::string path_;
   bool checkFiles_ = false;  // whether the files the lines name are looked for
-  std::string current_;  // the line as read (comments blanked)
+  std::string current_;      // the line as read (comments blanked)
   int line_ = 0;
   std::string label_;
   int labelColumn_ = 1;
@@ -298,8 +298,7 @@ void Reader::Read(const app::Line& line) {
     // Sylva reads `po...` as the polygons the word names.
     const bool word =
         tokens_.size() > 1 && std::isalpha(static_cast<unsigned char>(tokens_[1].text[0]));
-    const bool pixels =
-        word && tokens_[1].text[0] == 'p' && tokens_[1].text.rfind("po", 0) != 0;
+    const bool pixels = word && tokens_[1].text[0] == 'p' && tokens_[1].text.rfind("po", 0) != 0;
     lineStyle_ = pixels ? LineStyle::kPixel : LineStyle::kWorld;
     ExtraValues(word ? 2 : 1);
   } else if (L == "line width increment:") {
@@ -524,7 +523,8 @@ void Reader::Light() {
       char* end = nullptr;
       const double v = std::strtod(r.text.c_str(), &end);
       if (end != r.text.c_str() + r.text.size() || !std::isfinite(v)) {
-        Error(r.column, "expected a number after '" + std::string(1, c) + "', not '" + r.text + "'");
+        Error(r.column,
+              "expected a number after '" + std::string(1, c) + "', not '" + r.text + "'");
         return;
       }
       x.push_back(v);
@@ -549,9 +549,10 @@ void Reader::Light() {
   if (lights_ == 1) {
     if (toward) firstLight_ = toward;
     if (!ignored.empty())
-      Warn(labelColumn_, "'light:': Sylva uses the light's direction (V, or O seen from the "
-                         "origin) for its key light; " +
-                             ignored + " (colours, spot, attenuation) ignored");
+      Warn(labelColumn_,
+           "'light:': Sylva uses the light's direction (V, or O seen from the "
+           "origin) for its key light; " +
+               ignored + " (colours, spot, attenuation) ignored");
   }
 }
 
@@ -599,8 +600,8 @@ void Reader::Surface() {
   std::error_code ec;
   if (checkFiles_ && !fs::exists(def.file, ec)) {
     def.missing = true;
-    Warn(tokens_[1].column, "surface '" + def.name + "' is not drawn: its file " + def.file +
-                                " does not exist");
+    Warn(tokens_[1].column,
+         "surface '" + def.name + "' is not drawn: its file " + def.file + " does not exist");
   }
   for (auto& old : v_.surfaces) {
     if (old.name == def.name) {
@@ -880,8 +881,7 @@ void ParseAnimationFile(const std::string& text, const std::string& path, ViewFi
   plant::FrameRange frames;
   // cpfg's `last frame: -1`: up to the derivation length.
   if (number(first, "first frame", 0, 0, &frames.first) &&
-      number(last, "last frame", -1, -1, &frames.last) &&
-      number(step, "step", 1, 1, &frames.step))
+      number(last, "last frame", -1, -1, &frames.last) && number(step, "step", 1, 1, &frames.step))
     view.overlay = frames;
 }
 

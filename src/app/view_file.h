@@ -40,19 +40,19 @@ namespace sylva::app {
 // What a view file (and its colour files) says that Sylva acts on; unset:
 // the file does not say it.
 struct ViewFile {
-  std::string path;                             // the view file read; empty when there was none
-  std::optional<double> angle;                  // `angle increment:` or 360 / `angle factor:`
-  std::optional<double> width;                  // `initial line width:`
-  std::optional<double> widthIncrement;         // `line width increment:`
-  std::optional<int> initialColor;              // `initial color:`
-  std::optional<int> colorIncrement;            // `color increment:`
-  std::optional<Vec3> tropism;                  // unit: `tropism direction:` or `tropism: T`
-  std::optional<double> elasticity;             // `initial elasticity:` or `tropism: E`
-  std::optional<double> elasticityIncrement;    // `elasticity increment:` or `tropism: S`
-  std::optional<Vec3> viewpoint;                // `viewpoint:` (the eye)
-  std::optional<Vec3> target;                   // `view reference point:`
-  std::optional<double> scale;                  // `scale factor:` (> 0)
-  std::optional<double> viewingAngle;           // `viewing angle:` (degrees, 0..180): perspective
+  std::string path;                           // the view file read; empty when there was none
+  std::optional<double> angle;                // `angle increment:` or 360 / `angle factor:`
+  std::optional<double> width;                // `initial line width:`
+  std::optional<double> widthIncrement;       // `line width increment:`
+  std::optional<int> initialColor;            // `initial color:`
+  std::optional<int> colorIncrement;          // `color increment:`
+  std::optional<Vec3> tropism;                // unit: `tropism direction:` or `tropism: T`
+  std::optional<double> elasticity;           // `initial elasticity:` or `tropism: E`
+  std::optional<double> elasticityIncrement;  // `elasticity increment:` or `tropism: S`
+  std::optional<Vec3> viewpoint;              // `viewpoint:` (the eye)
+  std::optional<Vec3> target;                 // `view reference point:`
+  std::optional<double> scale;                // `scale factor:` (> 0)
+  std::optional<double> viewingAngle;         // `viewing angle:` (degrees, 0..180): perspective
   // cpfg's line style: widths in pixels on the screen (`initial line
   // width: 2 pixels`, `line style: pixel`, or neither: cpfg's default,
   // with a width of 1), not in world units (`initial line width: 0.1`,

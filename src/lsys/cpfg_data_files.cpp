@@ -12,7 +12,9 @@
 namespace sylva::lsys {
 namespace {
 
-bool IsBlank(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
+bool IsBlank(char c) {
+  return std::isspace(static_cast<unsigned char>(c)) != 0;
+}
 
 std::string Shown(char c) {
   if (c == '\n') return "a line break";
@@ -83,15 +85,32 @@ std::string UnescapeC(std::string_view body) {
     }
     const char e = body[++i];
     switch (e) {
-      case 'n': s += '\n'; break;
-      case 't': s += '\t'; break;
-      case 'r': s += '\r'; break;
-      case 'a': s += '\a'; break;
-      case 'b': s += '\b'; break;
-      case 'f': s += '\f'; break;
-      case 'v': s += '\v'; break;
-      case '0': s += '\0'; break;
-      default: s += e;  // \\ \" \' and the rest: the character itself
+      case 'n':
+        s += '\n';
+        break;
+      case 't':
+        s += '\t';
+        break;
+      case 'r':
+        s += '\r';
+        break;
+      case 'a':
+        s += '\a';
+        break;
+      case 'b':
+        s += '\b';
+        break;
+      case 'f':
+        s += '\f';
+        break;
+      case 'v':
+        s += '\v';
+        break;
+      case '0':
+        s += '\0';
+        break;
+      default:
+        s += e;  // \\ \" \' and the rest: the character itself
     }
   }
   return s;
@@ -157,9 +176,8 @@ bool ParseScanFormat(std::string_view f, ScanFormat* out, std::string* why) {
       d.kind = conv == 's' ? Kind::kWord : Kind::kChars;
       if (conv == 'c' && d.width == 0) d.width = 1;
     } else if (conv == 's' || conv == 'c') {
-      *why = "'" + spec +
-             "' reads text, and cpfg's variables are numbers (write '%*" + std::string(1, conv) +
-             "' to skip it)";
+      *why = "'" + spec + "' reads text, and cpfg's variables are numbers (write '%*" +
+             std::string(1, conv) + "' to skip it)";
       return false;
     } else {
       *why = "'" + spec + "' is not a conversion Sylva reads (numbers: %lf %f %g %e %d %i; " +

@@ -162,11 +162,11 @@ Expected<std::vector<CpfgFunction>> CpfgFunction::ParseSet(const std::string& te
     }
   }
   int major = 0, minor = 0;
-  if (lines.empty() ||
-      std::sscanf(lines[0].c_str(), "funcgalleryver %d %d", &major, &minor) != 2)
+  if (lines.empty() || std::sscanf(lines[0].c_str(), "funcgalleryver %d %d", &major, &minor) != 2)
     return FileError(path, 1, "not a cpfg function set (expected 'funcgalleryver 1 1')");
   if (major != 1 || minor != 1)
-    return FileError(path, 1, "unsupported function set version (Sylva reads 'funcgalleryver 1 1')");
+    return FileError(path, 1,
+                     "unsupported function set version (Sylva reads 'funcgalleryver 1 1')");
   long items = -1;
   if (lines.size() < 2 || std::sscanf(lines[1].c_str(), "items: %ld", &items) != 1 || items < 0)
     return FileError(path, 2, "expected 'items: N'");

@@ -882,12 +882,13 @@ class Parser {
       for (std::string_view c : kCpfgFunctions) {
         if (name == c && name.rfind("curve", 0) == 0) {
           // cpfg curveXYZc.cpp: the curves are the view file's `curve:` files.
-          return Error(col,
-                       "cpfg function '" + name +
-                           "' is not supported by Sylva: it reads the curve of a view file's "
-                           "'curve:' line (curveX/Y/Z(id, t): a coordinate of its point at t from 0 "
-                           "to 1; curveGAL(id): the curve's length)",
-                       len);
+          return Error(
+              col,
+              "cpfg function '" + name +
+                  "' is not supported by Sylva: it reads the curve of a view file's "
+                  "'curve:' line (curveX/Y/Z(id, t): a coordinate of its point at t from 0 "
+                  "to 1; curveGAL(id): the curve's length)",
+              len);
         }
         if (name == c)
           return Error(col, "cpfg function '" + name + "' is not supported by Sylva", len);
@@ -1443,7 +1444,8 @@ class ExprCompiler {
         if (!StringArg(text, &a, &mode, &modeCol))
           return Err(int(a) + 1, "expected the mode of 'fopen' in quotes (\"r\" or \"w\")");
         SkipSpace(text, &a);
-        if (a >= text.size() || text[a] != ')') return Err(int(a) + 1, "expected ')' after 'fopen'");
+        if (a >= text.size() || text[a] != ')')
+          return Err(int(a) + 1, "expected ')' after 'fopen'");
         if (!mode.empty() && mode[0] == 'r') {
           uint32_t id = 0;
           std::string why;
@@ -1613,8 +1615,9 @@ class ExprCompiler {
           for (const ArrayShape& x : *scope.arrays)
             if (x.name == name) a = &x;
         if (!a)
-          return Err(tcol, "'" + name + "' is not an array (arrays are declared in 'define: { array " +
-                               name + "[n]; }')",
+          return Err(tcol,
+                     "'" + name + "' is not an array (arrays are declared in 'define: { array " +
+                         name + "[n]; }')",
                      int(name.size()));
         Push(OpCode::kConst, 0, tcol);  // the offset, built one index at a time
         ++onStack;
@@ -1685,7 +1688,7 @@ class ExprCompiler {
     for (const Target& t : targets) call.element.push_back(t.element ? 1 : 0);
     Push(OpCode::kFscanf, (*scope.dataFiles)->AddCall(std::move(call)), col);
     for (size_t k = targets.size(); k-- > 0;) Push(targets[k].store, targets[k].slot, col);
-    blockDepth = std::max(blockDepth, maxDepth + 1);  // kDup
+    blockDepth = std::max(blockDepth, maxDepth + 1);     // kDup
     if (scope.writesGlobal) *scope.writesGlobal = true;  // files are read in word order
     return true;
   }

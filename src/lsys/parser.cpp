@@ -650,7 +650,8 @@ bool GrammarParser::ParseBlockAt(const Line& l, std::string_view view, size_t* p
       if (opt_.readFile) {
         auto text = opt_.readFile(path);
         if (!text) return MakeError(SourceLoc{path, 0, 0}, "cannot read file");
-        if (text->size() > limit) return MakeError(SourceLoc{path, 0, 0}, "file is larger than the limit of 16 MiB");
+        if (text->size() > limit)
+          return MakeError(SourceLoc{path, 0, 0}, "file is larger than the limit of 16 MiB");
         return std::move(*text);
       }
       return ReadFile(path, limit);
@@ -2140,8 +2141,7 @@ static int BlockDepth(const std::string& t, int depth, std::string_view next) {
       depth += c == '{' ? 1 : (c == '}' ? -1 : 0);
     } else if (c == '{' &&
                ((prev == ':' && t.find_first_not_of(" \t\r", i + 1) == std::string::npos) ||
-                (prev == ':' && StartsArrayDefinition(t, i + 1)) ||
-                IsStatementBlock(t, i, next))) {
+                (prev == ':' && StartsArrayDefinition(t, i + 1)) || IsStatementBlock(t, i, next))) {
       depth = 1;
     }
     if (!IsSpace(c)) prev = c;

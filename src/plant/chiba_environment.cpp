@@ -80,7 +80,8 @@ std::vector<ChibaDef::Source> ChibaDirections(const ChibaDef& def) {
       1, int(std::ceil(std::log(double(std::max(def.samples, 1)) / 8.0) / std::log(4.0))) + 1);
   for (const DTri& t : SubdividedOctahedron(std::min(level, 8))) {
     ChibaDef::Source s;
-    for (int c = 0; c < 3; ++c) s.dir[c] = (float(t[0][c]) + float(t[1][c]) + float(t[2][c])) / 3.0f;
+    for (int c = 0; c < 3; ++c)
+      s.dir[c] = (float(t[0][c]) + float(t[1][c]) + float(t[2][c])) / 3.0f;
     Normalize(s.dir);
     out.push_back(s);
   }

@@ -4,11 +4,12 @@
 #include <cmath>
 #include <string>
 
-
 namespace sylva::plant {
 namespace {
 
-uint32_t Be16(const unsigned char* p) { return uint32_t(p[0]) << 8 | p[1]; }
+uint32_t Be16(const unsigned char* p) {
+  return uint32_t(p[0]) << 8 | p[1];
+}
 uint32_t Be32(const unsigned char* p) {
   return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3];
 }
@@ -150,8 +151,7 @@ Status CloverEnvironment::Answer(std::span<EnvQuery> queries) {
       for (int dx = -r[0]; dx < r[0]; ++dx) {
         const int cx = node[0] + dx;
         if (cx < 0 || cx >= def_.size[0]) continue;
-        if (float(dx * dx) / float(r[0] * r[0]) + float(dy * dy) / float(r[1] * r[1]) > 1)
-          continue;
+        if (float(dx * dx) / float(r[0] * r[0]) + float(dy * dy) / float(r[1] * r[1]) > 1) continue;
         uint8_t& o = objects_[size_t(cy) * size_t(def_.size[0]) + size_t(cx)];
         if (add == 1 && o < 255) ++o;
         if (add == -1 && o > 0) --o;

@@ -34,12 +34,12 @@
 namespace sylva::plant {
 
 struct CloverDef {
-  int size[2] = {512, 512};     // `grid size:` cells
-  float pos[2] = {-1, -1};      // `grid position:` lower left corner
-  float range[2] = {2, 2};      // `grid range:` extent
-  float transmittance = 0.6f;   // `transmittance:` of one leaf
+  int size[2] = {512, 512};      // `grid size:` cells
+  float pos[2] = {-1, -1};       // `grid position:` lower left corner
+  float range[2] = {2, 2};       // `grid range:` extent
+  float transmittance = 0.6f;    // `transmittance:` of one leaf
   bool removeOldLeaves = false;  // `remove old leaves: on`
-  bool zIsUp = true;            // `z is up:`
+  bool zIsUp = true;             // `z is up:`
 };
 
 // An input image's channels, rows from the bottom (as SGI images and

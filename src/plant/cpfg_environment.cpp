@@ -118,8 +118,8 @@ Diagnostic Warning(const std::string& file, const Line& line, int column0, int l
 
 // A printf conversion of cpfg's `turtle position:` format.
 struct Conversion {
-  char kind = 'f';     // f, e or g (their upper-case forms print the same digits)
-  int precision = 6;   // printf's default
+  char kind = 'f';    // f, e or g (their upper-case forms print the same digits)
+  int precision = 6;  // printf's default
 };
 
 // The conversions of a format, at most 3 as cpfg counts them; nullopt when
@@ -204,9 +204,8 @@ class DensityProgram final : public Environment {
       in.push_back(DensityQuery{q.position, {q.params.data(), q.params.size()}});
       which.push_back(i);
     }
-    const std::vector<double> answers = program_ == Program::kHonda81
-                                            ? Honda81Answers(honda_, in)
-                                            : EcosystemAnswers(eco_, in);
+    const std::vector<double> answers =
+        program_ == Program::kHonda81 ? Honda81Answers(honda_, in) : EcosystemAnswers(eco_, in);
     for (size_t k = 0; k < which.size(); ++k) queries[which[k]].params[0] = answers[k];
     return {};
   }
@@ -220,7 +219,7 @@ class DensityProgram final : public Environment {
 
 // The spec file of honda81 or ecosystem: `keyword: value` lines.
 void ReadDensitySpec(Program program, const std::string& path, const std::string& text,
-              Honda81Def& honda, EcosystemDef& eco, DiagnosticList& diags) {
+                     Honda81Def& honda, EcosystemDef& eco, DiagnosticList& diags) {
   const char* name = program == Program::kHonda81 ? "honda81" : "ecosystem";
   for (const Line& line : LinesOf(text)) {
     auto d = DirectiveOf(line.text);
@@ -321,8 +320,10 @@ bool ReadCloverSpec(const std::string& path, const std::string& text, const Read
     std::string why;
     if (bytes) {
       auto img = ReadCloverImage(*bytes, imagePath);
-      if (img) image = std::move(*img);
-      else why = img.error().message;
+      if (img)
+        image = std::move(*img);
+      else
+        why = img.error().message;
     } else {
       why = "cannot read " + imagePath;
     }
@@ -417,14 +418,14 @@ std::optional<CpfgEnvironmentRef> FindCpfgEnvironment(const std::string& grammar
     }
   }
   const size_t dot = base.rfind('.');
-  const std::string beside = Join(dir, (dot == std::string::npos ? base : base.substr(0, dot)) + ".e");
+  const std::string beside =
+      Join(dir, (dot == std::string::npos ? base : base.substr(0, dot)) + ".e");
   if (ReadText(beside, readFile)) return CpfgEnvironmentRef{beside, {}, {}, 1};
   return std::nullopt;
 }
 
 std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
-                                                 const Reader& readFile,
-                                                 DiagnosticList& diags) {
+                                                 const Reader& readFile, DiagnosticList& diags) {
   auto text = ReadText(ref.file, readFile);
   if (!text) {
     Diagnostic d = MakeError(ref.namedAt,
@@ -456,12 +457,10 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
                           "or %g: no position is sent, so the program answers no ?E"));
         position = std::vector<Conversion>{};
       }
-    } else if (d->key == "communication type" || d->key == "verbose" ||
-               d->key == "remote host" || d->key == "strings only" ||
-               d->key == "binary data" || d->key == "turtle heading" ||
-               d->key == "turtle left" || d->key == "turtle up" ||
-               d->key == "turtle line width" || d->key == "turtle scale factor" ||
-               d->key == "following module") {
+    } else if (d->key == "communication type" || d->key == "verbose" || d->key == "remote host" ||
+               d->key == "strings only" || d->key == "binary data" || d->key == "turtle heading" ||
+               d->key == "turtle left" || d->key == "turtle up" || d->key == "turtle line width" ||
+               d->key == "turtle scale factor" || d->key == "following module") {
       // How cpfg talks to the process, or turtle data that Sylva's built-in
       // programs do not read (none of them uses more than the position).
     } else if (d->key == "interpreted modules" || d->key == "when interpret") {
@@ -470,9 +469,9 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
                             ":' is read but not acted on: Sylva sends only ?E modules to "
                             "the environment"));
     } else {
-      diags.Add(Warning(ref.file, line, keyCol, int(d->key.size()),
-                        "unknown directive '" + d->key +
-                            "' in the environment file: ignored, as cpfg does"));
+      diags.Add(Warning(
+          ref.file, line, keyCol, int(d->key.size()),
+          "unknown directive '" + d->key + "' in the environment file: ignored, as cpfg does"));
     }
   }
   if (!executableLine) {
@@ -501,12 +500,13 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
   } else if (program == "chiba") {
     kind = Program::kChiba;
   } else {
-    diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
-                      "the environment program '" + program +
-                          "' is not built into Sylva (it has honda81, ecosystem, clover and chiba): "
-                          "?E "
-                          "is not answered, its parameters keep the values written in the "
-                          "grammar"));
+    diags.Add(
+        Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
+                "the environment program '" + program +
+                    "' is not built into Sylva (it has honda81, ecosystem, clover and chiba): "
+                    "?E "
+                    "is not answered, its parameters keep the values written in the "
+                    "grammar"));
     return nullptr;
   }
   // The program's arguments: `-e FILE` (the .e itself), then its spec file.
@@ -534,9 +534,9 @@ std::unique_ptr<Environment> LoadCpfgEnvironment(const CpfgEnvironmentRef& ref,
   std::optional<CloverImage> image;
   ChibaDef chiba;
   if (specFile.empty()) {
-    diags.Add(Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
-                      program + " is given no specification file: it runs with its defaults" +
-                          defaults));
+    diags.Add(
+        Warning(ref.file, *executableLine, programCol, int(args[0].first.size()),
+                program + " is given no specification file: it runs with its defaults" + defaults));
   } else {
     const std::string specPath = Join(ParentOf(ref.file), specFile);
     auto spec = ReadText(specPath, readFile);

@@ -41,8 +41,8 @@ namespace sylva::plant {
 // folder names none. `readFile` reads a file's text (empty: the file
 // system).
 struct CpfgEnvironmentRef {
-  std::string file;     // the .e file, resolved against the grammar's folder
-  SourceLoc namedAt;    // the specifications line naming it, if any
+  std::string file;   // the .e file, resolved against the grammar's folder
+  SourceLoc namedAt;  // the specifications line naming it, if any
   std::string namedLine;
   int namedLength = 1;
 };

@@ -101,8 +101,7 @@ std::vector<double> EcosystemAnswers(const EcosystemDef& def,
   // decide in word order.
   std::vector<std::vector<uint32_t>> near(n);
   ForNeighbours(pts, 2 * maxReach, [&](uint32_t i, uint32_t j) {
-    if (overlap(i, j) &&
-        (vigor[i] < vigor[j] || (vigor[i] == vigor[j] && radius[i] < radius[j])))
+    if (overlap(i, j) && (vigor[i] < vigor[j] || (vigor[i] == vigor[j] && radius[i] < radius[j])))
       near[i].push_back(j);
     return true;
   });

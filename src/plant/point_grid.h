@@ -42,8 +42,9 @@ class PointGrid {
       if (Finite(i)) keys_[i] = Key(Cell(i, 0), Cell(i, 1), Cell(i, 2));
     order_.resize(n);
     std::iota(order_.begin(), order_.end(), 0u);
-    std::sort(order_.begin(), order_.end(),
-              [&](uint32_t a, uint32_t b) { return keys_[a] < keys_[b] || (keys_[a] == keys_[b] && a < b); });
+    std::sort(order_.begin(), order_.end(), [&](uint32_t a, uint32_t b) {
+      return keys_[a] < keys_[b] || (keys_[a] == keys_[b] && a < b);
+    });
     for (size_t k = 0; k < n;) {
       size_t e = k;
       while (e < n && keys_[order_[e]] == keys_[order_[k]]) ++e;

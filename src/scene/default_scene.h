@@ -30,7 +30,9 @@ draw::DrawList DefaultScene(std::shared_ptr<const mesh::TriangleMesh> plant,
 
 // Whether a camera at `eye` sees the default ground of a plant whose box
 // starts at lo.y from above (eye.y >= lo.y).
-inline bool SeesGroundFromAbove(const Vec3& eye, const Vec3& lo) { return eye.y() >= lo.y(); }
+inline bool SeesGroundFromAbove(const Vec3& eye, const Vec3& lo) {
+  return eye.y() >= lo.y();
+}
 
 // The ground's colour near the plant (linear); toward its rim it turns to
 // what the default lights make of the background colour.

@@ -569,8 +569,8 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   bool changesTropism = false, drawsCylinders = false, underscore = false;
   for (Op op : ops) {
     underscore |= op == Op::kElasticity;
-    changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp ||
-                      op == Op::kTropismDown || op == Op::kElasticity;
+    changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp || op == Op::kTropismDown ||
+                      op == Op::kElasticity;
     drawsCylinders |= op == Op::kGcStart || op == Op::kGcPoint || op == Op::kGcEnd ||
                       op == Op::kGcTangent || op == Op::kGcRadius;
   }

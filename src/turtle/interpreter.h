@@ -75,7 +75,7 @@ struct TurtleDef {
   double widthScale = 1;      // drawn diameter = width x widthScale
   Vec3 tropism{0, -1, 0};
   bool tropismGiven = false;  // the grammar or view file names it; else cpfg's `_` bends up (0,1,0)
-  double susceptibility = 0;       // 0: no tropism (until @Ts, @Ti or @Td changes it)
+  double susceptibility = 0;  // 0: no tropism (until @Ts, @Ti or @Td changes it)
   double elasticityIncrement = 0;  // @Ti and @Td without a value add and subtract it
   int initialColor = 0;            // colour index the turtle starts with
   int colorIncrement = 1;          // ; and , without a parameter add and subtract it

@@ -86,8 +86,7 @@ TEST(CpfgSpecifications, MissingNamedFilesWarnAndHostileSpecificationsAreNotRead
   const std::string all = v->diagnostics.FormatAll();
   EXPECT_FALSE(v->diagnostics.HasErrors()) << all;
   EXPECT_NE(all.find("specifications:2:3"), std::string::npos) << all;
-  EXPECT_NE(all.find("view file 'gone.v', which is not in the object's folder"),
-            std::string::npos)
+  EXPECT_NE(all.find("view file 'gone.v', which is not in the object's folder"), std::string::npos)
       << all;
   EXPECT_NE(all.find("colour map 'p.map'"), std::string::npos) << all;
 

@@ -134,9 +134,9 @@ TEST(ViewFile, AnimationFilesOverlayFramesOnlyWithoutClearingOrDoubleBuffering) 
                      toEnd);
   ASSERT_TRUE(toEnd.overlay.has_value());
   EXPECT_EQ(toEnd.overlay->last, -1);
-  for (const char* still : {"double buffer: on\nclear between frames: off\nlast frame: -1\n",
-                            "double buffer: off\nclear between frames: on\nlast frame: x\n",
-                            "last frame: 5\n"}) {
+  for (const char* still :
+       {"double buffer: on\nclear between frames: off\nlast frame: -1\n",
+        "double buffer: off\nclear between frames: on\nlast frame: x\n", "last frame: 5\n"}) {
     ViewFile v;
     ParseAnimationFile(still, "a.a", v);
     EXPECT_FALSE(v.overlay.has_value()) << still;
@@ -442,8 +442,7 @@ TEST(ViewFile, ASurfaceFileThatIsNotThereWarnsAndDrawsNothing) {
   ASSERT_TRUE(view != nullptr);
   const std::string all = Messages(view->diagnostics);
   EXPECT_NE(all.find("2:12 warning: surface 'c' is not drawn: its file " +
-                     (Scratch() / "calyx_gone.s").lexically_normal().string() +
-                     " does not exist"),
+                     (Scratch() / "calyx_gone.s").lexically_normal().string() + " does not exist"),
             std::string::npos)
       << all;
   ASSERT_EQ(view->surfaces.size(), 1u);

@@ -36,8 +36,7 @@ TEST(CpfgContext, EqualsBindsTheModulesAroundIt) {
 
 TEST(CpfgContext, EqualsAtTheEndOfTheContextMatchesAnyRest) {
   // topiary-2d: `F(n) > [Signal=] --> Signal F(n)`.
-  EXPECT_EQ(DeriveText("axiom: F(1)[JFF]F(2)\nF(n) > [J=] --> J F(n)\n", 1),
-            "JF(1)[JFF]F(2)");
+  EXPECT_EQ(DeriveText("axiom: F(1)[JFF]F(2)\nF(n) > [J=] --> J F(n)\n", 1), "JF(1)[JFF]F(2)");
 }
 
 TEST(CpfgContext, CloseBracketWithoutItsOpenLeavesTheBranch) {

@@ -49,8 +49,7 @@ TEST(CpfgSrand, InTheHomomorphismReseedsTheDrawing) {
 
 TEST(CpfgSrand, InStartEachReseedsTheStep) {
   const std::string rules = "axiom: A A A A A A A A\n" + std::string(kRules);
-  EXPECT_EQ(DeriveText("StartEach: {srand(7);}\n" + rules, 1),
-            DeriveText("seed: 7\n" + rules, 1));
+  EXPECT_EQ(DeriveText("StartEach: {srand(7);}\n" + rules, 1), DeriveText("seed: 7\n" + rules, 1));
 }
 
 TEST(CpfgSrand, OnlyAsAStatement) {
@@ -116,8 +115,7 @@ TEST(CpfgDecomposition, ThousandsOfPassesDeep) {
 
 TEST(CpfgText, TextParameterIsTheNumberOfTheText) {
   // simple-alpha, equilibrium: `@L("%.0f", n)` labels.
-  ParseResult r =
-      ParseGrammarText("axiom: @L(\"a\") @L(\"b\", 2) @L(\"a\") A(\"b\")\n", "c.l", {});
+  ParseResult r = ParseGrammarText("axiom: @L(\"a\") @L(\"b\", 2) @L(\"a\") A(\"b\")\n", "c.l", {});
   ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
   EXPECT_EQ(FormatWord(testing::MustDerive(*r.grammar).word, r.grammar->symbols),
             "@L(0)@L(1,2)@L(0)A(1)");

@@ -128,9 +128,10 @@ TEST(CpfgDataFiles, ReadingAClosedOrUnopenedFileIsARunTimeError) {
             std::string::npos)
       << w.error().message;
   // A number that is not finite.
-  ParseResult nan = ParseWith("Start: { fp = fopen(\"n.dat\", \"r\"); fscanf(fp, \"%lf\", &x); }\n"
-                              "axiom: A\n",
-                              {{"/obj/n.dat", "\n nan"}});
+  ParseResult nan = ParseWith(
+      "Start: { fp = fopen(\"n.dat\", \"r\"); fscanf(fp, \"%lf\", &x); }\n"
+      "axiom: A\n",
+      {{"/obj/n.dat", "\n nan"}});
   ASSERT_TRUE(nan.grammar);
   auto wn = Derive(*nan.grammar, DeriveOptions{});
   ASSERT_FALSE(wn);
@@ -172,8 +173,9 @@ TEST(CpfgDataFiles, NamesAreRelativeToTheGrammarAndHostileFilesAreClearErrors) {
   std::filesystem::create_directories(dir / "obj" / "sub");
   std::ofstream(dir / "obj" / "sub" / "d.dat") << "42\n";
   const std::string grammar = (dir / "obj" / "plant.l").string();
-  std::ofstream(grammar) << "Start: { fp = fopen(\"sub/d.dat\", \"r\"); fscanf(fp, \"%lf\", &x); }\n"
-                            "axiom: A(x)\n";
+  std::ofstream(grammar)
+      << "Start: { fp = fopen(\"sub/d.dat\", \"r\"); fscanf(fp, \"%lf\", &x); }\n"
+         "axiom: A(x)\n";
   // Wherever the process runs, the name is found beside the grammar.
   ParseResult r = ParseGrammarFile(grammar);
   EXPECT_EQ(Word(r), "A(42)");
@@ -215,11 +217,11 @@ TEST(CpfgDataFiles, ScanAgreesWithTheCLibrarysScanf) {
   // Differential: the C library's sscanf on the same text and format gives
   // the same count and values (fscanf differs from sscanf only at EOF,
   // where both return -1 before the first conversion).
-  const char* formats[] = {"%lf",     "%lf %lf",  "x=%lf",   "%*s %lf", "%3lf%lf",
-                           " %lf,%lf", "%lf\n%lf", "%*c%lf",  "a %lf",   "%2lf %*3c%lf"};
-  const char* inputs[] = {"1 2",  "x=3.5",   "abc 4",  "12345 6", "  -1e3,7", "",
-                          "   ",  "1,\n 2", "x= 2",   "a\t9",    "0x1p3 4", ".5e1 -.25",
-                          "1e",   "+7 x",    "12 34"};
+  const char* formats[] = {"%lf",      "%lf %lf",  "x=%lf",  "%*s %lf", "%3lf%lf",
+                           " %lf,%lf", "%lf\n%lf", "%*c%lf", "a %lf",   "%2lf %*3c%lf"};
+  const char* inputs[] = {"1 2",     "x=3.5",     "abc 4",  "12345 6", "  -1e3,7",
+                          "",        "   ",       "1,\n 2", "x= 2",    "a\t9",
+                          "0x1p3 4", ".5e1 -.25", "1e",     "+7 x",    "12 34"};
   int compared = 0;
   for (const char* f : formats) {
     ScanFormat fmt;
@@ -227,9 +229,8 @@ TEST(CpfgDataFiles, ScanAgreesWithTheCLibrarysScanf) {
     ASSERT_TRUE(ParseScanFormat(f, &fmt, &why)) << f << ": " << why;
     ASSERT_LE(fmt.assignments, 2);
     for (const char* in : inputs) {
-      CpfgDataFiles files("", [in](const std::string&) -> Expected<std::string> {
-        return std::string(in);
-      });
+      CpfgDataFiles files(
+          "", [in](const std::string&) -> Expected<std::string> { return std::string(in); });
       uint32_t id = 0;
       ASSERT_TRUE(files.Add("d", &id, &why)) << why;
       CpfgDataFiles::Call call;
@@ -238,8 +239,8 @@ TEST(CpfgDataFiles, ScanAgreesWithTheCLibrarysScanf) {
       const uint32_t c = files.AddCall(call);
       double mine[2] = {-7, -7}, theirs[2] = {-7, -7};
       int count = 0;
-      ASSERT_TRUE(files.Scan(files.Open(id), c, mine, &count, &why)) << f << " on " << in << ": "
-                                                                     << why;
+      ASSERT_TRUE(files.Scan(files.Open(id), c, mine, &count, &why))
+          << f << " on " << in << ": " << why;
       const int expected = std::sscanf(in, f, &theirs[0], &theirs[1]);
       EXPECT_EQ(count, expected) << "format '" << f << "' on '" << in << "'";
       for (int k = 0; k < fmt.assignments; ++k)

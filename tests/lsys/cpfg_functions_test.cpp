@@ -247,10 +247,10 @@ TEST(CpfgFunctions, AFunctionSetGivesItsFunctionsInOrderAndByName) {
   ASSERT_FALSE(count);
   EXPECT_EQ(count.error().loc.line, 2);
   EXPECT_EQ(count.error().message, "'items: 3' but the set has 1 functions ('fver' lines)");
-  auto point = CpfgFunction::ParseSet(
-      std::string("funcgalleryver 1 1\nitems: 2\n") + kHump +
-          "fver 1 1\nname: b\nsamples: 0\nflip: off\npoints: 4\n0 0\n1\n",
-      "s");
+  auto point =
+      CpfgFunction::ParseSet(std::string("funcgalleryver 1 1\nitems: 2\n") + kHump +
+                                 "fver 1 1\nname: b\nsamples: 0\nflip: off\npoints: 4\n0 0\n1\n",
+                             "s");
   ASSERT_FALSE(point);
   EXPECT_EQ(point.error().loc.line, 18);  // the 18th line of the set
   EXPECT_EQ(point.error().message, "expected a point 'x y'");

@@ -168,7 +168,8 @@ TEST(MultiModulePredecessor, SameWordWithAnyThreadCount) {
 }
 
 TEST(MultiModulePredecessor, BracketsCannotBePartOfIt) {
-  EXPECT_EQ(FirstError("axiom: A\nA [ --> B\n"), "2:3 '[' cannot be rewritten without its ']': a predecessor holds brackets only "
+  EXPECT_EQ(FirstError("axiom: A\nA [ --> B\n"),
+            "2:3 '[' cannot be rewritten without its ']': a predecessor holds brackets only "
             "in balanced pairs");
   EXPECT_EQ(FirstError("axiom: A\nA * --> B\n"),
             "2:3 '*' cannot be (part of) a predecessor: it stands alone as a context");

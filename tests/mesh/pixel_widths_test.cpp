@@ -85,7 +85,9 @@ TEST(PixelWidths, ResolvedRadiiScaleWithDistanceAndBoundsIgnoreThem) {
   // 3 px at the eye's distance 5 and 50: about ten times as wide in the world.
   const double ratio = r.segments[1].radiusStart / r.segments[0].radiusStart;
   EXPECT_NEAR(ratio, 10.0, 0.5) << "far over near world radius";
-  EXPECT_NEAR(r.segments[0].radiusStart * PixelOffset(view, g.segments[0].start, Vec3(0, 1, 0)).norm(), 3.0, 1e-4);
+  EXPECT_NEAR(
+      r.segments[0].radiusStart * PixelOffset(view, g.segments[0].start, Vec3(0, 1, 0)).norm(), 3.0,
+      1e-4);
   // Without a view: a pixel is 1/kNominalPixels of the largest extent (45).
   const PlantGeometry n = ResolvePixelWidths(g, nullptr);
   EXPECT_NEAR(n.segments[0].radiusStart, 3.0 * 45 / kNominalPixels, 1e-6);

@@ -195,10 +195,8 @@ TEST(CpfgEnvironment, EcosystemThinsOverlappingPlants) {
   f.files["obj/density.spec"] = "verbose: off\ngrid size: 128x128x1\n3d case: no\n";
   // Plants of radius 0.3, 0.1 and 0.2 along x at 0, 0.35 and 3: the
   // second overlaps the first, which is larger.
-  const char* g =
-      "axiom: [@M(0,0,0) P ?E(0.3)] [@M(0.35,0,0) P ?E(0.1)] [@M(3,0,0) P ?E(0.2)]\n";
-  EXPECT_EQ(WordOf(Grow(f, g, 0)),
-            "[@M(0,0,0)P?E(1)][@M(0.35,0,0)P?E(0)][@M(3,0,0)P?E(1)]");
+  const char* g = "axiom: [@M(0,0,0) P ?E(0.3)] [@M(0.35,0,0) P ?E(0.1)] [@M(3,0,0) P ?E(0.2)]\n";
+  EXPECT_EQ(WordOf(Grow(f, g, 0)), "[@M(0,0,0)P?E(1)][@M(0.35,0,0)P?E(0)][@M(3,0,0)P?E(1)]");
 }
 
 // A 10 x 10 grid of unit cells from (0, 0), leaves letting half through.
@@ -215,9 +213,11 @@ TEST(CloverEnvironment, LeavesShadeTheCellsOfTheirDisc) {
   CloverEnvironment env(UnitGrid(), nullptr, 2);
   // A leaf of area 4 pi (radius 2: 3 cells) at (5.5, 5.5), node (5, 5).
   std::vector<double> leaf{1, 4 * M_PI}, under{1}, beside{1}, off{1}, two{0, 7};
-  std::vector<EnvQuery> q{
-      {Vec3(5.5, 5.5, 0), {}, leaf}, {Vec3(5.2, 5.9, 0), {}, under},
-      {Vec3(9.5, 5.5, 0), {}, beside}, {Vec3(-0.5, 5, 0), {}, off}, {Vec3(2.5, 5.5, 0), {}, two}};
+  std::vector<EnvQuery> q{{Vec3(5.5, 5.5, 0), {}, leaf},
+                          {Vec3(5.2, 5.9, 0), {}, under},
+                          {Vec3(9.5, 5.5, 0), {}, beside},
+                          {Vec3(-0.5, 5, 0), {}, off},
+                          {Vec3(2.5, 5.5, 0), {}, two}};
   ASSERT_TRUE(env.Answer(q).ok());
   EXPECT_EQ(leaf, (std::vector<double>{1, 4 * M_PI})) << "a leaf is not answered";
   EXPECT_EQ(under[0], 0.5);
@@ -391,12 +391,14 @@ TEST(ChibaEnvironment, ClustersTowardTheLightShadeByOverlappingArea) {
   // Unit clusters: one right above the first (full overlap), one above the
   // third but shifted by 1 (lens of area 2 pi/3 - sqrt(3)/2).
   std::vector<double> a{1, 0, 0, 0}, b{1}, c{1}, e{1};
-  std::vector<EnvQuery> q{{Vec3(0, 0, 0), {}, a}, {Vec3(0, 2, 0), {}, b},
-                          {Vec3(10, 0, 0), {}, c}, {Vec3(11, 2, 0), {}, e}};
+  std::vector<EnvQuery> q{{Vec3(0, 0, 0), {}, a},
+                          {Vec3(0, 2, 0), {}, b},
+                          {Vec3(10, 0, 0), {}, c},
+                          {Vec3(11, 2, 0), {}, e}};
   ASSERT_TRUE(env.Answer(q).ok());
   EXPECT_NEAR(a[0], 0.25, 1e-6);  // 1 - 0.75 * pi / pi
   EXPECT_NEAR(a[2], 1.0, 1e-6) << "the brightest direction is the one source";
-  EXPECT_EQ(b[0], 1.0);           // nothing above it
+  EXPECT_EQ(b[0], 1.0);  // nothing above it
   const double lens = 2 * M_PI / 3 - std::sqrt(3.0) / 2;
   EXPECT_NEAR(c[0], 1 - 0.75 * lens / M_PI, 1e-6);
   EXPECT_EQ(e[0], 1.0);
@@ -410,8 +412,10 @@ TEST(ChibaEnvironment, WithoutAreaABallLetsThroughByChordLength) {
   // through its centre: a chord of 1 = its diameter, so 0.6^1. A ball off
   // to the side at distance 0.4 of the ray: chord 2 sqrt(0.25 - 0.16) = 0.6.
   std::vector<double> a{1}, b{0.5}, c{1}, d{0.5};
-  std::vector<EnvQuery> q{{Vec3(0, 0, 0), {}, a}, {Vec3(0, 3, 0), {}, b},
-                          {Vec3(5, 0, 0), {}, c}, {Vec3(5.4, 3, 0), {}, d}};
+  std::vector<EnvQuery> q{{Vec3(0, 0, 0), {}, a},
+                          {Vec3(0, 3, 0), {}, b},
+                          {Vec3(5, 0, 0), {}, c},
+                          {Vec3(5.4, 3, 0), {}, d}};
   ASSERT_TRUE(env.Answer(q).ok());
   EXPECT_NEAR(a[0], 0.6, 1e-6);
   EXPECT_NEAR(c[0], std::pow(0.6, 0.6), 1e-6);
@@ -484,11 +488,9 @@ TEST(CpfgEnvironment, SpecFileProblemsAreWarnedAndDefaultsKept) {
   Folder f;
   f.files["obj/t.e"] = "executable: honda81 -e t.e density.spec\nturtle position:%g %g\n";
   std::string w = Warnings(f, kTips);
-  EXPECT_NE(w.find("cannot read honda81's specification file obj/density.spec"),
-            std::string::npos)
+  EXPECT_NE(w.find("cannot read honda81's specification file obj/density.spec"), std::string::npos)
       << w;
-  EXPECT_NE(w.find("'turtle position:' sends 2 coordinates and honda81 needs 3"),
-            std::string::npos)
+  EXPECT_NE(w.find("'turtle position:' sends 2 coordinates and honda81 needs 3"), std::string::npos)
       << w;
   f.files["obj/density.spec"] = "radius: 2\nspeed: 9\n";
   w = Warnings(f, kTips);

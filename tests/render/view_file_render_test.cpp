@@ -51,7 +51,9 @@ double DrawnAspect(const std::string& png) {
 struct Png {
   int w = 0, h = 0;
   std::vector<unsigned char> px;
-  const unsigned char* At(int x, int y) const { return &px[4 * (size_t(y) * size_t(w) + size_t(x))]; }
+  const unsigned char* At(int x, int y) const {
+    return &px[4 * (size_t(y) * size_t(w) + size_t(x))];
+  }
 };
 Png Load(const std::string& png) {
   Png p;
@@ -103,10 +105,10 @@ TEST(ViewFile, ACameraBelowThePlantSeesItWithoutTheGround) {
   // A trunk 15 to the side of a flat whorl, as terminalia's tree.l draws
   // (main at 8ca261c: 0 background pixels of 19,200; without the ground
   // 19,008).
-  const std::string grammar = WriteFile(
-      "below.l",
-      "axiom: [-(90)f(15)+(90)f(-2)F(4)] F(1) [&(90) F(3)] [^(90) F(3)] [+(90) F(3)] "
-      "[-(90) F(3)]\n");
+  const std::string grammar =
+      WriteFile("below.l",
+                "axiom: [-(90)f(15)+(90)f(-2)F(4)] F(1) [&(90) F(3)] [^(90) F(3)] [+(90) F(3)] "
+                "[-(90) F(3)]\n");
   WriteFile("below.v",
             "initial line width: 0.1\nviewpoint: 1.1,-60,0\nview reference point: 1.1,0,0\n"
             "projection: perspective\n");
