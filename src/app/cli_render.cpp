@@ -317,10 +317,13 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   } else {
     // The default scene: the plant on a ground plane, lit by the default
     // rig; the shadow map fitted to the whole plant, whatever was culled.
-    // No ground when the camera looks from below it (a cpfg view file's
-    // viewpoint under the plant): it would hide everything.
+    // No ground when the camera looks from below it (it would hide
+    // everything), nor for a cpfg object (a view file, or a `.l` drawn from
+    // cpfg's default view): cpfg draws none, and a ground would hide what
+    // hangs below the base and fight with a base polygon drawn at it.
+    const bool cpfgObject = viewFile || cpfgDefaultView;
     list = scene::DefaultScene(m, palette, bounds.lo, bounds.hi,
-                               scene::SeesGroundFromAbove(camera->Eye(), bounds.lo));
+                               !cpfgObject && scene::SeesGroundFromAbove(camera->Eye(), bounds.lo));
     if (viewFile && viewFile->lightToward) list.lights[0].direction = -keyToward.cast<float>();
     list.wireframe = cmd.wireframe;
   }

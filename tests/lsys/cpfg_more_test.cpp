@@ -14,20 +14,12 @@
 namespace sylva::lsys {
 namespace {
 
+using testing::DiagnosticLines;
+using testing::Joined;
+
 // "line:col message" of every diagnostic.
 std::vector<std::string> Diagnostics(const std::string& text) {
-  ParseResult r = ParseGrammarText(text, "c.l");
-  std::vector<std::string> out;
-  for (const auto& d : r.diagnostics.items)
-    out.push_back(std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " +
-                  d.message);
-  return out;
-}
-
-std::string Joined(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += x + "\n";
-  return s;
+  return DiagnosticLines(ParseGrammarText(text, "c.l"));
 }
 
 TEST(CpfgSymbols, UnderscoreIsReadSilentlyAndWarnsOnlyForExtraParameters) {

@@ -12,6 +12,7 @@ namespace sylva::lsys {
 namespace {
 
 using testing::DeriveText;
+using testing::Joined;
 using testing::MustParse;
 
 // "line:col message" of every diagnostic (all must be warnings).
@@ -25,12 +26,6 @@ std::vector<std::string> Warnings(const std::string& text, const ParseOptions& o
                   d.message);
   }
   return out;
-}
-
-std::string Joined(const std::vector<std::string>& v) {
-  std::string s;
-  for (const auto& x : v) s += x + "\n";
-  return s;
 }
 
 TEST(Cpfg, UnimplementedCommandsWarnOncePerSymbolAtTheirFirstUse) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "core/atomic_file.h"
 #include "lsys/deriver.h"
@@ -18,6 +19,22 @@ inline Grammar MustParse(const std::string& text, const ParseOptions& opt = {}) 
     return Grammar{};
   }
   return std::move(*r.grammar);
+}
+
+// "line:col message" of every diagnostic of a parse, in order.
+inline std::vector<std::string> DiagnosticLines(const ParseResult& r) {
+  std::vector<std::string> out;
+  for (const auto& d : r.diagnostics.items)
+    out.push_back(std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " +
+                  d.message);
+  return out;
+}
+
+// Lines joined for a failure message.
+inline std::string Joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += x + "\n";
+  return s;
 }
 
 inline DeriveResult MustDerive(const Grammar& g, DeriveOptions opt = {}) {
