@@ -132,6 +132,33 @@ TEST(ViewFile, ACameraBelowThePlantSeesItWithoutTheGround) {
   std::filesystem::remove(Scratch() / "below.v");
 }
 
+TEST(ViewFile, ACpfgObjectIsDrawnWithoutTheDefaultGround) {
+  // cpfg draws no ground. lilac-congo's view (viewpoint 4,-5,30, parallel)
+  // on a plant with a branch hanging below its base: with Sylva's default
+  // ground the lower part of the picture was a grey plane (main at c6acb62:
+  // 11,389 light background pixels of 19,200; without the ground 18,570).
+  const std::string grammar =
+      WriteFile("noground.l", "axiom: &(30) F(10) [+(60) F(6)] [-(60) F(6)] ^(200) F(9)\n");
+  WriteFile("noground.v",
+            "initial line width: 0.3\nviewpoint: 4,-5,30\nview reference point: 0,0,0\n"
+            "projection: parallel\nscale factor: 0.95\n");
+  const std::string png = (Scratch() / "noground.png").string();
+  std::string err;
+  ASSERT_EQ(Render(grammar, png, "160x120", &err), 0) << err;
+  const Png p = Load(png);
+  ASSERT_GT(p.w, 0);
+  int background = 0;
+  for (int y = 0; y < p.h; ++y)
+    for (int x = 0; x < p.w; ++x) {
+      const unsigned char* c = p.At(x, y);
+      if (c[0] + c[1] + c[2] > 3 * 225) ++background;
+    }
+  const int all = p.w * p.h;
+  EXPECT_GT(background, all * 9 / 10) << "light background pixels of " << all;
+  EXPECT_LT(background, all * 99 / 100) << "the plant is drawn";
+  std::filesystem::remove(Scratch() / "noground.v");
+}
+
 TEST(ViewFile, RenderLooksFromTheViewpointUnlessCameraIsGiven) {
   // An L in the z = 0 plane: as wide as tall from +Z (cpfg's default
   // viewpoint), a vertical line from +X.
