@@ -1448,8 +1448,19 @@ void GrammarParser::Conditionals() {
   };
   std::vector<Open> stack;
   std::vector<Line> kept;
-  bool ended = false;
   kept.reserve(lines_.size());
+  // `lsystem:` lines still ahead: after `endlsystem`, #defines count only
+  // when another block follows (they are that block's, as vlab's Sedge
+  // #includes each sub-L-system's file, its #defines first); after the last
+  // block nothing is read (it is warned about).
+  int blocksAhead = 0;
+  for (const Line& l : lines_) {
+    size_t p = 0, kwAfter = 0;
+    while (p < l.text.size() && IsSpace(l.text[p])) ++p;
+    const char* kw = MatchKeyword(l.text, p, &kwAfter);
+    if (kw && std::string_view(kw) == "lsystem") ++blocksAhead;
+  }
+  bool ended = false;
   auto active = [&]() { return stack.empty() || stack.back().active; };
   // The directive word at the start of a line ("if", "ifdef", ...), or "".
   auto directive = [](const std::string& t, size_t* pos, size_t* after) {
@@ -1556,22 +1567,21 @@ void GrammarParser::Conditionals() {
       continue;
     }
     if (!active()) continue;
-    if (d == "define" && !ended) {
+    if (d == "define" && (!ended || blocksAhead > 0)) {
       ParseDefine(l, pos);
       continue;
     }
-    if (d == "undef" && !ended) {
+    if (d == "undef" && (!ended || blocksAhead > 0)) {
       ParseUndef(l, after);
       continue;
     }
     if (d.empty()) ExpandTextMacros(l);
-    // After `endlsystem` nothing is read (it is warned about): a second
-    // L-system's #defines are not this one's.
-    size_t kwAfter = 0;
-    if (d.empty()) {  // a later `lsystem:` block (sub-L-systems) is read again
-      const char* kw = MatchKeyword(l.text, pos, &kwAfter);
+    if (d.empty()) {
+      size_t p = 0, kwAfter = 0;
+      while (p < l.text.size() && IsSpace(l.text[p])) ++p;
+      const char* kw = MatchKeyword(l.text, p, &kwAfter);
       if (kw && std::string_view(kw) == "endlsystem") ended = true;
-      if (kw && std::string_view(kw) == "lsystem") ended = false;
+      if (kw && std::string_view(kw) == "lsystem") ended = false, --blocksAhead;
     }
     kept.push_back(std::move(l));
   }

@@ -44,6 +44,20 @@ TEST(SubLsystem, EachBlockRewritesOnlyItsOwnModules) {
   EXPECT_EQ(DeriveText(kTwoBlocks), "XF?(2,0.5)F[+B]B$F?(2,0.5)B$A");
 }
 
+TEST(SubLsystem, DefinesBetweenBlocksAreRead) {
+  // vlab's Sedge #includes each sub-L-system's file, its #defines first:
+  // they come after the main block's endlsystem. They were dropped with the
+  // rest of the file ("text after 'endlsystem' is ignored") and the
+  // derivation then failed on an unknown sub-L-system with no location.
+  const std::string text =
+      "lsystem: 1\nderivation length: 2\naxiom: A\nA --> ?(2,1)B$\nendlsystem\n"
+      "#define WIDTH .05\n#define LENGTH 2\n"
+      "lsystem: 2\nderivation length: 2\naxiom: B\nB --> f(WIDTH)F(LENGTH)\nendlsystem\n";
+  Grammar g = MustParse(text);
+  ASSERT_EQ(g.lsystems.size(), 2u);
+  EXPECT_EQ(DeriveText(text, 2), "?(2,1)f(0.05)F(2)$");
+}
+
 TEST(SubLsystem, QuestionModuleBelongsToTheOuterBlockAndDollarToTheInner) {
   // cpfg switches L-system after the `?(..)` module is rewritten and after
   // the `$` is: so `?` is rewritten by the enclosing block, `$` by the sub.
