@@ -15,7 +15,6 @@ constexpr Command kUndrawn[] = {
     {"@PD", "bicubic patch"},
     {"@Sx", "surface command"},
     {"@m", "move-to with drawing"},
-    {"@R", "set heading and up"},
     {"@D", "scale factor"},
     {"@i", "interpolation"},
     {"@L", "label"},
@@ -71,6 +70,22 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
              (u.most == 0 ? std::string("no parameters") : std::string(u.params)) + "; the other " +
              std::to_string(arity - u.most) + " are ignored";
     }
+    if (name == "@R") {
+      // blackbox.c 'R': 2 (z = 0), 3, or 6 with the up vector.
+      if (arity == 2 || arity == 3 || arity == 6) return std::nullopt;
+      if (arity < 2) {
+        return "'@R' (set the heading) needs 2 parameters (x, y), 3 (x, y, z) or 6 (the "
+               "heading and the up vector); with " +
+               Params(arity) + " it does nothing";
+      }
+      if (arity < 6) {
+        return "'@R' (set the heading) uses 3 parameters for the heading, or 6 with the up "
+               "vector; of its " +
+               Params(arity) + ", the last " + std::to_string(arity - 3) + " are ignored";
+      }
+      return "'@R' (set the heading and up vector) uses 6 parameters; the other " +
+             std::to_string(arity - 6) + " are ignored";
+    }
     if (name == "@M") {
       if (arity == 3) return std::nullopt;
       return "'@M' (move to) needs 3 parameters (x, y, z); with " + Params(arity) +
@@ -88,13 +103,17 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
     return "'_' (cpfg: set the tropism elasticity) uses 1 parameter; the other " +
            std::to_string(arity - 1) + " are ignored";
   }
-  if ((name == "{" || name == "}") && arity > 0) {
-    // cpfg interpret.c: `{(n)` and `}(n)` with n != 0 start and end a spline
-    // (its older generalized cylinder, general.c InitializeSpline).
-    return "'" + std::string(name) +
-           "' with a parameter: cpfg draws a polygon when it is 0 and otherwise a spline "
-           "generalized cylinder (the older form of @Gs ... @Ge), which Sylva does not "
-           "implement: with a parameter other than 0 it does nothing";
+  // cpfg interpret.c: `{(type, rings)` and `}(type)` with type != 0 start and
+  // end a spline (general.c InitializeSpline); the turtle draws them.
+  if (name == "{" && arity > 2) {
+    return "'{' (a polygon, or with a type other than 0 a spline) uses 2 parameters, the type "
+           "and the rings per piece; the other " +
+           std::to_string(arity - 2) + " are ignored";
+  }
+  if (name == "}" && arity > 1) {
+    return "'}' (the end of a polygon, or with a parameter other than 0 of a spline) uses 1 "
+           "parameter; the other " +
+           std::to_string(arity - 1) + " are ignored";
   }
   if (name == "$" && arity > 0) {
     // Some files write $(id, scale) for the start of a sub-L-system; cpfg's

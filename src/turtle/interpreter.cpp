@@ -14,6 +14,8 @@ namespace {
 
 constexpr int kDiscSides = 24;     // polygon vertices of a @o or @c disc
 constexpr int kCylinderRings = 8;  // segments per @Gc/@Ge piece without a parameter
+constexpr int kSplineRings = 4;    // segments per `{(n)` spline piece (cpfg's DEFAULT_RINGS)
+constexpr uint32_t kNoBranch = UINT32_MAX;
 
 enum class Op : uint8_t {
   kNone,
@@ -55,6 +57,9 @@ enum class Op : uint8_t {
   kGcRadius,     // @Gr
   kSubStart,     // ?(id, scale): a sub-L-system starts (grammars with sub-L-systems)
   kSubEnd,       // $ there: it ends
+  kSplineBegin,  // {(type[, rings]): a polygon when type is 0, else cpfg's spline
+  kSplineEnd,    // }(type): the same
+  kSetHeading,   // @R(hx, hy[, hz[, ux, uy, uz]])
 };
 
 Op OpFor(const std::string& name) {
@@ -124,6 +129,7 @@ Op OpFor(const std::string& name) {
   if (name == "@Ti") return Op::kTropismUp;
   if (name == "@Td") return Op::kTropismDown;
   if (name == "@Tf") return Op::kTwistForce;
+  if (name == "@R") return Op::kSetHeading;
   return Op::kNone;
 }
 
@@ -163,7 +169,12 @@ struct CpfgState {
   // pushes the turtle with its open cylinder); -1: none.
   int32_t branchFrom = -1;
   CylinderShape shape;
-  double scale = 1;  // sub-L-system scale (cpfg: scale_factor) of steps, widths, surfaces
+  double scale = 1;     // sub-L-system scale (cpfg: scale_factor) of steps, widths, surfaces
+  int32_t spline = -1;  // the open `{(n)` spline (an index into the splines), or -1
+  // The frame after the last F or G (or @Tf): @R without an up vector
+  // turns this up vector as it turns this heading (cpfg: prev_heading,
+  // prev_up; the "no twist" rule of adjust_up_and_left).
+  Vec3 prevHeading{0, 1, 0}, prevUp{0, 0, -1};
 };
 
 // A control point of a generalized cylinder: where the turtle was at @Gs,
@@ -180,6 +191,26 @@ struct ControlPoint {
 struct Cylinder {
   ControlPoint last;
   uint32_t branch = 0;
+};
+
+// cpfg's older generalized cylinder (vlab cpfg general.c, InitializeSpline,
+// SetControlPoint, FinishSpline): `{(type, rings)` opens it, and the
+// turtle's position after each F and f, and at each `.` outside a polygon,
+// is a control point; `}(type)` ends it. Types: 1 an open Hermite curve
+// (through the points, tangents along the headings, as @Gc), 2 the same
+// closed back to the first point, 3 an open uniform cubic B-spline (near the
+// points, not through them), 4 the same closed. Each piece between two
+// control points is cut into `rings` segments (cpfg's default 4).
+struct Spline {
+  bool closed = false, bspline = false;
+  int rings = kSplineRings;
+  uint32_t count = 0;           // control points so far
+  uint32_t branch = kNoBranch;  // the branch id of its segments, made at its first piece
+  uint32_t module = 0;          // the `{` that opened it
+  uint32_t depth = 0;           // the bracket depth that owns this copy (copied on write)
+  bool opened = true;           // opened by a `{` at that depth (not a branch's copy)
+  ControlPoint first[3];        // a closed spline's first points: they close it
+  ControlPoint last[3];         // the last 3 points (B-spline) or the last one (Hermite: last[2])
 };
 
 // X' = X cos a + Y sin a, Y' = Y cos a - X sin a: X turns toward Y.
@@ -327,6 +358,51 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
   return true;
 }
 
+// @R(hx, hy[, hz[, ux, uy, uz]]): cpfg's set heading (vlab cpfg
+// blackbox.c, 'R'). The heading becomes (hx, hy, hz) normalised (hz = 0
+// when not given; (0, 1, 0) when all are 0). With 6 parameters, a non-zero
+// up vector perpendicular to it (within 1e-9 of its length) becomes U,
+// normalised. Otherwise U follows cpfg's "no twist" rule
+// (adjust_up_and_left): the rotation that takes the heading after the last
+// F or G (or @Tf; the initial one before any) to the new heading turns the
+// up vector there; when they are parallel (|H0 x H| <= 1e-6) U stays. U is
+// then made exactly perpendicular to H, and L = H x U.
+[[gnu::noinline]] static void SetHeading(const double* p, uint32_t np, const Vec3& prevHeading,
+                                         const Vec3& prevUp, Frame& f) {
+  Vec3 h(p[0], p[1], np >= 3 ? p[2] : 0.0);
+  const double hn = h.norm();
+  h = hn == 0 ? Vec3(0, 1, 0) : Vec3(h / hn);  // NaN stays NaN: the range check names it
+  Vec3 up = f.up;
+  bool given = false;
+  if (np >= 6) {
+    const Vec3 u(p[3], p[4], p[5]);
+    const double un = u.norm();
+    if (un > 0 && std::abs(u.dot(h)) <= 1e-9 * un) {
+      up = u / un;
+      given = true;
+    }
+  }
+  if (!given) {
+    const Vec3 axis = prevHeading.cross(h);
+    const double sinA = axis.norm();
+    if (sinA > 1e-6) {
+      const double cosA = prevHeading.dot(h);
+      const Vec3 k = axis / sinA;
+      up = prevUp * cosA + k.cross(prevUp) * sinA + k * (k.dot(prevUp) * (1 - cosA));
+    }
+    up -= h * up.dot(h);
+    const double n = up.norm();
+    if (n > 1e-12) {
+      up /= n;
+    } else {  // U along H: any perpendicular
+      up = h.cross(std::abs(h.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitZ()).normalized();
+    }
+  }
+  f.heading = h;
+  f.up = up;
+  f.left = h.cross(up);
+}
+
 // @o and @c: a disc of diameter `diameter` centred at `centre` in the plane
 // of the unit vectors a and b, as a polygon of kDiscSides vertices running
 // from a toward b (its normal is a x b).
@@ -346,21 +422,20 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
   g.polygons.push_back(std::move(poly));
 }
 
-// One piece of a generalized cylinder (@Gc, @Ge), as cpfg draws it
-// (vlab cpfg, generalized cylinders, version 3400 on): the cubic Hermite
-// curve from control point a to b with tangents H_a |b - a| a.leaving and
-// H_b |b - a| b.arriving (@Gt), cut into `rings` segments of one branch. At
-// ring k the curve parameter t and the radius are the cubic Hermite curve
-// in the plane (t, radius) from (0, r_a) to (1, r_b) with tangents
-// a.radiusLeaving and b.radiusArriving (@Gr; a zero tangent is (1, r_b - r_a),
-// so without @Gr t = k / rings and the width runs linearly).
-[[gnu::noinline]] static void AddCylinderPiece(const ControlPoint& a, const ControlPoint& b,
-                                               int rings, double widthScale, uint32_t branch,
-                                               uint32_t parent, uint16_t depth, uint32_t module,
-                                               PlantGeometry& g) {
-  const double chord = (b.pos - a.pos).norm();
-  const Vec3 m0 = a.heading * (chord * a.shape.leaving);
-  const Vec3 m1 = b.heading * (chord * b.shape.arriving);
+// The segments of one piece of a generalized cylinder or spline from
+// control point a to b, along `curve` (curve(t), t in [0, 1], from `start`
+// to `end`), cut into `rings` segments of one branch, as cpfg draws it
+// (vlab cpfg general.c, interpolate_connection, version 3400 on). At ring k
+// the curve parameter t and the radius are the cubic Hermite curve in the
+// plane (t, radius) from (0, r_a) to (1, r_b) with tangents
+// a.shape.radiusLeaving and b.shape.radiusArriving (@Gr; a zero tangent is
+// (1, r_b - r_a), so without @Gr t = k / rings and the width runs
+// linearly). `chord` scales the radius tangents under @Gr(1).
+template <class Curve>
+static void AddPiece(const ControlPoint& a, const ControlPoint& b, const Vec3& start,
+                     const Vec3& end, double chord, int rings, const Curve& curve,
+                     double widthScale, uint32_t branch, uint32_t parent, uint16_t depth,
+                     uint32_t module, PlantGeometry& g) {
   // The (t, radius) curve; radii are half widths (cpfg's line_width / 2).
   const double r0 = 0.5 * a.width, dr = 0.5 * (b.width - a.width);
   Vec2 s0 = a.shape.radiusLeaving, s1 = b.shape.radiusArriving;
@@ -372,15 +447,12 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
   if (s1.x() == 0 && s1.y() == 0) s1 = Vec2(1, dr);
   const Vec2 c2(3 - 2 * s0.x() - s1.x(), 3 * dr - 2 * s0.y() - s1.y());
   const Vec2 c3(-2 + s0.x() + s1.x(), -2 * dr + s0.y() + s1.y());
-  Vec3 prev = a.pos;
+  Vec3 prev = start;
   double prevWidth = a.width;
   for (int k = 1; k <= rings; ++k) {
     const double r = double(k) / rings;
     const double t = ((c3.x() * r + c2.x()) * r + s0.x()) * r;
-    const double t2 = t * t, t3 = t2 * t;
-    const Vec3 p = k == rings ? b.pos
-                              : a.pos * (2 * t3 - 3 * t2 + 1) + m0 * (t3 - 2 * t2 + t) +
-                                    b.pos * (3 * t2 - 2 * t3) + m1 * (t3 - t2);
+    const Vec3 p = k == rings ? end : curve(t);
     const double w = k == rings ? b.width : 2 * (((c3.y() * r + c2.y()) * r + s0.y()) * r + r0);
     Segment sg;
     sg.start = prev;
@@ -399,6 +471,43 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
   }
 }
 
+// A Hermite piece (@Gc, @Ge, and `{(1)` and `{(2)` splines): the cubic
+// Hermite curve from control point a to b with tangents
+// H_a |b - a| a.leaving and H_b |b - a| b.arriving (@Gt).
+[[gnu::noinline]] static void AddCylinderPiece(const ControlPoint& a, const ControlPoint& b,
+                                               int rings, double widthScale, uint32_t branch,
+                                               uint32_t parent, uint16_t depth, uint32_t module,
+                                               PlantGeometry& g) {
+  const double chord = (b.pos - a.pos).norm();
+  const Vec3 m0 = a.heading * (chord * a.shape.leaving);
+  const Vec3 m1 = b.heading * (chord * b.shape.arriving);
+  auto hermite = [&](double t) {
+    const double t2 = t * t, t3 = t2 * t;
+    return Vec3(a.pos * (2 * t3 - 3 * t2 + 1) + m0 * (t3 - 2 * t2 + t) + b.pos * (3 * t2 - 2 * t3) +
+                m1 * (t3 - t2));
+  };
+  AddPiece(a, b, a.pos, b.pos, chord, rings, hermite, widthScale, branch, parent, depth, module, g);
+}
+
+// A uniform cubic B-spline piece (`{(3)` and `{(4)` splines) over the
+// control points q0 q1 q2 q3: from (q0 + 4 q1 + q2)/6 to (q1 + 4 q2 + q3)/6,
+// with the width, colour and @Gr settings of q1 at its start and q2 at its
+// end (cpfg general.c).
+[[gnu::noinline]] static void AddBSplinePiece(const ControlPoint& q0, const ControlPoint& q1,
+                                              const ControlPoint& q2, const ControlPoint& q3,
+                                              int rings, double widthScale, uint32_t branch,
+                                              uint32_t parent, uint16_t depth, uint32_t module,
+                                              PlantGeometry& g) {
+  const Vec3 c0 = (q0.pos + 4 * q1.pos + q2.pos) / 6;
+  const Vec3 c1 = (q2.pos - q0.pos) / 2;
+  const Vec3 c2 = (q0.pos - 2 * q1.pos + q2.pos) / 2;
+  const Vec3 c3 = (-q0.pos + 3 * q1.pos - 3 * q2.pos + q3.pos) / 6;
+  auto bspline = [&](double t) { return Vec3(((c3 * t + c2) * t + c1) * t + c0); };
+  const Vec3 end = (q1.pos + 4 * q2.pos + q3.pos) / 6;
+  AddPiece(q1, q2, c0, end, (end - c0).norm(), rings, bspline, widthScale, branch, parent, depth,
+           module, g);
+}
+
 // The rings of a @Gc(n) or @Ge(n) piece: n (at least 1), kCylinderRings
 // without a parameter. A double: the caller compares it with its limit
 // before converting.
@@ -406,6 +515,69 @@ static double CylinderRings(const double* p, uint32_t np) {
   if (!np) return kCylinderRings;
   if (!(p[0] >= 1)) return 1;  // NaN and below 1 (cpfg: at least 1)
   return std::floor(p[0]);
+}
+
+// The rings of a `{(type, rings)` spline or of a `.(rings)` piece in one:
+// cpfg truncates to an integer; 0 (or none) is `fallback`, below 1 a
+// straight segment. A double: the caller compares it with its limit before
+// converting.
+static double SplineRings(double v, double fallback) {
+  if (!(v == v)) return 1;  // NaN
+  const double r = std::trunc(v);
+  if (r == 0) return fallback;
+  return r < 1 ? 1 : r;
+}
+
+// An upper bound on the segments that `{(n)` splines draw: every F, f and
+// `.` while a spline is open in the turtle's branch draws at most a piece,
+// and a closing `}` at most 3.
+static double SplineSegmentBound(const lsys::Word& word, const std::vector<Op>& ops) {
+  struct Open {
+    bool open = false;
+    double rings = kSplineRings;
+  };
+  std::vector<Open> stack;
+  Open s;
+  double total = 0;
+  const bool hasParams = word.HasParams();
+  for (size_t i = 0; i < word.size(); ++i) {
+    const Op op = ops[word.symbols[i]];
+    const uint32_t np = hasParams ? word.paramStart[i + 1] - word.paramStart[i] : 0;
+    const double* p = np ? word.params.data() + word.paramStart[i] : nullptr;
+    switch (op) {
+      case Op::kPush:
+        stack.push_back(s);
+        break;
+      case Op::kPop:
+        if (!stack.empty()) {
+          s = stack.back();
+          stack.pop_back();
+        }
+        break;
+      case Op::kSplineBegin:
+        if (np && p[0] != 0) {
+          s.open = true;
+          s.rings = SplineRings(np >= 2 ? p[1] : 0, kSplineRings);
+        }
+        break;
+      case Op::kSplineEnd:
+        if (np && p[0] != 0 && s.open) {
+          total += 3 * s.rings;
+          s.open = false;
+        }
+        break;
+      case Op::kForwardDraw:
+      case Op::kForwardMove:
+        if (s.open) total += s.rings;
+        break;
+      case Op::kVertex:
+        if (s.open) total += np ? SplineRings(p[0], s.rings) : s.rings;
+        break;
+      default:
+        break;
+    }
+  }
+  return total;
 }
 
 // Every number the tessellator and the exporters will see must be finite
@@ -459,7 +631,7 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   std::vector<size_t> count(ops.size(), 0);
   for (size_t i = 0; i < word.size(); ++i) ++count[word.symbols[i]];
   size_t draws = 0, spheres = 0, surfaces = 0;
-  bool cylinders = false;
+  bool cylinders = false, splines = false;
   for (size_t sym = 0; sym < ops.size(); ++sym) {
     switch (ops[sym]) {
       case Op::kForwardDraw:
@@ -480,6 +652,9 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
       case Op::kGcEnd:
         cylinders |= count[sym] > 0;
         break;
+      case Op::kSplineBegin:
+        splines |= count[sym] > 0;
+        break;
       default:
         break;
     }
@@ -495,6 +670,7 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
           CylinderRings(hasParams ? word.params.data() + word.paramStart[i] : nullptr, np);
     }
   }
+  if (splines) cylinderRings += SplineSegmentBound(word, ops);
   if (cylinderRings > double(options.maxPrimitives))
     cylinderRings = double(options.maxPrimitives) + 1;
   draws += size_t(cylinderRings);
@@ -549,6 +725,12 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
       if (name == "$") ops[s] = Op::kSubEnd;
     }
   }
+  // cpfg's `{(n)` and `}(n)`: a polygon when n is 0, else a spline.
+  for (size_t s = 0; s < symbols.size(); ++s) {
+    if (symbols.arity(lsys::SymbolId(s)) < 1) continue;
+    if (ops[s] == Op::kPolygonBegin) ops[s] = Op::kSplineBegin;
+    if (ops[s] == Op::kPolygonEnd) ops[s] = Op::kSplineEnd;
+  }
 
   if (Status st = ClearAndReserve(word, ops, options, g); !st.ok()) return st;
   std::vector<uint32_t> branchParent{0};
@@ -561,6 +743,16 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   x.elasticity = def.susceptibility;
   std::vector<CpfgState> xstack;
   std::vector<double> subScales;  // the scale outside each open sub-L-system
+  std::vector<Spline> splines;    // `{(n)` splines, and their copies in branches
+  // What went wrong with splines, counted and reported once each: the first
+  // module and how many.
+  struct Problem {
+    uint32_t count = 0, module = 0;
+    void Add(size_t i) {
+      if (count++ == 0) module = uint32_t(i);
+    }
+  };
+  Problem badSplineType, strayEnd, fewPoints, neverEnded;
   t.color = uint16_t(std::clamp(def.initialColor, 0, 65535));
   const int colorStep = def.colorIncrement;
   SinCos sincos;
@@ -572,7 +764,8 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
     changesTropism |= op == Op::kTropismSet || op == Op::kTropismUp || op == Op::kTropismDown ||
                       op == Op::kElasticity;
     drawsCylinders |= op == Op::kGcStart || op == Op::kGcPoint || op == Op::kGcEnd ||
-                      op == Op::kGcTangent || op == Op::kGcRadius;
+                      op == Op::kGcTangent || op == Op::kGcRadius || op == Op::kSplineBegin ||
+                      op == Op::kSplineEnd || op == Op::kSetHeading || op == Op::kTwistForce;
   }
   const bool cpfgState = changesTropism || drawsCylinders || def.subLsystems;
   const bool tropism = def.susceptibility != 0 || changesTropism;
@@ -593,6 +786,49 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
     planar &= p.z() == 0;
   };
   uint32_t turnsSinceOrtho = 0;
+
+  // The open spline, owned by the current bracket depth: a branch that adds
+  // to its parent's spline works on its own copy (cpfg's PushSpline), so
+  // that `]` resumes the parent's where it was.
+  auto ownSpline = [&]() -> Spline& {
+    if (splines[size_t(x.spline)].depth != stack.size()) {
+      Spline copy = splines[size_t(x.spline)];
+      copy.depth = uint32_t(stack.size());
+      copy.branch = kNoBranch;
+      copy.opened = false;
+      x.spline = int32_t(splines.size());
+      splines.push_back(copy);
+    }
+    return splines[size_t(x.spline)];
+  };
+  // A control point of the open spline at the turtle, and the piece that
+  // ends there (`rings` segments; none before the spline has enough points,
+  // or between coincident ones).
+  auto splinePoint = [&](const ControlPoint& here, double rings, size_t i) {
+    Spline& sp = ownSpline();
+    if (sp.branch == kNoBranch) {
+      branchParent.push_back(t.branch);
+      sp.branch = uint32_t(branchParent.size() - 1);
+    }
+    const int ringCount = int(std::min(rings, 1e9));
+    const uint32_t need = sp.bspline ? 3 : 1;  // points before the first piece
+    if (sp.count >= need) {
+      if (!sp.bspline) {
+        if (here.pos != sp.last[2].pos)
+          AddCylinderPiece(sp.last[2], here, ringCount, def.widthScale, sp.branch, t.branch,
+                           t.depth, uint32_t(i), g);
+      } else if ((sp.last[0].pos + 4 * sp.last[1].pos + sp.last[2].pos) !=
+                 (sp.last[1].pos + 4 * sp.last[2].pos + here.pos)) {
+        AddBSplinePiece(sp.last[0], sp.last[1], sp.last[2], here, ringCount, def.widthScale,
+                        sp.branch, t.branch, t.depth, uint32_t(i), g);
+      }
+    }
+    if (sp.count < need) sp.first[sp.count] = here;
+    sp.last[0] = sp.last[1];
+    sp.last[1] = sp.last[2];
+    sp.last[2] = here;
+    ++sp.count;
+  };
 
   // The loop, compiled twice: words with cpfg's @T and @G commands keep a
   // second stack of state (CpfgState); every other word runs without it.
@@ -650,6 +886,18 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
             g.segments.push_back(sg);
           }
           if (tropism && ApplyTropism(tropismDir, x.elasticity, t.frame)) ++turnsSinceOrtho;
+          if constexpr (kCpfg) {
+            // cpfg: F and f add a control point to an open `{(n)` spline
+            // (G and g do not); F and G set the frame @R turns from.
+            if (x.spline >= 0 && (op == Op::kForwardDraw || op == Op::kForwardMove)) {
+              splinePoint({t.pos, t.frame.heading, t.frame.left, t.width, t.color, x.shape},
+                          splines[size_t(x.spline)].rings, i);
+            }
+            if (op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex) {
+              x.prevHeading = t.frame.heading;
+              x.prevUp = t.frame.up;
+            }
+          }
           break;
         }
         case Op::kTurnLeft:
@@ -712,6 +960,9 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           t = stack.back();
           stack.pop_back();
           if constexpr (kCpfg) {
+            if (x.spline >= 0 && splines[size_t(x.spline)].opened &&
+                splines[size_t(x.spline)].depth == stack.size() + 1)
+              neverEnded.Add(splines[size_t(x.spline)].module);
             x = xstack.back();
             xstack.pop_back();
           }
@@ -748,8 +999,29 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           t.color = uint16_t(np ? std::clamp(p[0], 0.0, 65535.0)
                                 : std::clamp(t.color - colorStep, 0, 65535));
           break;
+        case Op::kSplineBegin:
+          if constexpr (kCpfg) {
+            if (p[0] != 0) {
+              // {(type, rings): cpfg general.c InitializeSpline. A spline
+              // already open is dropped (what it drew stays).
+              const double type = std::trunc(p[0]);
+              if (!(type >= 1 && type <= 4)) {
+                badSplineType.Add(i);
+                break;
+              }
+              Spline sp;
+              sp.closed = int(type - 1) % 2 == 1;
+              sp.bspline = int(type - 1) / 2 == 1;
+              sp.rings = int(std::min(SplineRings(np >= 2 ? p[1] : 0, kSplineRings), 1e9));
+              sp.module = uint32_t(i);
+              sp.depth = uint32_t(stack.size());
+              x.spline = int32_t(splines.size());
+              splines.push_back(sp);
+              break;
+            }
+          }
+          [[fallthrough]];
         case Op::kPolygonBegin: {
-          if (np && p[0] != 0) break;  // cpfg: a spline cylinder, not drawn (warned)
           Polygon poly;
           poly.color = t.color;
           poly.module = uint32_t(i);
@@ -757,10 +1029,41 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           break;
         }
         case Op::kVertex:
-          if (!openPolygons.empty()) openPolygons.back().vertices.push_back(t.pos);
+          if (!openPolygons.empty()) {
+            openPolygons.back().vertices.push_back(t.pos);
+          } else if constexpr (kCpfg) {
+            // `.(n)` in a spline: a control point whose piece has n rings.
+            if (x.spline >= 0) {
+              const double rings = splines[size_t(x.spline)].rings;
+              splinePoint({t.pos, t.frame.heading, t.frame.left, t.width, t.color, x.shape},
+                          np ? SplineRings(p[0], rings) : rings, i);
+            }
+          }
           break;
+        case Op::kSplineEnd:
+          if constexpr (kCpfg) {
+            if (p[0] != 0) {
+              // }(type): cpfg general.c FinishSpline. A closed spline ends
+              // with its first point (Hermite) or first 3 (B-spline) again.
+              if (x.spline < 0) {
+                strayEnd.Add(i);
+                break;
+              }
+              Spline& sp = ownSpline();
+              const uint32_t least = sp.bspline ? (sp.closed ? 3 : 4) : 2;
+              if (sp.count < least) {
+                fewPoints.Add(sp.module);
+              } else if (sp.closed) {
+                const ControlPoint first[3] = {sp.first[0], sp.first[1], sp.first[2]};
+                for (uint32_t k = 0; k < (sp.bspline ? 3u : 1u); ++k)
+                  splinePoint(first[k], sp.rings, i);
+              }
+              x.spline = -1;
+              break;
+            }
+          }
+          [[fallthrough]];
         case Op::kPolygonEnd:
-          if (np && p[0] != 0) break;
           ClosePolygon(openPolygons, i, g);
           break;
         case Op::kSurface: {
@@ -869,6 +1172,16 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kTwistForce:
           // @Tf: cpfg records the frame so its next cylinder does not twist;
           // Sylva's tubes follow rotation-minimizing frames and never twist.
+          // The frame recorded is also the one @R turns from.
+          if constexpr (kCpfg) {
+            x.prevHeading = t.frame.heading;
+            x.prevUp = t.frame.up;
+          }
+          break;
+        case Op::kSetHeading:
+          if constexpr (kCpfg) {
+            if (np >= 2) SetHeading(p, np, x.prevHeading, x.prevUp, t.frame);
+          }
           break;
         case Op::kGcTangent:  // @Gt(a[, b]): blackbox.c, 't'
           if (np >= 1) {
@@ -927,6 +1240,24 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
     return {};
   };
   if (Status st = cpfgState ? run(std::true_type{}) : run(std::false_type{}); !st.ok()) return st;
+  if (x.spline >= 0) neverEnded.Add(splines[size_t(x.spline)].module);
+  auto report = [&](const Problem& pr, const std::string& what) {
+    if (pr.count == 0) return;
+    std::string text = "module " + std::to_string(pr.module + 1) + " (" +
+                       ModuleText(word, symbols, pr.module) + ")" + what;
+    if (pr.count > 1) text += " (and " + std::to_string(pr.count - 1) + " more like it)";
+    g.warnings.push_back(std::move(text));
+  };
+  report(badSplineType,
+         ": a spline's type is 1 to 4 (1 open and 2 closed Hermite curve, 3 open and 4 closed "
+         "B-spline); nothing is drawn for it");
+  report(strayEnd, ": ends no spline; ignored");
+  report(fewPoints,
+         " opens a spline with too few control points to draw (a Hermite curve needs 2, an open "
+         "B-spline 4, a closed one 3): nothing is drawn for it");
+  report(neverEnded,
+         " opens a spline that is never ended with '}(n)'; drawn up to its last control point "
+         "(a closed one is not closed)");
   if (x.cylinder >= 0) {
     g.warnings.push_back(
         "generalized cylinder (@Gs) is never ended with @Ge; drawn up to its last "

@@ -43,7 +43,17 @@
 //   @Ts(i, e) @Ti(i, d) @Td(i, d)  set, raise and lower the tropism
 //          susceptibility e (cpfg's elasticity) of the turtle (kept by [ ]);
 //          i must be 1
-//   @Tf    accepted, nothing to do: Sylva's tubes never twist
+//   @Tf    records the frame @R turns from; nothing else: Sylva's tubes
+//          never twist
+//   @R(hx, hy[, hz[, ux, uy, uz]])  set the heading (normalised), and U
+//          when given perpendicular to it; otherwise U is the up vector
+//          after the last F or G (or @Tf) turned as that heading turns to
+//          the new one (cpfg's no-twist rule); L = H x U
+//   {(t[, r]) ... }(t)  t != 0: cpfg's spline through the positions after
+//          each F and f (and each `.` outside a polygon): t = 1 Hermite
+//          (as @Gc), 2 Hermite closed, 3 uniform cubic B-spline, 4 the same
+//          closed; r segments a piece (default 4), `.(n)` n; a branch
+//          continues it on its own copy
 //   ?(id, s) ... $  in a grammar with sub-L-systems: the scale (TurtleDef::subLsystems)
 #pragma once
 

@@ -32,12 +32,33 @@ TEST(CpfgSymbols, UnderscoreIsReadSilentlyAndWarnsOnlyForExtraParameters) {
       << w[0];
 }
 
-TEST(CpfgSymbols, BracesWithAParameterWarnAsCpfgSplinesAtTheirFirstUse) {
-  auto w = Diagnostics("axiom: F {(1) F . F }(1) {(0) F }(0)\n");
+TEST(CpfgSymbols, BracesWithAParameterAreSplinesAndWarnOnlyForExtraParameters) {
+  // cpfg's `{(type, rings)` ... `}(type)` spline is drawn by the turtle.
+  for (const char* text : {"axiom: F {(1) F . F }(1) {(0) F }(0)\n", "axiom: {(3,8) F }(3)\n"}) {
+    auto none = Diagnostics(text);
+    EXPECT_TRUE(none.empty()) << text << Joined(none);
+  }
+  auto w = Diagnostics("axiom: F {(1,4,2) F }(1,2)\n");
   ASSERT_EQ(w.size(), 2u) << Joined(w);
-  EXPECT_EQ(w[0].rfind("1:10 '{' with a parameter: cpfg draws a polygon when it is 0", 0), 0u)
+  EXPECT_EQ(w[0].rfind("1:10 '{' (a polygon, or with a type other than 0 a spline) uses 2", 0), 0u)
       << w[0];
-  EXPECT_EQ(w[1].rfind("1:21 '}' with a parameter", 0), 0u) << w[1];
+  EXPECT_EQ(w[1].rfind("1:21 '}' (the end of a polygon", 0), 0u) << w[1];
+}
+
+TEST(CpfgSymbols, SetHeadingWarnsOnlyForArgumentCountsCpfgDoesNotRead) {
+  for (const char* text :
+       {"axiom: @R(0,0,1) F\n", "axiom: @R(1,0) F\n", "axiom: @R(1,0,0,0,1,0) F\n"}) {
+    auto none = Diagnostics(text);
+    EXPECT_TRUE(none.empty()) << text << Joined(none);
+  }
+  auto one = Diagnostics("axiom: F @R(1)\n");
+  ASSERT_EQ(one.size(), 1u) << Joined(one);
+  EXPECT_NE(one[0].find("needs 2 parameters (x, y), 3 (x, y, z) or 6"), std::string::npos)
+      << one[0];
+  EXPECT_NE(one[0].find("it does nothing"), std::string::npos) << one[0];
+  auto five = Diagnostics("axiom: F @R(1,0,0,0,1)\n");
+  ASSERT_EQ(five.size(), 1u) << Joined(five);
+  EXPECT_NE(five[0].find("the last 2 are ignored"), std::string::npos) << five[0];
 }
 
 TEST(CpfgDefines, RandomValueIsSubstitutedAsTextAndDrawnAnewAtEachUse) {

@@ -635,3 +635,196 @@ TEST(Turtle, DollarEndsASubLsystemWithoutRolling) {
 
 }  // namespace
 }  // namespace sylva::turtle
+
+namespace sylva::turtle {
+namespace {
+
+// cpfg's `{(type, rings)` ... `}(type)` splines (vlab cpfg general.c): the
+// turtle's position after each F and f is a control point.
+
+TEST(TurtleSpline, OpenHermiteCurvePassesThroughThePositionsAfterEachF) {
+  // Control points (0,1,0) heading +y, (-1,1,0) heading -x, (-1,0,0):
+  // the `{` itself is not one. F still draws its own segment (cpfg).
+  Drawn d = Draw("axiom: {(1) F +(90) F +(90) F }(1)\n");
+  const auto& s = d.geometry.segments;
+  ASSERT_EQ(s.size(), 3u + 2u * 4u);  // 3 F, 2 pieces of cpfg's default 4 rings
+  // Order: F, F, piece 1 (2..5), F, piece 2 (7..10).
+  EXPECT_VEC_NEAR(s[2].start, Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(s[5].end, Vec3(-1, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(s[10].end, Vec3(-1, 0, 0), 1e-12);
+  // At t = 1/2 the Hermite curve with tangents 1.2 H |p1 - p0| is
+  // (p0 + p1)/2 + 1.2 |p1 - p0| (H0 - H1)/8 = (-0.35, 1.15, 0).
+  EXPECT_VEC_NEAR(s[3].end, Vec3(-0.35, 1.15, 0), 1e-12);
+  EXPECT_EQ(s[2].branch, s[10].branch);
+  EXPECT_NE(s[2].branch, s[0].branch);  // one tube of its own
+  EXPECT_TRUE(d.geometry.warnings.empty()) << d.geometry.warnings[0];
+  // With f only the spline is all that is drawn, and it becomes a tube
+  // mesh within the turtle's bounds.
+  auto mesh =
+      testing::PlantFromText("axiom: {(1) f +(90) f +(90) f }(1)\n", -1, plant::Stage::kMesh);
+  ASSERT_TRUE(mesh.has_value());
+  EXPECT_EQ(mesh->geometry.segments.size(), 8u);
+  EXPECT_GT(mesh->mesh.triangleCount(), 8u * 3u) << mesh->mesh.triangleCount();
+  // Every vertex of the tube lies at its radius (0.5) from the curve.
+  double worst = 0;
+  for (const Vec3f& v : mesh->mesh.positions) {
+    double nearest = 1e9;
+    for (const Segment& sg : mesh->geometry.segments) {
+      const Vec3 d = sg.end - sg.start, q = v.cast<double>() - sg.start;
+      const double u = std::clamp(q.dot(d) / d.squaredNorm(), 0.0, 1.0);
+      nearest = std::min(nearest, (q - d * u).norm());
+    }
+    worst = std::max(worst, nearest);
+  }
+  EXPECT_LT(worst, 0.5 + 1e-4) << "farthest vertex from the curve";
+}
+
+TEST(TurtleSpline, ClosedHermiteCurveReturnsToItsFirstPoint) {
+  Drawn d = Draw("axiom: {(2) f +(90) f +(90) f +(90) f }(2)\n");
+  const auto& s = d.geometry.segments;
+  ASSERT_EQ(s.size(), 4u * 4u);  // 3 pieces, and the one that closes it
+  EXPECT_VEC_NEAR(s[0].start, Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(s[11].end, Vec3(0, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(s[15].end, Vec3(0, 1, 0), 1e-12);
+  // The closing piece leaves (0,0,0) with the heading of the last f, +x,
+  // and arrives at (0,1,0) with the first point's, +y: at t = 1/2 it is
+  // (0, 0.5, 0) + 1.2 (+x - +y)/8.
+  const double c = 1.2 / 8.0;
+  EXPECT_VEC_NEAR(s[13].end, Vec3(0 + c, 0.5 - c, 0), 1e-12);
+}
+
+TEST(TurtleSpline, BSplinesFollowTheUniformCubicBasis) {
+  // Q0 (0,1,0), Q1 (-1,1,0), Q2 (-1,0,0), Q3 (0,0,0): an open B-spline
+  // draws one piece, from (Q0 + 4 Q1 + Q2)/6 to (Q1 + 4 Q2 + Q3)/6, with
+  // (Q0 + 23 Q1 + 23 Q2 + Q3)/48 at t = 1/2.
+  Drawn d = Draw("axiom: {(3) f +(90) f +(90) f +(90) f }(3)\n");
+  const auto& s = d.geometry.segments;
+  ASSERT_EQ(s.size(), 4u);
+  EXPECT_VEC_NEAR(s[0].start, Vec3(-5.0 / 6, 5.0 / 6, 0), 1e-12);
+  EXPECT_VEC_NEAR(s[1].end, Vec3(-46.0 / 48, 24.0 / 48, 0), 1e-12);
+  EXPECT_VEC_NEAR(s[3].end, Vec3(-5.0 / 6, 1.0 / 6, 0), 1e-12);
+  // Closed (type 4): the 4 points make a loop of 4 pieces, symmetric about
+  // the square's centre, each from (Q[i-1] + 4 Q[i] + Q[i+1])/6.
+  Drawn c = Draw("axiom: {(4) f +(90) f +(90) f +(90) f }(4)\n");
+  const auto& r = c.geometry.segments;
+  ASSERT_EQ(r.size(), 16u);
+  EXPECT_VEC_NEAR(r[15].end, r[0].start, 1e-12);
+  EXPECT_VEC_NEAR(r[0].start, Vec3(-5.0 / 6, 5.0 / 6, 0), 1e-12);
+  EXPECT_VEC_NEAR(r[12].start, Vec3(-1.0 / 6, 5.0 / 6, 0), 1e-12);
+  for (const Segment& sg : r) {
+    const double d2 = (sg.end - Vec3(-0.5, 0.5, 0)).norm();
+    EXPECT_GT(d2, 0.45) << Str(sg.end);  // a rounded square inside the points
+    EXPECT_LT(d2, 0.5 * std::sqrt(2.0)) << Str(sg.end);
+  }
+}
+
+TEST(TurtleSpline, RingsOfTheSplineAndOfADot) {
+  // {(1, 2): 2 segments a piece; `.(6)` adds a control point whose piece
+  // has 6; G and g add none.
+  Drawn d = Draw("axiom: {(1,2) f f g .(6) f }(1)\n");
+  ASSERT_EQ(d.geometry.segments.size(), 2u + 6u + 2u);
+  EXPECT_VEC_NEAR(d.geometry.segments[1].end, Vec3(0, 2, 0), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.segments[7].end, Vec3(0, 3, 0), 1e-12);
+  EXPECT_VEC_NEAR(d.geometry.segments[9].end, Vec3(0, 4, 0), 1e-12);
+  // Widths and colours are the control points'.
+  Drawn w = Draw("axiom: !(2) ;(3) {(1) f !(4) f }(1)\n");
+  ASSERT_EQ(w.geometry.segments.size(), 4u);
+  EXPECT_NEAR(w.geometry.segments[0].radiusStart, 1.0, 1e-6);
+  EXPECT_NEAR(w.geometry.segments[3].radiusEnd, 2.0, 1e-6);
+  EXPECT_EQ(w.geometry.segments[0].color, 3);
+}
+
+TEST(TurtleSpline, ABranchContinuesItsParentsSplineOnItsOwnCopy) {
+  // cpfg's `[` pushes the open spline: the branch's first piece starts at
+  // the parent's last control point (0,1,0); `]` resumes the parent there.
+  Drawn d = Draw("axiom: {(1,1) f [-(90) f] f }(1)\n");
+  const auto& s = d.geometry.segments;
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_VEC_NEAR(s[0].start, Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(s[0].end, Vec3(1, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(s[1].start, Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(s[1].end, Vec3(0, 2, 0), 1e-12);
+  EXPECT_NE(s[0].branch, s[1].branch);
+  // `}(n)` inside a branch ends only the branch's spline.
+  Drawn e = Draw("axiom: {(1,1) f [f }(1) f] f }(1)\n");
+  EXPECT_EQ(e.geometry.segments.size(), 2u);
+  EXPECT_TRUE(e.geometry.warnings.empty()) << e.geometry.warnings[0];
+}
+
+TEST(TurtleSpline, BadTypesStrayEndsFewPointsAndOpenSplinesAreWarnings) {
+  auto warned = [](const std::string& axiom, const std::string& what) {
+    Drawn d = Draw("axiom: " + axiom + "\n");
+    for (const std::string& w : d.geometry.warnings)
+      if (w.find(what) != std::string::npos) return d.geometry.segments.size();
+    ADD_FAILURE() << axiom << ": no warning with '" << what << "'";
+    return size_t(1000);
+  };
+  EXPECT_EQ(warned("{(5) f f f f", "type is 1 to 4"), 0u);
+  EXPECT_EQ(warned("f }(1)", "ends no spline"), 0u);
+  EXPECT_EQ(warned("{(3) f f f }(3)", "too few control points"), 0u);
+  EXPECT_EQ(warned("{(1,1) f f f", "never ended"), 2u);
+  EXPECT_EQ(warned("[{(1,1) f f] f", "never ended"), 1u);
+  // {(0) and }(0) are a polygon.
+  Drawn p = Draw("axiom: {(0) f +(90) f +(90) f }(0)\n");
+  EXPECT_EQ(p.geometry.polygons.size(), 1u);
+  EXPECT_TRUE(p.geometry.segments.empty());
+}
+
+TEST(TurtleSpline, HugeRingCountsStopBeforeAllocating) {
+  plant::PlantSpec spec;
+  spec.path = "t.lsys";
+  spec.text = "axiom: {(1,1e300) f f }(1)\n";
+  spec.until = plant::Stage::kGeometry;
+  plant::PlantResult r = plant::BuildPlant(spec);
+  EXPECT_FALSE(r.plant.has_value());
+  EXPECT_NE(r.diagnostics.FormatAll().find("more than the limit"), std::string::npos)
+      << r.diagnostics.FormatAll();
+}
+
+// cpfg's @R (blackbox.c, 'R'): set the heading, and the up vector.
+
+TEST(TurtleSetHeading, HeadingIsNormalisedAndFMovesAlongIt) {
+  DrawOptions opt;
+  opt.recordModules = true;
+  Drawn d = Draw("axiom: @R(1,0,0) F @R(3,4) F @R(0,0,0) F\n", 0, opt);
+  const auto& pos = d.geometry.modulePosition;
+  ASSERT_EQ(pos.size(), 6u);
+  EXPECT_VEC_NEAR(pos[1], Vec3(1, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(pos[3], Vec3(1.6, 0.8, 0), 1e-12);  // (3, 4, 0) / 5
+  EXPECT_VEC_NEAR(pos[5], Vec3(1.6, 1.8, 0), 1e-12);  // all zero: (0, 1, 0)
+  for (const Frame& f : d.geometry.moduleFrame) {
+    EXPECT_NEAR(f.heading.norm(), 1, 1e-12);
+    EXPECT_NEAR(f.up.norm(), 1, 1e-12);
+    EXPECT_NEAR(f.heading.dot(f.up), 0, 1e-12);
+    EXPECT_VEC_NEAR(f.left, f.heading.cross(f.up), 1e-12);
+  }
+}
+
+TEST(TurtleSetHeading, UpFollowsTheNoTwistRuleFromTheLastF) {
+  // From the start frame (H +y, U -z) to H +z the rotation about x takes
+  // U to +y, and L = H x U = -x; the explicit up vector says the same.
+  const Frame a = FinalFrame("@R(0,0,1)");
+  EXPECT_VEC_NEAR(a.heading, Vec3(0, 0, 1), 1e-12);
+  EXPECT_VEC_NEAR(a.up, Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(a.left, Vec3(-1, 0, 0), 1e-12);
+  const Frame b = FinalFrame("@R(0,0,1,0,1,0)");
+  EXPECT_VEC_NEAR(b.up, Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(b.left, Vec3(-1, 0, 0), 1e-12);
+  // An up vector not perpendicular to the heading is not used.
+  const Frame c = FinalFrame("@R(0,0,1,0,1,1)");
+  EXPECT_VEC_NEAR(c.up, Vec3(0, 1, 0), 1e-12);
+  const Frame e = FinalFrame("@R(0,0,1,1,0,0)");
+  EXPECT_VEC_NEAR(e.up, Vec3(1, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(e.left, Vec3(0, 1, 0), 1e-12);
+  // The rule turns the frame after the last F, not the current one: a
+  // roll since then is undone...
+  const Frame r = FinalFrame("F /(90) @R(0,0,1)");
+  EXPECT_VEC_NEAR(r.up, Vec3(0, 1, 0), 1e-12);
+  // ...unless @Tf recorded it (U +x after the roll, kept by the turn about x).
+  const Frame t = FinalFrame("F /(90) @Tf @R(0,0,1)");
+  EXPECT_VEC_NEAR(t.up, Vec3(1, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(t.left, Vec3(0, 1, 0), 1e-12);
+}
+
+}  // namespace
+}  // namespace sylva::turtle
