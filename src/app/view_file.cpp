@@ -12,6 +12,7 @@
 #include "app/cpfg_specifications.h"
 #include "core/atomic_file.h"
 #include "lsys/deriver.h"
+#include "mesh/contour.h"
 
 namespace sylva::app {
 namespace {
@@ -58,10 +59,6 @@ constexpr Ignored kIgnored[] = {
     {"background color:", kNotActed},
     {"font:", kNotActed},
     {"winfont:", kNotActed},
-    {"polygonization level:", "the detail of tubes is --sides or --lod-eps"},
-    {"contour sides:", "the detail of tubes is --sides or --lod-eps"},
-    {"contour:", "generalized cylinder contours are circles in Sylva"},
-    {"twist of cylinders:", "Sylva's tubes follow rotation-minimizing frames"},
     {"blob:", kNotActed},
     {"torque:", "torque tropism is not implemented"},
     {"texture:", "textures are not implemented"},
@@ -142,6 +139,20 @@ class Reader {
     // cpfg's OpenGL renderer: the `light:` lines, else one directional
     // light toward `light direction:`.
     v_.lightToward = firstLight_ ? firstLight_ : lightDirection_;
+    v_.cylinderStyle = cylinder_;
+    if (contourLine_ && !cylinder_) {
+      current_ = contourText_;
+      v_.diagnostics.Add(At(contourLine_, contourColumn_, Severity::kWarning,
+                            "cpfg draws contours with its line style cylinder only ('line style: "
+                            "cylinder', or 'initial line width: W s'); this file's is not: its "
+                            "generalized cylinders are drawn round"));
+    } else if (sidesLine_ && !contourLine_) {
+      current_ = sidesText_;
+      v_.diagnostics.Add(At(sidesLine_, sidesColumn_, Severity::kWarning,
+                            "'" + sidesLabel_ +
+                                "' is read but not acted on: the file has no 'contour:' line, "
+                                "and round tubes take their detail from --sides or --lod-eps"));
+    }
   }
 
  private:
@@ -203,6 +214,7 @@ class Reader {
   void Tropism();
   void Surface();
   void Light();
+  void ContourLine();
 
   ViewFile& v_;
   std::string path_;
@@ -216,6 +228,11 @@ class Reader {
   bool tropismSeen_ = false;
   enum class LineStyle { kUnset, kPixel, kWorld };
   LineStyle lineStyle_ = LineStyle::kUnset;
+  bool cylinder_ = false;               // cpfg's line style cylinder
+  int contourLine_ = 0, contourColumn_ = 0;  // the first `contour:` line
+  int sidesLine_ = 0, sidesColumn_ = 0;      // `contour sides:`
+  std::string contourText_, sidesText_;      // those lines, for the excerpts
+  std::string sidesLabel_;                   // `contour sides:` or `polygonization level:`
   bool parallel_ = true;
   std::optional<Vec3> lightDirection_, firstLight_;
   int lights_ = 0;
@@ -300,6 +317,7 @@ void Reader::Read(const app::Line& line) {
         tokens_.size() > 1 && std::isalpha(static_cast<unsigned char>(tokens_[1].text[0]));
     const bool pixels = word && tokens_[1].text[0] == 'p' && tokens_[1].text.rfind("po", 0) != 0;
     lineStyle_ = pixels ? LineStyle::kPixel : LineStyle::kWorld;
+    cylinder_ = word && tokens_[1].text[0] == 's';
     ExtraValues(word ? 2 : 1);
   } else if (L == "line width increment:") {
     if (auto x = Number(0, "a width")) v_.widthIncrement = *x;
@@ -354,8 +372,10 @@ void Reader::Read(const app::Line& line) {
     const std::string w = tokens_.empty() ? "" : tokens_[0].text;
     if (w == "pixel" || w == "1") {
       lineStyle_ = LineStyle::kPixel;
+      cylinder_ = false;
     } else if (w == "polygon" || w == "cylinder" || w == "2" || w == "3") {
       lineStyle_ = LineStyle::kWorld;
+      cylinder_ = w == "cylinder" || w == "3";
     } else {
       // cpfg keeps the line style it had (interpret.c ReadViewData).
       Warn(tokens_.empty() ? int(current_.size()) + 1 : tokens_[0].column,
@@ -393,6 +413,50 @@ void Reader::Read(const app::Line& line) {
     Tropism();
   } else if (L == "surface:") {
     Surface();
+  } else if (L == "contour:") {
+    ContourLine();
+  } else if (L == "contour sides:" || L == "polygonization level:") {
+    // cpfg (ReadViewData): fewer than 3 is 3, with a message; the older
+    // `polygonization level: n` is 2^(n+1) sides.
+    std::optional<double> x = Number(0, L == "contour sides:" ? "a number of sides" : "a level");
+    if (x && L == "polygonization level:") {
+      if (*x != std::floor(*x) || *x < 0 || *x > 10) {
+        Error(tokens_[0].column, "expected a level from 0 to 10, not '" + tokens_[0].text + "'");
+        return;
+      }
+      x = std::pow(2.0, *x + 1);
+    }
+    if (x) {
+      if (*x != std::floor(*x)) {
+        Error(tokens_[0].column, "expected a whole number of sides, not '" + tokens_[0].text + "'");
+      } else if (*x < 3) {
+        Warn(tokens_[0].column, "a contour has at least 3 sides (cpfg uses 3)");
+        v_.contours.sides = 3;
+      } else if (*x > mesh::kMaxContourSides) {
+        Warn(tokens_[0].column, "more than " + std::to_string(mesh::kMaxContourSides) +
+                                    " contour sides: Sylva draws " +
+                                    std::to_string(mesh::kMaxContourSides));
+        v_.contours.sides = mesh::kMaxContourSides;
+      } else {
+        v_.contours.sides = int(*x);
+      }
+      sidesLine_ = line_;
+      sidesColumn_ = labelColumn_;
+      sidesText_ = current_;
+      sidesLabel_ = L;
+    }
+    ExtraValues(1);
+  } else if (L == "twist of cylinders:") {
+    // cpfg: `on...` turns the cross-sections with the turtle; anything else is off.
+    if (tokens_.empty()) {
+      Error(int(current_.size()) + 1, "expected 'on' or 'off'");
+    } else {
+      v_.contours.twist = tokens_[0].text.rfind("on", 0) == 0;
+      if (!v_.contours.twist && tokens_[0].text != "off")
+        Warn(tokens_[0].column, "'twist of cylinders:' is 'on' or 'off', not '" +
+                                    tokens_[0].text + "': off, as cpfg reads it");
+    }
+    ExtraValues(1);
   } else if (L == "function:" || L == "function set:") {
     // `function: FILE.func [samples]`: func(1, x) is the first such line.
     // cpfg tabulates the curve at `samples` points; Sylva evaluates it
@@ -611,6 +675,77 @@ void Reader::Surface() {
     }
   }
   v_.surfaces.push_back(std::move(def));
+}
+
+// `contour: n FILE.con` (cpfg's ReadViewData, store_contour): @#(n)
+// draws the generalized cylinders with the contour in FILE.con, beside the
+// view file. With checkFiles the file is read here: a missing one is a
+// warning (@#(n) draws round); a file named in another case than the
+// folder's (a model made on a case-insensitive file system) is found, with
+// a warning; one that cannot be read, or is malformed, an error.
+void Reader::ContourLine() {
+  if (tokens_.size() < 2) {
+    Error(int(current_.size()) + 1, "expected 'contour: ID FILE.con'");
+    return;
+  }
+  auto id = Number(0, "a contour id (the n of @#(n))");
+  if (!id) return;
+  if (*id != std::floor(*id) || std::abs(*id) > 1e9) {
+    Error(tokens_[0].column, "a contour id is a whole number, not '" + tokens_[0].text + "'");
+    return;
+  }
+  ExtraValues(2);
+  if (!contourLine_) {
+    contourLine_ = line_;
+    contourColumn_ = labelColumn_;
+    contourText_ = current_;
+  }
+  if (!checkFiles_) return;
+  const Token& name = tokens_[1];
+  fs::path file(name.text);
+  if (!file.is_absolute()) file = (fs::path(path_).parent_path() / file).lexically_normal();
+  std::error_code ec;
+  if (!fs::exists(file, ec)) {
+    // The same name in another case, if the folder has exactly one.
+    fs::path found;
+    int matches = 0;
+    auto lower = [](std::string s) {
+      for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+      return s;
+    };
+    const std::string want = lower(file.filename().string());
+    for (const auto& e : fs::directory_iterator(file.parent_path(), ec)) {
+      if (lower(e.path().filename().string()) == want) {
+        found = e.path();
+        ++matches;
+      }
+    }
+    if (matches != 1) {
+      Warn(name.column, "contour " + tokens_[0].text + " is not drawn: its file " +
+                            file.string() + " does not exist; @#(" + tokens_[0].text +
+                            ") draws round cylinders");
+      return;
+    }
+    Warn(name.column, "contour file " + file.string() + " does not exist; read " +
+                          found.string() +
+                          ", whose name differs in case (cpfg finds it only on a "
+                          "case-insensitive file system)");
+    file = found;
+  }
+  auto text = ReadFile(file.string(), mesh::kMaxContourFileBytes);
+  if (!text) {
+    Error(name.column, "contour file " + file.string() + " cannot be read: " +
+                           text.error().message);
+    return;
+  }
+  auto contour = mesh::ParseContour(*text, file.string(), &v_.diagnostics);
+  if (!contour) {
+    v_.diagnostics.Add(contour.error());
+    return;
+  }
+  if (v_.contours.byId.count(int(*id)))
+    Warn(tokens_[0].column, "contour " + tokens_[0].text + " is defined again: this line wins");
+  v_.contours.byId[int(*id)] = std::move(*contour);
 }
 
 Expected<std::string> ReadRegular(const std::string& path, size_t maxBytes) {
@@ -913,6 +1048,8 @@ void ApplyViewFile(const ViewFile& v, lsys::Grammar& g) {
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec) {
   if (!view) return;
   spec.draw.widthInPixels = view->widthInPixels;
+  if (view->cylinderStyle && !view->widthInPixels && !view->contours.byId.empty())
+    spec.draw.contours = std::make_shared<const turtle::CylinderContours>(view->contours);
   spec.cpfgSurfaces = view->surfaces;
   spec.cpfgFunctions = view->functions;
   spec.cpfgViewFile = view->path;

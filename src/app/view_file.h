@@ -34,6 +34,7 @@
 #include "lsys/parser.h"
 #include "plant/frames.h"
 #include "plant/plant.h"
+#include "turtle/interpreter.h"
 
 namespace sylva::app {
 
@@ -80,6 +81,13 @@ struct ViewFile {
   // `function: FILE.func [samples]` and `function set: FILE.fset`, in order
   // (func(1, x) the first).
   std::vector<lsys::ParseOptions::FunctionFile> functions;
+  // Generalized-cylinder contours for @#(n): `contour: n FILE.con` (the
+  // files read when the view file's files are checked; a missing one is a
+  // warning and @#(n) draws round), `contour sides: S`, `twist of
+  // cylinders: on|off`. cpfg draws them with its line style cylinder only
+  // (`line style: cylinder`, or `initial line width: W s...`).
+  turtle::CylinderContours contours;
+  bool cylinderStyle = false;
   DiagnosticList diagnostics;  // warnings, and errors that stop the build
 };
 
@@ -122,7 +130,8 @@ void ParseAnimationFile(const std::string& text, const std::string& path, ViewFi
 void ApplyViewFile(const ViewFile& view, lsys::Grammar& grammar);
 
 // Sets spec.cpfgSurfaces and spec.cpfgFunctions (the view's `surface:` and
-// `function:` lines) and
+// `function:` lines), spec.draw.contours (its contours, with line style
+// cylinder) and
 // spec.amendGrammar: the view applied and its diagnostics added to the
 // plant's (so --strict counts them).
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec);

@@ -20,8 +20,6 @@ constexpr Command kUndrawn[] = {
     {"@L", "label"},
     {"@b", "bounding box"},
     {"@Tx", "texture"},
-    {"@#", "generalized cylinder contour"},
-    {"@!", "number of sides of a cylinder's contour"},
     {"@;", "back-side colour"},
 };
 
@@ -57,6 +55,8 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
         {"@Ti", "raise tropism elasticity", "the tropism and the step", 2},
         {"@Td", "lower tropism elasticity", "the tropism and the step", 2},
         {"@Tf", "keep the twist", "none", 0},
+        {"@#", "generalized cylinder contour", "the contour's id", 1},
+        {"@!", "sides of a generalized cylinder's contour", "the number of sides", 1},
     };
     if (name == "@Gr" && arity == 3) {
       return std::string(

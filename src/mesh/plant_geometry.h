@@ -58,11 +58,28 @@ struct Sphere {
   uint32_t module = 0;
 };
 
+// A stretch of a generalized cylinder drawn with a cpfg contour (`@#(n)`,
+// mesh/contour.h): rings of `ringSize` points each, placed in the world by
+// the turtle, one ring after another. The tessellator joins point j of a
+// ring to points j and j + 1 of the next (two triangles a quad), the
+// normals smooth across the quads. `closed`: the last point of each ring
+// is its first (a closed contour; the seam's normals are shared).
+struct ContourTube {
+  std::vector<Vec3> points;  // rings * ringSize
+  uint32_t ringSize = 0;     // contour sides + 1
+  bool closed = false;
+  uint16_t color = 0;
+  uint32_t module = 0;  // the @Gc or @Ge that drew its first piece
+
+  size_t rings() const { return ringSize ? points.size() / ringSize : 0; }
+};
+
 struct PlantGeometry {
   std::vector<Segment> segments;
   std::vector<Polygon> polygons;
   std::vector<SurfaceInstance> surfaces;
   std::vector<Sphere> spheres;
+  std::vector<ContourTube> tubes;  // generalized cylinders with a contour
   uint32_t branchCount = 0;
   Vec3 boundsMin{0, 0, 0}, boundsMax{0, 0, 0};  // of every point drawn or visited
   bool planar = true;  // every point lies in the z = 0 plane (ABOP's 2D figures)

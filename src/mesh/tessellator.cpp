@@ -520,6 +520,57 @@ void TessellateSphere(const Sphere& s, int sides, TriangleMesh& out) {
   }
 }
 
+// Triangles of a contour tube: two a quad between consecutive rings.
+size_t TubeTriangleCount(const ContourTube& t) {
+  const size_t r = t.rings();
+  return r >= 2 && t.ringSize >= 2 ? 2 * (r - 1) * (size_t(t.ringSize) - 1) : 0;
+}
+
+// A contour tube (a generalized cylinder with a cpfg contour): its points
+// as they are, two triangles a quad, the normals the area-weighted sums of
+// the quads around each point (shared across the seam of a closed
+// contour). u runs 0..1 around, v 0..1 along.
+void EmitTube(const ContourTube& t, TriangleMesh& out) {
+  const size_t R = t.rings(), W = t.ringSize;
+  if (TubeTriangleCount(t) == 0) return;
+  const uint32_t base = uint32_t(out.positions.size());
+  std::vector<Vec3> normal(R * W, Vec3::Zero());
+  for (size_t i = 0; i + 1 < R; ++i) {
+    for (size_t j = 0; j + 1 < W; ++j) {
+      const size_t a = i * W + j, b = a + 1, d = a + W, c = d + 1;
+      const Vec3& pa = t.points[a];
+      const Vec3& pb = t.points[b];
+      const Vec3& pc = t.points[c];
+      const Vec3& pd = t.points[d];
+      const Vec3 n1 = (pb - pa).cross(pc - pa), n2 = (pc - pa).cross(pd - pa);
+      normal[a] += n1 + n2;
+      normal[b] += n1;
+      normal[c] += n1 + n2;
+      normal[d] += n2;
+      out.indices.insert(out.indices.end(), {base + uint32_t(a), base + uint32_t(b),
+                                             base + uint32_t(c), base + uint32_t(a),
+                                             base + uint32_t(c), base + uint32_t(d)});
+      out.material.push_back(t.color);
+      out.material.push_back(t.color);
+    }
+  }
+  if (t.closed) {
+    for (size_t i = 0; i < R; ++i) {
+      const Vec3 n = normal[i * W] + normal[i * W + W - 1];
+      normal[i * W] = normal[i * W + W - 1] = n;
+    }
+  }
+  for (size_t i = 0; i < R; ++i) {
+    for (size_t j = 0; j < W; ++j) {
+      const Vec3& n = normal[i * W + j];
+      const double len = n.norm();
+      out.positions.push_back(F(t.points[i * W + j]));
+      out.normals.push_back(len > 0 ? F(n / len) : Vec3f(0, 1, 0));
+      out.uvs.push_back(Vec2f(float(j) / float(W - 1), float(i) / float(R - 1)));
+    }
+  }
+}
+
 // Tessellate's stream path (MeshStream): spheres, polygons and surfaces
 // first (small; the totals must be known before the first piece), the
 // triangles per material from the plans, then the chains in pieces of
@@ -618,9 +669,9 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
   // the same boxes swept away from the light (their shadows).
   std::vector<uint8_t> inView, inShadow;
   const size_t nc = chains.size(), ns = g.spheres.size(), np = g.polygons.size(),
-               nf = g.surfaces.size();
+               nf = g.surfaces.size(), nt = g.tubes.size();
   if (view) {
-    std::vector<Box> boxes(nc + ns + np + nf);
+    std::vector<Box> boxes(nc + ns + np + nf + nt);
     ForRanges(options.pool, nc, BalancedGrain(options.pool, nc, 1024),
               [&](size_t begin, size_t end) {
                 for (size_t c = begin; c < end; ++c) {
@@ -648,6 +699,8 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
       for (const Vec3f& p : sm.positions) b.Add(SurfacePoint(si, p));
       b.Grow(1e-6 * (1 + si.position.norm()));  // the tessellation's rounding
     }
+    for (size_t i = 0; i < nt; ++i)
+      for (const Vec3& v : g.tubes[i].points) boxes[nc + ns + np + nf + i].Add(v);
     const Frustum frustum = Frustum::FromViewProjection(view->viewProjection);
     // Everything inside (a framed plant): no hierarchy needed.
     auto visibleIn = [&](const std::vector<Box>& b) {
@@ -776,6 +829,9 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     total +=
         points[np + i].coverage > 0 ? 2 : options.surfaces->at(g.surfaces[i].name).triangleCount();
   }
+  for (size_t i = 0; i < nt; ++i) {
+    if (shown(nc + ns + np + nf + i)) total += TubeTriangleCount(g.tubes[i]);
+  }
   const uint64_t limit = std::min<uint64_t>(options.maxTriangles, kMaxIndexedTriangles);
   if (out.triangleCount() + total > limit) {
     Diagnostic d;
@@ -807,7 +863,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
                 }
               });
   };
-  // Spheres, polygons and surfaces, appended to `dst`.
+  // Spheres, polygons, surfaces and contour tubes, appended to `dst`.
   auto emitRest = [&](TriangleMesh& dst) {
     for (size_t i = 0; i < ns; ++i) {
       if (sphereSides[i]) TessellateSphere(g.spheres[i], sphereSides[i], dst);
@@ -881,6 +937,9 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
       for (uint32_t i : s.indices) dst.indices.push_back(base + i);
       for (size_t t = 0; t < s.triangleCount(); ++t) dst.material.push_back(si.color);
     }
+    for (size_t i = 0; i < nt; ++i) {
+      if (shown(nc + ns + np + nf + i)) EmitTube(g.tubes[i], dst);
+    }
   };
   if (stats) {
     stats->chains += chains.size();
@@ -950,6 +1009,8 @@ Box TessellatedBounds(const PlantGeometry& g,
       box.Add(SurfacePoint(si, p));
     }
   }
+  for (const ContourTube& t : g.tubes)
+    for (const Vec3& v : t.points) box.Add(v);
   return box;
 }
 

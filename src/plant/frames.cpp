@@ -27,6 +27,7 @@ void Append(const mesh::PlantGeometry& frame, bool first, mesh::PlantGeometry& a
   all.polygons.insert(all.polygons.end(), frame.polygons.begin(), frame.polygons.end());
   all.surfaces.insert(all.surfaces.end(), frame.surfaces.begin(), frame.surfaces.end());
   all.spheres.insert(all.spheres.end(), frame.spheres.begin(), frame.spheres.end());
+  all.tubes.insert(all.tubes.end(), frame.tubes.begin(), frame.tubes.end());
   all.branchCount += std::max<uint32_t>(frame.branchCount, 1);
   if (first) {
     all.boundsMin = frame.boundsMin;
@@ -43,6 +44,7 @@ void Append(const mesh::PlantGeometry& frame, bool first, mesh::PlantGeometry& a
 size_t Primitives(const mesh::PlantGeometry& g) {
   size_t n = g.segments.size() + g.spheres.size() + g.surfaces.size();
   for (const mesh::Polygon& p : g.polygons) n += p.vertices.size();
+  for (const mesh::ContourTube& t : g.tubes) n += t.points.size();
   return n;
 }
 

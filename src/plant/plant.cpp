@@ -129,7 +129,7 @@ Expected<mesh::Box> MeshBounds(const Plant& plant, const PlantSpec& spec) {
 
 bool IsLineFigure(const mesh::PlantGeometry& geometry) {
   return geometry.planar && geometry.polygons.empty() && geometry.surfaces.empty() &&
-         geometry.spheres.empty();
+         geometry.spheres.empty() && geometry.tubes.empty();
 }
 
 Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics,

@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <map>
+#include <set>
 #include <type_traits>
 
 #include "core/assert.h"
@@ -55,6 +58,8 @@ enum class Op : uint8_t {
   kTwistForce,   // @Tf
   kGcTangent,    // @Gt
   kGcRadius,     // @Gr
+  kContour,      // @#: the cylinders' contour
+  kContourSides, // @!: the sides contours are drawn with
   kSubStart,     // ?(id, scale): a sub-L-system starts (grammars with sub-L-systems)
   kSubEnd,       // $ there: it ends
   kSplineBegin,  // {(type[, rings]): a polygon when type is 0, else cpfg's spline
@@ -130,6 +135,8 @@ Op OpFor(const std::string& name) {
   if (name == "@Td") return Op::kTropismDown;
   if (name == "@Tf") return Op::kTwistForce;
   if (name == "@R") return Op::kSetHeading;
+  if (name == "@#") return Op::kContour;
+  if (name == "@!") return Op::kContourSides;
   return Op::kNone;
 }
 
@@ -161,6 +168,9 @@ struct CylinderShape {
   bool scaleRadiusTangents = false;  // @Gr(k), k != 0: their radius parts times the chord
 };
 
+// The contour id of cpfg's default circle (no @#, or @# alone).
+constexpr int32_t kCircle = std::numeric_limits<int32_t>::min();
+
 struct CpfgState {
   double elasticity = 0;  // tropism susceptibility (cpfg: elasticity), @Ts @Ti @Td change it
   int32_t cylinder = -1;  // the open generalized cylinder (@Gs), or -1
@@ -175,6 +185,8 @@ struct CpfgState {
   // turns this up vector as it turns this heading (cpfg: prev_heading,
   // prev_up; the "no twist" rule of adjust_up_and_left).
   Vec3 prevHeading{0, 1, 0}, prevUp{0, 0, -1};
+  int32_t contour = kCircle;  // @#: the contour id, or kCircle
+  int32_t sides = 8;          // @!: the sides of contours
 };
 
 // A control point of a generalized cylinder: where the turtle was at @Gs,
@@ -184,13 +196,21 @@ struct ControlPoint {
   double width = 0;
   uint16_t color = 0;
   CylinderShape shape;  // the turtle's @Gt and @Gr settings there
+  // For contours: the up vector of the cross-section's frame (the turtle's,
+  // or carried from the previous point: CylinderContours), the contour and
+  // its sides.
+  Vec3 up{0, 0, -1};
+  int32_t contour = kCircle;
+  int32_t sides = 8;
 };
 
-// An open generalized cylinder: its last control point and the branch id
-// its tube segments carry.
+// An open generalized cylinder: its last control point, the branch id its
+// tube segments carry, and the contour tube its last piece went to (-1:
+// none), which the next piece continues.
 struct Cylinder {
   ControlPoint last;
   uint32_t branch = 0;
+  int32_t tube = -1;
 };
 
 // cpfg's older generalized cylinder (vlab cpfg general.c, InitializeSpline,
@@ -422,38 +442,59 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
   g.polygons.push_back(std::move(poly));
 }
 
-// The segments of one piece of a generalized cylinder or spline from
-// control point a to b, along `curve` (curve(t), t in [0, 1], from `start`
-// to `end`), cut into `rings` segments of one branch, as cpfg draws it
-// (vlab cpfg general.c, interpolate_connection, version 3400 on). At ring k
-// the curve parameter t and the radius are the cubic Hermite curve in the
-// plane (t, radius) from (0, r_a) to (1, r_b) with tangents
-// a.shape.radiusLeaving and b.shape.radiusArriving (@Gr; a zero tangent is
-// (1, r_b - r_a), so without @Gr t = k / rings and the width runs
-// linearly). `chord` scales the radius tangents under @Gr(1).
+// The radius profile of one piece of a generalized cylinder or spline from
+// control point a to b, as cpfg draws it (vlab cpfg general.c,
+// interpolate_connection, version 3400 on). At ring k of n the curve
+// parameter t and the radius are the cubic Hermite curve in the plane
+// (t, radius) from (0, r_a) to (1, r_b) with tangents a.shape.radiusLeaving
+// and b.shape.radiusArriving (@Gr; a zero tangent is (1, r_b - r_a), so
+// without @Gr t = k / n and the width runs linearly). `chord` scales the
+// radius tangents under @Gr(1).
+struct RadiusCurve {
+  RadiusCurve(const ControlPoint& a, const ControlPoint& b, double chord)
+      : r0(0.5 * a.width), dr(0.5 * (b.width - a.width)), endWidth(b.width) {
+    // Radii are half widths (cpfg's line_width / 2).
+    s0 = a.shape.radiusLeaving;
+    s1 = b.shape.radiusArriving;
+    if (b.shape.scaleRadiusTangents) {
+      s0.y() *= chord;
+      s1.y() *= chord;
+    }
+    if (s0.x() == 0 && s0.y() == 0) s0 = Vec2(1, dr);
+    if (s1.x() == 0 && s1.y() == 0) s1 = Vec2(1, dr);
+    c2 = Vec2(3 - 2 * s0.x() - s1.x(), 3 * dr - 2 * s0.y() - s1.y());
+    c3 = Vec2(-2 + s0.x() + s1.x(), -2 * dr + s0.y() + s1.y());
+  }
+  // Ring k of `rings`: the curve parameter and the width (ring `rings` is b).
+  void Ring(int k, int rings, double* t, double* width) const {
+    if (k == rings) {
+      *t = 1;
+      *width = endWidth;
+      return;
+    }
+    const double r = double(k) / rings;
+    *t = ((c3.x() * r + c2.x()) * r + s0.x()) * r;
+    *width = 2 * (((c3.y() * r + c2.y()) * r + s0.y()) * r + r0);
+  }
+  double r0, dr, endWidth;
+  Vec2 s0, s1, c2, c3;
+};
+
+// The segments of one piece from control point a to b, along `curve`
+// (curve(t), t in [0, 1], from `start` to `end`), cut into `rings` segments
+// of one branch, with the radii of RadiusCurve.
 template <class Curve>
 static void AddPiece(const ControlPoint& a, const ControlPoint& b, const Vec3& start,
                      const Vec3& end, double chord, int rings, const Curve& curve,
                      double widthScale, uint32_t branch, uint32_t parent, uint16_t depth,
                      uint32_t module, PlantGeometry& g) {
-  // The (t, radius) curve; radii are half widths (cpfg's line_width / 2).
-  const double r0 = 0.5 * a.width, dr = 0.5 * (b.width - a.width);
-  Vec2 s0 = a.shape.radiusLeaving, s1 = b.shape.radiusArriving;
-  if (b.shape.scaleRadiusTangents) {
-    s0.y() *= chord;
-    s1.y() *= chord;
-  }
-  if (s0.x() == 0 && s0.y() == 0) s0 = Vec2(1, dr);
-  if (s1.x() == 0 && s1.y() == 0) s1 = Vec2(1, dr);
-  const Vec2 c2(3 - 2 * s0.x() - s1.x(), 3 * dr - 2 * s0.y() - s1.y());
-  const Vec2 c3(-2 + s0.x() + s1.x(), -2 * dr + s0.y() + s1.y());
+  const RadiusCurve radius(a, b, chord);
   Vec3 prev = start;
   double prevWidth = a.width;
   for (int k = 1; k <= rings; ++k) {
-    const double r = double(k) / rings;
-    const double t = ((c3.x() * r + c2.x()) * r + s0.x()) * r;
+    double t, w;
+    radius.Ring(k, rings, &t, &w);
     const Vec3 p = k == rings ? end : curve(t);
-    const double w = k == rings ? b.width : 2 * (((c3.y() * r + c2.y()) * r + s0.y()) * r + r0);
     Segment sg;
     sg.start = prev;
     sg.end = p;
@@ -471,22 +512,40 @@ static void AddPiece(const ControlPoint& a, const ControlPoint& b, const Vec3& s
   }
 }
 
-// A Hermite piece (@Gc, @Ge, and `{(1)` and `{(2)` splines): the cubic
-// Hermite curve from control point a to b with tangents
-// H_a |b - a| a.leaving and H_b |b - a| b.arriving (@Gt).
+// The cubic Hermite curve of a piece (@Gc, @Ge, and `{(1)` and `{(2)`
+// splines) from control point a to b with tangents H_a |b - a| a.leaving and
+// H_b |b - a| b.arriving (@Gt), with its radius profile.
+struct PieceCurve {
+  PieceCurve(const ControlPoint& from, const ControlPoint& to)
+      : a(from), b(to), chord((b.pos - a.pos).norm()), radius(a, b, chord) {
+    m0 = a.heading * (chord * a.shape.leaving);
+    m1 = b.heading * (chord * b.shape.arriving);
+  }
+  void Ring(int k, int rings, double* t, double* width) const { radius.Ring(k, rings, t, width); }
+  Vec3 Point(double t) const {
+    const double t2 = t * t, t3 = t2 * t;
+    return a.pos * (2 * t3 - 3 * t2 + 1) + m0 * (t3 - 2 * t2 + t) + b.pos * (3 * t2 - 2 * t3) +
+           m1 * (t3 - t2);
+  }
+  Vec3 Tangent(double t) const {
+    const double t2 = t * t;
+    return (a.pos - b.pos) * (6 * t2 - 6 * t) + m0 * (3 * t2 - 4 * t + 1) + m1 * (3 * t2 - 2 * t);
+  }
+  const ControlPoint& a;
+  const ControlPoint& b;
+  double chord;
+  RadiusCurve radius;
+  Vec3 m0, m1;
+};
+
+// A Hermite piece as `rings` tube segments of one branch.
 [[gnu::noinline]] static void AddCylinderPiece(const ControlPoint& a, const ControlPoint& b,
                                                int rings, double widthScale, uint32_t branch,
                                                uint32_t parent, uint16_t depth, uint32_t module,
                                                PlantGeometry& g) {
-  const double chord = (b.pos - a.pos).norm();
-  const Vec3 m0 = a.heading * (chord * a.shape.leaving);
-  const Vec3 m1 = b.heading * (chord * b.shape.arriving);
-  auto hermite = [&](double t) {
-    const double t2 = t * t, t3 = t2 * t;
-    return Vec3(a.pos * (2 * t3 - 3 * t2 + 1) + m0 * (t3 - 2 * t2 + t) + b.pos * (3 * t2 - 2 * t3) +
-                m1 * (t3 - t2));
-  };
-  AddPiece(a, b, a.pos, b.pos, chord, rings, hermite, widthScale, branch, parent, depth, module, g);
+  const PieceCurve curve(a, b);
+  AddPiece(a, b, a.pos, b.pos, curve.chord, rings, [&](double t) { return curve.Point(t); },
+           widthScale, branch, parent, depth, module, g);
 }
 
 // A uniform cubic B-spline piece (`{(3)` and `{(4)` splines) over the
@@ -506,6 +565,106 @@ static void AddPiece(const ControlPoint& a, const ControlPoint& b, const Vec3& s
   const Vec3 end = (q1.pos + 4 * q2.pos + q3.pos) / 6;
   AddPiece(q1, q2, c0, end, (end - c0).norm(), rings, bspline, widthScale, branch, parent, depth,
            module, g);
+}
+
+// `v` turned by the rotation that takes the unit vector `from` to the unit
+// vector `to` about their common perpendicular (cpfg's adjust_up_and_leftS),
+// then made perpendicular to `to` and unit.
+static Vec3 Carry(const Vec3& v, const Vec3& from, const Vec3& to) {
+  const Vec3 axis = from.cross(to);
+  const double s = axis.norm(), c = from.dot(to);
+  Vec3 r = v;
+  if (s > 1e-12) {
+    const Vec3 k = axis / s;
+    r = v * c + k.cross(v) * s + k * (k.dot(v) * (1 - c));
+  }
+  r -= to * r.dot(to);
+  const double n = r.norm();
+  if (n > 1e-12) return r / n;
+  return mesh::Frame{}.up;  // degenerate (v along to): any perpendicular will not do better
+}
+
+// `v` (perpendicular to the unit axis k) turned about k by the angle whose
+// cosine and sine are c and s.
+static Vec3 Turn(const Vec3& v, const Vec3& k, double c, double s) {
+  return v * c + k.cross(v) * s;
+}
+
+// The piece as rings of the contours of a and b (each `ring` of ringSize
+// points, mesh::SampleContour), interpolated by the curve parameter, in the
+// frame carried along the curve (CylinderContours), appended to g.tubes:
+// to the tube `tube` when it ends where this piece starts, else to a new
+// one (`tube` is set to it). cpfg draws nothing for a piece shorter than
+// 1e-5.
+[[gnu::noinline]] static void AddContourPiece(const ControlPoint& a, const ControlPoint& b,
+                                              const std::vector<Vec3>& ringA,
+                                              const std::vector<Vec3>& ringB, bool closed,
+                                              int rings, double widthScale, bool twist,
+                                              uint32_t module, int32_t& tube, PlantGeometry& g) {
+  const PieceCurve curve(a, b);
+  if (!(curve.chord >= 1e-5)) return;
+  SYLVA_DCHECK(ringA.size() == ringB.size());
+  const size_t W = ringA.size();
+  // The angle from the up carried to b to b's own up, about b's heading.
+  double twistAngle = 0;
+  if (twist) {
+    const Vec3 carried = Carry(a.up, a.heading, b.heading);
+    twistAngle = std::atan2(b.heading.dot(carried.cross(b.up)), carried.dot(b.up));
+  }
+  std::vector<Vec3> points;
+  points.reserve(size_t(rings + 1) * W);
+  for (int k = 0; k <= rings; ++k) {
+    double t, w;
+    Vec3 p, h, up;
+    if (k == 0) {
+      t = 0;
+      w = a.width;
+      p = a.pos;
+      h = a.heading;
+      up = a.up;
+    } else if (k == rings) {
+      t = 1;
+      w = b.width;
+      p = b.pos;
+      h = b.heading;
+      up = b.up;
+    } else {
+      curve.Ring(k, rings, &t, &w);
+      p = curve.Point(t);
+      h = curve.Tangent(t);
+      const double n = h.norm();
+      h = n > 1e-12 ? Vec3(h / n) : a.heading;
+      up = Carry(a.up, a.heading, h);
+      if (twistAngle != 0) up = Turn(up, h, std::cos(twistAngle * t), std::sin(twistAngle * t));
+    }
+    const Vec3 left = h.cross(up);
+    const double r = 0.5 * w * widthScale;
+    const double along = r / curve.chord;
+    for (size_t j = 0; j < W; ++j) {
+      const Vec3 c = ringA[j] * (1 - t) + ringB[j] * t;
+      points.push_back(p + up * (r * c.x()) - left * (r * c.y()) + h * (along * c.z()));
+    }
+  }
+  if (tube >= 0) {
+    mesh::ContourTube& last = g.tubes[size_t(tube)];
+    bool joins = last.ringSize == W && last.color == a.color && last.closed == closed;
+    for (size_t j = 0; joins && j < W; ++j) {
+      const Vec3& q = last.points[last.points.size() - W + j];
+      joins = (q - points[j]).norm() <= 1e-9 * (1 + q.norm());
+    }
+    if (joins) {
+      last.points.insert(last.points.end(), points.begin() + std::ptrdiff_t(W), points.end());
+      return;
+    }
+  }
+  mesh::ContourTube t;
+  t.points = std::move(points);
+  t.ringSize = uint32_t(W);
+  t.closed = closed;
+  t.color = a.color;
+  t.module = module;
+  tube = int32_t(g.tubes.size());
+  g.tubes.push_back(std::move(t));
 }
 
 // The rings of a @Gc(n) or @Ge(n) piece: n (at least 1), kCylinderRings
@@ -612,6 +771,11 @@ static Status CheckRange(const PlantGeometry& g, const lsys::Word& word,
   for (const SurfaceInstance& si : g.surfaces) {
     if (!okPoint(si.position) || !okPoint(si.scale)) return fail(si.module, "a surface placement");
   }
+  for (const mesh::ContourTube& t : g.tubes) {
+    for (const Vec3& v : t.points) {
+      if (!okPoint(v)) return fail(t.module, "a contour point of a generalized cylinder");
+    }
+  }
   return {};
 }
 
@@ -624,6 +788,7 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   g.polygons.clear();
   g.surfaces.clear();
   g.spheres.clear();
+  g.tubes.clear();
   g.warnings.clear();
   g.modulePosition.clear();
   g.moduleFrame.clear();
@@ -741,6 +906,22 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   t.width = def.width;
   CpfgState x;
   x.elasticity = def.susceptibility;
+  // cpfg's contours (@#, @!): drawn only when the view file gives them.
+  const CylinderContours* contours = options.contours.get();
+  if (contours) x.sides = std::clamp(contours->sides, 3, mesh::kMaxContourSides);
+  // The rings of each (contour, sides) used, sampled once.
+  std::map<std::pair<int32_t, int32_t>, std::vector<Vec3>> contourRings;
+  auto ringOf = [&](int32_t id, int32_t sides) -> const std::vector<Vec3>& {
+    auto [it, fresh] = contourRings.try_emplace({id, sides});
+    if (fresh) {
+      it->second = id == kCircle ? mesh::CircleContour(sides)
+                                 : mesh::SampleContour(contours->byId.at(id), sides);
+    }
+    return it->second;
+  };
+  std::set<int32_t> warnedContours;
+  bool warnedSides = false;
+  uint64_t tubePoints = 0;
   std::vector<CpfgState> xstack;
   std::vector<double> subScales;  // the scale outside each open sub-L-system
   std::vector<Spline> splines;    // `{(n)` splines, and their copies in branches
@@ -765,7 +946,8 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
                       op == Op::kElasticity;
     drawsCylinders |= op == Op::kGcStart || op == Op::kGcPoint || op == Op::kGcEnd ||
                       op == Op::kGcTangent || op == Op::kGcRadius || op == Op::kSplineBegin ||
-                      op == Op::kSplineEnd || op == Op::kSetHeading || op == Op::kTwistForce;
+                      op == Op::kSplineEnd || op == Op::kSetHeading || op == Op::kTwistForce ||
+                      op == Op::kContour || op == Op::kContourSides;
   }
   const bool cpfgState = changesTropism || drawsCylinders || def.subLsystems;
   const bool tropism = def.susceptibility != 0 || changesTropism;
@@ -1119,7 +1301,10 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kGcStart:
         case Op::kGcPoint:
         case Op::kGcEnd: {
-          const ControlPoint here{t.pos, t.frame.heading, t.frame.left, t.width, t.color, x.shape};
+          ControlPoint here{t.pos, t.frame.heading, t.frame.left, t.width, t.color, x.shape};
+          here.up = t.frame.up;
+          here.contour = x.contour;
+          here.sides = x.sides;
           if (x.cylinder < 0 && x.branchFrom >= 0 && op != Op::kGcStart) {
             // The branch's first piece starts where its parent cylinder was.
             const ControlPoint from = cylinders[size_t(x.branchFrom)].last;
@@ -1140,8 +1325,36 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
             cyl.last = here;
             break;
           }
-          AddCylinderPiece(cyl.last, here, int(CylinderRings(p, np)), def.widthScale, cyl.branch,
-                           t.branch, t.depth, uint32_t(i), g);
+          const int rings = int(CylinderRings(p, np));
+          if (contours && !contours->twist) {
+            // cpfg without `twist of cylinders: on`: the cross-section's up
+            // is carried from the previous control point, not the turtle's.
+            here.up = Carry(cyl.last.up, cyl.last.heading, here.heading);
+          }
+          if (contours && (cyl.last.contour != kCircle || here.contour != kCircle)) {
+            const auto& ringA = ringOf(cyl.last.contour, cyl.last.sides);
+            const auto& ringB = ringOf(here.contour, cyl.last.sides);
+            const bool closed = (cyl.last.contour == kCircle ||
+                                 contours->byId.at(cyl.last.contour).closed) &&
+                                (here.contour == kCircle || contours->byId.at(here.contour).closed);
+            tubePoints += uint64_t(rings + 1) * ringA.size();
+            if (tubePoints > options.maxPrimitives) {
+              Diagnostic d;
+              d.kind = ErrorKind::kRuntime;
+              d.message = "the generalized cylinders with contours draw more than " +
+                          std::to_string(options.maxPrimitives) +
+                          " ring points (the limit of primitives); lower the derivation "
+                          "length (-n) or the contour sides, or raise --max-triangles";
+              g = PlantGeometry();
+              return d;
+            }
+            AddContourPiece(cyl.last, here, ringA, ringB, closed, rings, def.widthScale,
+                            contours->twist, uint32_t(i), cyl.tube, g);
+          } else {
+            AddCylinderPiece(cyl.last, here, rings, def.widthScale, cyl.branch, t.branch,
+                             t.depth, uint32_t(i), g);
+            cyl.tube = -1;
+          }
           cyl.last = here;
           if (op == Op::kGcEnd) x.cylinder = -1;
           break;
@@ -1202,6 +1415,47 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
             SinCosRadians(p[2] * kDegToRad, &sa, &ca);
             x.shape.radiusLeaving = Vec2(ca, sa) * p[3];
           }
+          break;
+        }
+        case Op::kContour: {  // @#(n): blackbox.c, '#'
+          if (!np) {
+            x.contour = kCircle;
+            break;
+          }
+          const double id = p[0];
+          const bool known = contours && id == std::floor(id) && std::abs(id) < 2e9 &&
+                             contours->byId.count(int(id));
+          x.contour = known ? int32_t(id) : kCircle;
+          const int32_t key = std::isfinite(id) ? int32_t(std::clamp(id, -2e9, 2e9)) : kCircle;
+          if (!known && warnedContours.insert(key).second) {
+            char text[32];
+            std::snprintf(text, sizeof text, "%g", id);
+            g.warnings.push_back(
+                "module " + std::to_string(i + 1) + " (" + ModuleText(word, symbols, i) +
+                ") selects contour " + std::string(text) + ", which " +
+                (contours ? "the view file does not define (no 'contour: " + std::string(text) +
+                                " FILE.con' line)"
+                          : std::string("is not in use (no view file gives contours with "
+                                        "'line style: cylinder')")) +
+                ": its generalized cylinders are drawn round, as cpfg does");
+          }
+          break;
+        }
+        case Op::kContourSides: {  // @!(s): blackbox.c, '!': at least 3, 8 without s
+          double sides = np ? p[0] : 8;
+          if (!(sides >= 3)) sides = 3;
+          if (sides > mesh::kMaxContourSides) {
+            sides = mesh::kMaxContourSides;
+            if (!warnedSides) {
+              warnedSides = true;
+              g.warnings.push_back("module " + std::to_string(i + 1) + " (" +
+                                   ModuleText(word, symbols, i) + ") asks for more than " +
+                                   std::to_string(mesh::kMaxContourSides) +
+                                   " contour sides: drawn with " +
+                                   std::to_string(mesh::kMaxContourSides));
+            }
+          }
+          x.sides = int32_t(sides);
           break;
         }
         case Op::kSubStart:  // ?(id, scale): cpfg's interpret.c UpdateCurrentLsystem
@@ -1270,6 +1524,9 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   if (Status s = CheckRange(g, word, symbols); !s.ok()) {
     g = PlantGeometry();
     return s;
+  }
+  for (const mesh::ContourTube& tube : g.tubes) {
+    for (const Vec3& v : tube.points) visit(v);
   }
   g.boundsMin = lo;
   g.boundsMax = hi;

@@ -54,14 +54,25 @@
 //          (as @Gc), 2 Hermite closed, 3 uniform cubic B-spline, 4 the same
 //          closed; r segments a piece (default 4), `.(n)` n; a branch
 //          continues it on its own copy
+//   @#(n)  the cross-section of the generalized cylinders that follow: cpfg's
+//          contour n (DrawOptions::contours); @# alone, or an n with no
+//          contour, the circle. Kept by [ ]. A piece between control points
+//          whose contours are not both circles is a ContourTube: rings of
+//          the contours interpolated by the curve parameter, point (x, y, z)
+//          of a ring of radius r at centre + r (x U - y L) + (r z / chord) H
+//          in the ring's frame (cpfg's make_contour)
+//   @!(s)  the sides those contours are drawn with (at least 3; @! alone, 8)
 //   ?(id, s) ... $  in a grammar with sub-L-systems: the scale (TurtleDef::subLsystems)
 #pragma once
 
+#include <map>
+#include <memory>
 #include <optional>
 
 #include "core/status.h"
 #include "lsys/grammar.h"
 #include "lsys/word.h"
+#include "mesh/contour.h"
 #include "mesh/plant_geometry.h"
 
 namespace sylva::turtle {
@@ -98,6 +109,24 @@ struct TurtleDef {
 
 TurtleDef TurtleDefFrom(const lsys::Grammar& g);
 
+// cpfg's generalized-cylinder cross-sections (mesh/contour.h), as a view
+// file with `line style: cylinder` gives them: its `contour: n FILE.con`
+// lines, `contour sides: S` and `twist of cylinders: on|off`.
+//
+// The frame a ring is drawn in (cpfg's generalized.c): at each control
+// point the turtle's H, and an up vector; between two points, the up of the
+// first carried to the ring's heading by the rotation that takes the one
+// heading to the other. With twist on, the up at a control point is the
+// turtle's and the rings between turn by the curve parameter times the angle
+// that takes the carried up to it; with twist off (cpfg's default), the up
+// at each control point is the one carried from the previous point, so the
+// turtle's rolls between control points do not turn the cross-section.
+struct CylinderContours {
+  std::map<int, mesh::Contour> byId;  // `contour: n FILE.con`
+  int sides = 8;                      // `contour sides:` (cpfg's default 8)
+  bool twist = false;                 // `twist of cylinders: on`
+};
+
 struct DrawOptions {
   bool recordModules = false;  // fill PlantGeometry::modulePosition / moduleFrame
   // The word may draw at most this many primitives (segments and polygon
@@ -107,6 +136,8 @@ struct DrawOptions {
   // The widths are pixels on screen (cpfg's line style `pixels`): copied
   // to PlantGeometry::widthInPixels.
   bool widthInPixels = false;
+  // cpfg's contours for @#(n) (null: none; every generalized cylinder round).
+  std::shared_ptr<const CylinderContours> contours;
 };
 
 // Coordinates, widths and scales the turtle may produce: beyond this, float

@@ -473,3 +473,73 @@ TEST(ViewFile, ASurfaceFileThatIsNotThereWarnsAndDrawsNothing) {
 
 }  // namespace
 }  // namespace sylva::app
+
+namespace sylva::app {
+namespace {
+
+TEST(ViewFile, ContourLinesReadTheirFilesForCylinderLineStyle) {
+  testing::WriteFile("ct_leaf.con", "5 3 open\n-1 0 0\n-1 0 0\n0 0.2 0\n1 0 0\n1 0 0\n");
+  testing::WriteFile("CT_Sepal.con",
+                     "cver 1 3\nname: s\npoints: 2 6\ntype: or\nsamples: 8\n"
+                     "-1 0 0 3\n1 0 0 3\n");
+  const std::string path = (testing::Scratch() / "ct.v").string();
+  ViewFile v = ParseViewFile(
+      "line style: cylinder\ncontour sides: 12\ntwist of cylinders: on\n"
+      "contour: 1 ct_leaf.con\ncontour: 2 ct_sepal.con\ncontour: 3 ct_gone.con\n",
+      path, /*checkFiles=*/true);
+  EXPECT_FALSE(v.diagnostics.HasErrors()) << Messages(v.diagnostics);
+  EXPECT_TRUE(v.cylinderStyle);
+  EXPECT_EQ(v.contours.sides, 12);
+  EXPECT_TRUE(v.contours.twist);
+  ASSERT_EQ(v.contours.byId.size(), 2u) << Messages(v.diagnostics);
+  EXPECT_EQ(v.contours.byId.at(1).points.size(), 5u);
+  EXPECT_EQ(v.contours.byId.at(2).points.size(), 6u);
+  // Found in another case, and missing: warnings at the file's name.
+  const std::string all = Messages(v.diagnostics);
+  ASSERT_EQ(v.diagnostics.items.size(), 2u) << all;
+  EXPECT_EQ(all.rfind("5:12 warning: contour file ", 0), 0u) << all;
+  EXPECT_NE(all.find("whose name differs in case"), std::string::npos) << all;
+  EXPECT_NE(all.find("6:12 warning: contour 3 is not drawn: its file"), std::string::npos) << all;
+  plant::PlantSpec spec;
+  AttachViewFile(std::make_shared<const ViewFile>(v), spec);
+  ASSERT_TRUE(spec.draw.contours != nullptr);
+  EXPECT_EQ(spec.draw.contours->byId.size(), 2u);
+}
+
+TEST(ViewFile, BadContourFileIsAnErrorAtItsOwnLine) {
+  testing::WriteFile("ct_bad.con", "4 3 open\n0 0 0\n1 zero 0\n");
+  const std::string path = (testing::Scratch() / "ctb.v").string();
+  ViewFile v = ParseViewFile("line style: cylinder\ncontour: 1 ct_bad.con\n", path, true);
+  ASSERT_EQ(v.diagnostics.ErrorCount(), 1u) << Messages(v.diagnostics);
+  const Diagnostic& d = v.diagnostics.items[0];
+  EXPECT_EQ(d.loc.file, (testing::Scratch() / "ct_bad.con").string());
+  EXPECT_EQ(d.loc.line, 3);
+  EXPECT_EQ(d.loc.column, 3);
+  EXPECT_NE(d.message.find("expected a number"), std::string::npos) << d.message;
+}
+
+TEST(ViewFile, ContoursWithoutCylinderLineStyleWarnAndAreNotUsed) {
+  testing::WriteFile("ct_p.con", "4 2 open\n-1 0\n-1 0\n1 0\n1 0\n");
+  const std::string path = (testing::Scratch() / "ctp.v").string();
+  ViewFile v =
+      ParseViewFile("initial line width: 2 pixels\ncontour: 1 ct_p.con\n", path, true);
+  ASSERT_EQ(v.diagnostics.items.size(), 1u) << Messages(v.diagnostics);
+  EXPECT_EQ(v.diagnostics.items[0].loc.line, 2);
+  EXPECT_NE(v.diagnostics.items[0].message.find("line style cylinder only"), std::string::npos)
+      << Messages(v.diagnostics);
+  plant::PlantSpec spec;
+  AttachViewFile(std::make_shared<const ViewFile>(v), spec);
+  EXPECT_TRUE(spec.draw.contours == nullptr);
+  // cpfg's older `polygonization level: n` is 2^(n+1) sides.
+  ViewFile level = ParseViewFile(
+      "line style: cylinder\npolygonization level: 3\ncontour: 1 x.con\n", "l.v");
+  EXPECT_TRUE(level.diagnostics.items.empty()) << Messages(level.diagnostics);
+  EXPECT_EQ(level.contours.sides, 16);
+  // `contour sides:` alone (no contour) is read but not acted on.
+  ViewFile s = ParseViewFile("contour sides: 16\n", "s.v");
+  ASSERT_EQ(s.diagnostics.items.size(), 1u) << Messages(s.diagnostics);
+  EXPECT_NE(s.diagnostics.items[0].message.find("no 'contour:' line"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sylva::app
