@@ -158,8 +158,32 @@ bool IsGlobalBlockKeyword(std::string_view k) {
   return k == "start" || k == "end" || k == "starteach" || k == "endeach";
 }
 
+// A production arrow (`->`, `-->`) in t from `from` on, outside
+// parentheses, statement blocks and strings.
+bool HasTopLevelArrow(const std::string& t, size_t from) {
+  int depth = 0;
+  for (size_t i = from; i < t.size(); ++i) {
+    const char c = t[i];
+    if (c == '"') {
+      for (++i; i < t.size() && t[i] != '"'; ++i)
+        if (t[i] == '\\') ++i;
+    } else if (c == '(' || c == '{') {
+      ++depth;
+    } else if (c == ')' || c == '}') {
+      --depth;
+    } else if (depth == 0 && c == '-' && i + 1 < t.size() && t[i + 1] == '>') {
+      return true;
+    }
+  }
+  return false;
+}
+
 // The keyword that starts `t` at `pos` ("keyword:", or a bare section
 // keyword alone on its line), case-insensitive; *after is just past it.
+// A line with a production arrow after the colon is a production whose
+// predecessor is spelled like a keyword (vlab's Lilac: `AXIOM : A_SW == 1
+// --> ...`, the modules A X I O M): no statement holds an arrow, and cpfg's
+// lexer reads `axiom:` only as `axiom` or `Axiom` with the colon right after.
 const char* MatchKeyword(const std::string& t, size_t pos, size_t* after) {
   const std::string lower = Lower(t.substr(pos, 20));
   for (const char* k : kKeywords) {
@@ -171,6 +195,7 @@ const char* MatchKeyword(const std::string& t, size_t pos, size_t* after) {
     const bool bare = kv == "endlsystem" || kv == "decomposition" || kv == "interpretation" ||
                       kv == "homomorphism";
     if (q < t.size() && t[q] == ':') {
+      if (HasTopLevelArrow(t, q + 1)) return nullptr;
       *after = q + 1;
       return k;
     }

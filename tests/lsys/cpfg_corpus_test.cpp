@@ -1,0 +1,53 @@
+// Constructs of the last failing files of the cpfg corpora (issue 18):
+// each test names the vlab object it comes from.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "lsys/parser.h"
+#include "lsys_test_util.h"
+
+namespace sylva::lsys {
+namespace {
+
+using testing::DiagnosticLines;
+using testing::Joined;
+
+std::vector<std::string> Diagnostics(const std::string& text) {
+  return DiagnosticLines(ParseGrammarText(text, "c.l"));
+}
+
+TEST(CpfgKeywords, KeywordSpelledPredecessorWithAnArrowIsAProduction) {
+  // vlab's Lilac: the axiom is the five modules A X I O M, rewritten by a
+  // decomposition production whose predecessor reads like `axiom:`.
+  const std::string text =
+      "#define A_SW 1\n"
+      "Lsystem: 1\n"
+      "derivation length: 1\n"
+      "Axiom: AXIOM\n"
+      "decomposition\n"
+      "maximum depth: 10\n"
+      "AXIOM : A_SW == 1 --> F(2)\n"
+      "AXIOM : A_SW == 2 --> G\n"
+      "endlsystem\n";
+  ParseResult r = ParseGrammarText(text, "c.l");
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  EXPECT_EQ(r.grammar->decomposition.productions.size(), 2u) << r.diagnostics.FormatAll();
+  EXPECT_EQ(testing::DeriveText(text, 1), "F(2)");
+}
+
+TEST(CpfgKeywords, StatementsWithBlanksBeforeTheColonOrArrowsInStringsStayStatements) {
+  const std::string text =
+      "Start: {printf(\"a -> b\\n\");}\n"
+      "axiom : A\n"
+      "derivation length : 2\n"
+      "A --> AB\n";
+  EXPECT_EQ(testing::DeriveText(text), "ABB");
+  auto d = Diagnostics(text);
+  ASSERT_EQ(d.size(), 1u) << Joined(d);
+  EXPECT_NE(d[0].find("prints nothing"), std::string::npos) << d[0];
+}
+
+}  // namespace
+}  // namespace sylva::lsys
