@@ -29,6 +29,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/define_sliders.h"
 #include "app/plant_view.h"
 #include "app/view_file.h"
 #include "app/viewer_window.h"
@@ -281,18 +282,11 @@ struct Shown {
   std::vector<std::pair<std::string, double>> constants;
   // Each #define's slider range, fixed: set from the file's value (not from
   // a value the slider set, or the range would follow the slider away).
-  std::map<std::string, std::pair<float, float>> ranges;
+  std::map<std::string, SliderRange> ranges;
   int derivationLength = 0;
   bool playing = false;  // stepping the derivation 0, 1, 2 ... by itself
   Clock::time_point lastPlayed;
 };
-
-// The slider range of a #define whose file value is v.
-std::pair<float, float> RangeFor(double v) {
-  if (v > 0) return {0.0f, float(2 * v)};
-  if (v < 0) return {float(2 * v), 0.0f};
-  return {-1.0f, 1.0f};
-}
 
 // What the panel asked for beyond a new job.
 struct PanelActions {
@@ -348,7 +342,7 @@ PanelActions DrawPanel(const std::string& path, Shown& shown, bool busy, double 
       ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
     for (const auto& [name, value] : shown.constants) {
       float v = float(job.overrides.count(name) ? job.overrides[name] : value);
-      const auto range = shown.ranges.count(name) ? shown.ranges[name] : RangeFor(value);
+      const auto range = shown.ranges.count(name) ? shown.ranges[name] : SliderRangeFor(value);
       if (ImGui::SliderFloat(name.c_str(), &v, range.first, range.second)) {
         job.overrides[name] = v;
         changed = true;
@@ -569,9 +563,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     if (auto& r = taken) {
       if (r->ok) {
         shown.constants = r->constants;
-        for (const auto& [name, value] : r->constants)
-          if (!r->overridden.count(name) || !shown.ranges.count(name))
-            shown.ranges[name] = RangeFor(value);
+        UpdateSliderRanges(r->constants, r->overridden, shown.ranges);
         shown.derivationLength = r->derivationLength;
         shown.id = r->id;
         const PlantLook wasLook = look;
