@@ -7,7 +7,8 @@
 #  2. a 2D figure of cpfg's `5 pixels` line width is drawn 5 pixels wide
 #     (it was a one-pixel line);
 #  3. a .l without a view file: cpfg's default view, parallel from +Z, as
-#     render draws it.
+#     render draws it;
+#  4. a 2D figure: the same lines on white, framed tightly.
 # Usage: viewer_cpfg_test.sh SYLVA_BINARY SOURCE_DIR WORK_DIR
 set -euo pipefail
 sylva="$1"; src="$2"; work="$3"
@@ -45,6 +46,11 @@ cp "$work/plant.l" "$work/bare.l"
 "$sylva" render "$work/bare.l" -o "$work/bare-render.png" --size 960x540
 "$sylva" view "$work/bare.l" --screenshot "$work/bare-view.png" --frames 5 --size 960x540
 
+# 4. A 2D figure (ABOP's Koch island): lines on white, framed tightly.
+cp "$src/grammars/abop/fig1_06_koch_island.lsys" "$work/koch.lsys"
+"$sylva" render "$work/koch.lsys" -o "$work/koch-render.png" --size 960x540
+"$sylva" view "$work/koch.lsys" --screenshot "$work/koch-view.png" --frames 5 --size 960x540
+
 python3 - "$work" "$src/tests/app" <<'PY'
 import sys; sys.dont_write_bytecode = True; sys.path.insert(0, sys.argv[2]); import png_rows as png
 work = sys.argv[1]
@@ -69,6 +75,14 @@ def compare(name):
 
 compare('plant')
 compare('bare')
+compare('koch')
+# Framed tightly: the island spans at least 90 % of the height (the margin
+# is 8 %), in render's picture and the viewer's alike.
+for name in ('koch-render', 'koch-view'):
+    w, h, rows = png.read(f'{work}/{name}.png')
+    ys = [y for y in range(h) if any(sum(rows[y][4 * x:4 * x + 3]) < 3 * 200 for x in range(PANEL, w))]
+    print(f'{name}: the figure spans rows {ys[0]} to {ys[-1]} of {h}')
+    assert ys[-1] - ys[0] + 1 >= 0.9 * h, f'{name}: the 2D figure is not framed tightly'
 
 # The pixel-wide line: the middle row crosses 4 to 6 dark pixels in both.
 for name in ('px-render', 'px-view'):

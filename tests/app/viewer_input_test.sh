@@ -10,7 +10,9 @@
 #  - a drag off the panel orbits;
 #  - an edit of the view file reloads the plant (wider branches);
 #  - a 2D figure's `5 pixels` line stays 5 pixels wide after zooming in
-#    (re-tessellated for the view).
+#    (re-tessellated for the view);
+#  - the panel's reset, step and play buttons show the axiom, step 1 and
+#    (by themselves) the last step.
 # Usage: viewer_input_test.sh SYLVA_BINARY SOURCE_DIR WORK_DIR
 set -euo pipefail
 sylva="$(realpath "$1")"; src="$(realpath "$2")"; work="$3"
@@ -113,6 +115,34 @@ start "$work/px.l"
 line="$shot"
 lineZoomed=$(X move 700 300 scroll 3 sleep 1.5 && shoot)
 kill "$viewer"; wait "$viewer" 2>/dev/null || true; viewer=""
+
+# play, step and reset (the panel's buttons, clicked): a binary tree of 6
+# steps drawn as lines.
+printf 'derivation length: 6\nangle: 30\naxiom: A\nA --> F(1)[+A][-A]\n' >"$work/grow.lsys"
+mkdir -p "$work/grow"
+dir="$work/grow"
+start "$work/grow.lsys"
+grown="$shot"
+click() { X move "$1" "$2" sleep 0.3 down 1 sleep 0.3 up 1 sleep 0.3 move 700 300 sleep 1; }
+click 127 87  # reset: the axiom
+reset=$(shoot)
+click 80 87  # step: step 1
+stepped=$(shoot)
+click 35 87  # play: steps 2 to 6 by themselves, at most 4 a second
+sleep 3
+played=$(shoot)
+kill "$viewer"; wait "$viewer" 2>/dev/null || true; viewer=""
+python3 - "$src/tests/app" "$grown" "$reset" "$stepped" "$played" <<'PY'
+import sys; sys.dont_write_bytecode = True; sys.path.insert(0, sys.argv[1]); import png_rows as png
+def dark(path):
+    w, h, rows = png.read(path)
+    return sum(1 for y in range(h) for x in range(360, w) if sum(rows[y][4 * x:4 * x + 3]) < 3 * 200)
+grown, reset, stepped, played = (dark(p) for p in sys.argv[2:])
+print(f'line pixels: step 6 {grown}, reset {reset}, step {stepped}, play {played}')
+assert reset == 0, 'reset should show the axiom A, which draws nothing'
+assert 0 < stepped < grown / 4, 'step should show step 1: one segment'
+assert abs(played - grown) <= grown * 0.02, 'play should run to the last step'
+PY
 
 python3 - "$src/tests/app" "$first" "$zoomed" "$panel" "$framed" "$orbited" "$reloaded" \
   "$line" "$lineZoomed" <<'PY'
