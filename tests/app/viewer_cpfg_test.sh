@@ -3,7 +3,8 @@
 # under Xvfb (app/plant_view.h is shared by both):
 #  1. a .l with a view file (`projection: parallel`, a viewpoint, a light
 #     direction): the viewer's first frame covers the pixels render's
-#     picture covers (masks compared right of the panel);
+#     picture covers (masks compared right of the panel), in the same
+#     colours (the same lights);
 #  2. a 2D figure of cpfg's `5 pixels` line width is drawn 5 pixels wide
 #     (it was a one-pixel line);
 #  3. a .l without a view file: cpfg's default view, parallel from +Z, as
@@ -72,6 +73,14 @@ def compare(name):
           f'{differ} differ ({100.0 * differ / max(union, 1):.2f} % of {union})')
     assert len(a) > 2000, f'{name}: render drew too little to compare ({len(a)} pixels)'
     assert differ <= 0.05 * union, f'{name}: the viewer does not start from render\'s view'
+    # The same lights: the colours of the pixels both cover agree (the
+    # viewer's smaller shadow map moves a few shadow edges).
+    _, _, view = png.read(f'{work}/{name}-view.png')
+    both = a & b
+    mean = sum(max(abs(rows[y][4 * x + c] - view[y][4 * x + c]) for c in range(3))
+               for x, y in both) / max(len(both), 1)
+    print(f'{name}: mean colour difference {mean:.3f} of 255 over {len(both)} pixels')
+    assert mean < 1.0, f'{name}: the viewer lights the plant otherwise than render'
 
 compare('plant')
 compare('bare')
