@@ -6,7 +6,7 @@
 #     picture covers (masks compared right of the panel), in the same
 #     colours (the same lights);
 #  2. a 2D figure of cpfg's `5 pixels` line width is drawn 5 pixels wide
-#     (it was a one-pixel line);
+#     (it was a one-pixel line), also with the view file given by --view;
 #  3. a .l without a view file: cpfg's default view, parallel from +Z, as
 #     render draws it;
 #  4. a 2D figure: the same lines on white, framed tightly.
@@ -41,6 +41,15 @@ printf 'axiom: F(10)\n' >"$work/px.l"
 printf 'initial line width: 5 pixels\n' >"$work/px.v"
 "$sylva" render "$work/px.l" -o "$work/px-render.png" --size 960x540
 "$sylva" view "$work/px.l" --screenshot "$work/px-view.png" --frames 5 --size 960x540
+# --view names the view file of a grammar without NAME.v beside it.
+printf 'axiom: F(10)\n' >"$work/lone.l"
+"$sylva" view "$work/lone.l" --view "$work/px.v" --screenshot "$work/px-flag.png" --frames 5 \
+  --size 960x540
+if "$sylva" view "$src/examples/scenes/flag.xml" --view "$work/px.v" --screenshot "$work/s.png" \
+  --frames 2 2>"$work/scene.err"; then
+  echo "view SCENE --view should be exit 2"; exit 1
+fi
+grep -q "is for grammars" "$work/scene.err"
 
 # 3. No view file: cpfg's default view (parallel, from +Z) of a 3D plant.
 cp "$work/plant.l" "$work/bare.l"
@@ -94,7 +103,7 @@ for name in ('koch-render', 'koch-view'):
     assert ys[-1] - ys[0] + 1 >= 0.9 * h, f'{name}: the 2D figure is not framed tightly'
 
 # The pixel-wide line: the middle row crosses 4 to 6 dark pixels in both.
-for name in ('px-render', 'px-view'):
+for name in ('px-render', 'px-view', 'px-flag'):
     w, h, rows = png.read(f'{work}/{name}.png')
     row = rows[h // 2]
     dark = sum(1 for x in range(PANEL, w) if sum(row[4 * x:4 * x + 3]) < 3 * 200)
