@@ -198,6 +198,9 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   vi->add_option("-n,--steps", view.steps, "grammars: the derivation step to start at")
       ->check(CLI::Range(0, lsys::kMaxDerivationLengthForDerive));
   vi->add_option("--seed", view.seed, "grammars: the seed to start with");
+  vi->add_option("--view", view.view,
+                 "grammars: cpfg view file (.v): angle, widths, colours, view direction, "
+                 "projection, lights (default: NAME.v beside the grammar, if any)");
 
   DeriveFlags check;
   CLI::App* c = app.add_subcommand(

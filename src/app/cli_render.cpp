@@ -9,6 +9,7 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/plant_view.h"
 #include "mesh/export.h"
 #include "plant/frames.h"
 #include "render/camera.h"
@@ -63,70 +64,6 @@ int ParseView(const std::string& size, const std::string& camera, ViewFlags& v, 
   return kExitOk;
 }
 
-// A cpfg view file's view direction, unless --camera gives one.
-void UseViewFileDirection(const ViewFile* view, ViewFlags& v) {
-  if (!view || v.explicitCamera) return;
-  if (auto dir = ViewDirection(*view)) {
-    v.explicitCamera = true;
-    v.cam[0] = (*dir)[0];
-    v.cam[1] = (*dir)[1];
-    v.cam[2] = 0;  // framed
-  }
-}
-
-// A cpfg file (`.l`) without a view file is viewed as cpfg views it by
-// default (interpret.c, InitializeParameters): from viewpoint 0,0,1 toward
-// the origin, in parallel projection. Unless --camera says otherwise.
-bool UseCpfgDefaultView(const std::string& grammar, const ViewFile* view, ViewFlags& v) {
-  if (std::filesystem::path(grammar).extension() != ".l") return false;
-  if (view && !view->path.empty()) return false;
-  if (v.explicitCamera) return false;
-  v.explicitCamera = true;
-  v.cam[0] = v.cam[1] = v.cam[2] = 0;
-  return true;
-}
-
-// cpfg's `scale factor:` zooms the framed view; its `viewing angle:` is
-// the perspective's field of view (the camera moves back or forward so the
-// framed box keeps its size: the distance times tan(35/2) / tan(a/2)).
-void UseViewFileScale(const ViewFile* view, render::Camera& camera) {
-  if (view && view->viewingAngle && !camera.orthographic) {
-    const double a = *view->viewingAngle;
-    camera.distance *= std::tan(camera.fovY * kDegToRad / 2) / std::tan(a * kDegToRad / 2);
-    camera.fovY = a;
-  }
-  if (!view || !view->scale) return;
-  if (camera.orthographic)
-    camera.orthoHeight /= *view->scale;  // the eye stays outside the plant
-  else
-    camera.distance /= *view->scale;
-}
-
-// The camera that frames the plant, or the one --camera gives. The box
-// comes from the geometry, before tessellation, so every detail (uniform
-// or screen-space) sees one view. Orthographic for 2D figures (`lines`)
-// and when a cpfg view file asks for a parallel projection.
-Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSpec& spec,
-                                     const ViewFlags& v, bool lines, bool orthographic,
-                                     mesh::Box* meshBox = nullptr) {
-  Vec3 lo = p.geometry.boundsMin, hi = p.geometry.boundsMax;
-  if (!lines) {
-    auto box = plant::MeshBounds(p, spec);
-    if (!box) return box.error();
-    if (meshBox) *meshBox = *box;
-    if ((box->lo.array() <= box->hi.array()).all()) {
-      lo = box->lo;
-      hi = box->hi;
-    }
-  }
-  const double aspect = double(v.width) / v.height;
-  render::Camera camera =
-      render::Camera::Frame(lo, hi, aspect, v.explicitCamera ? v.cam[0] : (lines ? 0 : 30),
-                            v.explicitCamera ? v.cam[1] : (lines ? 0 : 12), orthographic);
-  if (v.explicitCamera && v.cam[2] > 0) camera.distance = v.cam[2];
-  return camera;
-}
-
 // Box filter of K x K pixel blocks, averaged in linear light (sRGB decoded
 // and encoded again), alpha linearly.
 render::Image Downsample(const render::Image& big, int k) {
@@ -160,15 +97,6 @@ render::Image Downsample(const render::Image& big, int k) {
     }
   }
   return out;
-}
-
-// Whether a geometry's widths are pixels and some are wider than the one
-// pixel of a line.
-bool WiderThanAPixel(const mesh::PlantGeometry& g) {
-  if (!g.widthInPixels) return false;
-  for (const mesh::Segment& s : g.segments)
-    if (std::max(s.radiusStart, s.radiusEnd) > 0.5f + 1e-4f) return true;
-  return false;
 }
 
 }  // namespace
@@ -223,8 +151,6 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   std::shared_ptr<const ViewFile> viewFile;
   auto spec = SpecFrom(cmd.derive, err, &exit, &viewFile);
   if (!spec) return exit;
-  UseViewFileDirection(viewFile.get(), v);
-  const bool cpfgDefaultView = UseCpfgDefaultView(cmd.derive.file, viewFile.get(), v);
   if (cmd.sides) spec->detail.sides = *cmd.sides;
   spec->until = plant::Stage::kGeometry;
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
@@ -238,63 +164,39 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     if (!frames) return Report(frames.error(), err);
     plant->geometry = std::move(*frames);
   }
-  const mesh::PlantGeometry* geometry = &plant->geometry;
-  const mesh::Palette& palette = plant->palette;
-  // 2D figures (all in the z = 0 plane, nothing but segments) draw as lines
-  // in an orthographic view from +Z; everything else as a lit mesh. A 2D
-  // figure whose widths are pixels (a cpfg view file's line style) draws
-  // (some wider than one) as ribbons of those widths, on white like the lines.
-  const bool figure = plant::IsLineFigure(*geometry);
-  const bool ribbons = figure && WiderThanAPixel(*geometry);
-  const bool lines = figure && !ribbons;
-  const bool parallel = figure || cpfgDefaultView || (viewFile && viewFile->parallel);
-  render::LineBatch batch;
-  mesh::Box bounds;
-  auto camera = FrameCamera(*plant, *spec, v, figure, parallel, &bounds);
-  if (!camera) return Report(camera.error(), err);
-  if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
+  // The look, projection, direction, framing and lights the viewer starts
+  // from too (app/plant_view.h).
+  const PlantView view = ChoosePlantView(cmd.derive.file, viewFile.get(), &plant->geometry,
+                                         v.explicitCamera ? v.cam : nullptr);
+  const bool lines = view.look == PlantLook::kLines;
+  const bool ribbons = view.look == PlantLook::kRibbons;
+  auto bounds = FramedBox(view, *plant, *spec);
+  if (!bounds) return Report(bounds.error(), err);
+  const render::Camera camera = FramePlant(view, *bounds, double(v.width) / v.height);
   const int W = v.width * K, H = v.height * K;
-  float widestPixels = 0;  // the widest pixel width, in rendered pixels
   if (plant->geometry.widthInPixels) {
     // Pixel widths are output pixels: K of the K-times larger image.
     for (mesh::Segment& s : plant->geometry.segments) {
       s.radiusStart *= float(K);
       s.radiusEnd *= float(K);
-      widestPixels = std::max({widestPixels, 2 * s.radiusStart, 2 * s.radiusEnd});
     }
   }
-  // The key light (the shadow caster): toward cpfg's light when the view
-  // file gives one.
-  const Vec3 keyToward =
-      viewFile && viewFile->lightToward ? *viewFile->lightToward : render::KeyLightDirection();
+  draw::Lines figure;
   if (lines) {
-    draw::Lines figure = LinesOf(*plant);
-    batch.points = std::move(figure.points);
-    batch.colors = std::move(figure.colors);
+    figure = LinesOf(*plant);
   } else {
     // Screen-space detail unless --sides asks for uniform tubes; eps is in
     // output pixels, so K times as many in the K-times larger image.
-    if (!cmd.sides || geometry->widthInPixels) {
-      // Pixel widths need the view even at uniform detail (mesh/pixel_widths.h).
-      spec->view = ViewOf(*camera, W, H, lodEps * K);
-      // Shadows of what lies outside the view may fall inside it.
-      if (!ribbons) {
-        spec->view->shadowFrom = keyToward;
-        spec->view->shadowPlaneY = bounds.lo.y();
-        spec->view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(bounds);
-      }
-      // Twigs under a pixel fade as coverage lines (the renderer blends them).
-      spec->view->coverage = true;
-      // A 2D figure's pixel-wide lines are flat ribbons, never tubes
-      // (ribbons are drawn under 3 eps of radius).
-      if (ribbons) spec->view->eps = std::max(spec->view->eps, 0.2 * widestPixels);
-    }
+    // Pixel widths need the view even at uniform detail (mesh/pixel_widths.h).
+    if (!cmd.sides || plant->geometry.widthInPixels)
+      spec->view = ScreenViewFor(view, camera, W, H, lodEps * K, *bounds, 1.0, plant->geometry);
     DiagnosticList warnings;
     Status s = plant::Tessellate(*plant, *spec, warnings);
     exit = Report(warnings, err, cmd.derive.maxErrors, cmd.derive.strict);
     if (!s.ok()) return Report(s.error(), err);
     if (exit != kExitOk) return exit;
   }
+  const size_t lineCount = figure.points.size() / 2;
   const auto m = std::make_shared<const mesh::TriangleMesh>(std::move(plant->mesh));
 
   auto t0 = Clock::now();
@@ -305,35 +207,11 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (Status s = (*renderer)->Resize(W, H); !s.ok()) return Report(s.error(), err);
   const double contextMs = MsSince(t0);
   t0 = Clock::now();
-  draw::DrawList list;
-  if (lines) {
-    (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
-    if (Status s = (*renderer)->SetLines(batch); !s.ok()) return Report(s.error(), err);
-  } else if (ribbons) {
-    (*renderer)->SetBackground(mesh::Vec3f(1, 1, 1));
-    (*renderer)->SetShadows(false);
-    (*renderer)->SetMesh(*m, palette);
-    (*renderer)->SetWireframe(cmd.wireframe);
-  } else {
-    // The default scene: the plant on a ground plane, lit by the default
-    // rig; the shadow map fitted to the whole plant, whatever was culled.
-    // No ground when the camera looks from below it (it would hide
-    // everything), nor for a cpfg object (a view file, or a `.l` drawn from
-    // cpfg's default view): cpfg draws none, and a ground would hide what
-    // hangs below the base and fight with a base polygon drawn at it.
-    const bool cpfgObject = viewFile || cpfgDefaultView;
-    list = scene::DefaultScene(m, palette, bounds.lo, bounds.hi,
-                               !cpfgObject && scene::SeesGroundFromAbove(camera->Eye(), bounds.lo));
-    if (viewFile && viewFile->lightToward) list.lights[0].direction = -keyToward.cast<float>();
-    list.wireframe = cmd.wireframe;
-  }
+  draw::DrawList list = PlantScene(view, m, plant->palette, std::move(figure), *bounds, camera);
+  list.wireframe = cmd.wireframe;
   const double uploadMs = MsSince(t0);
   t0 = Clock::now();
-  if (lines || ribbons) {
-    (*renderer)->Draw(*camera);
-  } else if (Status s = (*renderer)->Draw(list, *camera); !s.ok()) {
-    return Report(s.error(), err);
-  }
+  if (Status s = (*renderer)->Draw(list, camera); !s.ok()) return Report(s.error(), err);
   render::Image image = (*renderer)->ReadPixels();
   const double drawMs = MsSince(t0);
   t0 = Clock::now();
@@ -347,8 +225,8 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
                 cmd.output.c_str(), v.width, v.height,
                 lines     ? "lines, orthographic"
                 : ribbons ? "pixel-wide ribbons, orthographic"
-                          : (parallel ? "mesh, orthographic" : "mesh, perspective"),
-                m->triangleCount(), batch.points.size() / 2, (*context)->Renderer().c_str());
+                          : (view.orthographic ? "mesh, orthographic" : "mesh, perspective"),
+                m->triangleCount(), lineCount, (*context)->Renderer().c_str());
   err << line;
   if (cmd.stats) {
     const plant::Timings& t = plant->time;
@@ -393,17 +271,16 @@ int RunMeshForView(const MeshCommand& cmd, std::ostream& out, std::ostream& err)
   std::shared_ptr<const ViewFile> viewFile;
   auto spec = SpecFrom(cmd.derive, err, &exit, &viewFile);
   if (!spec) return exit;
-  UseViewFileDirection(viewFile.get(), v);
-  const bool cpfgDefaultView = UseCpfgDefaultView(cmd.derive.file, viewFile.get(), v);
   spec->until = plant::Stage::kGeometry;
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   // Framed as `sylva render` frames a mesh (never as a line figure).
-  auto camera =
-      FrameCamera(*plant, *spec, v, false, cpfgDefaultView || (viewFile && viewFile->parallel));
-  if (!camera) return Report(camera.error(), err);
-  if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
-  spec->view = ViewOf(*camera, v.width, v.height, eps);
+  const PlantView view =
+      ChoosePlantView(cmd.derive.file, viewFile.get(), nullptr, v.explicitCamera ? v.cam : nullptr);
+  auto bounds = FramedBox(view, *plant, *spec);
+  if (!bounds) return Report(bounds.error(), err);
+  const render::Camera camera = FramePlant(view, *bounds, double(v.width) / v.height);
+  spec->view = ViewOf(camera, v.width, v.height, eps);
   return TessellateAndWrite(cmd, *plant, *spec, err);
 }
 

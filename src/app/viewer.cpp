@@ -29,18 +29,17 @@
 
 #include "app/cli.h"
 #include "app/commands.h"
+#include "app/define_sliders.h"
+#include "app/plant_view.h"
 #include "app/view_file.h"
 #include "app/viewer_window.h"
+#include "plant/frames.h"
 #include "plant/plant.h"
 #include "plant/surface_library.h"
 #include "render/camera.h"
 #include "render/renderer.h"
-#include "scene/default_scene.h"
 
 namespace sylva::app {
-
-// cli_render.cpp: the screen-space view of a camera.
-mesh::ScreenView ViewOf(const render::Camera& camera, int width, int height, double eps);
 
 namespace {
 
@@ -57,7 +56,8 @@ constexpr size_t kUploadBytesPerFrame = size_t(8) << 20;
 struct Job {
   uint64_t id = 0;
   std::string path;
-  uint64_t reload = 0;  // bumped when the file changes: the plant is rebuilt
+  std::string viewPath;  // --view: the cpfg view file; empty: NAME.v beside the grammar
+  uint64_t reload = 0;   // bumped when the file changes: the plant is rebuilt
   std::map<std::string, double> overrides;
   std::optional<uint64_t> seed;
   int steps = -1;
@@ -72,8 +72,9 @@ struct Job {
 
 // Jobs that differ only in the view (or the detail) reuse the plant.
 bool SamePlant(const Job& a, const Job& b) {
-  return a.path == b.path && a.reload == b.reload && a.overrides == b.overrides &&
-         a.seed == b.seed && a.steps == b.steps && a.threads == b.threads && a.strict == b.strict;
+  return a.path == b.path && a.viewPath == b.viewPath && a.reload == b.reload &&
+         a.overrides == b.overrides && a.seed == b.seed && a.steps == b.steps &&
+         a.threads == b.threads && a.strict == b.strict;
 }
 
 struct Result {
@@ -86,15 +87,19 @@ struct Result {
   mesh::TriangleMesh mesh;  // moved into the drawn scene when shown
   size_t triangles = 0;
   mesh::Palette palette;
-  render::Camera camera;          // the view it was tessellated for
-  Vec3 lo{0, 0, 0}, hi{1, 1, 1};  // the whole plant's box (ground and shadows fit it)
+  render::Camera camera;  // the view it was tessellated for
+  // How render shows this plant (app/plant_view.h): the look, projection,
+  // direction, framing and lights the viewer starts from.
+  PlantView view;
+  mesh::Box box{Vec3::Zero(), Vec3::Ones()};  // the framed box (ground and shadows fit it)
+  bool pixelWidths = false;          // widths in pixels: re-tessellated for each view, lod or not
+  std::vector<std::string> watched;  // the view file and its colour files (reloads)
   uint64_t modules = 0;
   int derivationLength = 0;
   std::vector<std::pair<std::string, double>> constants;  // file order not kept: sorted
   std::set<std::string> overridden;  // the constants the job set (the others are the file's)
-  // A 2D figure (plant::IsLineFigure): drawn as these lines, orthographic,
-  // with no ground and no shadow.
-  std::optional<draw::Lines> lines;
+  // A 2D figure drawn as lines (PlantLook::kLines): its lines.
+  draw::Lines lines;
   double deriveMs = 0, turtleMs = 0, tessellateMs = 0;
 };
 
@@ -108,7 +113,8 @@ struct WorkerState {
   std::optional<plant::Plant> plant;
   plant::PlantSpec spec;
   mesh::Box bounds;
-  bool lines = false;  // a 2D figure (plant::IsLineFigure): drawn as lines, never tessellated
+  PlantView view;
+  std::vector<std::string> watched;
   std::string diagnostics;
   std::optional<Job> failed;
   std::string failedDiagnostics;
@@ -126,20 +132,29 @@ Result RunJob(const Job& job, WorkerState& st) {
     spec.seed = job.seed;
     if (job.steps >= 0) spec.steps = job.steps;
     spec.threads = job.threads;
-    // cpfg's NAME.v (and .map, .mat) beside the grammar, read again on each reload.
-    AttachViewFile(LoadViewFiles(job.path, ""), spec);
+    // cpfg's NAME.v (or --view's file, and .map, .mat) beside the grammar,
+    // read again on each reload.
+    const std::shared_ptr<const ViewFile> viewFile = LoadViewFiles(job.path, job.viewPath);
+    AttachViewFile(viewFile, spec);
     spec.until = plant::Stage::kGeometry;
     plant::PlantResult built = plant::BuildPlant(spec);
     std::string diagnostics = built.diagnostics.FormatAll();
     std::optional<mesh::Box> bounds;
-    bool lines = false;
+    PlantView view;
+    if (built.plant && viewFile && viewFile->overlay) {
+      // cpfg's animation file draws its frames over each other, as render does.
+      DiagnosticList again;
+      auto frames = plant::DrawFrames(spec, *viewFile->overlay, again);
+      if (frames)
+        built.plant->geometry = std::move(*frames);
+      else
+        diagnostics += frames.error().Format();
+    }
     if (built.plant && job.strict && !built.diagnostics.items.empty()) {
       diagnostics += "sylva: error: --strict: warnings are treated as errors\n";
-    } else if (built.plant && plant::IsLineFigure(built.plant->geometry)) {
-      lines = true;
-      bounds = mesh::Box{built.plant->geometry.boundsMin, built.plant->geometry.boundsMax};
     } else if (built.plant) {
-      auto b = plant::MeshBounds(*built.plant, spec);
+      view = ChoosePlantView(job.path, viewFile.get(), &built.plant->geometry);
+      auto b = FramedBox(view, *built.plant, spec);
       if (b) bounds = *b;
       if (!b) diagnostics += b.error().message + "\n";
     }
@@ -154,7 +169,11 @@ Result RunJob(const Job& job, WorkerState& st) {
     st.history = {};
     st.diagnostics = diagnostics;
     st.bounds = *bounds;
-    st.lines = lines;
+    st.view = view;
+    st.watched.clear();
+    if (viewFile)
+      for (const std::string& f : {viewFile->path, viewFile->colorsPath, viewFile->animationPath})
+        if (!f.empty()) st.watched.push_back(f);
     st.plant = std::move(built.plant);
     st.spec = spec;
     st.built = job;
@@ -168,28 +187,22 @@ Result RunJob(const Job& job, WorkerState& st) {
   r.stale = failedBefore;
   r.diagnostics = failedBefore ? st.failedDiagnostics : st.diagnostics;
   plant::Plant& p = *st.plant;
-  const bool empty = !(st.bounds.lo.array() <= st.bounds.hi.array()).all();
-  const Vec3 lo = empty ? Vec3::Zero() : st.bounds.lo, hi = empty ? Vec3::Ones() : st.bounds.hi;
   const double aspect = double(job.width) / job.height;
-  r.camera = job.camera ? *job.camera
-                        : (st.lines ? render::Camera::Frame(lo, hi, aspect, 0, 0, true)
-                                    : render::Camera::Frame(lo, hi, aspect, 30, 12, false));
-  if (st.lines) {
+  r.camera = job.camera ? *job.camera : FramePlant(st.view, st.bounds, aspect);
+  r.pixelWidths = p.geometry.widthInPixels;
+  if (st.view.look == PlantLook::kLines) {
     r.lines = LinesOf(p);
   } else {
     plant::PlantSpec spec = st.spec;
     spec.detail.sides = job.sides;
+    // Pixel widths need the view even at uniform detail (mesh/pixel_widths.h).
+    if (job.lod || r.pixelWidths) {
+      // The viewer's shadow map is smaller than `sylva render`'s.
+      spec.view = ScreenViewFor(
+          st.view, r.camera, job.width, job.height, 0.5, st.bounds,
+          double(kViewerShadowMapSize) / render::Renderer::kDefaultShadowMapSize, p.geometry);
+    }
     if (job.lod) {
-      spec.view = ViewOf(r.camera, job.width, job.height, 0.5);
-      // Shadows of what lies outside the view may fall inside it; the
-      // viewer's shadow map is smaller than `sylva render`'s.
-      spec.view->shadowFrom = render::KeyLightDirection();
-      spec.view->shadowPlaneY = lo.y();
-      spec.view->shadowTexelsPerUnit = render::ShadowTexelsPerUnit(st.bounds) *
-                                       kViewerShadowMapSize /
-                                       render::Renderer::kDefaultShadowMapSize;
-      // Twigs under a pixel fade as coverage lines (the renderer blends them).
-      spec.view->coverage = true;
       spec.history = &st.history;
     } else {
       st.history = {};  // levels of another detail mean nothing to the next view
@@ -209,8 +222,9 @@ Result RunJob(const Job& job, WorkerState& st) {
   r.palette = p.palette;
   r.modules = p.DrawnWord().size();
   r.triangles = r.mesh.triangleCount();
-  r.lo = lo;
-  r.hi = hi;
+  r.view = st.view;
+  r.box = st.bounds;
+  r.watched = st.watched;
   r.deriveMs = p.time.parse + p.time.derive + p.time.interpret;
   r.turtleMs = p.time.turtle;
   r.tessellateMs = p.time.tessellate;
@@ -219,10 +233,12 @@ Result RunJob(const Job& job, WorkerState& st) {
 }
 
 // The camera has moved far enough from the one the shown mesh was
-// tessellated for to re-tessellate: 5 % nearer or farther, 2 degrees
-// around, or the target 2 % of the distance away.
+// tessellated for to re-tessellate: 5 % nearer or farther (or zoomed in or
+// out by 5 % in parallel projection), 2 degrees around, the target 2 % of
+// the distance away, or another projection.
 bool MovedFarEnough(const render::Camera& a, const render::Camera& b) {
-  return std::abs(std::log(a.distance / b.distance)) > 0.05 ||
+  return a.orthographic != b.orthographic || std::abs(std::log(a.distance / b.distance)) > 0.05 ||
+         (a.orthographic && std::abs(std::log(a.orthoHeight / b.orthoHeight)) > 0.05) ||
          std::abs(a.azimuth - b.azimuth) > 2 || std::abs(a.elevation - b.elevation) > 2 ||
          (a.target - b.target).norm() > 0.02 * a.distance || a.fovY != b.fovY;
 }
@@ -266,18 +282,11 @@ struct Shown {
   std::vector<std::pair<std::string, double>> constants;
   // Each #define's slider range, fixed: set from the file's value (not from
   // a value the slider set, or the range would follow the slider away).
-  std::map<std::string, std::pair<float, float>> ranges;
+  std::map<std::string, SliderRange> ranges;
   int derivationLength = 0;
   bool playing = false;  // stepping the derivation 0, 1, 2 ... by itself
   Clock::time_point lastPlayed;
 };
-
-// The slider range of a #define whose file value is v.
-std::pair<float, float> RangeFor(double v) {
-  if (v > 0) return {0.0f, float(2 * v)};
-  if (v < 0) return {float(2 * v), 0.0f};
-  return {-1.0f, 1.0f};
-}
 
 // What the panel asked for beyond a new job.
 struct PanelActions {
@@ -333,7 +342,7 @@ PanelActions DrawPanel(const std::string& path, Shown& shown, bool busy, double 
       ImGui::CollapsingHeader("constants", ImGuiTreeNodeFlags_DefaultOpen)) {
     for (const auto& [name, value] : shown.constants) {
       float v = float(job.overrides.count(name) ? job.overrides[name] : value);
-      const auto range = shown.ranges.count(name) ? shown.ranges[name] : RangeFor(value);
+      const auto range = shown.ranges.count(name) ? shown.ranges[name] : SliderRangeFor(value);
       if (ImGui::SliderFloat(name.c_str(), &v, range.first, range.second)) {
         job.overrides[name] = v;
         changed = true;
@@ -363,26 +372,13 @@ PanelActions DrawPanel(const std::string& path, Shown& shown, bool busy, double 
   return act;
 }
 
-// The drawn scene of a result: a 2D figure's lines on white, or the
-// plant's default scene.
+// The drawn scene of a result, as `sylva render` draws it (PlantScene).
 draw::DrawList SceneOf(Result& r) {
-  if (r.lines) {
-    draw::DrawList list;
-    list.background = mesh::Vec3f(1, 1, 1);
-    list.lines.push_back(std::move(*r.lines));
-    r.lines.reset();
-    return list;
-  }
-  return scene::DefaultScene(std::make_shared<const mesh::TriangleMesh>(std::move(r.mesh)),
-                             r.palette, r.lo, r.hi);
-}
-
-// A camera that frames the result: the 2D figure from +Z, orthographic;
-// a plant from `azimuth`, `elevation`.
-render::Camera FrameOf(const Result& r, double aspect, bool lines, double azimuth,
-                       double elevation) {
-  return lines ? render::Camera::Frame(r.lo, r.hi, aspect, 0, 0, true)
-               : render::Camera::Frame(r.lo, r.hi, aspect, azimuth, elevation, false);
+  draw::DrawList list =
+      PlantScene(r.view, std::make_shared<const mesh::TriangleMesh>(std::move(r.mesh)), r.palette,
+                 std::move(r.lines), r.box, r.camera);
+  r.lines = {};
+  return list;
 }
 
 }  // namespace
@@ -413,6 +409,10 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     if (cmd.steps || cmd.seed) {
       err << "sylva: error: -n and --seed are for grammars; a scene sets them on <plant> and "
              "<forest>\n";
+      return kExitBadInput;
+    }
+    if (!cmd.view.empty()) {
+      err << "sylva: error: --view is for grammars (a cpfg view file); a scene has its <camera>\n";
       return kExitBadInput;
     }
     ViewCommand scene = cmd;
@@ -446,6 +446,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   WorkerState state;  // the worker's alone; outlives it
   Worker<Job, Result> worker([&state](const Job& j) { return RunJobSafely(j, state); });
   job.path = path;
+  job.viewPath = cmd.view;
   job.strict = cmd.strict;
   job.width = width;
   job.height = height;
@@ -476,12 +477,15 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
   };
   post();
   fs::file_time_type mtime = fs::last_write_time(path, ec);
+  std::map<std::string, fs::file_time_type> watched;  // the view file and its colours
   auto lastPoll = Clock::now();
   double frameMs = 0;
   int frame = 0;
   int shots = 0;
   bool screenshotKeyDown = false;  // one picture per press of P, however long it is held
-  bool lines = false;              // the plant shown is a 2D figure
+  bool lines = false;              // the plant shown is a 2D figure drawn as lines
+  bool pixelWidths = false;        // the plant shown has pixel widths
+  PlantLook look = PlantLook::kMesh;
   MouseCamera mouse;
 
   while (!glfwWindowShouldClose(window.handle)) {
@@ -491,8 +495,17 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     if (Clock::now() - lastPoll > std::chrono::milliseconds(250)) {
       lastPoll = Clock::now();
       auto t = fs::last_write_time(path, ec);
-      if (!ec && t != mtime) {
-        mtime = t;
+      bool changed = !ec && t != mtime;
+      if (changed) mtime = t;
+      // The view file and its colour files too.
+      for (auto& [f, when] : watched) {
+        auto tf = fs::last_write_time(f, ec);
+        if (!ec && tf != when) {
+          when = tf;
+          changed = true;
+        }
+      }
+      if (changed) {
         ++job.reload;
         post();
       }
@@ -515,7 +528,7 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
             << shown.diagnostics;
       }
     }
-    if (taken && taken->ok && shown.plant && !taken->lines && !lines) {
+    if (taken && taken->ok && shown.plant && taken->view.look != PlantLook::kLines && !lines) {
       // A new tessellation of the plant shown: uploaded in slices over the
       // next frames while the shown one is drawn, then swapped in. One
       // arriving meanwhile waits (the newest only), so uploads finish.
@@ -550,13 +563,16 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     if (auto& r = taken) {
       if (r->ok) {
         shown.constants = r->constants;
-        for (const auto& [name, value] : r->constants)
-          if (!r->overridden.count(name) || !shown.ranges.count(name))
-            shown.ranges[name] = RangeFor(value);
+        UpdateSliderRanges(r->constants, r->overridden, shown.ranges);
         shown.derivationLength = r->derivationLength;
         shown.id = r->id;
-        const bool wasLines = lines;
-        lines = r->lines.has_value();
+        const PlantLook wasLook = look;
+        const bool wasOrthographic = shown.plant && shown.plant->view.orthographic;
+        look = r->view.look;
+        lines = look == PlantLook::kLines;
+        pixelWidths = r->pixelWidths;
+        for (const std::string& f : r->watched)
+          if (!watched.count(f)) watched[f] = fs::last_write_time(f, ec);
         // A first mesh, or a 2D figure: its scene, uploaded whole in the
         // next Draw (the first, replacing none, is not timed).
         const auto swapStart = Clock::now();
@@ -570,10 +586,11 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
           camera = r->camera;
           posted = camera;
           framed = true;
-        } else if (lines != wasLines) {
-          // A plant became a 2D figure or back: framed again (a plant's mesh,
-          // made for the last view, is re-tessellated for this one).
-          camera = FrameOf(*r, double(width) / height, lines, 30, 12);
+        } else if (look != wasLook || r->view.orthographic != wasOrthographic) {
+          // A plant became a 2D figure or back, or its view file another
+          // projection: framed again as render frames it (a mesh made for
+          // the last view is re-tessellated for this one).
+          camera = FramePlant(r->view, r->box, double(width) / height);
         }
         shown.lastFailed = r->stale;  // a view of the last good plant keeps the errors shown
         shown.plant = std::move(r);
@@ -598,8 +615,9 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     // After NewFrame: ImGui knows whether this frame's click is on the panel.
     mouse.Update(window.handle, camera);
     if (framed) camera.azimuth += cmd.orbit;
-    // Re-tessellation applies to meshes only: a 2D figure is drawn as lines.
-    const bool retessellate = framed && job.lod && !lines;
+    // Re-tessellation applies to meshes only (a 2D figure drawn as lines is
+    // not tessellated); pixel widths follow the view with or without lod.
+    const bool retessellate = framed && (job.lod || pixelWidths) && !lines;
     if (fbw > 0 && fbh > 0 && (fbw != job.width || fbh != job.height)) {
       job.width = fbw;
       job.height = fbh;
@@ -622,8 +640,8 @@ int RunView(const ViewCommand& cmd, std::ostream& out, std::ostream& err) {
     const bool frameKey =
         glfwGetKey(window.handle, GLFW_KEY_F) == GLFW_PRESS && !ImGui::GetIO().WantCaptureKeyboard;
     if ((act.frameAll || frameKey) && shown.plant)
-      camera = FrameOf(*shown.plant, double(fbw) / std::max(fbh, 1), lines, camera.azimuth,
-                       camera.elevation);
+      camera = FrameAll(shown.plant->view, shown.plant->box, double(fbw) / std::max(fbh, 1),
+                        camera.azimuth, camera.elevation);
     // Re-tessellate in the background once the camera has moved far
     // enough, one job at a time; the shown mesh is drawn meanwhile.
     if (retessellate && !worker.Busy() && !pending && !queued && MovedFarEnough(camera, posted)) {

@@ -32,6 +32,7 @@ struct ViewCommand {
   // Grammars (.lsys) only: the step and seed the viewer starts at.
   std::optional<int> steps;
   std::optional<uint64_t> seed;
+  std::string view;  // --view: a cpfg view file (default: NAME.v beside the grammar)
   // --orbit: degrees of azimuth the camera turns each frame (tests, demos);
   // with --frames, the frame and re-tessellation figures go to stdout.
   double orbit = 0;

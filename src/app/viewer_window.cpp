@@ -79,10 +79,16 @@ void MouseCamera::Update(GLFWwindow* window, render::Camera& camera) {
   if (right && rightPans) {
     const Mat4 v = camera.View();
     const Vec3 r(v(0, 0), v(0, 1), v(0, 2)), up(v(1, 0), v(1, 1), v(1, 2));
-    const double k = camera.distance * 0.0015;
+    // In parallel projection the view is orthoHeight units high: the
+    // target follows the cursor exactly.
+    int windowWidth = 0, windowHeight = 0;
+    glfwGetWindowSize(window, &windowWidth, &windowHeight);
+    const double k = camera.orthographic ? camera.orthoHeight / std::max(windowHeight, 1)
+                                         : camera.distance * 0.0015;
     camera.target += (-r * (mx - lastX) + up * (my - lastY)) * k;
   }
-  if (!io.WantCaptureMouse && io.MouseWheel != 0) camera.distance *= std::pow(0.9, io.MouseWheel);
+  // The wheel zooms (render::Camera::Zoom).
+  if (!io.WantCaptureMouse && io.MouseWheel != 0) camera.Zoom(std::pow(0.9, io.MouseWheel));
   lastX = mx;
   lastY = my;
 }

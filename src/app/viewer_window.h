@@ -30,7 +30,8 @@ struct Window {
 int OpenWindow(int width, int height, const std::string& title, bool vsync, Window& w,
                std::ostream& err);
 
-// Left drag orbits, right drag pans, the wheel zooms: a drag only when its
+// Left drag orbits, right drag pans, the wheel zooms (in parallel
+// projection it scales the extent shown): a drag only when its
 // button went down off the panel, the wheel only off the panel. Call it
 // after ImGui::NewFrame (which decides what the panel wants this frame).
 struct MouseCamera {

@@ -26,6 +26,10 @@ struct Camera {
   Mat4 View() const;
   Mat4 Projection(double aspect) const;
   Mat4 ViewProjection(double aspect) const { return Projection(aspect) * View(); }
+  // Zooms by `factor` (under 1: closer, what is shown grows by 1 / factor):
+  // the distance in perspective, the extent shown (orthoHeight) in an
+  // orthographic view, where moving the eye changes nothing on screen.
+  void Zoom(double factor) { (orthographic ? orthoHeight : distance) *= factor; }
 
   // A camera at the given angles that frames the box [lo, hi] with a margin.
   // Always a usable camera: a box with a non-finite, inverted or huge

@@ -41,6 +41,23 @@ TEST(Camera, DefaultViewLooksFromPlusZAndFramesTheCentre) {
   EXPECT_LT(ToPixel(c.ViewProjection(16.0 / 9), Vec3(0, 4, 0), 160, 90).y(), 45);
 }
 
+TEST(Camera, ZoomGrowsTheImageInBothProjections) {
+  // A point beside the target, in the plane facing the camera: its offset
+  // from the image centre grows by 1 / 0.8 after Zoom(0.8), in perspective
+  // (the eye nearer) as in an orthographic view (a smaller extent; moving
+  // the eye there changes nothing on screen).
+  for (bool ortho : {false, true}) {
+    Camera c = Camera::Frame(Vec3(-1, 0, -1), Vec3(1, 4, 1), 1.0, 0, 0, ortho);
+    const Vec3 side = c.target + Vec3(0.5, 0, 0);
+    const double before = ToPixel(c.ViewProjection(1), side, 200, 200).x() - 100;
+    c.Zoom(0.8);
+    const double after = ToPixel(c.ViewProjection(1), side, 200, 200).x() - 100;
+    EXPECT_GT(before, 1) << "ortho " << ortho;
+    EXPECT_NEAR(after / before, 1 / 0.8, 1e-9)
+        << "ortho " << ortho << ": " << before << " px, " << after << " px after zooming";
+  }
+}
+
 TEST(Camera, FramedBoxStaysInsideTheImage) {
   for (bool ortho : {false, true}) {
     Vec3 lo(-3, 0, -2), hi(2, 9, 1);

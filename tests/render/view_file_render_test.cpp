@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "app/graphics.h"
+#include "app/plant_view.h"
+#include "render/camera.h"
 #include "scratch_dir.h"
 
 namespace sylva::app {
@@ -180,6 +182,112 @@ TEST(ViewFile, RenderLooksFromTheViewpointUnlessCameraIsGiven) {
   EXPECT_GT(fromFront, 0.7) << "from +Z";
   EXPECT_LT(fromSide, 0.2) << "from +X";
   EXPECT_GT(cameraWins, 0.7) << "--camera over the view file";
+}
+
+// A view file's text as LoadViewFiles reads it.
+ViewFile ViewOf(const std::string& text) {
+  ViewFile v = ParseViewFile(text, "p.v");
+  v.path = "p.v";
+  return v;
+}
+
+mesh::PlantGeometry Tube3D() {
+  mesh::PlantGeometry g;
+  g.planar = false;
+  mesh::Segment s;
+  s.start = Vec3(0, 0, 0);
+  s.end = Vec3(0, 1, 1);
+  s.left = Vec3(1, 0, 0);
+  s.radiusStart = s.radiusEnd = 0.1f;
+  g.segments.push_back(s);
+  return g;
+}
+
+TEST(PlantView, ParallelViewFileGivesAnOrthographicCameraFromItsViewpoint) {
+  const ViewFile v = ViewOf(
+      "viewpoint: 0,10,10\nview reference point: 0,0,0\nprojection: parallel\n"
+      "scale factor: 2\nlight direction: 1,0,0\n");
+  const mesh::PlantGeometry g = Tube3D();
+  const PlantView view = ChoosePlantView("p.l", &v, &g);
+  EXPECT_EQ(view.look, PlantLook::kMesh);
+  EXPECT_TRUE(view.orthographic);
+  EXPECT_TRUE(view.cpfgObject) << "a cpfg object stands on no ground";
+  EXPECT_NEAR(view.azimuth, 0, 1e-9);
+  EXPECT_NEAR(view.elevation, 45, 1e-9);
+  EXPECT_NEAR((view.keyToward - Vec3(1, 0, 0)).norm(), 0, 1e-9)
+      << view.keyToward.transpose() << ": the key light comes from the view file's";
+  const mesh::Box box{Vec3(-1, 0, -1), Vec3(1, 2, 1)};
+  const render::Camera framed = FramePlant(view, box, 1.0);
+  const render::Camera unscaled = render::Camera::Frame(box.lo, box.hi, 1.0, 0, 45, true);
+  EXPECT_TRUE(framed.orthographic);
+  EXPECT_NEAR(framed.orthoHeight, unscaled.orthoHeight / 2, 1e-9)
+      << "scale factor 2 shows half the extent";
+}
+
+TEST(PlantView, ALFileWithoutAViewFileIsSeenAsCpfgSeesIt) {
+  const mesh::PlantGeometry g = Tube3D();
+  const PlantView cpfg = ChoosePlantView("plant.l", nullptr, &g);
+  EXPECT_TRUE(cpfg.orthographic);
+  EXPECT_TRUE(cpfg.cpfgObject);
+  EXPECT_EQ(cpfg.azimuth, 0);
+  EXPECT_EQ(cpfg.elevation, 0);
+  const PlantView sylva = ChoosePlantView("plant.lsys", nullptr, &g);
+  EXPECT_FALSE(sylva.orthographic);
+  EXPECT_FALSE(sylva.cpfgObject);
+  EXPECT_EQ(sylva.azimuth, 30);
+  EXPECT_EQ(sylva.elevation, 12);
+  const double camera[3] = {90, 10, 7};
+  const PlantView flag = ChoosePlantView("plant.l", nullptr, &g, camera);
+  EXPECT_EQ(flag.azimuth, 90) << "--camera wins";
+  EXPECT_EQ(flag.distance, 7);
+}
+
+TEST(PlantView, PixelWidthsWiderThanAPixelMakeA2DFigureRibbons) {
+  mesh::PlantGeometry g;
+  g.planar = true;
+  g.widthInPixels = true;
+  mesh::Segment s;
+  s.start = Vec3(0, 0, 0);
+  s.end = Vec3(0, 1, 0);
+  s.left = Vec3(1, 0, 0);
+  s.radiusStart = s.radiusEnd = 0.5f;  // one pixel wide
+  g.segments.push_back(s);
+  EXPECT_EQ(ChoosePlantView("f.l", nullptr, &g).look, PlantLook::kLines);
+  g.segments[0].radiusEnd = 2.5f;  // 5 pixels
+  const PlantView view = ChoosePlantView("f.l", nullptr, &g);
+  EXPECT_EQ(view.look, PlantLook::kRibbons);
+  EXPECT_TRUE(view.orthographic);
+  const render::Camera camera = FramePlant(view, mesh::Box{Vec3(0, 0, 0), Vec3(0, 1, 0)}, 1.0);
+  const mesh::ScreenView screen =
+      ScreenViewFor(view, camera, 100, 100, 0.5, mesh::Box{Vec3(0, 0, 0), Vec3(0, 1, 0)}, 1, g);
+  EXPECT_GE(screen.eps, 1.0) << "5-pixel ribbons must stay ribbons (under 3 eps of radius)";
+  EXPECT_EQ(screen.shadowTexelsPerUnit, 0) << "ribbons cast no shadow";
+}
+
+TEST(PlantView, FrameAllKeepsTheProjectionAndShowsTheWholeBox) {
+  const ViewFile v = ViewOf("viewpoint: 0,0,10\nprojection: parallel\nscale factor: 4\n");
+  const mesh::PlantGeometry g = Tube3D();
+  const PlantView view = ChoosePlantView("p.l", &v, &g);
+  const mesh::Box box{Vec3(-1, 0, -2), Vec3(3, 5, 1)};
+  for (double azimuth : {0.0, 70.0, 200.0}) {
+    const render::Camera c = FrameAll(view, box, 16.0 / 9, azimuth, 25);
+    EXPECT_TRUE(c.orthographic) << "frame all in a parallel view stays parallel";
+    EXPECT_EQ(c.azimuth, azimuth);
+    EXPECT_EQ(c.elevation, 25);
+    const Mat4 vp = c.ViewProjection(16.0 / 9);
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 p((k & 1) ? box.hi.x() : box.lo.x(), (k & 2) ? box.hi.y() : box.lo.y(),
+                   (k & 4) ? box.hi.z() : box.lo.z());
+      const Vec2 q = render::ToPixel(vp, p, 320, 180);
+      EXPECT_TRUE(q.x() >= 0 && q.x() <= 320 && q.y() >= 0 && q.y() <= 180)
+          << "corner " << p.transpose() << " at pixel " << q.transpose() << ", azimuth " << azimuth
+          << " (the scale factor zooms render's view, not frame all)";
+    }
+  }
+  const ViewFile persp = ViewOf("viewpoint: 0,0,10\nprojection: perspective\nviewing angle: 20\n");
+  const render::Camera c = FrameAll(ChoosePlantView("p.l", &persp, &g), box, 1.0, 10, 10);
+  EXPECT_FALSE(c.orthographic);
+  EXPECT_EQ(c.fovY, 20) << "frame all keeps the view file's viewing angle";
 }
 
 }  // namespace
