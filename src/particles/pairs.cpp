@@ -132,6 +132,49 @@ void Grow(std::vector<T>& v, size_t size) {
   v.resize(size);
 }
 
+// A chunk's contacts as a pass reads them.
+struct Contacts {
+  const PairContact* __restrict ct;
+  const uint32_t* __restrict q;
+  const uint32_t* __restrict slot;
+  double* __restrict impulse;
+};
+
+// A velocity pass's first half over the contacts of owners [pb, pe): each
+// contact's impulse from the velocities vin, its push on the owner added
+// to own[p], on the partner put in push[slot]. With kGas, returns the
+// largest residual of the bounce contacts (else 0).
+template <bool kGas>
+double VelocityOwners(size_t pb, size_t pe, const uint32_t* __restrict begin,
+                      const uint32_t* __restrict end, const Contacts cs, const Vec3* __restrict vin,
+                      Vec3* __restrict push, Vec3* __restrict own) {
+  double worst = 0;
+  for (size_t p = pb; p < pe; ++p) {
+    Vec3 sum = Vec3::Zero();
+    const Vec3 vp = vin[p];
+    const uint32_t kb = begin[p], ke = end[p];
+    for (uint32_t k = kb; k < ke; ++k) {
+      const PairContact& ct = cs.ct[k];
+      const double vn = ct.n.dot(vp - vin[cs.q[k]]);
+      const double impulse = cs.impulse[k];
+      // Off target: a pushing contact (impulse > 0) must meet its target
+      // speed; one that does not push must not fall short.
+      if constexpr (kGas)
+        worst =
+            std::max(worst, impulse > 0 ? std::abs(ct.target - vn) : std::max(0.0, ct.target - vn));
+      // The impulse toward the target, its sum over the passes kept at 0
+      // or more (contacts push, never pull).
+      const double acc = PositivePart(impulse + (ct.target - vn) * ct.k);
+      const Vec3 J = (acc - impulse) * ct.n;
+      cs.impulse[k] = acc;
+      sum += J;
+      push[cs.slot[k]] = J;
+    }
+    own[p] = sum;
+  }
+  return worst;
+}
+
 // fn(begin, end) over ranges of [0, n), on the pool if there is one.
 template <typename Fn>
 void Ranges(ThreadPool* pool, size_t n, Fn&& fn) {
@@ -382,38 +425,10 @@ void System::ParticleCollisions(double h) {
     Vec3* vout = pw.scratch.data();
     Chunks(pool_, chunks, [&](size_t c) {
       PairChunk& ch = pw.chunks[c];
-      // Locals, so that the loop keeps them in registers.
-      const PairContact* const cs = ch.contacts.data();
-      const uint32_t* const cq = ch.q.data();
-      const uint32_t* const slot = ch.slot.data();
-      double* const impulse = ch.impulse.data();
-      const uint32_t *const b = begin, *const e = end;
-      const Vec3* const vi = vin;
-      Vec3 *const push = out, *const ownSum = own;
-      double worst = 0;
       const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
-      for (size_t p = pb; p < pe; ++p) {
-        Vec3 sum = Vec3::Zero();
-        const Vec3 vp = vi[p];
-        for (uint32_t k = b[p]; k < e[p]; ++k) {
-          const PairContact& ct = cs[k];
-          const double vn = ct.n.dot(vp - vi[cq[k]]);
-          // Off target: a pushing contact (impulse > 0) must meet its
-          // target speed; one that does not push must not fall short.
-          if (gas)
-            worst = std::max(
-                worst, impulse[k] > 0 ? std::abs(ct.target - vn) : std::max(0.0, ct.target - vn));
-          // The impulse toward the target, its sum over the passes kept
-          // at 0 or more (contacts push, never pull).
-          const double acc = PositivePart(impulse[k] + (ct.target - vn) * ct.k);
-          const Vec3 J = (acc - impulse[k]) * ct.n;
-          impulse[k] = acc;
-          sum += J;
-          push[slot[k]] = J;
-        }
-        ownSum[p] = sum;
-      }
-      ch.residual = worst;
+      const Contacts cs{ch.contacts.data(), ch.q.data(), ch.slot.data(), ch.impulse.data()};
+      ch.residual = gas ? VelocityOwners<true>(pb, pe, begin, end, cs, vin, out, own)
+                        : VelocityOwners<false>(pb, pe, begin, end, cs, vin, out, own);
     });
     Chunks(pool_, chunks, [&](size_t c) {
       const Vec3 *const push = out, *const ownSum = own, *const vi = vin;

@@ -24,7 +24,9 @@ namespace sylva::particles {
 constexpr size_t kPairChunk = 256;
 
 // What the passes read of a contact between its owner p and partner q
-// (both in slot order), apart from q. 40 bytes.
+// (both in slot order), apart from q. 40 bytes. (A normal rounded to single
+// precision lost 9e-10 of an elastic gas's energy in 200 steps, against
+// 1e-12 asked, and left a pile unsettled.)
 struct PairContact {
   Vec3 n;         // unit, from q toward p, at the time of impact
   double target;  // relative normal speed the velocity passes aim for
