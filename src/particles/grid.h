@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/assert.h"
 #include "core/math.h"
 #include "particles/system.h"
 
@@ -59,6 +60,15 @@ class NeighbourGrid {
   // count.
   template <typename Fn>
   void ForEachCandidateRange(const Vec3& p, Fn&& visit) const;
+  // Half of that neighbourhood, so that a loop over all particles meets
+  // each pair once: for particle k of slot order (at p = sortedPositions()
+  // [k]), calls visit(from, to) for the particles after k in its own cell,
+  // the cell after it in x, and the 4 rows of 3 cells above its row in
+  // (z, y). Of two particles in neighbouring cells exactly one has the
+  // other in its half (the 27 cells of a neighbourhood have 27 distinct
+  // slots); of two in one cell, the first in slot order.
+  template <typename Fn>
+  void ForEachHalfCandidateRange(const Vec3& p, uint32_t k, Fn&& visit) const;
 
  private:
   uint32_t Slot(int64_t cx, int64_t cy, int64_t cz) const;
@@ -123,6 +133,31 @@ void NeighbourGrid::ForEachCandidateRange(const Vec3& p, Fn&& visit) const {
           const uint32_t slot = (first + d) & mask_;
           visit(start_[slot], start_[slot + 1]);
         }
+      }
+    }
+  }
+}
+
+template <typename Fn>
+void NeighbourGrid::ForEachHalfCandidateRange(const Vec3& p, uint32_t k, Fn&& visit) const {
+  const int64_t cx = CellOf(p.x()), cy = CellOf(p.y()), cz = CellOf(p.z());
+  const uint32_t own = Slot(cx, cy, cz);
+  SYLVA_DCHECK(start_[own] <= k && k < start_[own + 1]);
+  if (own + 1 <= mask_) {  // the own cell and the next are contiguous
+    visit(k + 1, start_[own + 2]);
+  } else {
+    visit(k + 1, start_[own + 1]);
+    visit(start_[0], start_[1]);
+  }
+  static constexpr int64_t kRows[4][2] = {{0, 1}, {1, -1}, {1, 0}, {1, 1}};  // dz, dy
+  for (const auto& row : kRows) {
+    const uint32_t first = Slot(cx - 1, cy + row[1], cz + row[0]);
+    if (first + 2 <= mask_) {
+      visit(start_[first], start_[first + 3]);
+    } else {
+      for (uint32_t d = 0; d < 3; ++d) {
+        const uint32_t slot = (first + d) & mask_;
+        visit(start_[slot], start_[slot + 1]);
       }
     }
   }

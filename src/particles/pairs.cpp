@@ -15,21 +15,29 @@
 // Layout (pairs.h). The work runs in the grid's slot order: each
 // particle's data is copied there once a step, so neighbours are near in
 // memory, and written back at the end. One walk of the grid finds the
-// contacts: the candidates of the 9 row ranges are screened by distance
-// without a branch into a small buffer, and each particle's contacts are
-// appended to its chunk's array (kPairChunk particles a chunk, the unit of
-// parallel work), so no counting pass is needed. The velocity passes take
-// the positive part of an impulse without a branch (its sign changes from
-// pass to pass: a branch on it was mispredicted often enough to cost half
-// the pass).
+// contacts, each pair once: each particle looks through half of its
+// neighbourhood (NeighbourGrid::ForEachHalfCandidateRange), screens the
+// candidates by distance without a branch into a small buffer, and
+// appends the contacts it finds (it owns them; the other ball is the
+// partner) to its chunk's array (kPairChunk particles a chunk, the unit of
+// parallel work), so no counting pass is needed. A counting sort by
+// partner then gives each contact a slot in its partner's run of pushes.
+// A pass computes each contact once, by its owner, adds it to the owner's
+// sum and puts it (negated by the partner) in that slot; then each particle
+// adds up its run, in one sweep. (Each particle kept a mirror image of
+// each of its contacts before: twice the time of impact, twice the passes'
+// work and memory.) The velocity passes take the positive part of an
+// impulse without a branch (its sign changes from pass to pass: a branch
+// on it was mispredicted often enough to cost half the pass).
 //
-// Response, in two kinds of passes over each particle's own list of
-// contacts (in the grid's order: the same whatever the thread count):
+// Response, in two kinds of passes over the contacts (found in the grid's
+// order, and each particle's sums in a fixed order: the same whatever the
+// thread count):
 //   velocity  a contact whose approach is faster than the step's forces
 //             could give (a collision) must leave at e times that speed; a
 //             slower one (resting) must not approach; the impulse summed
-//             over the passes stays at 0 or more. Each pass computes,
-//             for every particle, the impulses of its contacts from the
+//             over the passes stays at 0 or more. Each pass computes
+//             the impulse of every contact once from the
 //             velocities of the previous pass (Jacobi), each scaled by
 //             1 / max(contacts of i, contacts of j): the same factor on
 //             both sides, so momentum is conserved exactly and an isolated
@@ -107,6 +115,66 @@ inline double PositivePart(double x) {
 #endif
 }
 
+// min(x, 0) without a branch; NaN gives 0.
+inline double NegativePart(double x) {
+#if defined(__SSE2__)
+  return _mm_cvtsd_f64(_mm_min_sd(_mm_set_sd(x), _mm_setzero_pd()));
+#else
+  return x < 0 ? x : 0;
+#endif
+}
+
+// v.resize(size), with room for a quarter more when it grows, so that a
+// step whose contacts vary a little allocates nothing.
+template <typename T>
+void Grow(std::vector<T>& v, size_t size) {
+  if (v.capacity() < size) v.reserve(size + size / 4);
+  v.resize(size);
+}
+
+// A chunk's contacts as a pass reads them.
+struct Contacts {
+  const PairContact* __restrict ct;
+  const uint32_t* __restrict q;
+  const uint32_t* __restrict slot;
+  double* __restrict impulse;
+};
+
+// A velocity pass's first half over the contacts of owners [pb, pe): each
+// contact's impulse from the velocities vin, its push on the owner added
+// to own[p], on the partner put in push[slot]. With kGas, returns the
+// largest residual of the bounce contacts (else 0).
+template <bool kGas>
+double VelocityOwners(size_t pb, size_t pe, const uint32_t* __restrict begin,
+                      const uint32_t* __restrict end, const Contacts cs, const Vec3* __restrict vin,
+                      Vec3* __restrict push, Vec3* __restrict own) {
+  double worst = 0;
+  for (size_t p = pb; p < pe; ++p) {
+    Vec3 sum = Vec3::Zero();
+    const Vec3 vp = vin[p];
+    const uint32_t kb = begin[p], ke = end[p];
+    for (uint32_t k = kb; k < ke; ++k) {
+      const PairContact& ct = cs.ct[k];
+      const double vn = ct.n.dot(vp - vin[cs.q[k]]);
+      const double impulse = cs.impulse[k];
+      // Off target: a pushing contact (impulse > 0) must meet its target
+      // speed; one that does not push must not fall short.
+      if constexpr (kGas)
+        worst =
+            std::max(worst, impulse > 0 ? std::abs(ct.target - vn) : std::max(0.0, ct.target - vn));
+      // The impulse toward the target, its sum over the passes kept at 0
+      // or more (contacts push, never pull).
+      const double acc = PositivePart(impulse + (ct.target - vn) * ct.k);
+      const Vec3 J = (acc - impulse) * ct.n;
+      cs.impulse[k] = acc;
+      sum += J;
+      push[cs.slot[k]] = J;
+    }
+    own[p] = sum;
+  }
+  return worst;
+}
+
 // fn(begin, end) over ranges of [0, n), on the pool if there is one.
 template <typename Fn>
 void Ranges(ThreadPool* pool, size_t n, Fn&& fn) {
@@ -157,10 +225,11 @@ void System::ParticleCollisions(double h) {
   pw.grid.Build(X0, n, reach, pool_, true);
   const uint32_t* order = pw.grid.order().data();
   const Vec3* x0 = pw.grid.sortedPositions().data();
-  for (auto* a : {&pw.x, &pw.d, &pw.v, &pw.dv, &pw.scratch}) a->resize(n);
+  for (auto* a : {&pw.x, &pw.d, &pw.v, &pw.dv, &pw.scratch, &pw.own}) a->resize(n);
   for (auto* a : {&pw.w, &pw.r, &pw.move, &pw.first}) a->resize(n);
   pw.begin.resize(n);
   pw.end.resize(n);
+  pw.count.resize(n);
   pw.free.resize(n);
   pw.resting.resize(n);
   Vec3 *x = pw.x.data(), *d = pw.d.data(), *v = pw.v.data(), *dv = pw.dv.data();
@@ -181,14 +250,18 @@ void System::ParticleCollisions(double h) {
     }
   });
 
-  // Contacts, in one walk of the grid: each particle of a chunk appends
-  // its contacts to the chunk's array.
+  // Contacts, in one walk of the grid: each particle of a chunk looks
+  // through half of its neighbourhood (so each pair is met once) and
+  // appends the contacts it finds, which it owns, to the chunk's array.
   const size_t chunks = (n + kPairChunk - 1) / kPairChunk;
   if (pw.chunks.size() < chunks) pw.chunks.resize(chunks);
   const double r2 = reach * reach;
   Chunks(pool_, chunks, [&](size_t c) {
     PairChunk& ch = pw.chunks[c];
     ch.contacts.clear();
+    ch.q.clear();
+    ch.first.clear();
+    ch.bounce.clear();
     ch.speed = 0;
     ch.resting = false;
     // Particle p's contacts among the candidates cand[0, m).
@@ -200,7 +273,7 @@ void System::ParticleCollisions(double h) {
         const double R = r[p] + r[q];
         const Vec3 d0 = xp - x0[q];
         // Too far apart for their two steps to meet.
-        const double meet = R + move[p] + move[q];
+        const double meet = R + (move[p] + move[q]);
         if (d0.squaredNorm() > meet * meet) continue;
         const Vec3 dd = d[p] - d[q];
         const double t = TimeOfImpact(d0, dd, R);
@@ -220,7 +293,10 @@ void System::ParticleCollisions(double h) {
         // one contact into another within that step), and it bounces.
         const bool bounce =
             (t > 0 || (freeFlight[p] && freeFlight[q])) && vn0 < -2 * gained - 1e-12;
-        ch.contacts.push_back({nrm, 0.0, bounce ? -pairRestitution_ * vn0 : 0.0, 0.0, q, bounce});
+        ch.contacts.push_back({nrm, bounce ? -pairRestitution_ * vn0 : 0.0, 0.0});
+        ch.q.push_back(q);
+        ch.first.push_back(t);
+        ch.bounce.push_back(bounce);
         ch.speed = std::max(ch.speed, std::abs(vn0));
         resting[p] |= !bounce;
         first[p] = std::min(first[p], t);
@@ -233,9 +309,9 @@ void System::ParticleCollisions(double h) {
       begin[p] = uint32_t(ch.contacts.size());
       // The candidates: the grid's ranges, screened by distance without a
       // branch, kCandidates at a time.
-      uint32_t from[27], to[27];
+      uint32_t from[14], to[14];
       int ranges = 0;
-      pw.grid.ForEachCandidateRange(x0[p], [&](uint32_t f, uint32_t t) {
+      pw.grid.ForEachHalfCandidateRange(x0[p], uint32_t(p), [&](uint32_t f, uint32_t t) {
         from[ranges] = f;
         to[ranges] = t;
         ++ranges;
@@ -249,7 +325,7 @@ void System::ParticleCollisions(double h) {
         for (uint32_t k = from[g]; k < to[g]; ++k) {
           const double dx = sx[k].x() - px, dy = sx[k].y() - py, dz = sx[k].z() - pz;
           cand[m] = k;
-          m += uint32_t(dx * dx + dy * dy + dz * dz <= reach2) & uint32_t(k != p);
+          m += uint32_t(dx * dx + dy * dy + dz * dz <= reach2);
           if (m == kCandidates) {
             contacts(p, cand, m);
             m = 0;
@@ -258,76 +334,119 @@ void System::ParticleCollisions(double h) {
       }
       contacts(p, cand, m);
       end[p] = uint32_t(ch.contacts.size());
-      ch.resting |= resting[p] != 0;
     }
+    for (uint8_t b : ch.bounce) ch.resting |= !b;
+    // Room for half as many again, so that a pile whose contacts vary a
+    // little from step to step allocates nothing.
+    const size_t m = ch.contacts.size();
+    auto room = [m](auto& a) {
+      if (a.capacity() < m + m / 4) a.reserve(m + m / 2);
+    };
+    room(ch.contacts);
+    room(ch.q);
+    room(ch.first);
+    room(ch.bounce);
+    room(ch.impulse);
+    room(ch.slot);
+    ch.impulse.assign(m, 0.0);
+    ch.slot.resize(m);
   });
   double speed = 0;
   bool anyResting = false;
   size_t total = 0;
   for (size_t c = 0; c < chunks; ++c) {
-    speed = std::max(speed, pw.chunks[c].speed);
-    anyResting |= pw.chunks[c].resting;
-    total += pw.chunks[c].contacts.size();
+    PairChunk& ch = pw.chunks[c];
+    speed = std::max(speed, ch.speed);
+    anyResting |= ch.resting;
+    total += ch.contacts.size();
   }
   if (total == 0) return;
+  SYLVA_ASSERT(total <= UINT32_MAX);  // slots are 32-bit
+
+  // Where each contact's push on its partner goes: a counting sort of the
+  // contacts by partner, in the chunks' order, so that a particle reads
+  // its pushes as a partner in one run. It also brings the partner side's
+  // first contact time and resting contact. count[p]: p's contacts, its own
+  // and as partner. Serial (it reads 4 bytes a contact).
+  Grow(pw.partnerBegin, n + 2);
+  Grow(pw.out, total);
+  uint32_t* partnerBegin = pw.partnerBegin.data();
+  uint32_t* count = pw.count.data();
+  std::fill(partnerBegin, partnerBegin + n + 2, 0u);
+  for (size_t c = 0; c < chunks; ++c) {
+    for (uint32_t q : pw.chunks[c].q) ++partnerBegin[q + 2];
+  }
+  for (size_t p = 0; p < n; ++p) {
+    count[p] = end[p] - begin[p] + partnerBegin[p + 2];
+    partnerBegin[p + 2] += partnerBegin[p + 1];
+  }
+  for (size_t c = 0; c < chunks; ++c) {
+    PairChunk& ch = pw.chunks[c];
+    for (size_t e = 0; e < ch.q.size(); ++e) {
+      const uint32_t q = ch.q[e];
+      ch.slot[e] = partnerBegin[q + 1]++;
+      first[q] = std::min(first[q], ch.first[e]);
+      resting[q] |= !ch.bounce[e];
+    }
+  }
+  Vec3* out = pw.out.data();
+  Vec3* own = pw.own.data();
 
   // Velocity passes (Jacobi), kVelocityPasses; where no contact of the
   // step is resting, on while a collision contact is off its target by more
   // than kConverged of the step's largest approach speed, up to
   // pairMaxPasses (a pile keeps its fixed passes: converging them costs 15x
-  // and does not settle it). Each chunk records the largest residual of its
-  // bounce contacts; their maximum is the same whatever the thread count
-  // (a max does not depend on the order). The first pass also computes
-  // each contact's sharing factor.
+  // and does not settle it). A pass computes each contact's impulse once,
+  // by its owner, from the velocities of the pass before, and keeps the
+  // owner's sum and puts each contact's push on its partner in the
+  // partner's run; then each particle takes its own sum less the pushes of
+  // its run. Each
+  // chunk records the largest residual of its bounce contacts; their
+  // maximum is the same whatever the thread count (a max does not depend
+  // on the order). The first pass also computes each contact's sharing
+  // factor.
   pw.gas = !anyResting;
   pw.tolerance = kConverged * speed;
-  const int passes = pw.gas ? std::max(pairMaxPasses, kVelocityPasses) : kVelocityPasses;
+  Chunks(pool_, chunks, [&](size_t c) {
+    PairChunk& ch = pw.chunks[c];
+    const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
+    for (size_t p = pb; p < pe; ++p) {
+      for (uint32_t k = begin[p]; k < end[p]; ++k) {
+        const uint32_t q = ch.q[k];
+        const double f = 1.0 / double(std::max(count[p], count[q]));
+        ch.contacts[k].k = f / (w[p] + w[q]);
+      }
+    }
+  });
+  const bool gas = pw.gas;
+  const int passes = gas ? std::max(pairMaxPasses, kVelocityPasses) : kVelocityPasses;
   for (int pass = 0; pass < passes; ++pass) {
     const Vec3* vin = pw.v.data();
     Vec3* vout = pw.scratch.data();
     Chunks(pool_, chunks, [&](size_t c) {
       PairChunk& ch = pw.chunks[c];
-      PairContact* cs = ch.contacts.data();
-      double worst = 0;
+      const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
+      const Contacts cs{ch.contacts.data(), ch.q.data(), ch.slot.data(), ch.impulse.data()};
+      ch.residual = gas ? VelocityOwners<true>(pb, pe, begin, end, cs, vin, out, own)
+                        : VelocityOwners<false>(pb, pe, begin, end, cs, vin, out, own);
+    });
+    Chunks(pool_, chunks, [&](size_t c) {
+      const Vec3 *const push = out, *const ownSum = own, *const vi = vin;
+      const uint32_t* const run = partnerBegin;
+      Vec3* const vo = vout;
       const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
       for (size_t p = pb; p < pe; ++p) {
-        Vec3 sum = Vec3::Zero();
-        if (w[p] > 0) {
-          const Vec3 vp = vin[p];
-          if (pass == 0) {
-            for (uint32_t k = begin[p]; k < end[p]; ++k) {
-              const uint32_t q = cs[k].j;
-              const double f = 1.0 / double(std::max(end[p] - begin[p], end[q] - begin[q]));
-              cs[k].k = f / (w[p] + w[q]);
-            }
-          }
-          for (uint32_t k = begin[p]; k < end[p]; ++k) {
-            PairContact& ct = cs[k];
-            const double vn = ct.n.dot(vp - vin[ct.j]);
-            // Off target: a pushing contact (impulse > 0) must meet its
-            // target speed; one that does not push must not fall short.
-            if (pw.gas)
-              worst = std::max(
-                  worst, ct.impulse > 0 ? std::abs(ct.target - vn) : std::max(0.0, ct.target - vn));
-            // The impulse toward the target, its sum over the passes kept
-            // at 0 or more (contacts push, never pull). Both particles of a
-            // pair compute the same numbers.
-            const double acc = PositivePart(ct.impulse + (ct.target - vn) * ct.k);
-            const double J = acc - ct.impulse;
-            ct.impulse = acc;
-            sum += J * ct.n;
-          }
-        }
-        vout[p] = vin[p] + w[p] * sum;
+        Vec3 sum = ownSum[p];
+        for (uint32_t k = run[p]; k < run[p + 1]; ++k) sum -= push[k];
+        vo[p] = vi[p] + w[p] * sum;
       }
-      ch.residual = worst;
     });
     // The residuals were those of the velocities before this pass: met,
     // the pass changed nothing that matters; keep its result all the same.
     std::swap(pw.v, pw.scratch);
     v = pw.v.data();
     pw.passes = pass + 1;
-    if (pw.gas && pass + 1 >= kVelocityPasses) {
+    if (gas && pass + 1 >= kVelocityPasses) {
       double worst = 0;
       for (size_t c = 0; c < chunks; ++c) worst = std::max(worst, pw.chunks[c].residual);
       pw.residual = worst;
@@ -339,32 +458,52 @@ void System::ParticleCollisions(double h) {
   // the first contact.
   Ranges(pool_, n, [&](size_t b, size_t e2) {
     for (size_t p = b; p < e2; ++p) {
-      if (end[p] == begin[p] || w[p] == 0) continue;
+      if (count[p] == 0 || w[p] == 0) continue;
       const size_t i = order[p];
       x[p] += ((1 - first[p]) * h) * (v[p] - V[i]);
     }
   });
 
-  // Position passes (Jacobi): the remaining overlap along each normal.
+  // Position passes (Jacobi): the remaining overlap along each normal, in
+  // the same two halves as a velocity pass.
   const double rh = h;
   for (int pass = 0; pass < kPositionPasses; ++pass) {
     const Vec3* xin = pw.x.data();
     Vec3* xout = pw.scratch.data();
     Chunks(pool_, chunks, [&](size_t c) {
-      const PairContact* cs = pw.chunks[c].contacts.data();
+      const PairChunk& ch = pw.chunks[c];
+      const PairContact* const cs = ch.contacts.data();
+      const uint32_t* const cq = ch.q.data();
+      const uint32_t* const slot = ch.slot.data();
+      const uint32_t *const b = begin, *const e = end;
+      const Vec3* const xi = xin;
+      const double* const rad = r;
+      Vec3 *const push = out, *const ownSum = own;
       const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
       for (size_t p = pb; p < pe; ++p) {
-        if (w[p] == 0 || end[p] == begin[p]) {
+        Vec3 sum = Vec3::Zero();
+        const Vec3 xp = xi[p];
+        for (uint32_t k = b[p]; k < e[p]; ++k) {
+          const PairContact& ct = cs[k];
+          const uint32_t q = cq[k];
+          const double gap = ct.n.dot(xp - xi[q]) - (rad[p] + rad[q]);
+          const Vec3 s = (NegativePart(gap) * ct.k) * ct.n;
+          sum += s;
+          push[slot[k]] = s;
+        }
+        ownSum[p] = sum;
+      }
+    });
+    Chunks(pool_, chunks, [&](size_t c) {
+      const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
+      for (size_t p = pb; p < pe; ++p) {
+        if (w[p] == 0 || count[p] == 0) {
           xout[p] = xin[p];
           continue;
         }
-        Vec3 dx = Vec3::Zero();
-        for (uint32_t k = begin[p]; k < end[p]; ++k) {
-          const PairContact& ct = cs[k];
-          const double gap = ct.n.dot(xin[p] - xin[ct.j]) - (r[p] + r[ct.j]);
-          if (gap < 0) dx -= (gap * w[p] * ct.k) * ct.n;
-        }
-        Vec3 xp = xin[p] + dx;
+        Vec3 sum = own[p];
+        for (uint32_t k = partnerBegin[p]; k < partnerBegin[p + 1]; ++k) sum -= out[k];
+        Vec3 xp = xin[p] - w[p] * sum;
         Vec3 vp = v[p];
         // Out of the half-space colliders again (where a moving one ends
         // the step), without velocity into them.
@@ -395,7 +534,7 @@ void System::ParticleCollisions(double h) {
   // Then the particles with contacts take their new state.
   Ranges(pool_, n, [&](size_t b, size_t e2) {
     for (size_t p = b; p < e2; ++p) {
-      if (w[p] == 0 || end[p] == begin[p]) continue;
+      if (w[p] == 0 || count[p] == 0) continue;
       const size_t i = order[p];
       Vec3 vp = v[p];
       if (resting[p]) {

@@ -46,6 +46,43 @@ TEST(NeighbourGrid, EqualsBruteForceOn10kRandomPoints) {
 // The sort is stable and its passes split the work by fixed ranges, so the
 // slot order is the same for any thread count, and within a cell the
 // particles are in index order; also when most points share a few cells.
+// The half neighbourhoods (pairs.cpp's walk) meet every pair closer than
+// the cell size exactly once: on a table small enough that cells share
+// slots and rows wrap around its end (20 sets of 40 points), and on a larger
+// one.
+TEST(NeighbourGrid, HalfRangesMeetEachPairOnce) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 21; ++trial) {
+    const size_t n = trial < 20 ? 40 : 3000;
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<Vec3> x(n);
+    for (auto& p : x) p = Vec3(u(rng), u(rng), u(rng));
+    x[1] = x[0];  // two particles at one point
+    const double r = 0.25;
+    NeighbourGrid grid;
+    grid.Build(x.data(), n, r, nullptr, true);
+    const std::vector<Vec3>& sx = grid.sortedPositions();
+    std::vector<std::pair<uint32_t, uint32_t>> half, brute;
+    for (uint32_t k = 0; k < n; ++k) {
+      grid.ForEachHalfCandidateRange(sx[k], k, [&](uint32_t from, uint32_t to) {
+        for (uint32_t j = from; j < to; ++j) {
+          if ((sx[j] - sx[k]).squaredNorm() <= r * r)
+            half.emplace_back(std::min(k, j), std::max(k, j));
+        }
+      });
+      for (uint32_t j = k + 1; j < n; ++j) {
+        if ((sx[j] - sx[k]).squaredNorm() <= r * r) brute.emplace_back(k, j);
+      }
+    }
+    std::sort(half.begin(), half.end());
+    const size_t met = half.size();
+    half.erase(std::unique(half.begin(), half.end()), half.end());
+    EXPECT_EQ(met, half.size()) << n << " points: " << met - half.size() << " pairs met twice";
+    EXPECT_EQ(half, brute) << n << " points: " << half.size() << " pairs met, " << brute.size()
+                           << " within reach";
+  }
+}
+
 TEST(NeighbourGrid, SlotOrderIsTheSameForOneAndTwoThreads) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-3, 3);
