@@ -141,48 +141,58 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
                               : nullptr;
   for (size_t c = begin; c < end; c += kChunk) {
     const size_t ce = std::min(end, c + kChunk), m = ce - c;
-    if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds)) faults_.Flag();
-    if (colliders_.empty()) continue;
     size_t count = 0;
-    if (plane) {
-      count = kernels::BulkPlaneCandidateList(kernel_, plane->normal.data(), plane->point.data(), a,
-                                              s.radius.data(), c, ce, idx);
+    if (floor && restLanes_ == 8) {
+      // A lone static floor on eight lanes: the advance, the floor's
+      // candidates and its resting contacts in one pass; what is left of
+      // the candidates to the general path below.
+      bool ok = true;
+      count = kernels::BulkAdvanceRestOnPlane(q, *floor, a, s.radius.data(), c, ce, olds, idx, &ok);
+      if (!ok) faults_.Flag();
+      std::memset(done, 0, count);
     } else {
-      std::memset(flags, 0, m);
-      for (const Collider& col : colliders_) {
-        if (col.kind == Collider::Kind::kPlane && !col.moving()) {
-          kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a,
-                                       s.radius.data(), c, ce, flags);
-          continue;
-        }
-        // Any other collider (a moving one: the path in its frame at the
-        // start of the step).
-        const Vec3 shift = h * col.velocity;
-        for (size_t j = 0; j < m; ++j) {
-          flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
-                                 double(s.radius[c + j]));
-        }
-      }
-      // The candidates, in order; eight flags at a time (most particles
-      // touch nothing).
-      for (size_t j = 0; j < m; ++j) {
-        if (j % 8 == 0 && j + 8 <= m) {
-          uint64_t word;
-          std::memcpy(&word, flags + j, 8);
-          if (word == 0) {
-            j += 7;
+      if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds)) faults_.Flag();
+      if (colliders_.empty()) continue;
+      if (plane) {
+        count = kernels::BulkPlaneCandidateList(kernel_, plane->normal.data(), plane->point.data(),
+                                                a, s.radius.data(), c, ce, idx);
+      } else {
+        std::memset(flags, 0, m);
+        for (const Collider& col : colliders_) {
+          if (col.kind == Collider::Kind::kPlane && !col.moving()) {
+            kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a,
+                                         s.radius.data(), c, ce, flags);
             continue;
           }
+          // Any other collider (a moving one: the path in its frame at the
+          // start of the step).
+          const Vec3 shift = h * col.velocity;
+          for (size_t j = 0; j < m; ++j) {
+            flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
+                                   double(s.radius[c + j]));
+          }
         }
-        if (flags[j] && s.invMass[c + j] != 0) idx[count++] = uint16_t(j);
+        // The candidates, in order; eight flags at a time (most particles
+        // touch nothing).
+        for (size_t j = 0; j < m; ++j) {
+          if (j % 8 == 0 && j + 8 <= m) {
+            uint64_t word;
+            std::memcpy(&word, flags + j, 8);
+            if (word == 0) {
+              j += 7;
+              continue;
+            }
+          }
+          if (flags[j] && s.invMass[c + j] != 0) idx[count++] = uint16_t(j);
+        }
       }
-    }
-    // A lone static floor: its resting contacts four or eight at a time
-    // (the same bits as the path below).
-    if (floor) {
-      kernels::BulkRestOnPlane(restLanes_, *floor, a, s.radius.data(), olds, c, idx, count, done);
-    } else {
-      std::memset(done, 0, count);
+      // A lone static floor: its resting contacts four at a time (the same
+      // bits as the path below).
+      if (floor) {
+        kernels::BulkRestOnPlane(*floor, a, s.radius.data(), olds, c, idx, count, done);
+      } else {
+        std::memset(done, 0, count);
+      }
     }
     for (size_t k = 0; k < count; ++k) {
       if (done[k]) continue;

@@ -147,8 +147,9 @@ class BulkSystem {
 
   // Chooses the vector kernel (tests compare AVX with its scalar twin).
   // AVX only where the processor has it. restLanes: the lanes of the
-  // resting-floor kernel with AVX (4, or 8 where the processor has AVX-512;
-  // 0: the widest it runs).
+  // resting-floor path with AVX: 4 (a kernel after the advance), or 8 where
+  // the processor has AVX-512 (the advance, the floor's candidates and its
+  // resting contacts in one pass); 0: the widest it runs. Same bits.
   void SetKernel(kernels::Kernel k, int restLanes = 0) {
     kernel_ = k == kernels::Kernel::kAvx ? kernels::Best() : kernels::Kernel::kScalar;
     restLanes_ = kernel_ == kernels::Kernel::kScalar ? 0

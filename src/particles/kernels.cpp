@@ -396,199 +396,159 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   return _mm512_max_pd(b, a);
 }
 
-// Where eight candidates' values are: one run of consecutive indices (one
-// load), or two windows of 16 floats, from j[0] and from the first lane
-// past the first window (two masked loads and a permutation; stores expand
-// back into the windows: a run's end and the next run's start), or
-// scattered.
-struct Lanes8 {
-  size_t j[8];
-  size_t j0, jB;  // the windows' starts
-  int nA;         // lanes in the first window (a prefix: the indices increase)
-  bool run, window;
-  __m512i perm;                // lane l takes position j[l] - j0, or 16 + j[l] - jB
-  __m512i shift;               // lane l takes lane l + nA (the second window's lanes first)
-  __mmask16 validA, validB;    // the positions up to each window's last lane
-  __mmask16 placedA, placedB;  // the positions of the distinct lanes
-};
-
-[[SYLVA_AVX512]] inline __m512d Load8(const float* base, const Lanes8& g) {
-  if (g.run) return _mm512_cvtps_pd(_mm256_loadu_ps(base + g.j0));
-  if (g.window) {
-    const __m512 wa = _mm512_maskz_loadu_ps(g.validA, base + g.j0);
-    const __m512 wb = _mm512_maskz_loadu_ps(g.validB, base + g.jB);
-    return _mm512_cvtps_pd(_mm512_castps512_ps256(_mm512_permutex2var_ps(wa, g.perm, wb)));
-  }
-  const size_t* j = g.j;
-  return _mm512_cvtps_pd(_mm256_set_ps(base[j[7]], base[j[6]], base[j[5]], base[j[4]], base[j[3]],
-                                       base[j[2]], base[j[1]], base[j[0]]));
-}
-
-// Lanes `mask` of v (the order of Load8) to their places.
-[[SYLVA_AVX512]] inline void Store8(float* base, const Lanes8& g, unsigned mask, __m256 v) {
-  const __m512 w = _mm512_castps256_ps512(v);
-  const unsigned maskA = mask & ((1u << g.nA) - 1);
-  if (maskA) {
-    _mm512_mask_storeu_ps(base + g.j0, __mmask16(_pdep_u32(maskA, g.placedA)),
-                          _mm512_maskz_expand_ps(g.placedA, w));
-  }
-  if (mask >> g.nA) {
-    _mm512_mask_storeu_ps(base + g.jB, __mmask16(_pdep_u32(mask >> g.nA, g.placedB)),
-                          _mm512_maskz_expand_ps(g.placedB, _mm512_permutexvar_ps(g.shift, w)));
-  }
-}
-
-[[SYLVA_AVX512]] void RestOnPlaneAvx512(const PlaneRest& q, const BulkArrays& ar,
-                                        const float* radius, const float* const* old, size_t begin,
-                                        const uint16_t* idx, size_t count, uint8_t* done) {
-  const __m512d n[3] = {_mm512_set1_pd(q.n[0]), _mm512_set1_pd(q.n[1]), _mm512_set1_pd(q.n[2])};
-  const __m512d p[3] = {_mm512_set1_pd(q.p[0]), _mm512_set1_pd(q.p[1]), _mm512_set1_pd(q.p[2])};
-  const __m512d h = _mm512_set1_pd(q.h), mh = _mm512_set1_pd(-q.h), half = _mm512_set1_pd(0.5);
-  const __m512d mu = _mm512_set1_pd(q.friction), zero = _mm512_setzero_pd();
+// BulkAdvanceAvx's step, the plane's candidate test (PlaneListAvx's) and
+// the resting kernel in one pass over eight particles at a time, each value
+// in registers from its load to its store: the same operations on the same
+// values as the three passes in turn. Returns the first index it did not
+// do; the candidates the resting kernel leaves go to idx (relative to
+// first), *count counting them.
+[[SYLVA_AVX512]] size_t AdvanceRestAvx512(const BulkParams& q, const PlaneRest& rq,
+                                          const BulkArrays& ar, const float* radius, size_t i,
+                                          size_t e, size_t first, float* const* old, uint16_t* idx,
+                                          size_t* count, bool* good) {
+  const __m256 gx = _mm256_set1_ps(q.gx), gy = _mm256_set1_ps(q.gy), gz = _mm256_set1_ps(q.gz);
+  const __m256 wx = _mm256_set1_ps(q.wx), wy = _mm256_set1_ps(q.wy), wz = _mm256_set1_ps(q.wz);
+  const __m256 k1 = _mm256_set1_ps(q.k1), k2 = _mm256_set1_ps(q.k2), hf = _mm256_set1_ps(q.h);
+  const __m256 zerof = _mm256_setzero_ps(), limit = _mm256_set1_ps(q.limit);
+  const __m256 absf = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  __m256 within = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+  const __m512d n[3] = {_mm512_set1_pd(rq.n[0]), _mm512_set1_pd(rq.n[1]), _mm512_set1_pd(rq.n[2])};
+  const __m512d p[3] = {_mm512_set1_pd(rq.p[0]), _mm512_set1_pd(rq.p[1]), _mm512_set1_pd(rq.p[2])};
+  const __m512d h = _mm512_set1_pd(rq.h), mh = _mm512_set1_pd(-q.h), half = _mm512_set1_pd(0.5);
+  const __m512d mu = _mm512_set1_pd(rq.friction), zero = _mm512_setzero_pd();
   const __m512d one = _mm512_set1_pd(1.0), tiny = _mm512_set1_pd(1e-300);
   const __m512d tol = _mm512_set1_pd(1e-12), mtol = _mm512_set1_pd(-1e-12);
-  const __m512d limit2 = _mm512_set1_pd(q.limit2);
-  const float* const now[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
-                               ar.vx + begin, ar.vy + begin, ar.vz + begin};
-  float* const to[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
-                        ar.vx + begin, ar.vy + begin, ar.vz + begin};
-  for (size_t k0 = 0; k0 < count; k0 += 8) {
-    // Eight lanes, the last repeated past the end; a run of consecutive
-    // ones (the common case) needs only its first.
-    Lanes8 g;
-    const size_t lanes = std::min(size_t(8), count - k0);
-    g.j0 = idx[k0];
-    g.run = lanes == 8 && idx[k0 + 7] == g.j0 + 7;
-    g.window = false;
-    if (!g.run) {
-      for (size_t l = 0; l < 8; ++l) g.j[l] = idx[k0 + std::min(l, lanes - 1)];
-      int nA = 1;
-      while (nA < 8 && g.j[nA] - g.j0 < 16) ++nA;
-      g.nA = nA;
-      g.jB = nA < 8 ? g.j[nA] : g.j0;
-      g.window = g.j[7] - g.jB < 16;
-    }
-    if (g.window) {
-      alignas(64) int32_t perm[16] = {}, shift[16] = {};
-      g.placedA = g.placedB = 0;
-      for (int l = 0; l < 8; ++l) {
-        const bool inA = l < g.nA;
-        const int at = int(g.j[l] - (inA ? g.j0 : g.jB));
-        perm[l] = inA ? at : 16 + at;
-        (inA ? g.placedA : g.placedB) |= __mmask16(1u << at);
-        shift[l] = (l + g.nA) & 15;
+  const __m512d limit2 = _mm512_set1_pd(rq.limit2);
+  size_t listed = *count;
+  for (; i + 8 <= e; i += 8) {
+    const size_t o = i - first;
+    // The advance (BulkAdvanceAvx).
+    const __m256 x0 = _mm256_loadu_ps(ar.px + i), y0 = _mm256_loadu_ps(ar.py + i);
+    const __m256 z0 = _mm256_loadu_ps(ar.pz + i), u0 = _mm256_loadu_ps(ar.vx + i);
+    const __m256 v0 = _mm256_loadu_ps(ar.vy + i), s0 = _mm256_loadu_ps(ar.vz + i);
+    const __m256 w = _mm256_loadu_ps(ar.invMass + i);
+    const __m256 rx0 = _mm256_sub_ps(u0, wx), ry0 = _mm256_sub_ps(v0, wy);
+    const __m256 rz0 = _mm256_sub_ps(s0, wz);
+    const __m256 speed = _mm256_sqrt_ps(_mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(rx0, rx0), _mm256_mul_ps(ry0, ry0)), _mm256_mul_ps(rz0, rz0)));
+    const __m256 kd = _mm256_mul_ps(_mm256_add_ps(k1, _mm256_mul_ps(k2, speed)), w);
+    const __m256 movable = _mm256_cmp_ps(w, zerof, _CMP_GT_OQ);
+    const __m256 ax = _mm256_sub_ps(_mm256_and_ps(movable, gx), _mm256_mul_ps(kd, rx0));
+    const __m256 ay = _mm256_sub_ps(_mm256_and_ps(movable, gy), _mm256_mul_ps(kd, ry0));
+    const __m256 az = _mm256_sub_ps(_mm256_and_ps(movable, gz), _mm256_mul_ps(kd, rz0));
+    const __m256 u1 = _mm256_and_ps(movable, _mm256_add_ps(u0, _mm256_mul_ps(hf, ax)));
+    const __m256 v1 = _mm256_and_ps(movable, _mm256_add_ps(v0, _mm256_mul_ps(hf, ay)));
+    const __m256 s1 = _mm256_and_ps(movable, _mm256_add_ps(s0, _mm256_mul_ps(hf, az)));
+    const __m256 x1f = _mm256_add_ps(x0, _mm256_mul_ps(hf, u1));
+    const __m256 y1f = _mm256_add_ps(y0, _mm256_mul_ps(hf, v1));
+    const __m256 z1f = _mm256_add_ps(z0, _mm256_mul_ps(hf, s1));
+    _mm256_storeu_ps(old[0] + o, x0), _mm256_storeu_ps(old[1] + o, y0);
+    _mm256_storeu_ps(old[2] + o, z0), _mm256_storeu_ps(old[3] + o, u0);
+    _mm256_storeu_ps(old[4] + o, v0), _mm256_storeu_ps(old[5] + o, s0);
+    within = _mm256_and_ps(
+        within, _mm256_and_ps(_mm256_and_ps(Within(x1f, absf, limit), Within(y1f, absf, limit)),
+                              _mm256_and_ps(Within(z1f, absf, limit), Within(u1, absf, limit))));
+    within = _mm256_and_ps(within, _mm256_and_ps(Within(v1, absf, limit), Within(s1, absf, limit)));
+    __m256 values[6] = {x1f, y1f, z1f, u1, v1, s1};
+    // The candidates (PlaneListAvx): movable particles that end behind the plane.
+    const __m512d x[3] = {_mm512_cvtps_pd(x1f), _mm512_cvtps_pd(y1f), _mm512_cvtps_pd(z1f)};
+    const __m512d r = _mm512_cvtps_pd(_mm256_loadu_ps(radius + i));
+    const __mmask8 below = _mm512_cmp_pd_mask(
+        Dot3(n, _mm512_sub_pd(x[0], p[0]), _mm512_sub_pd(x[1], p[1]), _mm512_sub_pd(x[2], p[2])), r,
+        _CMP_LT_OQ);
+    const __mmask8 candidates = below & _mm256_cmp_ps_mask(w, zerof, _CMP_NEQ_UQ);
+    if (candidates) {
+      // The resting kernel on them.
+      const __m512d a[3] = {_mm512_cvtps_pd(x0), _mm512_cvtps_pd(y0), _mm512_cvtps_pd(z0)};
+      const __m512d va[3] = {_mm512_cvtps_pd(u0), _mm512_cvtps_pd(v0), _mm512_cvtps_pd(s0)};
+      const __m512d v[3] = {_mm512_cvtps_pd(u1), _mm512_cvtps_pd(v1), _mm512_cvtps_pd(s1)};
+      __m512d dv[3], A[3], u[3], ap[3];
+      for (int c = 0; c < 3; ++c) {
+        dv[c] = _mm512_sub_pd(v[c], va[c]);
+        A[c] = _mm512_mul_pd(h, dv[c]);
+        u[c] = _mm512_sub_pd(_mm512_sub_pd(x[c], a[c]), _mm512_mul_pd(half, A[c]));
+        ap[c] = _mm512_sub_pd(a[c], p[c]);
       }
-      g.perm = _mm512_load_si512(perm);
-      g.shift = _mm512_load_si512(shift);
-      g.validA = __mmask16((2u << (g.j[g.nA - 1] - g.j0)) - 1);
-      g.validB = g.nA < 8 ? __mmask16((2u << (g.j[7] - g.jB)) - 1) : __mmask16(0);
-    }
-    __m512d a[3], va[3], x[3], v[3];
-    for (int c = 0; c < 3; ++c) {
-      a[c] = Load8(old[c], g);
-      va[c] = Load8(old[3 + c], g);
-      x[c] = Load8(now[c], g);
-      v[c] = Load8(now[3 + c], g);
-    }
-    const __m512d r = Load8(radius + begin, g);
-    __m512d dv[3], A[3], u[3], ap[3];
-    for (int c = 0; c < 3; ++c) {
-      dv[c] = _mm512_sub_pd(v[c], va[c]);
-      A[c] = _mm512_mul_pd(h, dv[c]);
-      u[c] = _mm512_sub_pd(_mm512_sub_pd(x[c], a[c]), _mm512_mul_pd(half, A[c]));
-      ap[c] = _mm512_sub_pd(a[c], p[c]);
-    }
-    // The plane's contact at the start (a candidate ends the step inside:
-    // d1 < 0): d0 <= 0 (s = 0).
-    const __m512d d0 = _mm512_sub_pd(Dot3(n, ap[0], ap[1], ap[2]), r);
-    __mmask8 ok = _mm512_cmp_pd_mask(d0, zero, _CMP_LE_OQ);
-    __m512d point[3], px[3];
-    for (int c = 0; c < 3; ++c) {
-      point[c] = _mm512_sub_pd(a[c], _mm512_mul_pd(d0, n[c]));
-      px[c] = _mm512_sub_pd(point[c], x[c]);
-    }
-    // Not a graze (sliding along the plane within rounding).
-    const __m512d xmax = Max(one, Max(Max(Abs(x[0]), Abs(x[1])), Abs(x[2])));
-    const __m512d umax = Max(tiny, Max(Max(Abs(u[0]), Abs(u[1])), Abs(u[2])));
-    const __m512d un = Dot3(n, u[0], u[1], u[2]);
-    const __mmask8 slides =
-        _mm512_cmp_pd_mask(Dot3(n, px[0], px[1], px[2]), _mm512_mul_pd(tol, xmax), _CMP_LE_OQ) &
-        _mm512_cmp_pd_mask(un, _mm512_mul_pd(mtol, umax), _CMP_GE_OQ);
-    ok &= ~slides;
-    // Resting: no faster toward the plane than the step's forces made it.
-    const __m512d gained = Max(zero, _mm512_mul_pd(mh, Dot3(n, dv[0], dv[1], dv[2])));
-    ok &= ~_mm512_cmp_pd_mask(Neg(un), gained, _CMP_GT_OQ);
-    // The response.
-    const __m512d en = Dot3(n, v[0], v[1], v[2]);
-    const __m512d jn = Max(zero, Neg(en));
-    __m512d vt[3];
-    for (int c = 0; c < 3; ++c) vt[c] = _mm512_sub_pd(v[c], _mm512_mul_pd(en, n[c]));
-    const __m512d change = _mm512_mul_pd(mu, jn);
-    const __m512d len = _mm512_sqrt_pd(
-        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(vt[0], vt[0]), _mm512_mul_pd(vt[1], vt[1])),
-                      _mm512_mul_pd(vt[2], vt[2])));
-    const __mmask8 stops = _mm512_cmp_pd_mask(len, change, _CMP_LE_OQ);
-    const __m512d keep = _mm512_sub_pd(one, _mm512_div_pd(change, len));
-    const __m512d up = Max(en, zero);
-    __m512d out[3], x1[3], x1p[3];
-    for (int c = 0; c < 3; ++c) {
-      const __m512d f = _mm512_mask_blend_pd(stops, _mm512_mul_pd(vt[c], keep), zero);
-      out[c] = _mm512_add_pd(f, _mm512_mul_pd(up, n[c]));
-      x1[c] = _mm512_add_pd(point[c], _mm512_mul_pd(h, out[c]));
-      x1p[c] = _mm512_sub_pd(x1[c], p[c]);
-    }
-    // Ends on the plane: no second contact, nothing to project.
-    ok &= _mm512_cmp_pd_mask(_mm512_sub_pd(Dot3(n, x1p[0], x1p[1], x1p[2]), r), zero, _CMP_GE_OQ);
-    // Rounded to floats on the plane's side: a rounding's displacement,
-    // doubled, must not cross it. (A rounding that changes nothing passes
-    // here too: its doubled displacement is 0, the test above.)
-    __m256 xf[3];
-    __m512d rx[3], by[3];
-    for (int c = 0; c < 3; ++c) {
-      xf[c] = _mm512_cvtpd_ps(x1[c]);
-      rx[c] = _mm512_cvtps_pd(xf[c]);
-      by[c] = _mm512_sub_pd(_mm512_add_pd(rx[c], _mm512_sub_pd(rx[c], x1[c])), p[c]);
-    }
-    const __m512d db = _mm512_sub_pd(Dot3(n, by[0], by[1], by[2]), r);
-    ok &= _mm512_cmp_pd_mask(db, zero, _CMP_GE_OQ);
-    // Within the magnitude limit.
-    const __m512d xx =
-        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(rx[0], rx[0]), _mm512_mul_pd(rx[1], rx[1])),
-                      _mm512_mul_pd(rx[2], rx[2]));
-    const __m512d vv =
-        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(out[0], out[0]), _mm512_mul_pd(out[1], out[1])),
-                      _mm512_mul_pd(out[2], out[2]));
-    ok &= _mm512_cmp_pd_mask(_mm512_add_pd(xx, vv), limit2, _CMP_LE_OQ);
-    const unsigned mask = unsigned(ok) & ((1u << lanes) - 1);
-    const __m256 values[6] = {xf[0],
-                              xf[1],
-                              xf[2],
-                              _mm512_cvtpd_ps(out[0]),
-                              _mm512_cvtpd_ps(out[1]),
-                              _mm512_cvtpd_ps(out[2])};
-    if (lanes == 8) {
-      const uint64_t bytes = _pdep_u64(mask, 0x0101010101010101ull);  // a byte a lane
-      std::memcpy(done + k0, &bytes, 8);
-    } else {
-      for (size_t l = 0; l < lanes; ++l) done[k0 + l] = (mask >> l) & 1;
-    }
-    if (g.run) {
-      if (mask == 0xff) {
-        for (int c = 0; c < 6; ++c) _mm256_storeu_ps(to[c] + g.j0, values[c]);
-      } else {
-        for (int c = 0; c < 6; ++c) _mm256_mask_storeu_ps(to[c] + g.j0, __mmask8(mask), values[c]);
+      // The plane's contact at the start (a candidate ends the step inside:
+      // d1 < 0): d0 <= 0 (s = 0).
+      const __m512d d0 = _mm512_sub_pd(Dot3(n, ap[0], ap[1], ap[2]), r);
+      __mmask8 ok = _mm512_cmp_pd_mask(d0, zero, _CMP_LE_OQ);
+      __m512d point[3], px[3];
+      for (int c = 0; c < 3; ++c) point[c] = _mm512_sub_pd(a[c], _mm512_mul_pd(d0, n[c]));
+      // Not a graze (sliding along the plane within rounding): a path not
+      // into the plane (rare for a candidate), ending on it.
+      const __m512d umax = Max(tiny, Max(Max(Abs(u[0]), Abs(u[1])), Abs(u[2])));
+      const __m512d un = Dot3(n, u[0], u[1], u[2]);
+      const __mmask8 along = _mm512_cmp_pd_mask(un, _mm512_mul_pd(mtol, umax), _CMP_GE_OQ);
+      if (along & ok) {
+        for (int c = 0; c < 3; ++c) px[c] = _mm512_sub_pd(point[c], x[c]);
+        const __m512d xmax = Max(one, Max(Max(Abs(x[0]), Abs(x[1])), Abs(x[2])));
+        ok &= ~(
+            _mm512_cmp_pd_mask(Dot3(n, px[0], px[1], px[2]), _mm512_mul_pd(tol, xmax), _CMP_LE_OQ) &
+            along);
       }
-    } else if (g.window) {
-      for (int c = 0; c < 6; ++c) Store8(to[c], g, mask, values[c]);
-    } else {
-      alignas(32) float fx[6][8];
-      for (int c = 0; c < 6; ++c) _mm256_store_ps(fx[c], values[c]);
-      for (size_t l = 0; l < lanes; ++l) {
-        if (!((mask >> l) & 1)) continue;
-        for (int c = 0; c < 6; ++c) to[c][g.j[l]] = fx[c][l];
+      // Resting: no faster toward the plane than the step's forces made it.
+      const __m512d gained = Max(zero, _mm512_mul_pd(mh, Dot3(n, dv[0], dv[1], dv[2])));
+      ok &= ~_mm512_cmp_pd_mask(Neg(un), gained, _CMP_GT_OQ);
+      // The response.
+      const __m512d en = Dot3(n, v[0], v[1], v[2]);
+      const __m512d jn = Max(zero, Neg(en));
+      __m512d vt[3];
+      for (int c = 0; c < 3; ++c) vt[c] = _mm512_sub_pd(v[c], _mm512_mul_pd(en, n[c]));
+      const __m512d change = _mm512_mul_pd(mu, jn);
+      const __m512d len = _mm512_sqrt_pd(
+          _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(vt[0], vt[0]), _mm512_mul_pd(vt[1], vt[1])),
+                        _mm512_mul_pd(vt[2], vt[2])));
+      const __mmask8 stops = _mm512_cmp_pd_mask(len, change, _CMP_LE_OQ);
+      const __m512d keep = _mm512_sub_pd(one, _mm512_div_pd(change, len));
+      const __m512d up = Max(en, zero);
+      __m512d out[3], x1[3], x1p[3];
+      for (int c = 0; c < 3; ++c) {
+        const __m512d f = _mm512_mask_blend_pd(stops, _mm512_mul_pd(vt[c], keep), zero);
+        out[c] = _mm512_add_pd(f, _mm512_mul_pd(up, n[c]));
+        x1[c] = _mm512_add_pd(point[c], _mm512_mul_pd(h, out[c]));
+        x1p[c] = _mm512_sub_pd(x1[c], p[c]);
       }
+      // Ends on the plane: no second contact, nothing to project.
+      ok &= _mm512_cmp_pd_mask(_mm512_sub_pd(Dot3(n, x1p[0], x1p[1], x1p[2]), r), zero, _CMP_GE_OQ);
+      // Rounded to floats on the plane's side: a rounding's displacement,
+      // doubled, must not cross it. (A rounding that changes nothing passes
+      // here too: its doubled displacement is 0, the test above.)
+      __m256 xf[3];
+      __m512d rx[3], by[3];
+      for (int c = 0; c < 3; ++c) {
+        xf[c] = _mm512_cvtpd_ps(x1[c]);
+        rx[c] = _mm512_cvtps_pd(xf[c]);
+        by[c] = _mm512_sub_pd(_mm512_add_pd(rx[c], _mm512_sub_pd(rx[c], x1[c])), p[c]);
+      }
+      const __m512d db = _mm512_sub_pd(Dot3(n, by[0], by[1], by[2]), r);
+      ok &= _mm512_cmp_pd_mask(db, zero, _CMP_GE_OQ);
+      // Within the magnitude limit.
+      const __m512d xx =
+          _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(rx[0], rx[0]), _mm512_mul_pd(rx[1], rx[1])),
+                        _mm512_mul_pd(rx[2], rx[2]));
+      const __m512d vv =
+          _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(out[0], out[0]), _mm512_mul_pd(out[1], out[1])),
+                        _mm512_mul_pd(out[2], out[2]));
+      ok &= _mm512_cmp_pd_mask(_mm512_add_pd(xx, vv), limit2, _CMP_LE_OQ);
+      const __mmask8 done = ok & candidates;
+      const __m256 rested[6] = {xf[0],
+                                xf[1],
+                                xf[2],
+                                _mm512_cvtpd_ps(out[0]),
+                                _mm512_cvtpd_ps(out[1]),
+                                _mm512_cvtpd_ps(out[2])};
+      for (int c = 0; c < 6; ++c) values[c] = _mm256_mask_blend_ps(done, values[c], rested[c]);
+      // The rest to the general path.
+      for (unsigned left = unsigned(candidates & ~done); left; left &= left - 1)
+        idx[listed++] = uint16_t(o + unsigned(__builtin_ctz(left)));
     }
+    float* const to[6] = {ar.px, ar.py, ar.pz, ar.vx, ar.vy, ar.vz};
+    for (int c = 0; c < 6; ++c) _mm256_storeu_ps(to[c] + i, values[c]);
   }
+  *count = listed;
+  *good = *good && _mm256_movemask_ps(within) == 0xff;
+  return i;
 }
 
 #pragma GCC diagnostic pop
@@ -667,10 +627,27 @@ size_t BulkPlaneCandidateList(Kernel kernel, const double* n, const double* p, c
   return count;
 }
 
-void BulkRestOnPlane(int lanes, const PlaneRest& q, const BulkArrays& a, const float* radius,
+size_t BulkAdvanceRestOnPlane(const BulkParams& q, const PlaneRest& rest, const BulkArrays& a,
+                              const float* radius, size_t begin, size_t end, float* const* old,
+                              uint16_t* idx, bool* ok) {
+  size_t count = 0;
+  const size_t tail =
+      AdvanceRestAvx512(q, rest, a, radius, begin, end, begin, old, idx, &count, ok);
+  // The tail (fewer than eight): the advance, and its candidates to the
+  // general path.
+  for (size_t i = tail; i < end; ++i) *ok &= BulkOne(q, a, i, old, i - begin);
+  for (size_t i = tail; i < end; ++i) {
+    const double d =
+        (rest.n[0] * (double(a.px[i]) - rest.p[0]) + rest.n[1] * (double(a.py[i]) - rest.p[1])) +
+        rest.n[2] * (double(a.pz[i]) - rest.p[2]);
+    if (d < double(radius[i]) && a.invMass[i] != 0) idx[count++] = uint16_t(i - begin);
+  }
+  return count;
+}
+
+void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radius,
                      const float* const* old, size_t begin, const uint16_t* idx, size_t count,
                      uint8_t* done) {
-  if (lanes == 8) return RestOnPlaneAvx512(q, a, radius, old, begin, idx, count, done);
   RestOnPlaneAvx(q, a, radius, old, begin, idx, count, done);
 }
 

@@ -129,13 +129,22 @@ struct PlaneRest {
 // the arrays, increasing, each a movable particle that ends the step inside
 // the plane: the plane's candidates; `old` holds the step's start state by
 // chunk index as in BulkAdvance): writes the particles it resolves into the arrays and
-// sets done[k] to 1 for them, 0 for the rest. `lanes`: 4 (AVX) or 8
-// (AVX-512), the same bits; at most RestLanes().
-void BulkRestOnPlane(int lanes, const PlaneRest& q, const BulkArrays& a, const float* radius,
+// sets done[k] to 1 for them, 0 for the rest. AVX, four lanes.
+void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radius,
                      const float* const* old, size_t begin, const uint16_t* idx, size_t count,
                      uint8_t* done);
-// The widest BulkRestOnPlane this processor runs: 8 lanes with AVX-512 (F,
-// DQ, VL) and BMI2, 4 with AVX, 0 without AVX (no vector path).
+// BulkAdvance (AVX), BulkPlaneCandidateList and BulkRestOnPlane in one
+// pass over [begin, end), each particle's values kept in registers from
+// its load to its store (8 lanes; only where RestLanes() is 8): the same
+// bits as the three in turn. Writes to idx the candidates the resting
+// kernel leaves (for the general path), as BulkPlaneCandidateList, and
+// returns their count; ANDs BulkAdvance's check into *ok.
+size_t BulkAdvanceRestOnPlane(const BulkParams& q, const PlaneRest& rest, const BulkArrays& a,
+                              const float* radius, size_t begin, size_t end, float* const* old,
+                              uint16_t* idx, bool* ok);
+// The widest resting-floor path this processor runs: 8 lanes
+// (BulkAdvanceRestOnPlane) with AVX-512 (F, DQ, VL) and BMI2, 4
+// (BulkRestOnPlane) with AVX, 0 without AVX (no vector path).
 int RestLanes();
 
 }  // namespace sylva::particles::kernels
