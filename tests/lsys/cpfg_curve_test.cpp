@@ -97,6 +97,23 @@ TEST(CpfgCurve, ViewFileCurvesServeCurveXYAndGal) {
   EXPECT_NEAR(w->word.params[1], M_PI / 2, 5e-4) << w->word.params[1];
 }
 
+TEST(CpfgCurve, StatementBlocksReadCurvesAsRidleysSpiralDoes) {
+  // vlab's Ridley/spiral.l walks the curve in a while loop of a block.
+  const std::string g =
+      "Start: {L = curveGAL(1);}\naxiom: A(0)\n"
+      "A(s) : s < L {x = 0; while (s < 0.75 * L) {s = s + 0.5; x = curveX(1, s / L);}} "
+      "--> B(s, x)\n";
+  ParseResult r = ParseGrammarText(g, "c.l", Files());
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  DeriveOptions opt;
+  opt.steps = 1;
+  auto w = Derive(*r.grammar, opt);
+  ASSERT_TRUE(w) << w.error().Format();
+  ASSERT_EQ(w->word.params.size(), 2u);
+  EXPECT_DOUBLE_EQ(w->word.params[0], 2.5);
+  EXPECT_NEAR(w->word.params[1], 2.5, 1e-3) << w->word.params[1];  // x at length 2.5 of 3
+}
+
 TEST(CpfgCurve, ErrorsAreLocated) {
   auto first = [](const std::string& g, const ParseOptions& opt) {
     ParseResult r = ParseGrammarText(g, "c.l", opt);
