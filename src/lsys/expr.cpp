@@ -333,7 +333,7 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
         if (++loops > kMaxLoopIterations)
           return Fail(err, int(columns_[pc]),
                       "loop ran more than 1000000 times (a loop that never ends?)");
-        pc = in.arg - 1;
+        pc = size_t(in.arg) - 1;  // arg 0: wraps, and ++pc makes it 0
         break;
       case OpCode::kAdd:
         --sp;
@@ -358,7 +358,7 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
       case OpCode::kAndJump:
         if (stack[sp - 1] == 0) {
           stack[sp - 1] = 0;
-          pc = in.arg - 1;
+          pc = size_t(in.arg) - 1;
         } else {
           --sp;
         }
@@ -366,17 +366,17 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
       case OpCode::kOrJump:
         if (stack[sp - 1] != 0) {
           stack[sp - 1] = 1;
-          pc = in.arg - 1;
+          pc = size_t(in.arg) - 1;
         } else {
           --sp;
         }
         break;
       case OpCode::kJumpIfZero:
         --sp;
-        if (stack[sp] == 0) pc = in.arg - 1;
+        if (stack[sp] == 0) pc = size_t(in.arg) - 1;
         break;
       case OpCode::kJump:
-        pc = in.arg - 1;
+        pc = size_t(in.arg) - 1;
         break;
       case OpCode::kRan:
         stack[sp - 1] = stack[sp - 1] * rng.Uniform();
