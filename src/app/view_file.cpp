@@ -23,6 +23,7 @@ namespace fs = std::filesystem;
 // a few kilobytes of materials.
 constexpr size_t kMaxViewBytes = size_t(1) << 20;
 constexpr size_t kMaxColorBytes = size_t(64) << 10;
+constexpr size_t kMaxBackgroundBytes = size_t(16) << 20;  // a background scene file
 constexpr size_t kMapBytes = 768;
 constexpr size_t kMaterialBytes = 15;
 // A file that is not a view file (a binary one) stops here, not after a
@@ -63,7 +64,6 @@ constexpr Ignored kIgnored[] = {
     {"torque:", "torque tropism is not implemented"},
     {"texture:", "textures are not implemented"},
     {"tapered lines:", "Sylva's tubes taper to the width of the next segment"},
-    {"background scene:", kNotActed},
     {"interpretation step:", kNotActed},
     {"interpretation past %:", kNotActed},
     {"rayshade objects:", kNotActed},
@@ -71,7 +71,6 @@ constexpr Ignored kIgnored[] = {
     {"initial scale:", "@D scaling is not implemented"},
     {"scale multiplier:", "@D scaling is not implemented"},
     {"environment display:", kNotActed},
-    {"curve:", "cpfg curve files are not read"},
     {"antialiasing:", "use render --supersample"},
     {"min zoom:", kNotActed},
     {"max zoom:", kNotActed},
@@ -483,6 +482,56 @@ void Reader::Read(const app::Line& line) {
       return;
     }
     if (tokens_.size() > 1) Number(1, "a number of samples");
+    ExtraValues(2);
+  } else if (L == "background scene:") {
+    // cpfg: the names are separated by blanks, commas or semicolons.
+    if (tokens_.empty()) {
+      Error(int(current_.size()) + 1, "expected 'background scene: FILE'");
+      return;
+    }
+    for (const Token& t : tokens_) {
+      size_t s = 0;
+      while (s < t.text.size()) {
+        size_t e = t.text.find_first_of(",;", s);
+        if (e == std::string::npos) e = t.text.size();
+        if (e > s) {
+          const fs::path file(t.text.substr(s, e - s));
+          ViewFile::NamedFile f;
+          f.file = file.is_absolute()
+                       ? file.string()
+                       : (fs::path(path_).parent_path() / file).lexically_normal().string();
+          f.line = line_;
+          f.column = t.column + int(s);
+          v_.backgroundFiles.push_back(std::move(f));
+        }
+        s = e + 1;
+      }
+    }
+  } else if (L == "curve:") {
+    // `curve: FILE.con [samples]`: curveX(1, t) reads the first; samples
+    // is the size of cpfg's arc-length table (lsys/cpfg_curve.h).
+    if (tokens_.empty()) {
+      Error(int(current_.size()) + 1, "expected 'curve: FILE.con [samples]'");
+      return;
+    }
+    const fs::path file(tokens_[0].text);
+    lsys::ParseOptions::CurveFile c;
+    c.file = file.is_absolute()
+                 ? file.string()
+                 : (fs::path(path_).parent_path() / file).lexically_normal().string();
+    c.from = path_;
+    c.line = line_;
+    c.column = tokens_[0].column;
+    if (tokens_.size() > 1) {
+      const std::optional<double> n = Number(1, "a number of samples");
+      if (!n) return;
+      if (*n < 2 || *n > 1000000 || *n != std::floor(*n)) {
+        Error(tokens_[1].column, "a curve's samples must be a whole number from 2 to 1000000");
+        return;
+      }
+      c.samples = int(*n);
+    }
+    v_.curves.push_back(std::move(c));
     ExtraValues(2);
   } else {
     for (const Ignored& ig : kIgnored) {
@@ -905,6 +954,23 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
     before.items.insert(before.items.end(), v->diagnostics.items.begin(),
                         v->diagnostics.items.end());
     v->diagnostics.items = std::move(before.items);
+    // The background scenes the view file names (app/cpfg_background.h).
+    for (const ViewFile::NamedFile& f : v->backgroundFiles) {
+      auto text = ReadRegular(f.file, kMaxBackgroundBytes);
+      if (!text) {
+        Diagnostic d = text.error();
+        d.message = "background scene: " + d.message;
+        d.loc = SourceLoc{viewPath.string(), f.line, f.column};
+        v->diagnostics.Add(std::move(d));
+        continue;
+      }
+      auto scene = ParseBackgroundScene(*text, f.file, v->diagnostics);
+      if (!scene) {
+        v->diagnostics.Add(scene.error());
+        continue;
+      }
+      v->backgrounds.push_back(std::make_shared<const BackgroundScene>(std::move(*scene)));
+    }
   }
   // cpfg's animation file beside the grammar (only its overlaid frames
   // change a still picture).
@@ -1052,6 +1118,12 @@ void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec
     spec.draw.contours = std::make_shared<const turtle::CylinderContours>(view->contours);
   spec.cpfgSurfaces = view->surfaces;
   spec.cpfgFunctions = view->functions;
+  spec.cpfgCurves = view->curves;
+  if (!view->backgrounds.empty()) {
+    spec.amendGeometry = [view](mesh::PlantGeometry& geometry, mesh::Palette& palette) {
+      for (const auto& b : view->backgrounds) AddBackgroundScene(*b, geometry, palette);
+    };
+  }
   spec.cpfgViewFile = view->path;
   spec.amendGrammar = [view](lsys::Grammar& g, DiagnosticList& diagnostics) {
     for (const Diagnostic& d : view->diagnostics.items) diagnostics.Add(d);

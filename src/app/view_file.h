@@ -28,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "app/cpfg_background.h"
 #include "core/diagnostic.h"
 #include "core/math.h"
 #include "lsys/grammar.h"
@@ -88,6 +89,17 @@ struct ViewFile {
   // (`line style: cylinder`, or `initial line width: W s...`).
   turtle::CylinderContours contours;
   bool cylinderStyle = false;
+  // `curve: FILE.con [samples]`, in order (curveX(1, t) the first).
+  std::vector<lsys::ParseOptions::CurveFile> curves;
+  // `background scene: FILE[,FILE...]`: the files, resolved, with the
+  // line and column that name them; LoadViewFiles reads them into
+  // `backgrounds` (app/cpfg_background.h), drawn with the plant.
+  struct NamedFile {
+    std::string file;
+    int line = 0, column = 0;
+  };
+  std::vector<NamedFile> backgroundFiles;
+  std::vector<std::shared_ptr<const BackgroundScene>> backgrounds;
   DiagnosticList diagnostics;  // warnings, and errors that stop the build
 };
 
@@ -129,9 +141,10 @@ void ParseAnimationFile(const std::string& text, const std::string& path, ViewFi
 // as the turtle's defaults).
 void ApplyViewFile(const ViewFile& view, lsys::Grammar& grammar);
 
-// Sets spec.cpfgSurfaces and spec.cpfgFunctions (the view's `surface:` and
-// `function:` lines), spec.draw.contours (its contours, with line style
-// cylinder) and
+// Sets spec.cpfgSurfaces, spec.cpfgFunctions and spec.cpfgCurves (the
+// view's `surface:`, `function:` and `curve:` lines), spec.draw.contours
+// (its contours, with line style cylinder), spec.amendGeometry (its
+// background scenes drawn with the plant) and
 // spec.amendGrammar: the view applied and its diagnostics added to the
 // plant's (so --strict counts them).
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec);

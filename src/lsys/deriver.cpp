@@ -860,6 +860,7 @@ Status Pass::Run(const Word& in, Word& out, bool* changed) {
   w.paramStart = inHasParams ? in.paramStart.data() : nullptr;
   w.params = inHasParams ? in.params.data() : nullptr;
   w.skip = g_.contextSkip.data();
+  w.ring = g_.ring;
   if (needsMatch_) {
     match_.ResizeUninitialized(n);
     MatchBrackets(in);

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "core/math.h"
+#include "lsys/cpfg_curve.h"
 #include "lsys/cpfg_data_files.h"
 #include "lsys/cpfg_function.h"
 #include "lsys/expr_parser.h"
@@ -185,6 +186,7 @@ static int OpArity(OpCode op) {
     case OpCode::kTrunc:
     case OpCode::kRan:
     case OpCode::kFunc:
+    case OpCode::kCurve:
       return 1;
     case OpCode::kClamp:
       return 3;
@@ -331,7 +333,7 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
         if (++loops > kMaxLoopIterations)
           return Fail(err, int(columns_[pc]),
                       "loop ran more than 1000000 times (a loop that never ends?)");
-        pc = in.arg - 1;
+        pc = size_t(in.arg) - 1;  // arg 0: wraps, and ++pc makes it 0
         break;
       case OpCode::kAdd:
         --sp;
@@ -356,7 +358,7 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
       case OpCode::kAndJump:
         if (stack[sp - 1] == 0) {
           stack[sp - 1] = 0;
-          pc = in.arg - 1;
+          pc = size_t(in.arg) - 1;
         } else {
           --sp;
         }
@@ -364,17 +366,17 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
       case OpCode::kOrJump:
         if (stack[sp - 1] != 0) {
           stack[sp - 1] = 1;
-          pc = in.arg - 1;
+          pc = size_t(in.arg) - 1;
         } else {
           --sp;
         }
         break;
       case OpCode::kJumpIfZero:
         --sp;
-        if (stack[sp] == 0) pc = in.arg - 1;
+        if (stack[sp] == 0) pc = size_t(in.arg) - 1;
         break;
       case OpCode::kJump:
-        pc = in.arg - 1;
+        pc = size_t(in.arg) - 1;
         break;
       case OpCode::kRan:
         stack[sp - 1] = stack[sp - 1] * rng.Uniform();
@@ -389,6 +391,9 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
         break;
       case OpCode::kFunc:
         stack[sp - 1] = funcs_[in.arg]->Value(stack[sp - 1]);
+        break;
+      case OpCode::kCurve:
+        stack[sp - 1] = curves_[in.arg / 3]->AtLength(stack[sp - 1])[int(in.arg % 3)];
         break;
       case OpCode::kBran:
       case OpCode::kBiran: {
@@ -475,9 +480,8 @@ constexpr FunctionInfo kFunctions[] = {
 
 // cpfg's functions that Sylva does not have: named as such when called.
 constexpr std::string_view kCpfgFunctions[] = {
-    "srand",  "inblob",   "stop",           "printf",         "fprintf", "fopen",
-    "fclose", "fflush",   "fscanf",         "play",           "curveX",  "curveY",
-    "curveZ", "curveGAL", "setDerivLength", "getDerivLength", "display"};
+    "srand",  "inblob", "stop", "printf",         "fprintf",        "fopen",  "fclose",
+    "fflush", "fscanf", "play", "setDerivLength", "getDerivLength", "display"};
 
 bool IsRandom(OpCode op) {
   return op == OpCode::kRan || op == OpCode::kUniform || op == OpCode::kNormal ||
@@ -862,8 +866,52 @@ class Parser {
     return n;
   }
 
+  // cpfg's curveX/Y/Z(id, t) and curveGAL(id) (curveXYZc.cpp): id a
+  // constant from 1 to the number of curves; curveGAL is that curve's
+  // length, a constant.
+  NodePtr Curve(const std::string& name, int col, int len, int depth) {
+    const bool length = name == "curveGAL";
+    const std::string usage = length ? "curveGAL takes 1 argument: curveGAL(id)"
+                                     : name + " takes 2 arguments: " + name + "(id, t)";
+    ++p_;  // '('
+    NodePtr id = Ternary(depth + 1);
+    if (!id) return nullptr;
+    NodePtr t;
+    if (!length) {
+      if (!Accept(",")) return Error(Col(), usage);
+      t = Ternary(depth + 1);
+      if (!t) return nullptr;
+    }
+    if (!Accept(")")) return Error(Col(), usage);
+    const size_t count = scope_.curves ? scope_.curves->size() : 0;
+    if (count == 0)
+      return Error(col,
+                   name +
+                       " needs cpfg curve files: name them with 'curve: FILE.con' lines in "
+                       "the view file",
+                   len);
+    if (id->op != OpCode::kConst || id->value != std::floor(id->value) || id->value < 1 ||
+        id->value > double(count)) {
+      return Error(col,
+                   name + ": id must be a whole number from 1 to " + std::to_string(count) +
+                       " (the view file's 'curve:' lines)",
+                   len);
+    }
+    const uint32_t index = uint32_t(id->value) - 1;
+    if (length) {
+      auto n = Make(OpCode::kConst, col);
+      n->value = (*scope_.curves)[index]->Length();
+      return n;
+    }
+    auto n = Make(OpCode::kCurve, col, std::move(t));
+    n->slot = index * 3 + uint32_t(name == "curveX" ? 0 : (name == "curveY" ? 1 : 2));
+    return n;
+  }
+
   NodePtr Call(const std::string& name, int col, int len, int depth) {
     if (name == "func") return Func(col, len, depth);
+    if (name == "curveX" || name == "curveY" || name == "curveZ" || name == "curveGAL")
+      return Curve(name, col, len, depth);
     if (scope_.macros) {
       auto it = scope_.macros->find(name);
       if (it != scope_.macros->end()) return Macro(name, it->second, col, len, depth);
@@ -880,16 +928,6 @@ class Parser {
                          "(...);'), not inside an expression",
                      len);
       for (std::string_view c : kCpfgFunctions) {
-        if (name == c && name.rfind("curve", 0) == 0) {
-          // cpfg curveXYZc.cpp: the curves are the view file's `curve:` files.
-          return Error(
-              col,
-              "cpfg function '" + name +
-                  "' is not supported by Sylva: it reads the curve of a view file's "
-                  "'curve:' line (curveX/Y/Z(id, t): a coordinate of its point at t from 0 "
-                  "to 1; curveGAL(id): the curve's length)",
-              len);
-        }
         if (name == c)
           return Error(col, "cpfg function '" + name + "' is not supported by Sylva", len);
       }
@@ -1032,8 +1070,8 @@ class ExprCompiler {
   // Folds one node whose children are folded.
   bool FoldNode(Node& n) {
     if (n.op == OpCode::kConst || n.op == OpCode::kFormal || n.op == OpCode::kGlobal ||
-        n.op == OpCode::kFunc || IsRandom(n.op) || n.op == OpCode::kIndex ||
-        n.op == OpCode::kGlobalAt)
+        n.op == OpCode::kFunc || n.op == OpCode::kCurve || IsRandom(n.op) ||
+        n.op == OpCode::kIndex || n.op == OpCode::kGlobalAt)
       return true;
     for (auto& k : n.kids) {
       if (k->op != OpCode::kConst) {
@@ -1199,6 +1237,7 @@ class ExprCompiler {
   void TakeFunctions(Expr& e) const {
     for (const Instr& in : e.code_) {
       if (in.op == OpCode::kFunc && scope_ && scope_->functions) e.funcs_ = *scope_->functions;
+      if (in.op == OpCode::kCurve && scope_ && scope_->curves) e.curves_ = *scope_->curves;
       if ((in.op == OpCode::kFopen || in.op == OpCode::kFscanf || in.op == OpCode::kFclose) &&
           scope_ && scope_->dataFiles)
         e.files_ = *scope_->dataFiles;

@@ -25,6 +25,7 @@
 namespace sylva::lsys {
 
 class CpfgFunction;
+class CpfgCurve;
 class CpfgDataFiles;
 
 enum class OpCode : uint8_t {
@@ -74,6 +75,7 @@ enum class OpCode : uint8_t {
   kBran,         // cpfg bran(a, b): beta distribution
   kBiran,        // cpfg biran(n, p): binomial distribution
   kFunc,         // cpfg func(id, x): top = funcs_[arg]->Value(top)
+  kCurve,        // cpfg curveX/Y/Z(id, t): top = coordinate arg % 3 of curves_[arg / 3] at top
   kGlobal,       // push globals[arg]
   kStore,        // pop into vars[arg] (a formal slot or a local)
   kStoreGlobal,  // pop into globals[arg]
@@ -159,6 +161,7 @@ class Expr {
   std::vector<Instr> code_;
   std::vector<uint32_t> columns_;  // per instruction: column of the operation, for errors
   std::vector<std::shared_ptr<const CpfgFunction>> funcs_;  // of kFunc: the grammar's functions
+  std::vector<std::shared_ptr<const CpfgCurve>> curves_;    // of kCurve: the grammar's curves
   std::shared_ptr<CpfgDataFiles> files_;  // of kFopen, kFscanf, kFclose: the grammar's data files
 };
 

@@ -87,6 +87,8 @@ struct ExprScope {
   const std::shared_ptr<CpfgDataFiles>* dataFiles = nullptr;
   // cpfg function files, for `func(id, x)`: id 1 is the first.
   const std::vector<std::shared_ptr<const CpfgFunction>>* functions = nullptr;
+  // cpfg curve files, for `curveX(id, t)` ... and `curveGAL(id)`: id 1 is the first.
+  const std::vector<std::shared_ptr<const CpfgCurve>>* curves = nullptr;
   // cpfg arrays: `a[i][j]` in expressions, `a[i][j] = v;` in blocks.
   const std::vector<ArrayShape>* arrays = nullptr;
   // The hidden global slot `srand(seed);` stores to (-1: srand is an error

@@ -16,6 +16,7 @@
 
 #include "core/diagnostic.h"
 #include "lsys/cpfg_data_files.h"
+#include "lsys/cpfg_curve.h"
 #include "lsys/cpfg_function.h"
 #include "lsys/expr.h"
 #include "lsys/expr_parser.h"
@@ -216,6 +217,12 @@ struct Grammar {
   std::vector<std::string> strings;
   // cpfg function files (`functions: a.func b.func`), for func(id, x).
   std::vector<std::shared_ptr<const CpfgFunction>> functions;
+  // cpfg's `ring lsystem`: the word is a ring for context matching, its
+  // last module the left neighbour of its first (lsys/matcher.h).
+  bool ring = false;
+  // cpfg curve files (a view file's `curve:` lines), for curveX/Y/Z(id, t)
+  // and curveGAL(id).
+  std::vector<std::shared_ptr<const CpfgCurve>> curves;
   std::optional<Expr> startBlock, startEachBlock, endEachBlock, endBlock;
   // cpfg data files the blocks read (`fopen(NAME, "r")`, `fscanf`), read
   // when parsed; null when there are none. A derivation starts with none

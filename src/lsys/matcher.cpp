@@ -83,6 +83,10 @@ bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, d
       // Ignored modules first (an ignored `[` too: it then never matches,
       // as in cpfg).
       while (j < n && w.skip[w.symbols[j]]) ++j;
+      if (j >= n && w.ring && depth == 0 && n > 0) {  // on around the ring
+        j = 0;
+        while (j < n && w.skip[w.symbols[j]]) ++j;
+      }
       if (j >= n || w.symbols[j] != kOpenBracket || depth == kMaxNesting) return false;
       opened[depth++] = uint32_t(j);
       ++j;

@@ -16,6 +16,11 @@
 // (the context then reads into and out of branches); the left context
 // always follows the branching (cpfg's LconDiff). Both matchers bind the
 // context modules' parameters into the formal slots.
+//
+// A ring word (cpfg's `ring lsystem`, WordView::ring) closes on itself: a
+// left context that reaches the start of the word goes on from its end,
+// and a right context that reaches the end goes on from its start, each at
+// most once per module read, so a word of ignored modules does not loop.
 #pragma once
 
 #include <cstdint>
@@ -33,6 +38,7 @@ struct WordView {
   const double* params = nullptr;
   const uint32_t* bracketMatch = nullptr;  // at '[' and ']' positions; kNoMatch if unbalanced
   const uint8_t* skip = nullptr;           // per symbol id
+  bool ring = false;  // cpfg's ring L-system: the last module is the first one's left neighbour
 };
 
 // Bracket partners of every '[' and ']' (other entries are left unset).
@@ -54,8 +60,13 @@ bool MatchRight(const Production& p, const WordView& w, size_t i, size_t next, d
 // --- inline definitions (hot: called once or twice per module) ---
 
 inline size_t PrevInContext(const WordView& w, size_t j) {
+  bool wrapped = false;
   for (;;) {
-    if (j == 0) return kNoPosition;
+    if (j == 0) {
+      if (!w.ring || wrapped || w.size == 0) return kNoPosition;
+      wrapped = true;
+      j = w.size;  // the ring's last module is the first one's left neighbour
+    }
     --j;
     const SymbolId s = w.symbols[j];
     if (s == kCloseBracket) {
@@ -70,8 +81,13 @@ inline size_t PrevInContext(const WordView& w, size_t j) {
 }
 
 inline size_t NextInContext(const WordView& w, size_t j) {
+  bool wrapped = false;
   for (;;) {
-    if (j >= w.size) return kNoPosition;
+    if (j >= w.size) {
+      if (!w.ring || wrapped || w.size == 0) return kNoPosition;
+      wrapped = true;
+      j = 0;  // the ring's first module is the last one's right neighbour
+    }
     const SymbolId s = w.symbols[j];
     if (w.skip[s]) {  // ignored (a bracket too, when ignore: names it)
       ++j;

@@ -234,6 +234,9 @@ class GrammarParser {
     }
     if (msg.rfind("func(id, x)", 0) == 0 && functionFilesFailed_) return;  // reported at the file
     if (msg.rfind("func(id, x) needs cpfg function files", 0) == 0) msg += FunctionsHint();
+    if (msg.rfind("curve", 0) == 0 && curveFilesFailed_) return;  // reported at the file
+    if (msg.find(" needs cpfg curve files") != std::string::npos)
+      msg += FunctionsHint("'curve:' line");
     if (const Line::Expansion* e = l.ExpansionAt(col)) {
       msg += " (in the text of '#define " + e->name + "' at line " + std::to_string(e->defineLine) +
              ")";
@@ -314,11 +317,12 @@ class GrammarParser {
   std::optional<SymbolId> Intern(const Line& l, int col, const std::string& name, int arity);
   void JoinContinuations();
   void LoadOptionFunctions();
+  void LoadOptionCurves();
   // Where Sylva looked for function files outside the grammar, for the
   // error of a func() without any: the view file it read or looked for.
-  std::string FunctionsHint() const {
-    if (!opt_.viewFile.empty())
-      return "; the view file " + opt_.viewFile + " has no 'function:' or 'function set:' line";
+  std::string FunctionsHint(
+      const std::string& lines = "'function:' or 'function set:' line") const {
+    if (!opt_.viewFile.empty()) return "; the view file " + opt_.viewFile + " has no " + lines;
     if (files_.empty()) return "";
     std::filesystem::path v(files_[0]);
     v.replace_extension(".v");
@@ -370,6 +374,7 @@ class GrammarParser {
   // or #undef of one in the grammar replaces it.
   std::set<std::string> functionSetNames_;
   bool functionFilesFailed_ = false;  // a view file's function file could not be read
+  bool curveFilesFailed_ = false;     // a view file's curve file could not be read
   std::unordered_map<std::string, ArityUse> arityUse_;
   std::unordered_set<std::string> unsupportedWarned_;  // name + reason
   std::unordered_map<std::string, bool> isSurface_;
@@ -837,6 +842,7 @@ bool GrammarParser::ParseConstExpr(const Line& l, size_t pos, size_t end, double
                                    Expr* exprOut) {
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   scope.functions = &g_.functions;
+  scope.curves = &g_.curves;
   std::string_view view(l.text.data(), end);
   Expr e;
   ExprParseError err;
@@ -908,6 +914,7 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     // text, substituted where the name is used.
     ExprScope scope{&g_.constants, nullptr, nullptr, &macros_};
     scope.functions = &g_.functions;
+    scope.curves = &g_.curves;
     std::string_view view(t.data(), end);
     Expr e;
     ExprParseError err;
@@ -986,6 +993,7 @@ void GrammarParser::ParseMacro(const Line& l, const std::string& name, int col, 
   // Check the body where it is written, its parameters standing as formals.
   ExprScope scope{&g_.constants, &usedConstants_, &m.params, &macros_};
   scope.functions = &g_.functions;
+  scope.curves = &g_.curves;
   std::string_view view(t.data(), end);
   Expr body;
   ExprParseError err;
@@ -1241,6 +1249,7 @@ void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end)
   }
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   scope.functions = &g_.functions;
+  scope.curves = &g_.curves;
   scope.globals = &g_.globals;
   scope.arrays = &g_.arrays;
   Successor s;
@@ -1664,6 +1673,27 @@ void GrammarParser::LoadOptionFunctions() {
   }
 }
 
+// ParseOptions::curveFiles (a view file's `curve:` lines). Errors point at
+// the naming line.
+void GrammarParser::LoadOptionCurves() {
+  for (const ParseOptions::CurveFile& cf : opt_.curveFiles) {
+    std::string why;
+    auto text = Read(cf.file, &why);
+    std::string problem;
+    if (!text) {
+      problem = "cannot read curve file '" + cf.file + "': " + why;
+    } else if (auto c = CpfgCurve::Parse(*text, cf.file, cf.samples); !c) {
+      problem = "in curve file " + cf.file + ":" + std::to_string(c.error().loc.line) + ": " +
+                c.error().message;
+    } else {
+      g_.curves.push_back(std::make_shared<const CpfgCurve>(std::move(c).value()));
+      continue;
+    }
+    diags_.Add(MakeError(SourceLoc{cf.from, cf.line, cf.column}, problem));
+    curveFilesFailed_ = true;
+  }
+}
+
 // `functions: a.func b.func`: cpfg function files, func(1, x) is the first.
 // Names are relative to the grammar file. They replace those a view file
 // names (ParseOptions::functionFiles).
@@ -1728,6 +1758,7 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
   }
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   scope.functions = &g_.functions;
+  scope.curves = &g_.curves;
   scope.globals = &g_.globals;
   scope.arrays = &g_.arrays;
   HiddenGlobalSlots(t, after, k == "start", &scope);
@@ -2050,6 +2081,7 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
     if (k == "axiom") {
       ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
       scope.functions = &g_.functions;
+      scope.curves = &g_.curves;
       scope.globals = &g_.globals;
       scope.arrays = &g_.arrays;
       Successor unused;
@@ -2460,6 +2492,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   p.formalCount = uint16_t(formals.size());
   ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
   scope.functions = &g_.functions;
+  scope.curves = &g_.curves;
   scope.arrays = &g_.arrays;
 
   // Condition, with cpfg's statement blocks around it.
@@ -2643,10 +2676,14 @@ void GrammarParser::ParseLine(const Line& l) {
     for (size_t i = pos; i < t.size(); ++i)
       if (!IsSpace(t[i])) words += char(std::tolower(static_cast<unsigned char>(t[i])));
     if (words == "ringlsystem") {
-      Error(l, int(pos) + 1,
-            "'ring lsystem' is not supported by Sylva (cpfg: the word is a ring, its last "
-            "module the left neighbour of its first in context matching)",
-            int(t.size() - pos));
+      if (lsystem_ > 0) {
+        Error(l, int(pos) + 1,
+              "'ring lsystem' in a sub-L-system is not supported by Sylva (the main "
+              "L-system's word is a ring when its header says so)",
+              int(t.size() - pos));
+        return;
+      }
+      g_.ring = true;
       return;
     }
   }
@@ -2902,6 +2939,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   JoinContinuations();
   // Before the #defines are read: a function set defines names.
   LoadOptionFunctions();
+  LoadOptionCurves();
   Conditionals();
   CollectGlobals();
   g_.path = path;

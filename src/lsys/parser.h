@@ -60,6 +60,17 @@ struct ParseOptions {
     bool set = false;
   };
   std::vector<FunctionFile> functionFiles;
+  // cpfg curve files (a view file's `curve: FILE [samples]` lines), for
+  // curveX/Y/Z(id, t) and curveGAL(id): id 1 is the first. `samples` is
+  // the size of cpfg's arc-length table (100 when the line gives none).
+  struct CurveFile {
+    std::string file;
+    std::string from;
+    int line = 0;
+    int column = 0;
+    int samples = 100;
+  };
+  std::vector<CurveFile> curveFiles;
   // The cpfg view file read for this grammar (empty: none was found); the
   // error of a func() without function files says where Sylva looked.
   std::string viewFile;

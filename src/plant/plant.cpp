@@ -200,6 +200,7 @@ std::optional<Grower> Grower::Start(const PlantSpec& spec, DiagnosticList& diagn
     if (cpfgEnv) popt.environmentGiven = true;  // its own warnings say what is answered
   }
   popt.functionFiles = spec.cpfgFunctions;
+  popt.curveFiles = spec.cpfgCurves;
   popt.viewFile = spec.cpfgViewFile;
   // `~lF`: cpfg's one-letter surface `l` then `F` when l.obj exists and lF.obj does not.
   SurfaceLibrary surfaces(spec.path, spec.surfacePath, spec.readFile);
@@ -372,6 +373,7 @@ PlantResult Grower::Finish() && {
     }
     p.geometry = std::move(*geometry);
     AddWarnings(p.geometry.warnings, g.path, r.diagnostics);
+    if (spec_.amendGeometry) spec_.amendGeometry(p.geometry, p.palette);
     p.time.turtle = MsSince(t0);
   }
   if (spec_.until >= Stage::kMesh) {

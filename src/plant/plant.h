@@ -83,6 +83,9 @@ struct PlantSpec {
   // cpfg function files for func(id, x) when the grammar names none (a view
   // file's `function:` lines; lsys::ParseOptions::functionFiles).
   std::vector<lsys::ParseOptions::FunctionFile> cpfgFunctions;
+  // cpfg curve files for curveX/Y/Z(id, t) and curveGAL(id) (a view file's
+  // `curve:` lines; lsys::ParseOptions::curveFiles).
+  std::vector<lsys::ParseOptions::CurveFile> cpfgCurves;
   // The view file those come from (lsys::ParseOptions::viewFile).
   std::string cpfgViewFile;
   int threads = 0;  // derivation threads; 0: all hardware threads; at most 256
@@ -112,6 +115,10 @@ struct PlantSpec {
   // settings from outside the grammar (a cpfg view file, app/view_file.h)
   // go in here. Its diagnostics join the plant's; an error stops the build.
   std::function<void(lsys::Grammar& grammar, DiagnosticList& diagnostics)> amendGrammar;
+  // Called once the plant is drawn (Stage::kGeometry), before it is
+  // tessellated: a front end adds what it draws with the plant (a cpfg view
+  // file's background scene, app/cpfg_background.h) and its colours.
+  std::function<void(mesh::PlantGeometry& geometry, mesh::Palette& palette)> amendGeometry;
   // Called after each derivation step, from the calling thread.
   std::function<void(int step, int steps, uint64_t modules)> progress;
 };

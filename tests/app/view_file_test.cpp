@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "app/cli_test_util.h"
+#include "mesh/color.h"
 
 namespace sylva::app {
 namespace {
@@ -348,6 +349,64 @@ TEST(ViewFile, FunctionLinesGiveFuncItsFilesInOrder) {
   ASSERT_TRUE(r.plant.has_value()) << r.diagnostics.FormatAll();
   ASSERT_EQ(r.plant->word.params.size(), 1u);
   EXPECT_NEAR(r.plant->word.params[0], 0.5, 0.003) << r.plant->word.params[0];  // y = 2x
+}
+
+TEST(ViewFile, CurveLinesGiveCurveXTheirFilesAndSamples) {
+  ViewFile v = ParseViewFile("curve: profile.con\ncurve: sub/b.con 40\n", "/x/p.v");
+  EXPECT_TRUE(v.diagnostics.items.empty()) << Messages(v.diagnostics);
+  ASSERT_EQ(v.curves.size(), 2u);
+  EXPECT_EQ(v.curves[0].file, "/x/profile.con");
+  EXPECT_EQ(v.curves[0].samples, 100);  // cpfg's default
+  EXPECT_EQ(v.curves[0].line, 1);
+  EXPECT_EQ(v.curves[0].column, 8);
+  EXPECT_EQ(v.curves[1].file, "/x/sub/b.con");
+  EXPECT_EQ(v.curves[1].samples, 40);
+  EXPECT_NE(Messages(ParseViewFile("curve: a.con 1\n", "p.v").diagnostics)
+                .find("1:14 error: a curve's samples must be a whole number from 2 to 1000000"),
+            std::string::npos)
+      << Messages(ParseViewFile("curve: a.con 1\n", "p.v").diagnostics);
+
+  // Through the plant: curveGAL(1) is the length of the view file's curve.
+  const std::string grammar = WriteFile("vc.l", "axiom: A(curveGAL(1), curveY(1, 0.5))\n");
+  WriteFile("vc.v", "curve: vc.con\n");
+  WriteFile("vc.con", "points: 4\ndimension: 4\n0 0 0 3\n0 1 0 1\n0 2 0 1\n0 3 0 3\n");
+  plant::PlantSpec spec;
+  spec.path = grammar;
+  spec.until = plant::Stage::kWord;
+  AttachViewFile(LoadViewFiles(grammar, ""), spec);
+  plant::PlantResult r = plant::BuildPlant(spec);
+  ASSERT_TRUE(r.plant.has_value()) << r.diagnostics.FormatAll();
+  ASSERT_EQ(r.plant->word.params.size(), 2u);
+  EXPECT_NEAR(r.plant->word.params[0], 3.0, 1e-5) << r.plant->word.params[0];
+  EXPECT_NEAR(r.plant->word.params[1], 1.5, 1e-3) << r.plant->word.params[1];
+}
+
+TEST(ViewFile, BackgroundSceneIsDrawnWithThePlant) {
+  const std::string grammar = WriteFile("bgs.l", "axiom: F(3)\n");
+  WriteFile("bgs.v", "background scene: bgs.dat\n");
+  WriteFile("bgs.dat", "material 0 0 0 1  0 0.5 0 1\npolygon -4 0 -4  -4 0 4  4 0 4  4 0 -4\n");
+  plant::PlantSpec spec;
+  spec.path = grammar;
+  spec.until = plant::Stage::kGeometry;
+  auto view = LoadViewFiles(grammar, "");
+  ASSERT_NE(view, nullptr);
+  EXPECT_FALSE(view->diagnostics.HasErrors()) << Messages(view->diagnostics);
+  AttachViewFile(view, spec);
+  plant::PlantResult r = plant::BuildPlant(spec);
+  ASSERT_TRUE(r.plant.has_value()) << r.diagnostics.FormatAll();
+  ASSERT_EQ(r.plant->geometry.polygons.size(), 1u);
+  EXPECT_EQ(r.plant->geometry.segments.size(), 1u);
+  EXPECT_NEAR(r.plant->geometry.boundsMin.x(), -4, 1e-12)
+      << r.plant->geometry.boundsMin.transpose();
+  const uint16_t c = r.plant->geometry.polygons[0].color;
+  ASSERT_LT(c, r.plant->palette.size());
+  EXPECT_NEAR(r.plant->palette[c].y(), mesh::SrgbToLinear(0.5f), 1e-6) << c;
+  // A scene file that is not there: an error at the view file's line.
+  WriteFile("bgs.v", "\nbackground scene: gone.dat\n");
+  view = LoadViewFiles(grammar, "");
+  ASSERT_NE(view, nullptr);
+  EXPECT_NE(Messages(view->diagnostics).find("2:19 error: background scene:"), std::string::npos)
+      << Messages(view->diagnostics);
 }
 
 TEST(ViewFile, AFunctionSetLineGivesFuncItsFunctionsByName) {

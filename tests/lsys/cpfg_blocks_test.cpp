@@ -50,6 +50,20 @@ TEST(CpfgBlocks, IfElseWhileDoAndCompoundAssignments) {
   EXPECT_EQ(DeriveText(g, 1), "F(120,1,8)F(6,0,8)");
 }
 
+TEST(CpfgBlocks, LoopAsTheFirstStatementOfABlockLoops) {
+  // vlab's phyllotaxis-ridley/spiral.l opens its block with `while`: the
+  // loop's jump back to instruction 0 once ended the block after one pass
+  // (B(2,0,0.3,0.1)).
+  EXPECT_EQ(DeriveText("axiom: A(0, 0)\n"
+                       "A(s, a) : s < 1 {while (a < 1 && s < 1) {x = 2; a = a + 0.3; s = s + 0.1;}"
+                       " a = a - 1; y = 5;} --> B(x, y, a, s)\n",
+                       1),
+            "B(2,5,0.2,0.4)");
+  EXPECT_EQ(
+      DeriveText("axiom: A(0)\nA(k) : {do k = k + 2; while (k < 7); m = 1;} * --> B(k, m)\n", 1),
+      "B(8,1)");
+}
+
 TEST(CpfgBlocks, LocalsStartAtZeroEachTimeAProductionIsTried) {
   // y is assigned only when x > 1: A(0) must not see the 4 of A(2).
   EXPECT_EQ(DeriveText("axiom: A(2) A(0)\nA(x) : {if (x > 1) y = x*2;} * --> B(y)\n", 1),

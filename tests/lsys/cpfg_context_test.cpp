@@ -112,5 +112,29 @@ TEST(CpfgContext, ConsiderWithoutBracketsReadsTheRightContextFlat) {
   EXPECT_EQ(DeriveText("consider: AB[]\naxiom: A[xB]C\nA > B --> X\n", 1), "A[xB]C");
 }
 
+// --- `ring lsystem`: the word is a ring ---
+
+TEST(CpfgRing, LastModuleIsTheFirstOnesLeftNeighbour) {
+  // B is first: its left neighbour is the last module, A, only in a ring.
+  const std::string g = "axiom: B C D A\nA < B --> X\nA > B --> Y\n";
+  EXPECT_EQ(DeriveText(g, 1), "BCDA");
+  EXPECT_EQ(DeriveText("ring lsystem\n" + g, 1), "XCDY");
+  // Vlab's Ring/ring.l with dir 1: B > A passes A leftwards, round the end.
+  const std::string ring = "ring lsystem\naxiom: A B B B\nB > A : 1 --> A\nA --> B\n";
+  EXPECT_EQ(DeriveText(ring, 1), "BBBA");
+  EXPECT_EQ(DeriveText(ring, 2), "BBAB");
+}
+
+TEST(CpfgRing, ContextsWrapOnceAndSkipIgnoredModules) {
+  // Ignored modules are passed over across the seam; a context longer than
+  // the word reads the ring round again, one module at a time.
+  EXPECT_EQ(DeriveText("ring lsystem\nignore: f\naxiom: B f C f\nC < B --> X\n", 1), "XfCf");
+  EXPECT_EQ(DeriveText("ring lsystem\naxiom: A\nA < A > A --> Z\n", 1), "Z");
+  // A word of ignored modules only: no context, no hang.
+  EXPECT_EQ(DeriveText("ring lsystem\nignore: f\naxiom: f f\nA < f --> Z\nf > A --> Z\n", 1), "ff");
+  // The right context steps into a branch at the start of the word.
+  EXPECT_EQ(DeriveText("ring lsystem\naxiom: [C] B A\nA > [C] --> Y\n", 1), "[C]BY");
+}
+
 }  // namespace
 }  // namespace sylva::lsys

@@ -129,14 +129,14 @@ TEST(CpfgLines, ContextContinuedOnTheNextLine) {
   EXPECT_EQ(e.rfind("2:1 expected a production", 0), 0u) << e;
 }
 
-TEST(CpfgUnsupported, RingLsystemAndCurveFunctionsSayWhatTheyAreWhereTheyAre) {
-  const std::string ring = testing::FirstError("Lsystem: 0\nring lsystem\naxiom: A\n");
-  EXPECT_EQ(ring.rfind("2:1 'ring lsystem' is not supported by Sylva (cpfg: the word is a ring", 0),
-            0u)
+TEST(CpfgUnsupported, RingInASubLsystemAndCurvesWithoutFilesSayWhatTheyAreWhereTheyAre) {
+  const std::string ring = testing::FirstError(
+      "Lsystem: 0\naxiom: A\nendlsystem\nLsystem: 1\nring lsystem\naxiom: B\nendlsystem\n");
+  EXPECT_EQ(ring.rfind("5:1 'ring lsystem' in a sub-L-system is not supported by Sylva", 0), 0u)
       << ring;
   const std::string curve = testing::FirstError("Start: {L=curveGAL(1);}\naxiom: A\n");
-  EXPECT_EQ(curve.rfind("1:11 cpfg function 'curveGAL' is not supported by Sylva: it reads the "
-                        "curve of a view file's 'curve:' line",
+  EXPECT_EQ(curve.rfind("1:11 curveGAL needs cpfg curve files: name them with 'curve: FILE.con' "
+                        "lines in the view file; no view file was read",
                         0),
             0u)
       << curve;
