@@ -255,7 +255,7 @@ void System::ParticleCollisions(double h) {
   // appends the contacts it finds, which it owns, to the chunk's array.
   const size_t chunks = (n + kPairChunk - 1) / kPairChunk;
   if (pw.chunks.size() < chunks) pw.chunks.resize(chunks);
-  const double r2 = reach * reach;
+  const double r2 = reach * reach * (1 + 1e-9);
   Chunks(pool_, chunks, [&](size_t c) {
     PairChunk& ch = pw.chunks[c];
     ch.contacts.clear();
@@ -317,7 +317,10 @@ void System::ParticleCollisions(double h) {
         ++ranges;
       });
       const Vec3* const sx = x0;  // locals: the loop keeps them in registers
-      const double reach2 = r2;
+      // p's own reach: its radius and step with the largest of the others
+      // (no pair that can meet is farther; the margin covers rounding).
+      const double reachP = ((r[p] + maxR) + (move[p] + maxMove)) * (1 + 1e-9);
+      const double reach2 = std::min(r2, reachP * reachP);
       const double px = sx[p].x(), py = sx[p].y(), pz = sx[p].z();
       uint32_t cand[kCandidates];
       uint32_t m = 0;
