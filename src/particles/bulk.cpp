@@ -27,7 +27,8 @@ Vec3f Round(const Vec3& x) {
 // on a thin one, where the next step could not tell its side. A rounded
 // point that crosses or touches one is pushed off it along the contact
 // normal by a few single-precision ulps and rounded again.
-Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double radius, double h) {
+Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double radius, double h,
+                   MeshMemo* memo) {
   Vec3f xf = Round(x);
   const double skin = 4 * double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
   Vec3 base = x;
@@ -42,7 +43,7 @@ Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double
     for (const Collider& c : colliders) {
       Contact ct;
       const Vec3 w = h * c.velocity;  // where a moving collider ends the step
-      if (c.Intersect(x - w, beyond - w, &ct, radius)) {
+      if (c.Intersect(x - w, beyond - w, &ct, radius, memo)) {
         base += skin * ct.normal;
         xf = Round(base);
         crossed = true;
@@ -168,8 +169,9 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
           // start of the step).
           const Vec3 shift = h * col.velocity;
           for (size_t j = 0; j < m; ++j) {
-            flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
-                                   double(s.radius[c + j]));
+            flags[j] |=
+                col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
+                           double(s.radius[c + j]), memos_.empty() ? nullptr : &memos_[c + j]);
           }
         }
         // The candidates, in order; eight flags at a time (most particles
@@ -199,9 +201,10 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       const size_t j = idx[k], i = c + j;
       Vec3 x = s.position(i), v = s.velocity(i);
       const double r = double(s.radius[i]);
+      MeshMemo* const memo = memos_.empty() ? nullptr : &memos_[i];
       const ContactOutcome out =
           RespondToContacts(colliders_, Vec3(old[0][j], old[1][j], old[2][j]),
-                            Vec3(old[3][j], old[4][j], old[5][j]), x, v, h, r);
+                            Vec3(old[3][j], old[4][j], old[5][j]), x, v, h, r, memo);
       if (out == ContactOutcome::kNone) continue;
       if (out == ContactOutcome::kKilled) {
         // Dies at its age at the start of the step (rounded down), so it is
@@ -213,7 +216,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       }
       if (out == ContactOutcome::kStuck) s.invMass[i] = 0;
       if (out == ContactOutcome::kUnresolved) faults_.Unresolved(i);
-      const Vec3f xf = RoundOutside(colliders_, x, r, h);
+      const Vec3f xf = RoundOutside(colliders_, x, r, h, memo);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
       if (!MaybeWithinLimit(xf.cast<double>(), v, faults_.limit2())) faults_.Flag();
@@ -261,6 +264,12 @@ Status BulkSystem::Step(double h) {
                               limit};
   faults_.Begin(maxMagnitude);
   const size_t n = state.size();
+  // A memo a particle for the mesh queries (kept by index: after RemoveDead
+  // one may serve another particle, which is safe, only slower once).
+  const bool meshes = std::any_of(colliders_.begin(), colliders_.end(), [](const Collider& c) {
+    return c.kind == Collider::Kind::kMesh;
+  });
+  if (meshes && meshMemos_ && memos_.size() != n) memos_.resize(n);
   ThreadPool* const pool = pools_.pool();
   // Ranges of whole chunks, a few a thread.
   const size_t grain = (BalancedGrain(pool, n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;

@@ -145,6 +145,14 @@ class BulkSystem {
   // Fingerprint of positions and velocities (bit patterns).
   uint64_t Hash() const;
 
+  // Whether particles remember the mesh triangles they lie on between
+  // steps (MeshMemo; on by default): off, every mesh query is a full one.
+  // The same answers either way (tests compare them), only slower.
+  void SetMeshMemos(bool on) {
+    meshMemos_ = on;
+    memos_.clear();
+  }
+
   // Chooses the vector kernel (tests compare AVX with its scalar twin).
   // AVX only where the processor has it. restLanes: the lanes of the
   // resting-floor path with AVX: 4 (a kernel after the advance), or 8 where
@@ -166,6 +174,10 @@ class BulkSystem {
   kernels::Kernel kernel_ = kernels::Best();
   int restLanes_ = kernels::RestLanes();
   FaultLatch faults_;
+  // What each particle remembers of the mesh it lies on (MeshMemo), where a
+  // collider is a mesh; empty otherwise.
+  std::vector<MeshMemo> memos_;
+  bool meshMemos_ = true;
 };
 
 }  // namespace sylva::particles

@@ -1,7 +1,9 @@
 #include "particles/collider.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 
 #include "core/assert.h"
@@ -64,6 +66,30 @@ Vec3 ClosestOnSegment(const Vec3& p0, const Vec3& p1, const Vec3& x) {
   const double ee = e.squaredNorm();
   const double t = ee > 0 ? std::clamp(e.dot(x - p0) / ee, 0.0, 1.0) : 0.0;
   return p0 + t * e;
+}
+
+// The point of triangle (p0, p1, p2) nearest x (Ericson, "Real-Time
+// Collision Detection", 5.1.5).
+Vec3 ClosestOnTriangle(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& x) {
+  const Vec3 ab = p1 - p0, ac = p2 - p0, ap = x - p0;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return p0;
+  const Vec3 bp = x - p1;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return p1;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return p0 + (d1 / (d1 - d3)) * ab;
+  const Vec3 cp = x - p2;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return p2;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return p0 + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return p1 + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (p2 - p1);
+  const double denom = va + vb + vc;
+  if (!(denom != 0)) return p0;  // degenerate: treated as its first vertex
+  return p0 + ab * (vb / denom) + ac * (vc / denom);
 }
 
 // Whether q, on the plane of the convex polygon `poly` (counter-clockwise
@@ -163,6 +189,8 @@ bool Collider::IntersectGrownPolygon(const Vec3& a, const Vec3& b, double r, Con
 
 TriangleBvh::TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint32_t, 3>> triangles)
     : v_(std::move(vertices)), tris_(std::move(triangles)) {
+  static std::atomic<uint64_t> serials{0};
+  serial_ = ++serials;
   for (const auto& t : tris_) {
     for (uint32_t k : t) SYLVA_ASSERT(k < v_.size());
   }
@@ -184,9 +212,18 @@ uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
       [&](const std::array<uint32_t, 3>& t) { return Vec3(v_[t[0]] + v_[t[1]] + v_[t[2]]); });
 }
 
-bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r) const {
+bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r, const MeshMemo* memo) const {
   if (nodes_.empty()) return false;
+  if (const double reach = MemoReach(memo, a, b, r); reach >= 0) {
+    for (int k = 0; k < memo->count; ++k) {
+      if (double(memo->dist[k]) <= reach) return true;
+    }
+    return false;
+  }
   const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
+  // Clear of every triangle's box (a flake high above a terrain).
+  if ((lo.array() > nodes_[0].hi.array()).any() || (hi.array() < nodes_[0].lo.array()).any())
+    return false;
   if (dims_[0] > 0) {  // the grid: whether a cell the box covers lists a triangle
     const Vec3 glo = (lo - gridLo_) / cell_, ghi = (hi - gridLo_) / cell_;
     if (((ghi - glo).array() + 1).prod() <= 8.5) {
@@ -254,8 +291,8 @@ bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r
   return true;
 }
 
-[[gnu::noinline]] bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c,
-                                              double r) const {
+[[gnu::noinline]] bool TriangleBvh::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r,
+                                              MeshMemo* memo) const {
   if (nodes_.empty()) return false;
   const Vec3 d = b - a;
   double best = 2;
@@ -278,6 +315,9 @@ bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r
       l[k] = std::max(0, int(std::floor(glo[k])));
       h[k] = std::min(dims_[k] - 1, int(std::floor(ghi[k])));
     }
+    // Within the memo's ball: only its triangles are in reach.
+    if (const double reach = MemoReach(memo, a, b, r); reach >= 0)
+      return IntersectNear(*memo, reach, a, b, c, r, l, h);
     for (int z = l[2]; z <= h[2]; ++z)
       for (int y = l[1]; y <= h[1]; ++y)
         for (int x = l[0]; x <= h[0]; ++x) {
@@ -285,6 +325,7 @@ bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r
               (size_t(z) * size_t(dims_[1]) + size_t(y)) * size_t(dims_[0]) + size_t(x);
           for (uint32_t t = start_[cell]; t < start_[cell + 1]; ++t) test(items_[t]);
         }
+    if (memo && best <= 1) Remember(a, r, memo);
   } else {
     WalkSegment(
         nodes_, a, d, best,
@@ -297,6 +338,97 @@ bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r
   *c = found;
   if (r == 0) c->point = Skin(a + best * d, found.normal);
   return true;
+}
+
+double TriangleBvh::MemoReach(const MeshMemo* memo, const Vec3& a, const Vec3& b, double r) const {
+  if (!memo || memo->mesh != serial_) return -1;
+  // A margin far above the rounding of the triangle tests.
+  const double margin = 1e-6 * (1 + memo->centre.cwiseAbs().maxCoeff() + r);
+  const double room = memo->clear - r - margin;
+  const double far =
+      std::sqrt(std::max((a - memo->centre).squaredNorm(), (b - memo->centre).squaredNorm()));
+  if (!(far <= room)) return -1;
+  return far + r + margin;
+}
+
+bool TriangleBvh::IntersectNear(const MeshMemo& memo, double reach, const Vec3& a, const Vec3& b,
+                                Contact* c, double r, const int l[3], const int h[3]) const {
+  // The full query meets triangle t first in the first cell of [l, h] (z,
+  // then y, then x) that lists it, and a cell lists its triangles in
+  // increasing order; of equal entries the first met wins. A triangle no
+  // cell of [l, h] lists is not tested at all.
+  double best = 2;
+  size_t bestKey = SIZE_MAX;
+  uint32_t bestTri = 0;
+  Contact found;
+  for (int k = 0; k < memo.count; ++k) {
+    if (double(memo.dist[k]) > reach) continue;  // farther than r from the path
+    const uint32_t t = memo.near[k];
+    const std::array<uint8_t, 6>& cells = cells_[t];  // lo x y z, hi x y z
+    bool listed = true;
+    int at[3];
+    for (int q = 0; q < 3; ++q) {
+      listed = listed && cells[q] <= h[q] && cells[3 + q] >= l[q];
+      at[q] = std::max(l[q], int(cells[q]));
+    }
+    if (!listed) continue;
+    Contact ct;
+    if (!HitTriangle(t, a, b, r, 2, &ct)) continue;
+    const size_t key =
+        (size_t(at[2]) * size_t(dims_[1]) + size_t(at[1])) * size_t(dims_[0]) + size_t(at[0]);
+    if (ct.s < best || (ct.s == best && (key < bestKey || (key == bestKey && t < bestTri)))) {
+      best = ct.s;
+      bestKey = key;
+      bestTri = t;
+      found = ct;
+    }
+  }
+  if (best > 1) return false;
+  *c = found;
+  if (r == 0) c->point = Skin(a + best * (b - a), found.normal);
+  return true;
+}
+
+void TriangleBvh::Remember(const Vec3& centre, double r, MeshMemo* memo) const {
+  // Every triangle within R of the centre, from the grid cells about it
+  // (a triangle no such cell lists is farther: its box misses the cube of
+  // half-width R). A tenth of a cell of room for the particle to move.
+  memo->mesh = 0;
+  const double R = r + 0.1 * cell_;
+  int l[3], h[3], cells = 1;
+  for (int k = 0; k < 3; ++k) {
+    const double lo = (centre[k] - R - gridLo_[k]) / cell_,
+                 hi = (centre[k] + R - gridLo_[k]) / cell_;
+    if (!(hi >= 0 && lo < dims_[k])) return;
+    l[k] = std::max(0, int(std::floor(lo)));
+    h[k] = std::min(dims_[k] - 1, int(std::floor(hi)));
+    cells *= h[k] - l[k] + 1;
+  }
+  if (cells > 27) return;
+  int count = 0;
+  for (int z = l[2]; z <= h[2]; ++z)
+    for (int y = l[1]; y <= h[1]; ++y)
+      for (int x = l[0]; x <= h[0]; ++x) {
+        const size_t cell =
+            (size_t(z) * size_t(dims_[1]) + size_t(y)) * size_t(dims_[0]) + size_t(x);
+        for (uint32_t i = start_[cell]; i < start_[cell + 1]; ++i) {
+          const uint32_t t = items_[i];
+          if (std::find(memo->near, memo->near + count, t) != memo->near + count) continue;
+          const std::array<uint32_t, 3>& tri = tris_[t];
+          const Vec3 q = ClosestOnTriangle(v_[tri[0]], v_[tri[1]], v_[tri[2]], centre);
+          const double dist = (q - centre).norm();
+          if (dist >= R) continue;
+          if (count == MeshMemo::kNear) return;  // too many to be worth it
+          float rounded = float(dist);           // rounded down
+          if (double(rounded) > dist) rounded = std::nextafter(rounded, 0.0f);
+          memo->dist[count] = rounded;
+          memo->near[count++] = t;
+        }
+      }
+  memo->mesh = serial_;
+  memo->centre = centre;
+  memo->clear = R;
+  memo->count = count;
 }
 
 void TriangleBvh::BuildGrid() {
@@ -332,6 +464,15 @@ void TriangleBvh::BuildGrid() {
   }
   for (size_t i = 1; i <= cells; ++i) count[i] += count[i - 1];
   start_ = count;
+  cells_.resize(tris_.size());
+  for (uint32_t ti = 0; ti < tris_.size(); ++ti) {
+    int l[3], h[3];
+    range(tris_[ti], l, h);
+    for (int k = 0; k < 3; ++k) {
+      cells_[ti][k] = uint8_t(l[k]);  // dims <= 256
+      cells_[ti][3 + k] = uint8_t(h[k]);
+    }
+  }
   items_.resize(total);
   for (uint32_t ti = 0; ti < tris_.size(); ++ti) {
     int l[3], h[3];
@@ -457,7 +598,8 @@ Collider Collider::Capsules(std::shared_ptr<const CapsuleBvh> bvh) {
 }
 
 [[gnu::noinline, gnu::flatten]] bool Collider::IntersectAny(const Vec3& a, const Vec3& b,
-                                                            Contact* c, double r) const {
+                                                            Contact* c, double r,
+                                                            MeshMemo* memo) const {
   const Vec3 d = b - a;
   // The thin kinds and the plane first: they need no grown sphere or box.
   switch (kind) {
@@ -482,7 +624,7 @@ Collider Collider::Capsules(std::shared_ptr<const CapsuleBvh> bvh) {
     case Kind::kCapsules: {
       // In the hierarchy's coordinates (offset 0 unless the solid moved).
       const Vec3 ao = a - offset, bo = b - offset;
-      const bool hit = kind == Kind::kMesh ? mesh && mesh->Intersect(ao, bo, c, r)
+      const bool hit = kind == Kind::kMesh ? mesh && mesh->Intersect(ao, bo, c, r, memo)
                                            : capsules && capsules->Intersect(ao, bo, c, r);
       if (hit) c->point += offset;
       return hit;
@@ -719,16 +861,19 @@ namespace {
 // the surface), and a sphere the particle rests on this step (the path left
 // along its tangent, which the surface bends away from; the projection puts
 // the end back on it). u is h times the path's velocity at a.
-[[gnu::always_inline]] inline const Collider* FindContact(
-    const std::vector<Collider>& colliders, const Vec3& a, const Vec3& x, const Vec3& u,
-    const Collider* const* restingOn, Contact* best, bool* grazed, double r, double e, double h) {
+[[gnu::always_inline]] inline const Collider* FindContact(const std::vector<Collider>& colliders,
+                                                          const Vec3& a, const Vec3& x,
+                                                          const Vec3& u,
+                                                          const Collider* const* restingOn,
+                                                          Contact* best, bool* grazed, double r,
+                                                          double e, double h, MeshMemo* memo) {
   best->s = 2;
   const Collider* hit = nullptr;
   for (const Collider& c : colliders) {
     Contact ct;
     bool sliding;
     if (!c.moving()) [[likely]] {
-      if (!c.Intersect(a, x, &ct, r) || ct.s >= best->s) continue;
+      if (!c.Intersect(a, x, &ct, r, memo) || ct.s >= best->s) continue;
       sliding = ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
                 u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff());
     } else {
@@ -737,7 +882,7 @@ namespace {
       // frame too.
       const Vec3 w = h * c.velocity;
       const Vec3 ar = a - e * w, xr = x - w, ur = u - w;
-      if (!c.Intersect(ar, xr, &ct, r) || ct.s >= best->s) continue;
+      if (!c.Intersect(ar, xr, &ct, r, memo) || ct.s >= best->s) continue;
       sliding = ct.normal.dot(ct.point - xr) <= 1e-12 * std::max(1.0, xr.cwiseAbs().maxCoeff()) &&
                 ur.dot(ct.normal) >= -1e-12 * std::max(1e-300, ur.cwiseAbs().maxCoeff());
     }
@@ -784,7 +929,7 @@ namespace {
 
 [[gnu::flatten]] ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
                                                   Vec3 va, Vec3& x, Vec3& v, double h,
-                                                  double radius) {
+                                                  double radius, MeshMemo* memo) {
   // The step as a path of constant acceleration from a, through x at its
   // end: p(tau) = a + tau u + tau^2 A / 2 for tau = t / h in [0, 1], with
   // u = h w (w the path's velocity at a) and A = h^2 acc, so that nothing
@@ -805,7 +950,7 @@ namespace {
     const Collider* none[2] = {nullptr, nullptr};
     Contact c0;
     bool grazed0 = false;
-    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0, radius, 0, h);
+    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0, radius, 0, h, memo);
     if (!hit) {
       if (!grazed0) return ContactOutcome::kNone;
       ProjectOut(colliders, x, v, radius, h);
@@ -822,7 +967,7 @@ namespace {
       const Collider* resting0[2] = {hit, nullptr};
       Contact c1;
       bool grazed1 = false;
-      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1, radius, 0, h)) {
+      if (!FindContact(colliders, c0.point, x1, u1, resting0, &c1, &grazed1, radius, 0, h, memo)) {
         x = x1;
         v = out;
         ProjectOut(colliders, x, v, radius, h);
@@ -841,7 +986,8 @@ namespace {
   for (;;) {
     Contact best;
     const double e = 1 - rem;  // of the step, at a
-    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed, radius, e, h);
+    const Collider* hit =
+        FindContact(colliders, a, x, u, restingOn, &best, &grazed, radius, e, h, memo);
     if (!hit) break;
     const Vec3& n = best.normal;
     if (++contacts > kMaxContacts) [[unlikely]] {

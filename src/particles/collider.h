@@ -38,6 +38,25 @@
 namespace sylva::particles {
 
 class CapsuleBvh;
+class TriangleBvh;
+
+// What one particle remembers of the mesh it lies on, between its queries
+// (a particle system keeps one a particle; 112 bytes): every triangle but
+// near[0..count) is at least `clear` from `centre` (the hierarchy's
+// coordinates). A query whose path (of a ball of radius r) stays within
+// clear - r (less a rounding margin) of the centre can touch only those,
+// so it tests only them, taking the first in the order the full query
+// meets them: the same answer, bit for bit. Any content is safe (a memo is
+// checked before use); a full query that finds a contact refreshes it.
+struct MeshMemo {
+  static constexpr int kNear = 8;
+  uint64_t mesh = 0;  // TriangleBvh::serial() of its mesh; 0: nothing remembered
+  Vec3 centre{0, 0, 0};
+  double clear = 0;
+  uint32_t near[kNear] = {};
+  float dist[kNear] = {};  // each one's distance from the centre, rounded down
+  int count = 0;
+};
 
 // What happens to a particle that hits a collider.
 enum class Response {
@@ -64,14 +83,21 @@ class TriangleBvh {
   // points within r of a triangle: two faces offset by r, and a capsule of
   // radius r about every edge): where a ball of radius r centred on the
   // path first touches a triangle. The contact point is the ball's centre.
-  bool Intersect(const Vec3& a, const Vec3& b, Contact* c, double r = 0) const;
+  // With a memo (see MeshMemo), a short path near the memo's centre tests
+  // only the triangles it lists, and a full query that finds a contact
+  // refreshes it: the same answer either way.
+  bool Intersect(const Vec3& a, const Vec3& b, Contact* c, double r = 0,
+                 MeshMemo* memo = nullptr) const;
+  // A number no other hierarchy of this process has (MeshMemo::mesh).
+  uint64_t serial() const { return serial_; }
   // The bounding box of every triangle.
   Vec3 lo() const { return nodes_.empty() ? Vec3::Zero() : nodes_[0].lo; }
   Vec3 hi() const { return nodes_.empty() ? Vec3::Zero() : nodes_[0].hi; }
   // Whether the box of the segment a -> b grown by r overlaps the box of a
   // leaf of the hierarchy (a few triangles): false means no triangle is
   // within r of the path. The broad phase of a mesh collider.
-  bool Near(const Vec3& a, const Vec3& b, double r) const;
+  // A memo (MeshMemo) answers for a path within its ball.
+  bool Near(const Vec3& a, const Vec3& b, double r, const MeshMemo* memo = nullptr) const;
   size_t triangleCount() const { return tris_.size(); }
   size_t nodeCount() const { return nodes_.size(); }
   int depth() const { return depth_; }
@@ -86,6 +112,17 @@ class TriangleBvh {
   void BuildGrid();
   bool HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r, double best,
                    Contact* c) const;
+  // The query through the memo's triangles alone, over the grid cells [l, h].
+  // For a path within the memo's ball: how far from the centre (plus r and
+  // a rounding margin) a triangle may be and still be touched; else -1.
+  double MemoReach(const MeshMemo* memo, const Vec3& a, const Vec3& b, double r) const;
+  // The query through the memo's triangles within `reach` of its centre
+  // alone, over the grid cells [l, h].
+  bool IntersectNear(const MeshMemo& memo, double reach, const Vec3& a, const Vec3& b, Contact* c,
+                     double r, const int l[3], const int h[3]) const;
+  // Lists in `memo` the triangles near `centre` for a ball of radius r.
+  void Remember(const Vec3& centre, double r, MeshMemo* memo) const;
+  uint64_t serial_ = 0;
   std::vector<Vec3> v_;
   std::vector<std::array<uint32_t, 3>> tris_;
   std::vector<Node> nodes_;
@@ -98,6 +135,8 @@ class TriangleBvh {
   double cell_ = 1;
   int dims_[3] = {0, 0, 0};
   std::vector<uint32_t> start_, items_;
+  // The cells each triangle is listed in: lo x, y, z, hi x, y, z.
+  std::vector<std::array<uint8_t, 6>> cells_;
 };
 
 // A collider is a plain description; the factories below fill it, and
@@ -171,11 +210,14 @@ struct Collider {
   // inside a container; a polygon's rim, a triangle's edges and capsules
   // grown by r). The contact point is where the centre is at contact, so
   // the centre stays at least r from the surface. r = 0 is a point.
-  bool Intersect(const Vec3& a, const Vec3& b, Contact* c, double r = 0) const;
+  // A memo (MeshMemo) serves a mesh's queries; other kinds ignore it.
+  bool Intersect(const Vec3& a, const Vec3& b, Contact* c, double r = 0,
+                 MeshMemo* memo = nullptr) const;
   // A cheap test that is false only when the path a -> b of a ball of
   // radius r certainly does not touch the collider (the per-particle fast
   // path; for a mesh, a walk down its hierarchy: TriangleBvh::Near).
-  [[gnu::always_inline]] bool MayHit(const Vec3& a, const Vec3& b, double r = 0) const;
+  [[gnu::always_inline]] bool MayHit(const Vec3& a, const Vec3& b, double r = 0,
+                                     const MeshMemo* memo = nullptr) const;
   // Half-space kinds (plane, sphere, box): if x, the centre of a ball of
   // radius r, is inside the solid grown by r, the nearest point of its
   // grown surface (at r from the surface) and its outward normal. Thin
@@ -185,7 +227,7 @@ struct Collider {
  private:
   // Every kind, out of line; Intersect and Project inline the plane, the
   // kind of most resting contacts.
-  bool IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r) const;
+  bool IntersectAny(const Vec3& a, const Vec3& b, Contact* c, double r, MeshMemo* memo) const;
   bool ProjectAny(const Vec3& x, Vec3* surface, Vec3* normal, double r) const;
   bool IntersectGrownPolygon(const Vec3& a, const Vec3& b, double r, Contact* c) const;
 };
@@ -235,13 +277,15 @@ constexpr int kInelasticContacts = 16;
 // finally projected out of every half-space solid. x and v are updated.
 // `radius` is the particle's (m, >= 0; see Collider::Intersect): its centre
 // stays at least that far from every surface.
+// `memo`: the particle's MeshMemo (or null), for its mesh queries.
 ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
-                                 Vec3& v, double h, double radius = 0);
+                                 Vec3& v, double h, double radius = 0, MeshMemo* memo = nullptr);
 
 // --- inline ---
 
-inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r) const {
-  if (kind != Kind::kPlane) return IntersectAny(a, b, c, r);
+inline bool Collider::Intersect(const Vec3& a, const Vec3& b, Contact* c, double r,
+                                MeshMemo* memo) const {
+  if (kind != Kind::kPlane) return IntersectAny(a, b, c, r, memo);
   // The plane moved out by r.
   const double d1 = normal.dot(b - point) - r;
   if (d1 >= 0) return false;
@@ -267,7 +311,8 @@ inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n, double r) c
   return true;
 }
 
-[[gnu::always_inline]] inline bool Collider::MayHit(const Vec3& a, const Vec3& b, double r) const {
+[[gnu::always_inline]] inline bool Collider::MayHit(const Vec3& a, const Vec3& b, double r,
+                                                    const MeshMemo* memo) const {
   switch (kind) {
     case Kind::kPlane:
       return normal.dot(b - point) < r;
@@ -291,7 +336,7 @@ inline bool Collider::Project(const Vec3& x, Vec3* surface, Vec3* n, double r) c
       return std::min(d0, d1) <= r && std::max(d0, d1) >= -r;
     }
     case Kind::kMesh:
-      return mesh && mesh->Near(a - offset, b - offset, r);
+      return mesh && mesh->Near(a - offset, b - offset, r, memo);
     case Kind::kCapsules:
       return true;
   }

@@ -212,6 +212,72 @@ TEST(Colliders, BvhAgreesWithBruteForce) {
   EXPECT_GT(hits, 200) << "the test should cross the surface often";
 }
 
+// A bumpy height field of 2 (n - 1)^2 triangles over [0, 0.1 (n - 1)]^2.
+TriangleBvh BumpyField(int n, std::vector<Vec3>* vertices,
+                       std::vector<std::array<uint32_t, 3>>* triangles) {
+  std::vector<Vec3>& v = *vertices;
+  std::vector<std::array<uint32_t, 3>>& t = *triangles;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      v.emplace_back(i * 0.1, 0.2 * std::sin(i * 0.7) * std::cos(j * 0.5), j * 0.1);
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const uint32_t a = j * n + i, b = a + 1, c = a + n, d = c + 1;
+      t.push_back({a, c, b});
+      t.push_back({b, c, d});
+    }
+  return TriangleBvh(v, t);
+}
+
+TEST(TriangleBvh, MemoGivesTheFullQuerysAnswerBitForBit) {
+  // Balls (radius 0, 1 cm, 10 cm) lying on a bumpy field, on faces, on
+  // edges and at vertices shared by up to six triangles (where several
+  // triangles touch at once and the full query's order decides), each
+  // queried along a run of short paths (into the surface, along it, away,
+  // and of length 0) with one memo, every answer against the full query.
+  std::vector<Vec3> v;
+  std::vector<std::array<uint32_t, 3>> t;
+  const TriangleBvh bvh = BumpyField(41, &v, &t);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(0, 1), w(-1, 1);
+  int hits = 0, remembered = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const double r = k % 3 == 0 ? 0.0 : k % 3 == 1 ? 0.01 : 0.1;
+    const auto& tri = t[size_t(u(rng) * double(t.size())) % t.size()];
+    // On the face, on an edge or at a vertex.
+    double b1 = u(rng), b2 = u(rng);
+    if (b1 + b2 > 1) b1 = 1 - b1, b2 = 1 - b2;
+    if (k % 5 == 1) b2 = 0;
+    if (k % 5 == 2) b1 = b2 = 0;
+    const Vec3 n = (v[tri[1]] - v[tri[0]]).cross(v[tri[2]] - v[tri[0]]).normalized();
+    const Vec3 on = v[tri[0]] + b1 * (v[tri[1]] - v[tri[0]]) + b2 * (v[tri[2]] - v[tri[0]]);
+    Vec3 a = on + (r + 1e-9 * (k % 7)) * n;
+    MeshMemo memo;
+    for (int step = 0; step < 6; ++step) {
+      const double len = step == 0 ? 0.003 : step % 3 == 0 ? 0 : 0.004 * u(rng);
+      const Vec3 d = step % 2 == 0 ? Vec3(-n + 0.3 * Vec3(w(rng), w(rng), w(rng)))
+                                   : Vec3(w(rng), w(rng), w(rng));
+      const Vec3 b = a + len * d.normalized();
+      Contact full, fast;
+      const bool hitFull = bvh.Intersect(a, b, &full, r);
+      const bool hitFast = bvh.Intersect(a, b, &fast, r, &memo);
+      ASSERT_EQ(hitFast, hitFull) << "ball " << k << " path " << step << " radius " << r;
+      if (hitFull) {
+        ++hits;
+        ASSERT_EQ(fast.s, full.s) << "ball " << k << " path " << step;
+        ASSERT_EQ(fast.point, full.point) << "ball " << k << " path " << step;
+        ASSERT_EQ(fast.normal, full.normal) << "ball " << k << " path " << step;
+      }
+      // The broad phase with the memo never misses a contact.
+      if (hitFull) ASSERT_TRUE(bvh.Near(a, b, r, &memo)) << "ball " << k << " path " << step;
+      remembered += memo.mesh == bvh.serial() && memo.count > 1;
+      if (hitFull) a = full.point;  // rests where the contact put it
+    }
+  }
+  EXPECT_GT(hits, 5000) << "paths that touched the field";
+  EXPECT_GT(remembered, 3000) << "queries with a memo of several triangles (ties possible)";
+}
+
 TEST(Colliders, MeshKeepsRainOff) {
   // Particles rain on a closed cube mesh; none ends up inside it.
   std::vector<Vec3> v;
