@@ -87,6 +87,10 @@ struct PlantGeometry {
   // line style `pixels` (`initial line width: 2 pixels`). The tessellator
   // turns them into world radii for its view (mesh/pixel_widths.h).
   bool widthInPixels = false;
+  // cpfg's line style cylinder (a view file's `line style: cylinder`): the
+  // plant is drawn as tubes even when it lies in a plane, as cpfg draws it,
+  // not as the lines of a 2D figure (plant::IsLineFigure).
+  bool cylinderStyle = false;
 
   // Problems that do not stop the drawing (an unmatched `}`, a polygon with
   // fewer than 3 vertices), each naming the module.

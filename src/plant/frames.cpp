@@ -34,6 +34,7 @@ void Append(const mesh::PlantGeometry& frame, bool first, mesh::PlantGeometry& a
     all.boundsMax = frame.boundsMax;
     all.planar = frame.planar;
     all.widthInPixels = frame.widthInPixels;
+    all.cylinderStyle = frame.cylinderStyle;
   } else {
     all.boundsMin = all.boundsMin.cwiseMin(frame.boundsMin);
     all.boundsMax = all.boundsMax.cwiseMax(frame.boundsMax);

@@ -128,8 +128,8 @@ Expected<mesh::Box> MeshBounds(const Plant& plant, const PlantSpec& spec) {
 }
 
 bool IsLineFigure(const mesh::PlantGeometry& geometry) {
-  return geometry.planar && geometry.polygons.empty() && geometry.surfaces.empty() &&
-         geometry.spheres.empty() && geometry.tubes.empty();
+  return geometry.planar && !geometry.cylinderStyle && geometry.polygons.empty() &&
+         geometry.surfaces.empty() && geometry.spheres.empty() && geometry.tubes.empty();
 }
 
 Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnostics,

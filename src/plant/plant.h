@@ -173,7 +173,8 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
 Expected<mesh::Box> MeshBounds(const Plant& plant, const PlantSpec& spec);
 
 // True when the geometry is a flat line figure (every point in z = 0,
-// nothing but segments): ABOP's 2D figures, drawn as lines, not tubes.
+// nothing but segments, and not cpfg's line style cylinder): ABOP's 2D
+// figures, drawn as lines, not tubes.
 bool IsLineFigure(const mesh::PlantGeometry& geometry);
 
 // The grammar's palette (`palette:`, written in sRGB) in linear RGB, or the

@@ -1532,6 +1532,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   g.boundsMax = hi;
   g.planar = planar;
   g.widthInPixels = options.widthInPixels;
+  g.cylinderStyle = options.cylinderStyle;
   g.branchCount = uint32_t(branchParent.size());
   return {};
 }

@@ -136,6 +136,8 @@ struct DrawOptions {
   // The widths are pixels on screen (cpfg's line style `pixels`): copied
   // to PlantGeometry::widthInPixels.
   bool widthInPixels = false;
+  // cpfg's line style cylinder: copied to PlantGeometry::cylinderStyle.
+  bool cylinderStyle = false;
   // cpfg's contours for @#(n) (null: none; every generalized cylinder round).
   std::shared_ptr<const CylinderContours> contours;
 };

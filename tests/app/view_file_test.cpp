@@ -563,6 +563,7 @@ TEST(ViewFile, ContourLinesReadTheirFilesForCylinderLineStyle) {
   AttachViewFile(std::make_shared<const ViewFile>(v), spec);
   ASSERT_TRUE(spec.draw.contours != nullptr);
   EXPECT_EQ(spec.draw.contours->byId.size(), 2u);
+  EXPECT_TRUE(spec.draw.cylinderStyle);
 }
 
 TEST(ViewFile, BadContourFileIsAnErrorAtItsOwnLine) {
@@ -589,6 +590,7 @@ TEST(ViewFile, ContoursWithoutCylinderLineStyleWarnAndAreNotUsed) {
   plant::PlantSpec spec;
   AttachViewFile(std::make_shared<const ViewFile>(v), spec);
   EXPECT_TRUE(spec.draw.contours == nullptr);
+  EXPECT_FALSE(spec.draw.cylinderStyle);
   // cpfg's older `polygonization level: n` is 2^(n+1) sides.
   ViewFile level = ParseViewFile(
       "line style: cylinder\npolygonization level: 3\ncontour: 1 x.con\n", "l.v");

@@ -142,5 +142,18 @@ TEST(TurtleContour, ContourTubesTessellateIntoQuadsWithUnitNormals) {
   EXPECT_NEAR(b.hi.z() - b.lo.z(), 2.0, 1e-6);
 }
 
+TEST(TurtleContour, CylinderLineStyleIsNeverALineFigure) {
+  // vlab's GeneralizedCylinder lies in the plane z = 0; cpfg draws it as a
+  // cylinder (`line style: cylinder`), not as the lines of a 2D figure.
+  const std::string axiom = "@Gs F + F @Gc F @Ge";
+  mesh::PlantGeometry plain = Draw(axiom, DrawOptions{});
+  EXPECT_TRUE(plant::IsLineFigure(plain));
+  DrawOptions o;
+  o.cylinderStyle = true;
+  mesh::PlantGeometry cylinders = Draw(axiom, o);
+  EXPECT_TRUE(cylinders.planar);
+  EXPECT_FALSE(plant::IsLineFigure(cylinders));
+}
+
 }  // namespace
 }  // namespace sylva::turtle
