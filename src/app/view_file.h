@@ -131,7 +131,7 @@ void ApplyViewFile(const ViewFile& view, lsys::Grammar& grammar);
 
 // Sets spec.cpfgSurfaces and spec.cpfgFunctions (the view's `surface:` and
 // `function:` lines), spec.draw.contours (its contours, with line style
-// cylinder) and
+// cylinder: then even none, so that @#(n) names what is missing) and
 // spec.amendGrammar: the view applied and its diagnostics added to the
 // plant's (so --strict counts them).
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec);
