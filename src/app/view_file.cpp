@@ -1115,7 +1115,7 @@ void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec
   if (!view) return;
   spec.draw.widthInPixels = view->widthInPixels;
   spec.draw.cylinderStyle = view->cylinderStyle && !view->widthInPixels;
-  if (view->cylinderStyle && !view->widthInPixels && !view->contours.byId.empty())
+  if (view->cylinderStyle && !view->widthInPixels)
     spec.draw.contours = std::make_shared<const turtle::CylinderContours>(view->contours);
   spec.cpfgSurfaces = view->surfaces;
   spec.cpfgFunctions = view->functions;

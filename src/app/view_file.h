@@ -143,8 +143,9 @@ void ApplyViewFile(const ViewFile& view, lsys::Grammar& grammar);
 
 // Sets spec.cpfgSurfaces, spec.cpfgFunctions and spec.cpfgCurves (the
 // view's `surface:`, `function:` and `curve:` lines), spec.draw.contours
-// (its contours, with line style cylinder), spec.amendGeometry (its
-// background scenes drawn with the plant) and
+// (its contours, with line style cylinder: then even none, so that @#(n)
+// names what is missing), spec.amendGeometry (its background scenes drawn
+// with the plant) and
 // spec.amendGrammar: the view applied and its diagnostics added to the
 // plant's (so --strict counts them).
 void AttachViewFile(std::shared_ptr<const ViewFile> view, plant::PlantSpec& spec);

@@ -149,7 +149,6 @@ Expected<Contour> Parser::Parse() {
   return Unversioned(header);
 }
 
-
 // `N DIMENSION open|closed`, then N points of DIMENSION numbers, free-form
 // (cpfg's _ReadContour0000).
 Expected<Contour> Parser::Unversioned(const std::vector<Word>& header) {

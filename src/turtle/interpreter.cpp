@@ -1433,8 +1433,8 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
             g.warnings.push_back(
                 "module " + std::to_string(i + 1) + " (" + ModuleText(word, symbols, i) +
                 ") selects contour " + std::string(text) + ", which " +
-                (contours ? "the view file does not define (no 'contour: " + std::string(text) +
-                                " FILE.con' line)"
+                (contours ? "the view file does not give (no 'contour: " + std::string(text) +
+                                " FILE.con' line, or its file is missing or bad)"
                           : std::string("is not in use (no view file gives contours with "
                                         "'line style: cylinder')")) +
                 ": its generalized cylinders are drawn round, as cpfg does");

@@ -52,9 +52,9 @@ TEST(Contour, BadFilesAreErrorsAtTheirLineAndColumn) {
     return std::to_string(c.error().loc.line) + ":" + std::to_string(c.error().loc.column) + " " +
            c.error().message;
   };
-  EXPECT_EQ(at("5 3 open\n1 2 3\n4 x 6\n").rfind("3:3 expected a number (coordinate 2 of point 2)",
-                                                  0),
-            0u)
+  EXPECT_EQ(
+      at("5 3 open\n1 2 3\n4 x 6\n").rfind("3:3 expected a number (coordinate 2 of point 2)", 0),
+      0u)
       << at("5 3 open\n1 2 3\n4 x 6\n");
   EXPECT_EQ(at("4 3 opne\n").rfind("1:5 expected 'open' or 'closed', not 'opne'", 0), 0u)
       << at("4 3 opne\n");

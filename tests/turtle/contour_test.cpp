@@ -115,7 +115,7 @@ TEST(TurtleContour, UnknownContourWarnsAndDrawsRound) {
   EXPECT_TRUE(g.tubes.empty());
   EXPECT_EQ(g.segments.size(), 2u);
   ASSERT_EQ(g.warnings.size(), 1u);
-  EXPECT_NE(g.warnings[0].find("selects contour 7, which the view file does not define"),
+  EXPECT_NE(g.warnings[0].find("selects contour 7, which the view file does not give"),
             std::string::npos)
       << g.warnings[0];
   mesh::PlantGeometry none = Draw("@#(1)@Gs F @Ge(2)", DrawOptions{});
