@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/diagnostic.h"
+#include "lsys/array_bounds.h"
 #include "lsys/cpfg_data_files.h"
 #include "lsys/cpfg_function.h"
 #include "lsys/expr.h"
@@ -221,6 +222,10 @@ struct Grammar {
   // when parsed; null when there are none. A derivation starts with none
   // open; afterwards ShortReads() says where fscanf stopped early.
   std::shared_ptr<CpfgDataFiles> dataFiles;
+  // Where the grammar indexes its arrays (null: it has none); after a
+  // derivation, Warnings() says which arrays were indexed out of bounds
+  // (read at the nearest element, as cpfg does).
+  std::shared_ptr<ArrayBounds> arrayBounds;
   // Some production assigns a global variable: its steps are then rewritten
   // left to right on one thread, as cpfg does, so the assignments happen in
   // word order.

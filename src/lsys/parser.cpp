@@ -268,6 +268,9 @@ class GrammarParser {
   void ParseGlobalBlock(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseFunctions(const Line& l, size_t after, size_t end);
   void ParseArrays(const Line& l, size_t after, size_t end);
+  // Arrays in the expressions of line l: each index written is a site of
+  // the grammar's ArrayBounds (cpfg's clamped indices, warned about).
+  void UseArrays(const Line& l, ExprScope& scope);
   void CollectGlobals();
   void HiddenGlobalSlots(const std::string& t, size_t from, bool start, ExprScope* scope);
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
@@ -661,6 +664,17 @@ bool GrammarParser::CheckBrackets(const Line& l, const std::vector<SymbolId>& sy
     return false;
   }
   return true;
+}
+
+void GrammarParser::UseArrays(const Line& l, ExprScope& scope) {
+  scope.arrays = &g_.arrays;
+  if (g_.arrays.empty()) return;
+  if (!g_.arrayBounds) g_.arrayBounds = std::make_shared<ArrayBounds>();
+  scope.arrayBounds = g_.arrayBounds;
+  scope.indexSite = [this, &l](int column, const ArrayShape& a, int dimension) {
+    return g_.arrayBounds->AddSite(Loc(l, column), std::string(OriginalAt(l, column)), a.name,
+                                   dimension, a.dims[size_t(dimension - 1)]);
+  };
 }
 
 bool GrammarParser::ParseBlockAt(const Line& l, std::string_view view, size_t* pos,
@@ -1242,7 +1256,7 @@ void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end)
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   scope.functions = &g_.functions;
   scope.globals = &g_.globals;
-  scope.arrays = &g_.arrays;
+  UseArrays(l, scope);
   Successor s;
   if (!ParseActualWord(l, after, end, scope, &s)) return;
   if (s.symbols.empty()) {
@@ -1729,7 +1743,7 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
   ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
   scope.functions = &g_.functions;
   scope.globals = &g_.globals;
-  scope.arrays = &g_.arrays;
+  UseArrays(l, scope);
   HiddenGlobalSlots(t, after, k == "start", &scope);
   std::string_view view(t.data(), end);
   size_t pos = after;
@@ -2051,7 +2065,7 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
       ExprScope scope{&g_.constants, &usedConstants_, nullptr, &macros_};
       scope.functions = &g_.functions;
       scope.globals = &g_.globals;
-      scope.arrays = &g_.arrays;
+      UseArrays(l, scope);
       Successor unused;
       ParseActualWord(l, after, end, scope, &unused);
       return true;
@@ -2460,7 +2474,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   p.formalCount = uint16_t(formals.size());
   ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
   scope.functions = &g_.functions;
-  scope.arrays = &g_.arrays;
+  UseArrays(l, scope);
 
   // Condition, with cpfg's statement blocks around it.
   std::vector<std::string> locals;

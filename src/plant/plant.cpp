@@ -360,6 +360,9 @@ PlantResult Grower::Finish() && {
   // cpfg data files that fscanf read less of than its formats asked.
   if (g.dataFiles)
     for (Diagnostic& d : g.dataFiles->ShortReads()) r.diagnostics.Add(std::move(d));
+  // cpfg arrays indexed out of bounds (read at the nearest element).
+  if (g.arrayBounds)
+    for (Diagnostic& d : g.arrayBounds->Warnings()) r.diagnostics.Add(std::move(d));
   if (spec_.until >= Stage::kGeometry) {
     const auto t0 = Clock::now();
     auto geometry =

@@ -180,6 +180,24 @@ TEST(CliMesh, UnknownSurfacePointsAtTheTilde) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+TEST(Cli, ArrayIndexOutOfBoundsIsAWarningAfterTheDerivationAndAnErrorWithStrict) {
+  // vlab's CelticKnot reads turn0[7] of a 7-element array: cpfg uses the
+  // last element; so does Sylva, with a warning at the index (once per array).
+  std::string f = WriteFile("knot.l",
+                            "define: { array t[2] = {5, 6}; }\naxiom: A(0)\n"
+                            "A(i) --> B(t[i]) A(i+1)\n");
+  auto plain = RunSylva({"derive", f, "-n", "3"});
+  EXPECT_EQ(plain.code, 0) << plain.err;
+  EXPECT_NE(plain.out.find("B(5)B(6)B(6)A(3)"), std::string::npos) << plain.out;
+  EXPECT_NE(plain.err.find("knot.l:3:12: warning: index 2 of array 't' is outside 0 to 1: Sylva "
+                           "uses element 1 instead, as cpfg does"),
+            std::string::npos)
+      << plain.err;
+  auto strict = RunSylva({"derive", "--strict", f, "-n", "3"});
+  EXPECT_EQ(strict.code, 2) << strict.err;
+  EXPECT_EQ(strict.out, "");
+}
+
 TEST(Cli, StrictMakesWarningsErrorsOnEveryCommand) {
   std::string f = WriteFile("gc.l", "axiom: A\nA --> F@D F@PS A\n");
   auto plain = RunSylva({"check", f});
