@@ -137,7 +137,7 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
   const auto t0 = Clock::now();
   SurfaceLibrary surfaces(plant.grammar.path, spec.surfacePath, spec.readFile);
   surfaces.Define(spec.cpfgSurfaces);
-  if (Status s = surfaces.LoadFor(plant.geometry, plant.grammar); !s.ok()) return s;
+  if (Status s = surfaces.LoadFor(plant.geometry, plant.grammar, &diagnostics); !s.ok()) return s;
   mesh::TessellateOptions options;
   options.detail = spec.detail;
   options.view = spec.view;

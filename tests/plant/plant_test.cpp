@@ -228,15 +228,24 @@ TEST(SurfaceLibrary, CallerFoldersComeFirstThenTheGrammarsThenTheBundledOnes) {
   EXPECT_EQ(lib.searchPath()[2], (dir.path / "surfaces").string());
 }
 
-TEST(SurfaceLibrary, UnknownSurfacePointsAtItsUseInTheGrammar) {
+TEST(SurfaceLibrary, UnknownSurfaceIsAWarningAtItsUseAndDrawsNothing) {
   PlantSpec spec;
   spec.path = "s.lsys";
-  spec.text = "axiom: F\nF --> F[+F~nosuch]\n";
+  spec.text = "axiom: F\nF --> F[+F~nosuch]~nosuch\n";
   spec.steps = 1;
   PlantResult r = BuildPlant(spec);
-  ASSERT_FALSE(r.plant);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
   const std::string all = r.diagnostics.FormatAll();
-  EXPECT_NE(all.find("s.lsys:2:11: error: unknown surface 'nosuch'"), std::string::npos) << all;
+  EXPECT_NE(all.find("s.lsys:2:11: warning: unknown surface 'nosuch' is not drawn (as in cpfg)"),
+            std::string::npos)
+      << all;
+  EXPECT_EQ(r.diagnostics.items.size(), 1u) << all;  // once per name
+  // Nothing is drawn for it: the mesh is the one without the surfaces.
+  PlantSpec plain = spec;
+  plain.text = "axiom: F\nF --> F[+F]\n";
+  PlantResult p = BuildPlant(plain);
+  ASSERT_TRUE(p.plant) << p.diagnostics.FormatAll();
+  EXPECT_EQ(r.plant->mesh.triangleCount(), p.plant->mesh.triangleCount());
 }
 
 }  // namespace
