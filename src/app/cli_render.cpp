@@ -86,10 +86,27 @@ bool UseCpfgDefaultView(const std::string& grammar, const ViewFile* view, ViewFl
   return true;
 }
 
-// cpfg's `scale factor:` zooms the framed view; its `viewing angle:` is
-// the perspective's field of view (the camera moves back or forward so the
-// framed box keeps its size: the distance times tan(35/2) / tan(a/2)).
+// cpfg's `scale factor:` zooms the framed view of a parallel projection
+// (CalculateWindow: the box's span divided by it). In perspective cpfg
+// frames nothing (control.c, SetView): the eye is at vrp + (viewpoint -
+// vrp) / scale, looking at the view reference point vrp, with a field of
+// view of `viewing angle:` (45 degrees by default), so Sylva places the
+// camera there when the view file gives a viewpoint or reference point.
+// Otherwise `viewing angle:` is the field of view of the framed camera
+// (moved back or forward so the framed box keeps its size: the distance
+// times tan(35/2) / tan(a/2)).
 void UseViewFileScale(const ViewFile* view, render::Camera& camera) {
+  if (view && !view->path.empty() && !view->parallel && !camera.orthographic &&
+      (view->viewpoint || view->target)) {
+    const Vec3 at = view->target.value_or(Vec3(0, 0, 0));
+    const double d = (view->viewpoint.value_or(Vec3(0, 0, 1)) - at).norm() / view->scale.value_or(1);
+    if (d > 0 && std::isfinite(d)) {
+      camera.target = at;
+      camera.distance = d;
+      camera.fovY = view->viewingAngle.value_or(45);
+      return;
+    }
+  }
   if (view && view->viewingAngle && !camera.orthographic) {
     const double a = *view->viewingAngle;
     camera.distance *= std::tan(camera.fovY * kDegToRad / 2) / std::tan(a * kDegToRad / 2);
