@@ -148,6 +148,9 @@ struct LsystemBlock {
 struct Grammar {
   std::string name;  // `lsystem:` or the file name
   std::string path;  // main file
+  // The main file is a cpfg file (`.l`): drawn by cpfg's turtle, which has
+  // no `'` (Sylva's grammars step the colour index with it).
+  bool cpfgFile = false;
   int derivationLength = 0;
   double angle = 90;  // degrees
   double step = 1;

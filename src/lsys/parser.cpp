@@ -607,6 +607,15 @@ bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string*
   return false;
 }
 
+// cpfg's query modules: the turtle or the environment answers each with
+// the parameters it has (cpfg's clover asks `?E(1)` at apices and
+// `?E(2, area)` at leaves), and a production matches only the number of
+// parameters it names, as cpfg's PredDiff does; so uses with different
+// numbers of parameters are not warned about.
+static bool IsQueryName(const std::string& name) {
+  return name == "?E" || name == "?P" || name == "?H" || name == "?L" || name == "?U";
+}
+
 std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std::string& name,
                                               int arity) {
   if (arity > kMaxArity) {
@@ -631,7 +640,7 @@ std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std:
   auto it = arityUse_.find(name);
   if (it == arityUse_.end()) {
     arityUse_.emplace(name, ArityUse{arity, Loc(l, col)});
-  } else if (it->second.arity != arity && name != "[" && name != "]") {
+  } else if (it->second.arity != arity && name != "[" && name != "]" && !IsQueryName(name)) {
     // One warning per name.
     if (it->second.arity >= 0) {
       Warn(Loc(l, col), OriginalAt(l, col),
@@ -2920,6 +2929,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   CollectGlobals();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
+  g_.cpfgFile = std::filesystem::path(path).extension() == ".l";
   // module: declarations apply to the whole file, wherever they stand.
   for (const Line& l : lines_) {
     size_t p = 0;

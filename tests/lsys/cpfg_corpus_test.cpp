@@ -49,5 +49,23 @@ TEST(CpfgKeywords, StatementsWithBlanksBeforeTheColonOrArrowsInStringsStayStatem
   EXPECT_NE(d[0].find("prints nothing"), std::string::npos) << d[0];
 }
 
+TEST(CpfgQueries, OneQueryWithDifferentParameterCountsIsNotWarnedAbout) {
+  // vlab's 13-clover asks `?E(1)` at apices and `?E(2,la)` at leaves: in
+  // cpfg both are queries, and a production matches only the number of
+  // parameters it names (PredDiff), as in Sylva. Other modules still warn.
+  const std::string text =
+      "axiom: A ?E(1) L ?E(2,3)\n"
+      "A > ?E(r) --> B(r)\n"
+      "?E(t,a) --> *\n"
+      "L --> L(1)\n";
+  auto d = Diagnostics(text);
+  for (const std::string& line : d)
+    EXPECT_EQ(line.find("'?E' is used with"), std::string::npos) << Joined(d);
+  bool lWarned = false;
+  for (const std::string& line : d)
+    lWarned |= line.find("module 'L' is used with 1 parameter here and with 0") != std::string::npos;
+  EXPECT_TRUE(lWarned) << Joined(d);
+}
+
 }  // namespace
 }  // namespace sylva::lsys

@@ -326,3 +326,32 @@ TEST(Plant, AnEmptyMeshIsAWarningNotSilence) {
 
 }  // namespace
 }  // namespace sylva::plant
+
+namespace sylva::plant {
+namespace {
+
+// Colour index of each segment of a one-line grammar drawn from `path`.
+std::vector<int> SegmentColors(const std::string& path, const std::string& text) {
+  PlantSpec spec;
+  spec.path = path;
+  spec.text = text;
+  spec.until = Stage::kGeometry;
+  PlantResult r = BuildPlant(spec);
+  std::vector<int> out;
+  if (!r.plant) {
+    ADD_FAILURE() << r.diagnostics.FormatAll();
+    return out;
+  }
+  for (const auto& s : r.plant->geometry.segments) out.push_back(s.color);
+  return out;
+}
+
+TEST(Plant, QuoteStepsTheColourInSylvaGrammarsAndIsNoCommandInCpfgFiles) {
+  // cpfg's turtle (vlab interpret.c, InterpretSymbol) has no case for `'`:
+  // in a cpfg file it is a module that draws nothing.
+  EXPECT_EQ(SegmentColors("q.lsys", "axiom: F'F'(5)F\n"), (std::vector<int>{0, 1, 5}));
+  EXPECT_EQ(SegmentColors("q.l", "axiom: F'F'(5)F;F\n"), (std::vector<int>{0, 0, 0, 1}));
+}
+
+}  // namespace
+}  // namespace sylva::plant
