@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -272,6 +273,7 @@ class GrammarParser {
   // the grammar's ArrayBounds (cpfg's clamped indices, warned about).
   void UseArrays(const Line& l, ExprScope& scope);
   void CollectGlobals();
+  void CheckSubLsystemIds();
   void HiddenGlobalSlots(const std::string& t, size_t from, bool start, ExprScope* scope);
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
                       size_t lhsEnd);
@@ -2905,10 +2907,47 @@ void GrammarParser::Finish() {
   g_.subLsystems = g_.lsystems.size() > 1;
   for (int a = 1; a <= kMaxArity && !g_.subLsystems; ++a)
     g_.subLsystems = g_.symbols.Find("?", a).has_value();
+  CheckSubLsystemIds();
   g_.cutSymbol = g_.symbols.Find("%", 0);
   if (g_.dataFiles && g_.dataFiles->empty()) g_.dataFiles.reset();
   g_.axiom = std::move(axiom_);
   g_.axiomLoc = axiomLoc_;
+}
+
+// `?(id, ...)` with a constant id that no `lsystem:` block has, in the
+// axiom or a successor: cpfg stops when the derivation gets there ("L-system
+// N not in .l file"); Sylva says so where it is written, before deriving.
+void GrammarParser::CheckSubLsystemIds() {
+  if (!g_.subLsystems) return;
+  std::string ids;
+  for (const LsystemBlock& b : g_.lsystems) ids += (ids.empty() ? "" : ", ") + std::to_string(b.id);
+  auto check = [&](const Successor& w, const SourceLoc& loc, const char* where) {
+    size_t param = 0;
+    for (SymbolId sym : w.symbols) {
+      const int arity = g_.symbols.arity(sym);
+      if (arity >= 1 && g_.symbols.name(sym) == "?" && param < w.params.size() &&
+          w.params[param].IsConstant()) {
+        const double id = std::trunc(w.params[param].constant());
+        bool known = false;
+        for (const LsystemBlock& b : g_.lsystems) known |= double(b.id) == id;
+        if (!known) {
+          char shown[32];
+          std::snprintf(shown, sizeof shown, "%.6g", id);
+          diags_.Add(MakeError(loc,
+                               std::string("'?(") + shown + ", ...)' in " + where +
+                                   " starts sub-L-system " + shown +
+                                   ", but the file's 'lsystem:' blocks are numbered " + ids,
+                               1, g_.SourceLine(loc)));
+          return;
+        }
+      }
+      param += size_t(arity);
+    }
+  };
+  check(axiom_, axiomLoc_, "the axiom");
+  for (const auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation})
+    for (const Production& p : sec->productions)
+      check(p.successor, p.loc, "the successor of this production");
 }
 
 ParseResult GrammarParser::Run(const std::string& text, const std::string& path) {

@@ -67,5 +67,20 @@ TEST(CpfgQueries, OneQueryWithDifferentParameterCountsIsNotWarnedAbout) {
   EXPECT_TRUE(lWarned) << Joined(d);
 }
 
+TEST(CpfgSubLsystems, UnknownConstantIdIsAnErrorWhereItIsWritten) {
+  // A sub-L-system that no block defines (as vlab's Sedge met when its
+  // #included blocks were dropped) failed at the step that reached it,
+  // with no line: cpfg too stops there ("L-system 2 not in .l file").
+  const std::string head = "lsystem: 1\nderivation length: 3\naxiom: A\nA --> F ?(2,1)X$\nendlsystem\n";
+  EXPECT_EQ(testing::FirstError(head),
+            "4:1 '?(2, ...)' in the successor of this production starts sub-L-system 2, but the "
+            "file's 'lsystem:' blocks are numbered 1");
+  EXPECT_EQ(testing::FirstError("lsystem: 1\naxiom: ?(3)B$\nendlsystem\n"),
+            "2:8 '?(3, ...)' in the axiom starts sub-L-system 3, but the file's 'lsystem:' blocks "
+            "are numbered 1");
+  EXPECT_EQ(testing::FirstError(head + "lsystem: 2\naxiom: X\nX --> FX\nendlsystem\n"),
+            "<no error>");
+}
+
 }  // namespace
 }  // namespace sylva::lsys
