@@ -125,7 +125,8 @@ void UseViewFileScale(const ViewFile* view, render::Camera& camera) {
 // and when a cpfg view file asks for a parallel projection.
 Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSpec& spec,
                                      const ViewFlags& v, bool lines, bool orthographic,
-                                     mesh::Box* meshBox = nullptr) {
+                                     mesh::Box* meshBox = nullptr,
+                                     const ViewFile* view = nullptr) {
   Vec3 lo = p.geometry.boundsMin, hi = p.geometry.boundsMax;
   if (!lines) {
     auto box = plant::MeshBounds(p, spec);
@@ -135,6 +136,11 @@ Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSp
       lo = box->lo;
       hi = box->hi;
     }
+  }
+  // cpfg's `box:` is the view volume a parallel view frames (CalculateWindow).
+  if (view && view->box && orthographic) {
+    lo = (*view->box)[0];
+    hi = (*view->box)[1];
   }
   const double aspect = double(v.width) / v.height;
   render::Camera camera =
@@ -267,7 +273,8 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   const bool parallel = figure || cpfgDefaultView || (viewFile && viewFile->parallel);
   render::LineBatch batch;
   mesh::Box bounds;
-  auto camera = FrameCamera(*plant, *spec, v, figure, parallel, &bounds);
+  auto camera = FrameCamera(*plant, *spec, v, figure, parallel, &bounds,
+                            cmd.camera.empty() ? viewFile.get() : nullptr);
   if (!camera) return Report(camera.error(), err);
   if (cmd.camera.empty()) UseViewFileScale(viewFile.get(), *camera);
   const int W = v.width * K, H = v.height * K;
