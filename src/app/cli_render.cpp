@@ -99,7 +99,8 @@ void UseViewFileScale(const ViewFile* view, render::Camera& camera) {
   if (view && !view->path.empty() && !view->parallel && !camera.orthographic &&
       (view->viewpoint || view->target)) {
     const Vec3 at = view->target.value_or(Vec3(0, 0, 0));
-    const double d = (view->viewpoint.value_or(Vec3(0, 0, 1)) - at).norm() / view->scale.value_or(1);
+    const double d =
+        (view->viewpoint.value_or(Vec3(0, 0, 1)) - at).norm() / view->scale.value_or(1);
     if (d > 0 && std::isfinite(d)) {
       camera.target = at;
       camera.distance = d;
@@ -125,8 +126,7 @@ void UseViewFileScale(const ViewFile* view, render::Camera& camera) {
 // and when a cpfg view file asks for a parallel projection.
 Expected<render::Camera> FrameCamera(const plant::Plant& p, const plant::PlantSpec& spec,
                                      const ViewFlags& v, bool lines, bool orthographic,
-                                     mesh::Box* meshBox = nullptr,
-                                     const ViewFile* view = nullptr) {
+                                     mesh::Box* meshBox = nullptr, const ViewFile* view = nullptr) {
   Vec3 lo = p.geometry.boundsMin, hi = p.geometry.boundsMax;
   if (!lines) {
     auto box = plant::MeshBounds(p, spec);

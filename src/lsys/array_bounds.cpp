@@ -43,9 +43,9 @@ std::vector<Diagnostic> ArrayBounds::Warnings() const {
     if (lo < 0) used = "element 0";
     if (hi >= double(s.size))
       used += (used.empty() ? "element " : " or ") + std::to_string(s.size - 1);
-    const std::string which =
-        multiDimensional_ && s.dimension > 1 ? " (its index " + std::to_string(s.dimension) + ")"
-                                             : "";
+    const std::string which = multiDimensional_ && s.dimension > 1
+                                  ? " (its index " + std::to_string(s.dimension) + ")"
+                                  : "";
     Diagnostic d =
         MakeError(s.loc,
                   std::string(what) + " of array '" + s.array + "'" + which + " is outside 0 to " +

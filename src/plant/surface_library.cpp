@@ -126,8 +126,9 @@ Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::
       Diagnostic d;
       d.severity = Severity::kWarning;
       d.loc.file = g.path;
-      d.message = "unknown surface '" + name + "' is not drawn (as in cpfg): no view-file 'surface: " +
-                  name + "' line, and no " + file + " in";
+      d.message = "unknown surface '" + name +
+                  "' is not drawn (as in cpfg): no view-file 'surface: " + name +
+                  "' line, and no " + file + " in";
       for (size_t i = 0; i < searchPath_.size(); ++i) {
         d.message += (i ? ", " : " ") + searchPath_[i];
       }

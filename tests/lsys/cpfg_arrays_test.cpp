@@ -61,8 +61,7 @@ TEST(CpfgArrays, IndexOutOfBoundsUsesTheNearestElementAndWarnsOncePerArray) {
   EXPECT_EQ(FormatWord(r->word, g.symbols), "B(10)C(10)B(20)C(10)B(30)C(20)B(30)C(30)A(4)");
   auto w = ArrayWarnings(g);
   ASSERT_EQ(w.size(), 1u) << testing::Joined(w);  // once per array: its first site
-  EXPECT_EQ(w[0].rfind("3:12 index 3 of array 'a' is outside 0 to 2: Sylva uses element 2", 0),
-            0u)
+  EXPECT_EQ(w[0].rfind("3:12 index 3 of array 'a' is outside 0 to 2: Sylva uses element 2", 0), 0u)
       << w[0];
   // A store at a negative second index writes element [0][0].
   Grammar s = MustParse(

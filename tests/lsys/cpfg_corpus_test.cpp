@@ -63,7 +63,8 @@ TEST(CpfgQueries, OneQueryWithDifferentParameterCountsIsNotWarnedAbout) {
     EXPECT_EQ(line.find("'?E' is used with"), std::string::npos) << Joined(d);
   bool lWarned = false;
   for (const std::string& line : d)
-    lWarned |= line.find("module 'L' is used with 1 parameter here and with 0") != std::string::npos;
+    lWarned |=
+        line.find("module 'L' is used with 1 parameter here and with 0") != std::string::npos;
   EXPECT_TRUE(lWarned) << Joined(d);
 }
 
@@ -71,7 +72,8 @@ TEST(CpfgSubLsystems, UnknownConstantIdIsAnErrorWhereItIsWritten) {
   // A sub-L-system that no block defines (as vlab's Sedge met when its
   // #included blocks were dropped) failed at the step that reached it,
   // with no line: cpfg too stops there ("L-system 2 not in .l file").
-  const std::string head = "lsystem: 1\nderivation length: 3\naxiom: A\nA --> F ?(2,1)X$\nendlsystem\n";
+  const std::string head =
+      "lsystem: 1\nderivation length: 3\naxiom: A\nA --> F ?(2,1)X$\nendlsystem\n";
   EXPECT_EQ(testing::FirstError(head),
             "4:1 '?(2, ...)' in the successor of this production starts sub-L-system 2, but the "
             "file's 'lsystem:' blocks are numbered 1");

@@ -213,8 +213,7 @@ TEST(ViewFile, PerspectiveIsCpfgsCameraNotAFramedBox) {
   // 2-unit stem centred on vrp seen from 5 units: 2 / (2 * 5 * tan(22.5))
   // = 48 % of the picture's height (the framed, halved camera drew it past
   // both edges).
-  const std::string grammar =
-      WriteFile("persp.l", "axiom: !(0.05) F(2) [&(90) F(0.1)]\n");
+  const std::string grammar = WriteFile("persp.l", "axiom: !(0.05) F(2) [&(90) F(0.1)]\n");
   WriteFile("persp.v",
             "viewpoint: 0,1,10\nview reference point: 0,1,0\nprojection: perspective\n"
             "scale factor: 2.0\nline style: cylinder\n");
