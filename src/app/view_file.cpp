@@ -311,6 +311,15 @@ void Reader::Read(const app::Line& line) {
     // automatic window off): a parallel view frames it, not the plant.
     double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     int seen = 0;
+    // cpfg reads it with scanf, so `z:-4,4` (no blank after the colon) too.
+    for (size_t k = 0; k < tokens_.size(); ++k) {
+      Token& t = tokens_[k];
+      if (t.text.size() > 2 && t.text[1] == ':' && std::strchr("xyz", t.text[0])) {
+        Token rest{t.text.substr(2), t.column + 2};
+        t.text.resize(2);
+        tokens_.insert(tokens_.begin() + std::ptrdiff_t(k) + 1, std::move(rest));
+      }
+    }
     for (size_t k = 0; k < tokens_.size();) {
       const std::string& t = tokens_[k].text;
       const int axis = t == "x:" ? 0 : t == "y:" ? 1 : t == "z:" ? 2 : -1;

@@ -62,6 +62,11 @@ TEST(ViewFile, BoxIsTheViewVolumeAParallelViewFrames) {
   ASSERT_TRUE(v.box.has_value());
   EXPECT_EQ((*v.box)[0], Vec3(-10, -57, -1));
   EXPECT_EQ((*v.box)[1], Vec3(10, 70, 1));
+  // vlab's topiary writes `z:-4,4`: cpfg's scanf reads it.
+  ViewFile tight = ParseViewFile("box: x: -4,4 y: -2,7 z:-4,4\n", "p.v");
+  EXPECT_TRUE(tight.diagnostics.items.empty()) << Messages(tight.diagnostics);
+  ASSERT_TRUE(tight.box.has_value());
+  EXPECT_EQ((*tight.box)[0], Vec3(-4, -2, -4));
   ViewFile bad = ParseViewFile("box: x: -10,10 y: -57,70\n", "p.v");
   EXPECT_FALSE(bad.box.has_value());
   EXPECT_NE(Messages(bad.diagnostics).find("'box:' needs the ranges"), std::string::npos)
