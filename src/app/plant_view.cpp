@@ -45,6 +45,16 @@ PlantView ChoosePlantView(const std::string& grammarPath, const ViewFile* view,
   if (view && !camera) {
     v.scale = view->scale;
     if (!v.orthographic) v.viewingAngle = view->viewingAngle;
+    if (v.orthographic) v.viewBox = view->box;
+    if (hasViewFile && !v.orthographic && (view->viewpoint || view->target)) {
+      const Vec3 at = view->target.value_or(Vec3(0, 0, 0));
+      const double d =
+          (view->viewpoint.value_or(Vec3(0, 0, 1)) - at).norm() / view->scale.value_or(1);
+      if (d > 0 && std::isfinite(d)) {
+        v.cpfgTarget = at;
+        v.cpfgDistance = d;
+      }
+    }
   }
   v.keyFromViewFile = view && view->lightToward;
   v.keyToward = v.keyFromViewFile ? *view->lightToward : render::KeyLightDirection();
@@ -65,9 +75,17 @@ Expected<mesh::Box> FramedBox(const PlantView& view, const plant::Plant& plant,
 }
 
 render::Camera FramePlant(const PlantView& view, const mesh::Box& box, double aspect) {
-  render::Camera camera = render::Camera::Frame(box.lo, box.hi, aspect, view.azimuth,
-                                                view.elevation, view.orthographic);
+  const bool boxed = view.orthographic && view.viewBox;
+  render::Camera camera = render::Camera::Frame(
+      boxed ? (*view.viewBox)[0] : box.lo, boxed ? (*view.viewBox)[1] : box.hi, aspect,
+      view.azimuth, view.elevation, view.orthographic);
   if (view.distance > 0) camera.distance = view.distance;
+  if (view.cpfgDistance > 0 && !camera.orthographic) {
+    camera.target = view.cpfgTarget;
+    camera.distance = view.cpfgDistance;
+    camera.fovY = view.viewingAngle.value_or(45);
+    return camera;
+  }
   // cpfg's `viewing angle:` is the perspective's field of view: the camera
   // moves back or forward so the framed box keeps its size (the distance
   // times tan(35/2) / tan(a/2)). Its `scale factor:` zooms the framed view.
@@ -92,6 +110,8 @@ render::Camera FrameAll(const PlantView& view, const mesh::Box& box, double aspe
   all.elevation = elevation;
   all.distance = 0;
   all.scale.reset();
+  all.cpfgDistance = 0;  // everything shows: the box framed
+  all.viewBox.reset();
   return FramePlant(all, box, aspect);
 }
 

@@ -57,6 +57,16 @@ struct PlantView {
   bool cameraFlag = false;             // --camera given: the view file's zoom is not applied
   std::optional<double> scale;         // `scale factor:`
   std::optional<double> viewingAngle;  // `viewing angle:` (perspective)
+  // cpfg's perspective camera (control.c, SetView), which frames nothing:
+  // looking at the view reference point from `distance` (|viewpoint - vrp|
+  // / scale factor) with a field of view of `viewing angle:` (45 degrees by
+  // default). Set when a perspective view file gives a viewpoint or a
+  // reference point; 0: the box is framed.
+  Vec3 cpfgTarget = Vec3::Zero();
+  double cpfgDistance = 0;
+  // cpfg's `box:`: the view volume a parallel view frames (CalculateWindow)
+  // in place of the plant's box.
+  std::optional<std::array<Vec3, 2>> viewBox;
   Vec3 keyToward = Vec3::UnitY();      // unit, toward the key light
   bool keyFromViewFile = false;        // keyToward is the view file's light
 

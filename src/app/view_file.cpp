@@ -56,7 +56,6 @@ constexpr Ignored kIgnored[] = {
     {"shadow map:", kLighting},
     {"line:", kSurfaces},
     {"tsurface:", kSurfaces},
-    {"box:", "a fixed bounding box: Sylva frames the plant"},
     {"background color:", kNotActed},
     {"font:", kNotActed},
     {"winfont:", kNotActed},
@@ -324,6 +323,39 @@ void Reader::Read(const app::Line& line) {
   } else if (L == "viewpoint:" || L == "view reference point:") {
     if (auto p = Vector(0, "x,y,z")) (L == "viewpoint:" ? v_.viewpoint : v_.target) = *p;
     ExtraValues(3);
+  } else if (L == "box:") {
+    // cpfg's fixed view volume, `box: x: x0,x1 y: y0,y1 z: z0,z1` (its
+    // automatic window off): a parallel view frames it, not the plant.
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    int seen = 0;
+    // cpfg reads it with scanf, so `z:-4,4` (no blank after the colon) too.
+    for (size_t k = 0; k < tokens_.size(); ++k) {
+      Token& t = tokens_[k];
+      if (t.text.size() > 2 && t.text[1] == ':' && std::strchr("xyz", t.text[0])) {
+        Token rest{t.text.substr(2), t.column + 2};
+        t.text.resize(2);
+        tokens_.insert(tokens_.begin() + std::ptrdiff_t(k) + 1, std::move(rest));
+      }
+    }
+    for (size_t k = 0; k < tokens_.size();) {
+      const std::string& t = tokens_[k].text;
+      const int axis = t == "x:" ? 0 : t == "y:" ? 1 : t == "z:" ? 2 : -1;
+      if (axis < 0) {
+        Error(tokens_[k].column, "expected 'x:', 'y:' or 'z:' in 'box:', not '" + t + "'");
+        return;
+      }
+      auto a = Number(k + 1, "a number"), b = a ? Number(k + 2, "a number") : std::nullopt;
+      if (!b) return;
+      lo[axis] = std::min(*a, *b);
+      hi[axis] = std::max(*a, *b);
+      seen |= 1 << axis;
+      k += 3;
+    }
+    if (seen != 7) {
+      Error(labelColumn_, "'box:' needs the ranges 'x: x0,x1 y: y0,y1 z: z0,z1'");
+      return;
+    }
+    v_.box = {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2])};
   } else if (L == "scale factor:") {
     if (auto x = Number(0, "a scale")) {
       if (*x > 0)

@@ -55,6 +55,9 @@ struct ViewFile {
   std::optional<Vec3> target;                 // `view reference point:`
   std::optional<double> scale;                // `scale factor:` (> 0)
   std::optional<double> viewingAngle;         // `viewing angle:` (degrees, 0..180): perspective
+  // `box: x: x0,x1 y: y0,y1 z: z0,z1`: cpfg's fixed view volume, framed by
+  // a parallel view instead of the plant's bounds (low corner, high corner).
+  std::optional<std::array<Vec3, 2>> box;
   // cpfg's line style: widths in pixels on the screen (`initial line
   // width: 2 pixels`, `line style: pixel`, or neither: cpfg's default,
   // with a width of 1), not in world units (`initial line width: 0.1`,

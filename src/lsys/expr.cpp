@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "core/math.h"
+#include "lsys/array_bounds.h"
 #include "lsys/cpfg_curve.h"
 #include "lsys/cpfg_data_files.h"
 #include "lsys/cpfg_function.h"
@@ -261,12 +262,18 @@ bool Expr::Run(double* vars, double* globals, RandomStream& rng, double* out,
         break;
       case OpCode::kIndex: {
         const double v = stack[--sp];
+        double at = std::floor(v);  // cpfg: (int) index
         if (!(v >= 0 && v < double(in.arg))) {
-          char b[160];
-          std::snprintf(b, sizeof b, "array index %.6g is outside 0 to %u", v, in.arg - 1);
-          return Fail(err, int(columns_[pc]), b);
+          if (!bounds_ || in.value == 0 || std::isnan(v)) {
+            char b[160];
+            std::snprintf(b, sizeof b, "array index %.6g is outside 0 to %u", v, in.arg - 1);
+            return Fail(err, int(columns_[pc]), b);
+          }
+          // cpfg uses the nearest element (generate.c, Eval); noted for a warning.
+          bounds_->Note(uint32_t(in.value), v);
+          at = v < 0 ? 0 : double(in.arg - 1);
         }
-        stack[sp - 1] = stack[sp - 1] * in.arg + std::floor(v);  // cpfg: (int) index
+        stack[sp - 1] = stack[sp - 1] * in.arg + at;
         break;
       }
       case OpCode::kGlobalAt:
@@ -759,6 +766,11 @@ class Parser {
     return Error(col, "unexpected character '" + shown + "' in expression");
   }
 
+  // The index site of the dimension-th index of `a` at col, or 0.
+  double Site(int col, const ArrayShape& a, int dimension) const {
+    return scope_.indexSite ? double(scope_.indexSite(col, a, dimension)) : 0;
+  }
+
   const ArrayShape* FindArray(const std::string& name) const {
     if (!scope_.arrays) return nullptr;
     for (const ArrayShape& a : *scope_.arrays)
@@ -770,6 +782,7 @@ class Parser {
   NodePtr Element(const ArrayShape& a, int col, int len, int depth) {
     auto acc = Make(OpCode::kConst, col);
     acc->value = 0;
+    int dimension = 1;
     for (uint32_t d : a.dims) {
       SkipSpace();
       if (p_ >= t_.size() || t_[p_] != '[')
@@ -784,6 +797,7 @@ class Parser {
       if (!Accept("]")) return Error(Col(), "expected ']' after an index of '" + a.name + "'");
       auto ix = Make(OpCode::kIndex, col, std::move(acc), std::move(index));
       ix->slot = d;
+      ix->value = Site(col, a, dimension++);
       acc = std::move(ix);
     }
     SkipSpace();
@@ -1185,7 +1199,7 @@ class ExprCompiler {
         push(OpCode::kToBool);
         code[f.jump1].arg = uint32_t(code.size());
       } else {
-        push(n.op, n.slot);
+        push(n.op, n.slot, n.op == OpCode::kIndex ? n.value : 0);  // kIndex: its site
       }
       stack.pop_back();
     }
@@ -1241,6 +1255,7 @@ class ExprCompiler {
       if ((in.op == OpCode::kFopen || in.op == OpCode::kFscanf || in.op == OpCode::kFclose) &&
           scope_ && scope_->dataFiles)
         e.files_ = *scope_->dataFiles;
+      if (in.op == OpCode::kIndex && in.value != 0 && scope_) e.bounds_ = scope_->arrayBounds;
     }
   }
   const ExprScope* scope_ = nullptr;
@@ -1661,6 +1676,7 @@ class ExprCompiler {
         Push(OpCode::kConst, 0, tcol);  // the offset, built one index at a time
         ++onStack;
         *pos = q;
+        int dimension = 1;
         for (uint32_t d : a->dims) {
           SkipSpace(text, pos);
           if (*pos >= text.size() || text[*pos] != '[')
@@ -1674,6 +1690,8 @@ class ExprCompiler {
             return Err(int(*pos) + 1, "expected ']' after an index of '" + name + "'");
           ++*pos;
           Push(OpCode::kIndex, d, tcol);
+          if (scope.indexSite) blockCode.back().value = scope.indexSite(tcol, *a, dimension);
+          ++dimension;
         }
         SkipSpace(text, pos);
         if (*pos < text.size() && text[*pos] == '[')
@@ -1747,6 +1765,7 @@ class ExprCompiler {
     blockCode.push_back(Instr{OpCode::kConst, 0, 0});
     blockColumns.push_back(uint32_t(col));
     *pos = q;
+    int dimension = 1;
     for (uint32_t d : a->dims) {
       SkipSpace(text, pos);
       if (*pos >= text.size() || text[*pos] != '[')
@@ -1761,6 +1780,8 @@ class ExprCompiler {
         return Err(int(*pos) + 1, "expected ']' after an index of '" + name + "'");
       ++*pos;
       Push(OpCode::kIndex, d, col);
+      if (scope.indexSite) blockCode.back().value = scope.indexSite(col, *a, dimension);
+      ++dimension;
     }
     SkipSpace(text, pos);
     if (*pos < text.size() && text[*pos] == '[')

@@ -27,6 +27,7 @@ namespace sylva::lsys {
 class CpfgFunction;
 class CpfgCurve;
 class CpfgDataFiles;
+class ArrayBounds;
 
 enum class OpCode : uint8_t {
   kConst,
@@ -81,8 +82,10 @@ enum class OpCode : uint8_t {
   kStoreGlobal,  // pop into globals[arg]
   kLoop,         // jump back to arg; counts iterations (kMaxLoopIterations)
   // cpfg arrays, kept in the globals: an element's offset is built one
-  // index at a time (kIndex: top-1 = top-1 * arg + top, 0 <= top < arg, or
-  // an error), then read or written at globals[arg + offset].
+  // index at a time (kIndex: top-1 = top-1 * arg + top, 0 <= top < arg;
+  // value: the index site in the grammar's ArrayBounds, which an index out
+  // of bounds is noted at and clamped as cpfg does, or 0: an error), then
+  // read or written at globals[arg + offset].
   kIndex,
   kGlobalAt,       // top = globals[arg + top]
   kStoreGlobalAt,  // value = pop, offset = pop: globals[arg + offset] = value
@@ -163,6 +166,7 @@ class Expr {
   std::vector<std::shared_ptr<const CpfgFunction>> funcs_;  // of kFunc: the grammar's functions
   std::vector<std::shared_ptr<const CpfgCurve>> curves_;    // of kCurve: the grammar's curves
   std::shared_ptr<CpfgDataFiles> files_;  // of kFopen, kFscanf, kFclose: the grammar's data files
+  std::shared_ptr<ArrayBounds> bounds_;   // of kIndex with a site: the grammar's
 };
 
 }  // namespace sylva::lsys

@@ -11,6 +11,7 @@
 //   primary := number | name | name '(' args ')' | '(' ternary ')'
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -91,6 +92,12 @@ struct ExprScope {
   const std::vector<std::shared_ptr<const CpfgCurve>>* curves = nullptr;
   // cpfg arrays: `a[i][j]` in expressions, `a[i][j] = v;` in blocks.
   const std::vector<ArrayShape>* arrays = nullptr;
+  // Where an index out of bounds is noted (lsys/array_bounds.h): indexSite
+  // registers the `dimension`-th index of `array` written at `column` and
+  // returns its site (ArrayBounds::AddSite). Unset: such an index is an
+  // evaluation error.
+  std::function<uint32_t(int column, const ArrayShape& array, int dimension)> indexSite = nullptr;
+  std::shared_ptr<ArrayBounds> arrayBounds = nullptr;
   // The hidden global slot `srand(seed);` stores to (-1: srand is an error
   // here). The derivation draws random numbers from that seed once it is
   // set (Grammar::srandGlobal).

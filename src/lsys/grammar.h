@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/diagnostic.h"
+#include "lsys/array_bounds.h"
 #include "lsys/cpfg_data_files.h"
 #include "lsys/cpfg_curve.h"
 #include "lsys/cpfg_function.h"
@@ -148,6 +149,9 @@ struct LsystemBlock {
 struct Grammar {
   std::string name;  // `lsystem:` or the file name
   std::string path;  // main file
+  // The main file is a cpfg file (`.l`): drawn by cpfg's turtle, which has
+  // no `'` (Sylva's grammars step the colour index with it).
+  bool cpfgFile = false;
   int derivationLength = 0;
   double angle = 90;  // degrees
   double step = 1;
@@ -228,6 +232,10 @@ struct Grammar {
   // when parsed; null when there are none. A derivation starts with none
   // open; afterwards ShortReads() says where fscanf stopped early.
   std::shared_ptr<CpfgDataFiles> dataFiles;
+  // Where the grammar indexes its arrays (null: it has none); after a
+  // derivation, Warnings() says which arrays were indexed out of bounds
+  // (read at the nearest element, as cpfg does).
+  std::shared_ptr<ArrayBounds> arrayBounds;
   // Some production assigns a global variable: its steps are then rewritten
   // left to right on one thread, as cpfg does, so the assignments happen in
   // word order.

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -271,7 +272,11 @@ class GrammarParser {
   void ParseGlobalBlock(const Line& l, const std::string& k, size_t after, size_t end);
   void ParseFunctions(const Line& l, size_t after, size_t end);
   void ParseArrays(const Line& l, size_t after, size_t end);
+  // Arrays in the expressions of line l: each index written is a site of
+  // the grammar's ArrayBounds (cpfg's clamped indices, warned about).
+  void UseArrays(const Line& l, ExprScope& scope);
   void CollectGlobals();
+  void CheckSubLsystemIds();
   void HiddenGlobalSlots(const std::string& t, size_t from, bool start, ExprScope* scope);
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
                       size_t lhsEnd);
@@ -609,6 +614,15 @@ bool GrammarParser::LexName(const Line& l, size_t& pos, size_t end, std::string*
   return false;
 }
 
+// cpfg's query modules: the turtle or the environment answers each with
+// the parameters it has (cpfg's clover asks `?E(1)` at apices and
+// `?E(2, area)` at leaves), and a production matches only the number of
+// parameters it names, as cpfg's PredDiff does; so uses with different
+// numbers of parameters are not warned about.
+static bool IsQueryName(const std::string& name) {
+  return name == "?E" || name == "?P" || name == "?H" || name == "?L" || name == "?U";
+}
+
 std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std::string& name,
                                               int arity) {
   if (arity > kMaxArity) {
@@ -633,7 +647,7 @@ std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std:
   auto it = arityUse_.find(name);
   if (it == arityUse_.end()) {
     arityUse_.emplace(name, ArityUse{arity, Loc(l, col)});
-  } else if (it->second.arity != arity && name != "[" && name != "]") {
+  } else if (it->second.arity != arity && name != "[" && name != "]" && !IsQueryName(name)) {
     // One warning per name.
     if (it->second.arity >= 0) {
       Warn(Loc(l, col), OriginalAt(l, col),
@@ -666,6 +680,17 @@ bool GrammarParser::CheckBrackets(const Line& l, const std::vector<SymbolId>& sy
     return false;
   }
   return true;
+}
+
+void GrammarParser::UseArrays(const Line& l, ExprScope& scope) {
+  scope.arrays = &g_.arrays;
+  if (g_.arrays.empty()) return;
+  if (!g_.arrayBounds) g_.arrayBounds = std::make_shared<ArrayBounds>();
+  scope.arrayBounds = g_.arrayBounds;
+  scope.indexSite = [this, &l](int column, const ArrayShape& a, int dimension) {
+    return g_.arrayBounds->AddSite(Loc(l, column), std::string(OriginalAt(l, column)), a.name,
+                                   dimension, a.dims[size_t(dimension - 1)]);
+  };
 }
 
 bool GrammarParser::ParseBlockAt(const Line& l, std::string_view view, size_t* pos,
@@ -1251,7 +1276,7 @@ void GrammarParser::ParseAxiom(const Line& l, int col, size_t after, size_t end)
   scope.functions = &g_.functions;
   scope.curves = &g_.curves;
   scope.globals = &g_.globals;
-  scope.arrays = &g_.arrays;
+  UseArrays(l, scope);
   Successor s;
   if (!ParseActualWord(l, after, end, scope, &s)) return;
   if (s.symbols.empty()) {
@@ -1760,7 +1785,7 @@ void GrammarParser::ParseGlobalBlock(const Line& l, const std::string& k, size_t
   scope.functions = &g_.functions;
   scope.curves = &g_.curves;
   scope.globals = &g_.globals;
-  scope.arrays = &g_.arrays;
+  UseArrays(l, scope);
   HiddenGlobalSlots(t, after, k == "start", &scope);
   std::string_view view(t.data(), end);
   size_t pos = after;
@@ -2083,7 +2108,7 @@ bool GrammarParser::ParseHeader(const Line& l, size_t pos) {
       scope.functions = &g_.functions;
       scope.curves = &g_.curves;
       scope.globals = &g_.globals;
-      scope.arrays = &g_.arrays;
+      UseArrays(l, scope);
       Successor unused;
       ParseActualWord(l, after, end, scope, &unused);
       return true;
@@ -2493,7 +2518,7 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
   ExprScope scope{&g_.constants, &usedConstants_, &formals, &macros_};
   scope.functions = &g_.functions;
   scope.curves = &g_.curves;
-  scope.arrays = &g_.arrays;
+  UseArrays(l, scope);
 
   // Condition, with cpfg's statement blocks around it.
   std::vector<std::string> locals;
@@ -2919,10 +2944,47 @@ void GrammarParser::Finish() {
   g_.subLsystems = g_.lsystems.size() > 1;
   for (int a = 1; a <= kMaxArity && !g_.subLsystems; ++a)
     g_.subLsystems = g_.symbols.Find("?", a).has_value();
+  CheckSubLsystemIds();
   g_.cutSymbol = g_.symbols.Find("%", 0);
   if (g_.dataFiles && g_.dataFiles->empty()) g_.dataFiles.reset();
   g_.axiom = std::move(axiom_);
   g_.axiomLoc = axiomLoc_;
+}
+
+// `?(id, ...)` with a constant id that no `lsystem:` block has, in the
+// axiom or a successor: cpfg stops when the derivation gets there ("L-system
+// N not in .l file"); Sylva says so where it is written, before deriving.
+void GrammarParser::CheckSubLsystemIds() {
+  if (!g_.subLsystems) return;
+  std::string ids;
+  for (const LsystemBlock& b : g_.lsystems) ids += (ids.empty() ? "" : ", ") + std::to_string(b.id);
+  auto check = [&](const Successor& w, const SourceLoc& loc, const char* where) {
+    size_t param = 0;
+    for (SymbolId sym : w.symbols) {
+      const int arity = g_.symbols.arity(sym);
+      if (arity >= 1 && g_.symbols.name(sym) == "?" && param < w.params.size() &&
+          w.params[param].IsConstant()) {
+        const double id = std::trunc(w.params[param].constant());
+        bool known = false;
+        for (const LsystemBlock& b : g_.lsystems) known |= double(b.id) == id;
+        if (!known) {
+          char shown[32];
+          std::snprintf(shown, sizeof shown, "%.6g", id);
+          diags_.Add(MakeError(loc,
+                               std::string("'?(") + shown + ", ...)' in " + where +
+                                   " starts sub-L-system " + shown +
+                                   ", but the file's 'lsystem:' blocks are numbered " + ids,
+                               1, g_.SourceLine(loc)));
+          return;
+        }
+      }
+      param += size_t(arity);
+    }
+  };
+  check(axiom_, axiomLoc_, "the axiom");
+  for (const auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation})
+    for (const Production& p : sec->productions)
+      check(p.successor, p.loc, "the successor of this production");
 }
 
 ParseResult GrammarParser::Run(const std::string& text, const std::string& path) {
@@ -2944,6 +3006,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   CollectGlobals();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
+  g_.cpfgFile = std::filesystem::path(path).extension() == ".l";
   // module: declarations apply to the whole file, wherever they stand.
   for (const Line& l : lines_) {
     size_t p = 0;

@@ -137,7 +137,7 @@ Status Tessellate(Plant& plant, const PlantSpec& spec, DiagnosticList& diagnosti
   const auto t0 = Clock::now();
   SurfaceLibrary surfaces(plant.grammar.path, spec.surfacePath, spec.readFile);
   surfaces.Define(spec.cpfgSurfaces);
-  if (Status s = surfaces.LoadFor(plant.geometry, plant.grammar); !s.ok()) return s;
+  if (Status s = surfaces.LoadFor(plant.geometry, plant.grammar, &diagnostics); !s.ok()) return s;
   mesh::TessellateOptions options;
   options.detail = spec.detail;
   options.view = spec.view;
@@ -361,6 +361,9 @@ PlantResult Grower::Finish() && {
   // cpfg data files that fscanf read less of than its formats asked.
   if (g.dataFiles)
     for (Diagnostic& d : g.dataFiles->ShortReads()) r.diagnostics.Add(std::move(d));
+  // cpfg arrays indexed out of bounds (read at the nearest element).
+  if (g.arrayBounds)
+    for (Diagnostic& d : g.arrayBounds->Warnings()) r.diagnostics.Add(std::move(d));
   if (spec_.until >= Stage::kGeometry) {
     const auto t0 = Clock::now();
     auto geometry =

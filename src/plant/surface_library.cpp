@@ -108,7 +108,8 @@ bool SurfaceLibrary::Has(const std::string& name) const {
   return !Locate(name, &text).empty();
 }
 
-Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::Grammar& g) {
+Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::Grammar& g,
+                               DiagnosticList* warnings) {
   std::set<std::string> names;
   for (const auto& si : geometry.surfaces) {
     if (!meshes_.count(si.name)) names.insert(si.name);
@@ -123,8 +124,11 @@ Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::
     const std::string found = Locate(name, &text);
     if (found.empty()) {
       Diagnostic d;
+      d.severity = Severity::kWarning;
       d.loc.file = g.path;
-      d.message = "unknown surface '" + name + "': no " + file + " in";
+      d.message = "unknown surface '" + name +
+                  "' is not drawn (as in cpfg): no view-file 'surface: " + name +
+                  "' line, and no " + file + " in";
       for (size_t i = 0; i < searchPath_.size(); ++i) {
         d.message += (i ? ", " : " ") + searchPath_[i];
       }
@@ -139,7 +143,9 @@ Status SurfaceLibrary::LoadFor(const mesh::PlantGeometry& geometry, const lsys::
         SetExcerpt(d, g.SourceLine(d.loc));
         d.length = int(name.size()) + 1;
       }
-      return d;
+      if (warnings) warnings->Add(std::move(d));
+      meshes_.emplace(name, mesh::TriangleMesh());
+      continue;
     }
     auto surface = text ? mesh::ParseObj(*text, found) : mesh::ReadObj(found);
     if (!surface) return surface.error();

@@ -41,10 +41,13 @@ class SurfaceLibrary {
   // Names cpfg .s surfaces (a view file's `surface:` lines).
   void Define(const std::vector<CpfgSurfaceDef>& defs);
 
-  // Loads every surface `geometry` places that is not loaded yet. An error
-  // (no such surface, a bad OBJ file) points at the surface's first use in
-  // `g` when it can.
-  Status LoadFor(const mesh::PlantGeometry& geometry, const lsys::Grammar& g);
+  // Loads every surface `geometry` places that is not loaded yet. A surface
+  // that is nowhere (no view-file `surface:` line, no NAME.obj) draws
+  // nothing, as in cpfg, with a warning in `warnings` (when given) at its
+  // first use in `g`, once per name. An error (a bad OBJ file, an unreadable
+  // .s file) points at the surface's file or its `surface:` line.
+  Status LoadFor(const mesh::PlantGeometry& geometry, const lsys::Grammar& g,
+                 DiagnosticList* warnings = nullptr);
 
   // Whether NAME.obj is in the search path (what the grammar parser asks
   // to read cpfg's one-letter `~lF` as `~l` then `F`).

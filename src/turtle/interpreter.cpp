@@ -334,6 +334,7 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   d.colorIncrement = g.colorIncrement;
   d.elasticityIncrement = g.elasticityIncrement;
   d.subLsystems = g.subLsystems;
+  d.quoteIsColor = !g.cpfgFile;
   return d;
 }
 
@@ -883,6 +884,10 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
                      const DrawOptions& options, PlantGeometry& g) {
   std::vector<Op> ops(symbols.size());
   for (size_t s = 0; s < symbols.size(); ++s) ops[s] = OpFor(symbols.name(lsys::SymbolId(s)));
+  if (!def.quoteIsColor) {  // cpfg's turtle has no `'` (interpret.c, InterpretSymbol)
+    for (size_t s = 0; s < symbols.size(); ++s)
+      if (symbols.name(lsys::SymbolId(s)) == "'") ops[s] = Op::kNone;
+  }
   if (def.subLsystems) {  // cpfg's `?(id, scale)` and `$` (not the roll of ABOP's `$`)
     for (size_t s = 0; s < symbols.size(); ++s) {
       const std::string& name = symbols.name(lsys::SymbolId(s));

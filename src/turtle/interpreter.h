@@ -105,6 +105,10 @@ struct TurtleDef {
   // (instead of rolling the turtle); the scale multiplies F f G g lengths,
   // the width (at once, and what ! and # set or add later) and surfaces.
   bool subLsystems = false;
+  // `'` steps the colour index as `;` does (Sylva's grammars, ABOP); false
+  // for a cpfg file (lsys::Grammar::cpfgFile), whose turtle has no `'`:
+  // it is a module that draws nothing.
+  bool quoteIsColor = true;
 };
 
 TurtleDef TurtleDefFrom(const lsys::Grammar& g);

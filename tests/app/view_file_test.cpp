@@ -55,6 +55,25 @@ TEST(ViewFile, ReadsWhatTheTurtleUses) {
   EXPECT_EQ(ParseViewFile("angle factor: 16\n", "p.v").angle.value_or(-1), 22.5);
 }
 
+TEST(ViewFile, BoxIsTheViewVolumeAParallelViewFrames) {
+  // vlab's insect-realistic: `box: x: -10,10 y: -57,70 z: -1,1` (cpfg's
+  // fixed view volume); was warned as not acted on.
+  ViewFile v = ParseViewFile("box: x: -10,10 y: 70,-57 z: -1,1\n", "p.v");
+  EXPECT_TRUE(v.diagnostics.items.empty()) << Messages(v.diagnostics);
+  ASSERT_TRUE(v.box.has_value());
+  EXPECT_EQ((*v.box)[0], Vec3(-10, -57, -1));
+  EXPECT_EQ((*v.box)[1], Vec3(10, 70, 1));
+  // vlab's topiary writes `z:-4,4`: cpfg's scanf reads it.
+  ViewFile tight = ParseViewFile("box: x: -4,4 y: -2,7 z:-4,4\n", "p.v");
+  EXPECT_TRUE(tight.diagnostics.items.empty()) << Messages(tight.diagnostics);
+  ASSERT_TRUE(tight.box.has_value());
+  EXPECT_EQ((*tight.box)[0], Vec3(-4, -2, -4));
+  ViewFile bad = ParseViewFile("box: x: -10,10 y: -57,70\n", "p.v");
+  EXPECT_FALSE(bad.box.has_value());
+  EXPECT_NE(Messages(bad.diagnostics).find("'box:' needs the ranges"), std::string::npos)
+      << Messages(bad.diagnostics);
+}
+
 TEST(ViewFile, LineStyleAndProjectionAsCpfgReadsThem) {
   // cpfg (interpret.c ReadViewData, InitializeParameters): widths are
   // pixels unless the width line says otherwise, 1 by default; the

@@ -49,5 +49,40 @@ TEST(CpfgKeywords, StatementsWithBlanksBeforeTheColonOrArrowsInStringsStayStatem
   EXPECT_NE(d[0].find("prints nothing"), std::string::npos) << d[0];
 }
 
+TEST(CpfgQueries, OneQueryWithDifferentParameterCountsIsNotWarnedAbout) {
+  // vlab's 13-clover asks `?E(1)` at apices and `?E(2,la)` at leaves: in
+  // cpfg both are queries, and a production matches only the number of
+  // parameters it names (PredDiff), as in Sylva. Other modules still warn.
+  const std::string text =
+      "axiom: A ?E(1) L ?E(2,3)\n"
+      "A > ?E(r) --> B(r)\n"
+      "?E(t,a) --> *\n"
+      "L --> L(1)\n";
+  auto d = Diagnostics(text);
+  for (const std::string& line : d)
+    EXPECT_EQ(line.find("'?E' is used with"), std::string::npos) << Joined(d);
+  bool lWarned = false;
+  for (const std::string& line : d)
+    lWarned |=
+        line.find("module 'L' is used with 1 parameter here and with 0") != std::string::npos;
+  EXPECT_TRUE(lWarned) << Joined(d);
+}
+
+TEST(CpfgSubLsystems, UnknownConstantIdIsAnErrorWhereItIsWritten) {
+  // A sub-L-system that no block defines (as vlab's Sedge met when its
+  // #included blocks were dropped) failed at the step that reached it,
+  // with no line: cpfg too stops there ("L-system 2 not in .l file").
+  const std::string head =
+      "lsystem: 1\nderivation length: 3\naxiom: A\nA --> F ?(2,1)X$\nendlsystem\n";
+  EXPECT_EQ(testing::FirstError(head),
+            "4:1 '?(2, ...)' in the successor of this production starts sub-L-system 2, but the "
+            "file's 'lsystem:' blocks are numbered 1");
+  EXPECT_EQ(testing::FirstError("lsystem: 1\naxiom: ?(3)B$\nendlsystem\n"),
+            "2:8 '?(3, ...)' in the axiom starts sub-L-system 3, but the file's 'lsystem:' blocks "
+            "are numbered 1");
+  EXPECT_EQ(testing::FirstError(head + "lsystem: 2\naxiom: X\nX --> FX\nendlsystem\n"),
+            "<no error>");
+}
+
 }  // namespace
 }  // namespace sylva::lsys

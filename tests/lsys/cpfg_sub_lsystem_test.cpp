@@ -79,16 +79,19 @@ TEST(SubLsystem, NestedSubLsystemsAndContextInTheirOwnBlock) {
   EXPECT_EQ(DeriveText(text, 1), "a?(1)b?(2)C+c$b$a");
 }
 
-TEST(SubLsystem, UnknownNumberIsARunTimeError) {
+TEST(SubLsystem, UnknownComputedNumberIsARunTimeError) {
+  // A constant number is checked where it is written
+  // (CpfgSubLsystems.UnknownConstantIdIsAnErrorWhereItIsWritten); one
+  // computed while deriving, when the step meets it.
   Grammar g = MustParse(
-      "lsystem: 1\naxiom: ?(5,1)F$\nendlsystem\nlsystem: 2\naxiom: F\n"
+      "lsystem: 1\naxiom: A(5)\nA(x) --> ?(x,1)F$\nendlsystem\nlsystem: 2\naxiom: F\n"
       "endlsystem\n");
   DeriveOptions o;
-  o.steps = 1;
+  o.steps = 2;
   auto r = Derive(g, o);
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().message,
-            "step 1: module 0, '?(5, ...)', starts sub-L-system 5, but the file's 'lsystem:' "
+            "step 2: module 0, '?(5, ...)', starts sub-L-system 5, but the file's 'lsystem:' "
             "blocks are numbered 1, 2");
 }
 

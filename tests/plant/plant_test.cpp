@@ -228,15 +228,24 @@ TEST(SurfaceLibrary, CallerFoldersComeFirstThenTheGrammarsThenTheBundledOnes) {
   EXPECT_EQ(lib.searchPath()[2], (dir.path / "surfaces").string());
 }
 
-TEST(SurfaceLibrary, UnknownSurfacePointsAtItsUseInTheGrammar) {
+TEST(SurfaceLibrary, UnknownSurfaceIsAWarningAtItsUseAndDrawsNothing) {
   PlantSpec spec;
   spec.path = "s.lsys";
-  spec.text = "axiom: F\nF --> F[+F~nosuch]\n";
+  spec.text = "axiom: F\nF --> F[+F~nosuch]~nosuch\n";
   spec.steps = 1;
   PlantResult r = BuildPlant(spec);
-  ASSERT_FALSE(r.plant);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
   const std::string all = r.diagnostics.FormatAll();
-  EXPECT_NE(all.find("s.lsys:2:11: error: unknown surface 'nosuch'"), std::string::npos) << all;
+  EXPECT_NE(all.find("s.lsys:2:11: warning: unknown surface 'nosuch' is not drawn (as in cpfg)"),
+            std::string::npos)
+      << all;
+  EXPECT_EQ(r.diagnostics.items.size(), 1u) << all;  // once per name
+  // Nothing is drawn for it: the mesh is the one without the surfaces.
+  PlantSpec plain = spec;
+  plain.text = "axiom: F\nF --> F[+F]\n";
+  PlantResult p = BuildPlant(plain);
+  ASSERT_TRUE(p.plant) << p.diagnostics.FormatAll();
+  EXPECT_EQ(r.plant->mesh.triangleCount(), p.plant->mesh.triangleCount());
 }
 
 }  // namespace
@@ -313,6 +322,35 @@ TEST(Plant, AnEmptyMeshIsAWarningNotSilence) {
   EXPECT_EQ(r.plant->mesh.triangleCount(), 0u);
   EXPECT_NE(r.diagnostics.FormatAll().find("warning: the plant draws nothing"), std::string::npos)
       << r.diagnostics.FormatAll();
+}
+
+}  // namespace
+}  // namespace sylva::plant
+
+namespace sylva::plant {
+namespace {
+
+// Colour index of each segment of a one-line grammar drawn from `path`.
+std::vector<int> SegmentColors(const std::string& path, const std::string& text) {
+  PlantSpec spec;
+  spec.path = path;
+  spec.text = text;
+  spec.until = Stage::kGeometry;
+  PlantResult r = BuildPlant(spec);
+  std::vector<int> out;
+  if (!r.plant) {
+    ADD_FAILURE() << r.diagnostics.FormatAll();
+    return out;
+  }
+  for (const auto& s : r.plant->geometry.segments) out.push_back(s.color);
+  return out;
+}
+
+TEST(Plant, QuoteStepsTheColourInSylvaGrammarsAndIsNoCommandInCpfgFiles) {
+  // cpfg's turtle (vlab interpret.c, InterpretSymbol) has no case for `'`:
+  // in a cpfg file it is a module that draws nothing.
+  EXPECT_EQ(SegmentColors("q.lsys", "axiom: F'F'(5)F\n"), (std::vector<int>{0, 1, 5}));
+  EXPECT_EQ(SegmentColors("q.l", "axiom: F'F'(5)F;F\n"), (std::vector<int>{0, 0, 0, 1}));
 }
 
 }  // namespace

@@ -290,5 +290,49 @@ TEST(PlantView, FrameAllKeepsTheProjectionAndShowsTheWholeBox) {
   EXPECT_EQ(c.fovY, 20) << "frame all keeps the view file's viewing angle";
 }
 
+// Rows of a PNG with drawn (dark) pixels, and whether the top or bottom
+// row has any (the drawing runs out of the frame).
+struct DrawnRows {
+  int rows = 0;
+  bool touchesEdge = false;
+};
+DrawnRows Rows(const std::string& png) {
+  const Png p = Load(png);
+  DrawnRows r;
+  for (int y = 0; y < p.h; ++y) {
+    bool any = false;
+    for (int x = 0; x < p.w && !any; ++x) {
+      const unsigned char* c = p.At(x, y);
+      any = c[0] + c[1] + c[2] < 3 * 160;
+    }
+    if (any) {
+      ++r.rows;
+      r.touchesEdge |= y == 0 || y == p.h - 1;
+    }
+  }
+  return r;
+}
+
+TEST(ViewFile, PerspectiveIsCpfgsCameraNotAFramedBox) {
+  // cpfg (control.c, SetView) frames nothing in perspective: the eye is at
+  // vrp + (viewpoint - vrp) / scale looking at vrp, with a 45 degree field
+  // of view. vlab's lamps say `scale factor: 2.0`; Sylva framed the lamp
+  // and then halved the distance, cutting it at the frame's edges. Here a
+  // 2-unit stem centred on vrp seen from 5 units: 2 / (2 * 5 * tan(22.5))
+  // = 48 % of the picture's height (the framed, halved camera drew it past
+  // both edges).
+  const std::string grammar = WriteFile("persp.l", "axiom: !(0.05) F(2) [&(90) F(0.1)]\n");
+  WriteFile("persp.v",
+            "viewpoint: 0,1,10\nview reference point: 0,1,0\nprojection: perspective\n"
+            "scale factor: 2.0\nline style: cylinder\n");
+  const std::string png = (Scratch() / "persp.png").string();
+  std::string err;
+  ASSERT_EQ(Render(grammar, png, "160x120", &err), 0) << err;
+  const DrawnRows r = Rows(png);
+  EXPECT_FALSE(r.touchesEdge) << r.rows << " rows of 120 drawn";
+  EXPECT_NEAR(r.rows / 120.0, 0.483, 0.04) << r.rows << " rows of 120 drawn";
+  std::filesystem::remove(Scratch() / "persp.v");
+}
+
 }  // namespace
 }  // namespace sylva::app
