@@ -754,6 +754,12 @@ class Parser {
       for (const auto& f : kFunctions) {
         if (name == f.name) return Error(col, "function '" + name + "' needs arguments", len);
       }
+      if (scope_.undefinedNames) {
+        scope_.undefinedNames->push_back(ExprParseError{col, len, name});
+        auto n = Make(OpCode::kConst, col);
+        n->value = 0;
+        return n;
+      }
       return Error(col, "unknown name '" + name + "' in expression", len);
     }
     if (c == ')' || c == ',' || c == ':')

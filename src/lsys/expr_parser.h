@@ -82,6 +82,11 @@ struct ExprScope {
   // to 0) and each is noted here, column and message, for the caller to warn
   // about. Null: they are errors.
   std::vector<ExprParseError>* outputCalls = nullptr;
+  // A name that nothing defines (no parameter, local, global, constant,
+  // macro or array): with this set it reads 0 and is noted here (column,
+  // length, the name as message) for the caller to warn about, as cpfg's
+  // parser does ("Identifier ... not previously defined"); null: an error.
+  std::vector<ExprParseError>* undefinedNames = nullptr;
   // cpfg's data files (`fp = fopen(NAME, "r");`, `fscanf(fp, "%lf", &x);`,
   // `fclose(fp);` in blocks): files are read into it when the block is
   // parsed. Null: reading files is an error.

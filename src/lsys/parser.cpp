@@ -382,6 +382,32 @@ class GrammarParser {
   bool curveFilesFailed_ = false;     // a view file's curve file could not be read
   std::unordered_map<std::string, ArityUse> arityUse_;
   std::unordered_set<std::string> unsupportedWarned_;  // name + reason
+  // In a cpfg file (`.l`), a name nothing defines reads 0 with a warning
+  // (once per name), as cpfg does; in Sylva's own `.lsys` files it stays an
+  // error (a typo). Lenient() lets a scope note such names in undefined_;
+  // WarnUndefined() warns about them after the parse succeeded.
+  std::vector<ExprParseError> undefined_;
+  std::unordered_set<std::string> undefinedWarned_;
+  bool CpfgFile() const {
+    return !files_.empty() && std::filesystem::path(files_[0]).extension() == ".l";
+  }
+  ExprScope Lenient(const ExprScope& scope) {
+    ExprScope s = scope;
+    undefined_.clear();
+    if (CpfgFile()) s.undefinedNames = &undefined_;
+    return s;
+  }
+  void WarnUndefined(const Line& l) {
+    for (const ExprParseError& u : undefined_) {
+      if (!undefinedWarned_.insert(u.message).second) continue;
+      Warn(Loc(l, u.column), OriginalAt(l, u.column),
+           "'" + u.message +
+               "' is not defined (no parameter, variable, constant or #define of that name): it "
+               "reads 0, as cpfg does (in a .lsys file this is an error)",
+           u.length);
+    }
+    undefined_.clear();
+  }
   std::unordered_map<std::string, bool> isSurface_;
   std::set<std::string> ignoreNames_, considerNames_;
   bool haveIgnore_ = false, haveConsider_ = false;
@@ -695,7 +721,7 @@ void GrammarParser::UseArrays(const Line& l, ExprScope& scope) {
 
 bool GrammarParser::ParseBlockAt(const Line& l, std::string_view view, size_t* pos,
                                  const ExprScope& scope, Expr* out) {
-  ExprScope withOutput = scope;
+  ExprScope withOutput = Lenient(scope);
   std::vector<ExprParseError> calls;
   withOutput.outputCalls = &calls;
   if (!g_.dataFiles) {
@@ -721,6 +747,7 @@ bool GrammarParser::ParseBlockAt(const Line& l, std::string_view view, size_t* p
     Error(l, err.column, err.message, err.length);
     return false;
   }
+  WarnUndefined(l);
   for (const ExprParseError& c : calls) {
     const std::string name(view.substr(size_t(c.column) - 1, size_t(c.length)));
     if (unsupportedWarned_.insert(name + "\x01output").second)
@@ -782,10 +809,11 @@ bool GrammarParser::ParseActualWord(const Line& l, size_t pos, size_t end, const
                  "a text parameter of '" + name + "' is read as the number of the text (" +
                      std::to_string(int(index)) + "), as cpfg does",
                  int(pos - s0));
-        } else if (!ParseExpr(view, &pos, scope, &e, &err)) {
+        } else if (!ParseExpr(view, &pos, Lenient(scope), &e, &err)) {
           Error(l, err.column, err.message, err.length);
           return false;
         }
+        WarnUndefined(l);
         if (!e.IsConstant()) out->allConstant = false;
         out->params.push_back(std::move(e));
         ++arity;
@@ -2556,10 +2584,11 @@ void GrammarParser::ParseProduction(const Line& l, size_t pos, size_t arrow, siz
     Expr weight;
     ExprParseError err;
     size_t wp = w;
-    if (!ParseExpr(view, &wp, scope, &weight, &err)) {
+    if (!ParseExpr(view, &wp, Lenient(scope), &weight, &err)) {
       Error(l, err.column, err.message, err.length);
       return;
     }
+    WarnUndefined(l);
     while (wp < rend && IsSpace(t[wp])) ++wp;
     if (wp < rend) {
       Error(l, int(wp) + 1, "unexpected text after the weight");
@@ -2634,10 +2663,11 @@ bool GrammarParser::ParseCondition(const Line& l, Production& p, const ExprScope
     const size_t c0 = c;
     Expr cond;
     ExprParseError err;
-    if (!ParseExpr(view, &c, scope, &cond, &err)) {
+    if (!ParseExpr(view, &c, Lenient(scope), &cond, &err)) {
       Error(l, err.column, err.message, err.length);
       return false;
     }
+    WarnUndefined(l);
     size_t e = c;
     while (e > c0 && IsSpace(t[e - 1])) --e;
     p.conditionColumn = int(c0) + 1;

@@ -209,7 +209,7 @@ TEST(CpfgBlocks, MalformedBlocksAreErrorsWithLocations) {
             "2:22 unexpected character '}' in expression");
   EXPECT_EQ(FirstError("axiom: A(1)\nA(x) : {y = x;\n  z = y + 1;\n"),
             "2:8 unclosed '{': the statement block has no '}'");
-  EXPECT_EQ(FirstError("axiom: A(1)\nA(x) --> B(x) {z = q + 1;} C(z)\n"),
+  EXPECT_EQ(FirstError("axiom: A(1)\nA(x) --> B(x) {z = q + 1;} C(z)\n", "c.lsys"),
             "2:20 unknown name 'q' in expression");
   EXPECT_EQ(FirstError("axiom: A(1)\nA(x) : {y += 1;} * --> B(y)\n"),
             "2:9 'y' has no value before this assignment");

@@ -84,5 +84,27 @@ TEST(CpfgSubLsystems, UnknownConstantIdIsAnErrorWhereItIsWritten) {
             "<no error>");
 }
 
+// vlab's cpfg (lsys_input.y) warns "Identifier ... not previously defined"
+// and reads 0; RebeccaKuo's cloud thesis files pass such a `t` to a module.
+TEST(CpfgNames, AnUndefinedNameReadsZeroWithAWarningInACpfgFile) {
+  const std::string text =
+      "axiom: A(2)\n"
+      "A(x) : t == 0 --> B(x + t) {y = x * T;} C(y)\n"
+      "B(x) --> B(x + t)\n";
+  ParseResult r = ParseGrammarText(text, "c.l");
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  auto d = DiagnosticLines(r);
+  ASSERT_EQ(d.size(), 2u) << Joined(d);  // once per name: t, then T
+  EXPECT_EQ(d[0].rfind("2:8 't' is not defined", 0), 0u) << d[0];
+  EXPECT_NE(d[0].find("reads 0, as cpfg does"), std::string::npos) << d[0];
+  EXPECT_EQ(d[1].rfind("2:37 'T' is not defined", 0), 0u) << d[1];
+  DeriveOptions opt;
+  opt.steps = 1;
+  const DeriveResult w = testing::MustDerive(*r.grammar, opt);
+  EXPECT_EQ(FormatWord(w.word, r.grammar->symbols), "B(2)C(0)");
+  // Sylva's own grammar files keep it an error: a typo.
+  EXPECT_EQ(testing::FirstError(text, "c.lsys"), "2:8 unknown name 't' in expression");
+}
+
 }  // namespace
 }  // namespace sylva::lsys

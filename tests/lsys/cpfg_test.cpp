@@ -284,8 +284,9 @@ TEST(Cpfg, DefineWithArgumentsIsAFunction) {
 }
 
 TEST(Cpfg, DefineWithArgumentsErrorsAreLocated) {
+  // A .lsys file: in a cpfg file (.l) an undefined name is a warning.
   auto firstError = [](const std::string& text) {
-    ParseResult r = ParseGrammarText(text, "c.l");
+    ParseResult r = ParseGrammarText(text, "c.lsys");
     EXPECT_FALSE(r.grammar);
     if (r.diagnostics.items.empty()) return std::string("<none>");
     const Diagnostic& d = r.diagnostics.items[0];

@@ -58,10 +58,10 @@ inline std::string SourcePath(const std::string& rel) {
   return std::string(SYLVA_SOURCE_DIR) + "/" + rel;
 }
 
-// The first error of parsing `text` as "line:column message", or
-// "<no error>".
-inline std::string FirstError(const std::string& text) {
-  ParseResult r = ParseGrammarText(text, "c.l");
+// The first error of parsing `text` (as the file `path`) as
+// "line:column message", or "<no error>".
+inline std::string FirstError(const std::string& text, const std::string& path = "c.l") {
+  ParseResult r = ParseGrammarText(text, path);
   for (const auto& d : r.diagnostics.items) {
     if (d.severity == Severity::kError)
       return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " + d.message;
