@@ -76,9 +76,9 @@ Expected<mesh::Box> FramedBox(const PlantView& view, const plant::Plant& plant,
 
 render::Camera FramePlant(const PlantView& view, const mesh::Box& box, double aspect) {
   const bool boxed = view.orthographic && view.viewBox;
-  render::Camera camera = render::Camera::Frame(
-      boxed ? (*view.viewBox)[0] : box.lo, boxed ? (*view.viewBox)[1] : box.hi, aspect,
-      view.azimuth, view.elevation, view.orthographic);
+  render::Camera camera = render::Camera::Frame(boxed ? (*view.viewBox)[0] : box.lo,
+                                                boxed ? (*view.viewBox)[1] : box.hi, aspect,
+                                                view.azimuth, view.elevation, view.orthographic);
   if (view.distance > 0) camera.distance = view.distance;
   if (view.cpfgDistance > 0 && !camera.orthographic) {
     camera.target = view.cpfgTarget;

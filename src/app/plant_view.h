@@ -67,8 +67,8 @@ struct PlantView {
   // cpfg's `box:`: the view volume a parallel view frames (CalculateWindow)
   // in place of the plant's box.
   std::optional<std::array<Vec3, 2>> viewBox;
-  Vec3 keyToward = Vec3::UnitY();      // unit, toward the key light
-  bool keyFromViewFile = false;        // keyToward is the view file's light
+  Vec3 keyToward = Vec3::UnitY();  // unit, toward the key light
+  bool keyFromViewFile = false;    // keyToward is the view file's light
 
   bool figure() const { return look != PlantLook::kMesh; }
 };

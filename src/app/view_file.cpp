@@ -226,7 +226,7 @@ class Reader {
   bool tropismSeen_ = false;
   enum class LineStyle { kUnset, kPixel, kWorld };
   LineStyle lineStyle_ = LineStyle::kUnset;
-  bool cylinder_ = false;               // cpfg's line style cylinder
+  bool cylinder_ = false;                    // cpfg's line style cylinder
   int contourLine_ = 0, contourColumn_ = 0;  // the first `contour:` line
   int sidesLine_ = 0, sidesColumn_ = 0;      // `contour sides:`
   std::string contourText_, sidesText_;      // those lines, for the excerpts
@@ -484,8 +484,8 @@ void Reader::Read(const app::Line& line) {
     } else {
       v_.contours.twist = tokens_[0].text.rfind("on", 0) == 0;
       if (!v_.contours.twist && tokens_[0].text != "off")
-        Warn(tokens_[0].column, "'twist of cylinders:' is 'on' or 'off', not '" +
-                                    tokens_[0].text + "': off, as cpfg reads it");
+        Warn(tokens_[0].column, "'twist of cylinders:' is 'on' or 'off', not '" + tokens_[0].text +
+                                    "': off, as cpfg reads it");
     }
     ExtraValues(1);
   } else if (L == "function:" || L == "function set:") {
@@ -802,21 +802,19 @@ void Reader::ContourLine() {
       }
     }
     if (matches != 1) {
-      Warn(name.column, "contour " + tokens_[0].text + " is not drawn: its file " +
-                            file.string() + " does not exist; @#(" + tokens_[0].text +
-                            ") draws round cylinders");
+      Warn(name.column, "contour " + tokens_[0].text + " is not drawn: its file " + file.string() +
+                            " does not exist; @#(" + tokens_[0].text + ") draws round cylinders");
       return;
     }
-    Warn(name.column, "contour file " + file.string() + " does not exist; read " +
-                          found.string() +
+    Warn(name.column, "contour file " + file.string() + " does not exist; read " + found.string() +
                           ", whose name differs in case (cpfg finds it only on a "
                           "case-insensitive file system)");
     file = found;
   }
   auto text = ReadFile(file.string(), mesh::kMaxContourFileBytes);
   if (!text) {
-    Error(name.column, "contour file " + file.string() + " cannot be read: " +
-                           text.error().message);
+    Error(name.column,
+          "contour file " + file.string() + " cannot be read: " + text.error().message);
     return;
   }
   auto contour = mesh::ParseContour(*text, file.string(), &v_.diagnostics);

@@ -16,8 +16,8 @@
 
 #include "core/diagnostic.h"
 #include "lsys/array_bounds.h"
-#include "lsys/cpfg_data_files.h"
 #include "lsys/cpfg_curve.h"
+#include "lsys/cpfg_data_files.h"
 #include "lsys/cpfg_function.h"
 #include "lsys/expr.h"
 #include "lsys/expr_parser.h"

@@ -388,13 +388,10 @@ class GrammarParser {
   // WarnUndefined() warns about them after the parse succeeded.
   std::vector<ExprParseError> undefined_;
   std::unordered_set<std::string> undefinedWarned_;
-  bool CpfgFile() const {
-    return !files_.empty() && std::filesystem::path(files_[0]).extension() == ".l";
-  }
   ExprScope Lenient(const ExprScope& scope) {
     ExprScope s = scope;
     undefined_.clear();
-    if (CpfgFile()) s.undefinedNames = &undefined_;
+    if (g_.cpfgFile) s.undefinedNames = &undefined_;
     return s;
   }
   void WarnUndefined(const Line& l) {

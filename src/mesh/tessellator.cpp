@@ -547,9 +547,9 @@ void EmitTube(const ContourTube& t, TriangleMesh& out) {
       normal[b] += n1;
       normal[c] += n1 + n2;
       normal[d] += n2;
-      out.indices.insert(out.indices.end(), {base + uint32_t(a), base + uint32_t(b),
-                                             base + uint32_t(c), base + uint32_t(a),
-                                             base + uint32_t(c), base + uint32_t(d)});
+      out.indices.insert(out.indices.end(),
+                         {base + uint32_t(a), base + uint32_t(b), base + uint32_t(c),
+                          base + uint32_t(a), base + uint32_t(c), base + uint32_t(d)});
       out.material.push_back(t.color);
       out.material.push_back(t.color);
     }

@@ -46,25 +46,25 @@ enum class Op : uint8_t {
   kSurface,
   kSphere,
   kMoveTo,
-  kDisc,         // @o
-  kCircle,       // @c
-  kGcStart,      // @Gs
-  kGcPoint,      // @Gc
-  kGcEnd,        // @Ge
-  kTropismSet,   // @Ts
-  kTropismUp,    // @Ti
-  kTropismDown,  // @Td
-  kElasticity,   // _ (cpfg: elasticity of the tropism)
-  kTwistForce,   // @Tf
-  kGcTangent,    // @Gt
-  kGcRadius,     // @Gr
-  kContour,      // @#: the cylinders' contour
-  kContourSides, // @!: the sides contours are drawn with
-  kSubStart,     // ?(id, scale): a sub-L-system starts (grammars with sub-L-systems)
-  kSubEnd,       // $ there: it ends
-  kSplineBegin,  // {(type[, rings]): a polygon when type is 0, else cpfg's spline
-  kSplineEnd,    // }(type): the same
-  kSetHeading,   // @R(hx, hy[, hz[, ux, uy, uz]])
+  kDisc,          // @o
+  kCircle,        // @c
+  kGcStart,       // @Gs
+  kGcPoint,       // @Gc
+  kGcEnd,         // @Ge
+  kTropismSet,    // @Ts
+  kTropismUp,     // @Ti
+  kTropismDown,   // @Td
+  kElasticity,    // _ (cpfg: elasticity of the tropism)
+  kTwistForce,    // @Tf
+  kGcTangent,     // @Gt
+  kGcRadius,      // @Gr
+  kContour,       // @#: the cylinders' contour
+  kContourSides,  // @!: the sides contours are drawn with
+  kSubStart,      // ?(id, scale): a sub-L-system starts (grammars with sub-L-systems)
+  kSubEnd,        // $ there: it ends
+  kSplineBegin,   // {(type[, rings]): a polygon when type is 0, else cpfg's spline
+  kSplineEnd,     // }(type): the same
+  kSetHeading,    // @R(hx, hy[, hz[, ux, uy, uz]])
 };
 
 Op OpFor(const std::string& name) {
@@ -545,8 +545,9 @@ struct PieceCurve {
                                                uint32_t parent, uint16_t depth, uint32_t module,
                                                PlantGeometry& g) {
   const PieceCurve curve(a, b);
-  AddPiece(a, b, a.pos, b.pos, curve.chord, rings, [&](double t) { return curve.Point(t); },
-           widthScale, branch, parent, depth, module, g);
+  AddPiece(
+      a, b, a.pos, b.pos, curve.chord, rings, [&](double t) { return curve.Point(t); }, widthScale,
+      branch, parent, depth, module, g);
 }
 
 // A uniform cubic B-spline piece (`{(3)` and `{(4)` splines) over the
@@ -1339,9 +1340,9 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           if (contours && (cyl.last.contour != kCircle || here.contour != kCircle)) {
             const auto& ringA = ringOf(cyl.last.contour, cyl.last.sides);
             const auto& ringB = ringOf(here.contour, cyl.last.sides);
-            const bool closed = (cyl.last.contour == kCircle ||
-                                 contours->byId.at(cyl.last.contour).closed) &&
-                                (here.contour == kCircle || contours->byId.at(here.contour).closed);
+            const bool closed =
+                (cyl.last.contour == kCircle || contours->byId.at(cyl.last.contour).closed) &&
+                (here.contour == kCircle || contours->byId.at(here.contour).closed);
             tubePoints += uint64_t(rings + 1) * ringA.size();
             if (tubePoints > options.maxPrimitives) {
               Diagnostic d;
@@ -1356,8 +1357,8 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
             AddContourPiece(cyl.last, here, ringA, ringB, closed, rings, def.widthScale,
                             contours->twist, uint32_t(i), cyl.tube, g);
           } else {
-            AddCylinderPiece(cyl.last, here, rings, def.widthScale, cyl.branch, t.branch,
-                             t.depth, uint32_t(i), g);
+            AddCylinderPiece(cyl.last, here, rings, def.widthScale, cyl.branch, t.branch, t.depth,
+                             uint32_t(i), g);
             cyl.tube = -1;
           }
           cyl.last = here;
@@ -1453,11 +1454,10 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
             sides = mesh::kMaxContourSides;
             if (!warnedSides) {
               warnedSides = true;
-              g.warnings.push_back("module " + std::to_string(i + 1) + " (" +
-                                   ModuleText(word, symbols, i) + ") asks for more than " +
-                                   std::to_string(mesh::kMaxContourSides) +
-                                   " contour sides: drawn with " +
-                                   std::to_string(mesh::kMaxContourSides));
+              g.warnings.push_back(
+                  "module " + std::to_string(i + 1) + " (" + ModuleText(word, symbols, i) +
+                  ") asks for more than " + std::to_string(mesh::kMaxContourSides) +
+                  " contour sides: drawn with " + std::to_string(mesh::kMaxContourSides));
             }
           }
           x.sides = int32_t(sides);

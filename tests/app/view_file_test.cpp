@@ -600,8 +600,7 @@ TEST(ViewFile, BadContourFileIsAnErrorAtItsOwnLine) {
 TEST(ViewFile, ContoursWithoutCylinderLineStyleWarnAndAreNotUsed) {
   testing::WriteFile("ct_p.con", "4 2 open\n-1 0\n-1 0\n1 0\n1 0\n");
   const std::string path = (testing::Scratch() / "ctp.v").string();
-  ViewFile v =
-      ParseViewFile("initial line width: 2 pixels\ncontour: 1 ct_p.con\n", path, true);
+  ViewFile v = ParseViewFile("initial line width: 2 pixels\ncontour: 1 ct_p.con\n", path, true);
   ASSERT_EQ(v.diagnostics.items.size(), 1u) << Messages(v.diagnostics);
   EXPECT_EQ(v.diagnostics.items[0].loc.line, 2);
   EXPECT_NE(v.diagnostics.items[0].message.find("line style cylinder only"), std::string::npos)
@@ -611,8 +610,8 @@ TEST(ViewFile, ContoursWithoutCylinderLineStyleWarnAndAreNotUsed) {
   EXPECT_TRUE(spec.draw.contours == nullptr);
   EXPECT_FALSE(spec.draw.cylinderStyle);
   // cpfg's older `polygonization level: n` is 2^(n+1) sides.
-  ViewFile level = ParseViewFile(
-      "line style: cylinder\npolygonization level: 3\ncontour: 1 x.con\n", "l.v");
+  ViewFile level =
+      ParseViewFile("line style: cylinder\npolygonization level: 3\ncontour: 1 x.con\n", "l.v");
   EXPECT_TRUE(level.diagnostics.items.empty()) << Messages(level.diagnostics);
   EXPECT_EQ(level.contours.sides, 16);
   // `contour sides:` alone (no contour) is read but not acted on.
