@@ -957,7 +957,10 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
     before.items.insert(before.items.end(), v->diagnostics.items.begin(),
                         v->diagnostics.items.end());
     v->diagnostics.items = std::move(before.items);
-    // The background scenes the view file names (app/cpfg_background.h).
+    // The background scenes the view file names (app/cpfg_background.h),
+    // their vertices within kMaxBackgroundVertices in all (the same file
+    // named 200 times was read 200 times and exhausted memory).
+    size_t backgroundVertices = 0;
     for (const ViewFile::NamedFile& f : v->backgroundFiles) {
       auto text = ReadRegular(f.file, kMaxBackgroundBytes);
       if (!text) {
@@ -972,6 +975,16 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
         v->diagnostics.Add(scene.error());
         continue;
       }
+      size_t vertices = 0;
+      for (const mesh::Polygon& p : scene->polygons) vertices += p.vertices.size();
+      if (vertices > kMaxBackgroundVertices - backgroundVertices) {
+        v->diagnostics.Add(MakeError(SourceLoc{viewPath.string(), f.line, f.column},
+                                     "background scene: the scenes have more than " +
+                                         std::to_string(kMaxBackgroundVertices) +
+                                         " vertices in all with this one"));
+        break;
+      }
+      backgroundVertices += vertices;
       v->backgrounds.push_back(std::make_shared<const BackgroundScene>(std::move(*scene)));
     }
   }
