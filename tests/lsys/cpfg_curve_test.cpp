@@ -89,6 +89,18 @@ TEST(CpfgCurve, LongEndpointCurveEvaluatesOnlyItsSpan) {
   EXPECT_NEAR(c->AtParameter(1).x(), 99999, 1e-3) << c->AtParameter(1).transpose();
 }
 
+// Coordinates beyond the turtle's +-1e15 are an error at their line: the
+// fuzzer found points at +-1e308 accepted with an infinite length.
+TEST(CpfgCurve, CoordinatesBeyondTheTurtlesRangeAreErrors) {
+  auto c = CpfgCurve::Parse("points: 4\n-1e308 0\n1e308 0\n-1e308 1\n1e308 1\n", "h.con");
+  ASSERT_FALSE(c) << c->Length();
+  EXPECT_EQ(c.error().loc.line, 2) << c.error().Format();
+  EXPECT_EQ(c.error().message, "'-1e308' is beyond +-1e15") << c.error().Format();
+  auto ok = CpfgCurve::Parse("points: 4\n-1e15 0\n1e15 0\n-1e15 1\n1e15 1\n", "k.con");
+  ASSERT_TRUE(ok) << ok.error().Format();
+  EXPECT_TRUE(std::isfinite(ok->Length())) << ok->Length();
+}
+
 TEST(CpfgCurve, ViewFileCurvesServeCurveXYAndGal) {
   const std::string g =
       "Start: {L = curveGAL(1);}\naxiom: A(L, curveX(1, 0.25), curveY(2, 0.5))\n"
