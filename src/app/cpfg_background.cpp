@@ -316,8 +316,9 @@ Expected<BackgroundScene> ParseBackgroundScene(const std::string& text, const st
       for (const Vec3& p : v) {
         if (!within(p))
           return At(path, key.line, key.column,
-                    "'" + k + "' places a point that is not a finite number within +-1e+15 "
-                    "units (the matrix or the numbers are too large)");
+                    "'" + k +
+                        "' places a point that is not a finite number within +-1e+15 "
+                        "units (the matrix or the numbers are too large)");
       }
     }
     for (size_t j = spheresBefore; j < b.scene.spheres.size(); ++j) {

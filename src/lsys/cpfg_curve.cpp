@@ -182,8 +182,7 @@ Expected<CpfgCurve> CpfgCurve::Parse(const std::string& text, const std::string&
       if (*end != '\0' || !std::isfinite(x))
         return FileError(path, number, "'" + word + "' is not a number");
       // The turtle's range: larger coordinates made the length infinite.
-      if (std::abs(x) > 1e15)
-        return FileError(path, number, "'" + word + "' is beyond +-1e15");
+      if (std::abs(x) > 1e15) return FileError(path, number, "'" + word + "' is beyond +-1e15");
       v.push_back(x);
     }
     if (int(v.size()) != dimension)
