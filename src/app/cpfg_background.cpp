@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "mesh/color.h"
+#include "turtle/interpreter.h"
 
 namespace sylva::app {
 namespace {
@@ -43,6 +44,7 @@ Expected<std::vector<Token>> Tokens(const std::string& text, const std::string& 
   std::vector<Token> out;
   std::map<std::string, std::vector<std::string>> defines;
   bool inComment = false;
+  int commentLine = 0, commentColumn = 0;  // where the open comment starts
   int number = 0;
   size_t start = 0;
   while (start <= text.size()) {
@@ -62,6 +64,8 @@ Expected<std::vector<Token>> Tokens(const std::string& text, const std::string& 
           line[i] = ' ';
         }
       } else if (line.compare(i, 2, "/*") == 0) {
+        commentLine = number;
+        commentColumn = int(i) + 1;
         line[i] = line[i + 1] = ' ';
         ++i;
         inComment = true;
@@ -111,12 +115,23 @@ Expected<std::vector<Token>> Tokens(const std::string& text, const std::string& 
     for (Token& w : words) {
       auto it = defines.find(w.text);
       if (it == defines.end()) {
+        if (out.size() >= kMaxBackgroundWords)
+          return At(path, w.line, w.column,
+                    "the file has more than " + std::to_string(kMaxBackgroundWords) + " words");
         out.push_back(std::move(w));
         continue;
       }
+      if (it->second.size() > kMaxBackgroundWords - out.size())
+        return At(path, w.line, w.column,
+                  "the file has more than " + std::to_string(kMaxBackgroundWords) +
+                      " words once '" + w.text + "' (" + std::to_string(it->second.size()) +
+                      " words) is substituted here");
       for (const std::string& v : it->second) out.push_back({v, w.line, w.column});
     }
   }
+  // cpfg's preprocessor (cpp) stops at a comment that is never closed.
+  if (inComment)
+    return At(path, commentLine, commentColumn, "a '/*' comment that is never closed with '*/'");
   return out;
 }
 
@@ -181,8 +196,11 @@ Expected<BackgroundScene> ParseBackgroundScene(const std::string& text, const st
   Builder b{path, warnings, {}};  // the rest: the members' defaults
   b.scene.path = path;
   const std::vector<Token>& t = *tokens;
+  size_t vertices = 0;  // in the polygons so far
   for (size_t i = 0; i < t.size();) {
     const Token& key = t[i++];
+    const size_t polygonsBefore = b.scene.polygons.size();
+    const size_t spheresBefore = b.scene.spheres.size();
     std::vector<double> n;
     while (i < t.size()) {
       auto x = NumberOf(t[i].text);
@@ -207,6 +225,10 @@ Expected<BackgroundScene> ParseBackgroundScene(const std::string& text, const st
                         "translucent background materials (alpha below 1) are drawn opaque",
                         Severity::kWarning));
       }
+      if (b.scene.colors.size() >= kMaxBackgroundMaterials)
+        return At(path, key.line, key.column,
+                  "more than " + std::to_string(kMaxBackgroundMaterials) +
+                      " materials in a background scene");
       b.scene.colors.push_back({float(n[4]), float(n[5]), float(n[6])});
       b.color = uint16_t(b.scene.colors.size());
     } else if (k == "polygon" || k == "polygonuv") {
@@ -278,6 +300,33 @@ Expected<BackgroundScene> ParseBackgroundScene(const std::string& text, const st
       return At(path, key.line, key.column,
                 NumberOf(k) ? "a number where a background keyword was expected"
                             : "unknown background scene keyword '" + k + "'");
+    }
+    // What this primitive added: finite, within the turtle's range, and
+    // within the limit on vertices.
+    auto within = [](const Vec3& p) {
+      return (p.array().abs() <= turtle::kMaxCoordinate).all();  // false for NaN
+    };
+    for (size_t j = polygonsBefore; j < b.scene.polygons.size(); ++j) {
+      const auto& v = b.scene.polygons[j].vertices;
+      vertices += v.size();
+      if (vertices > kMaxBackgroundVertices)
+        return At(path, key.line, key.column,
+                  "the background scene has more than " + std::to_string(kMaxBackgroundVertices) +
+                      " vertices at this '" + k + "'");
+      for (const Vec3& p : v) {
+        if (!within(p))
+          return At(path, key.line, key.column,
+                    "'" + k +
+                        "' places a point that is not a finite number within +-1e+15 "
+                        "units (the matrix or the numbers are too large)");
+      }
+    }
+    for (size_t j = spheresBefore; j < b.scene.spheres.size(); ++j) {
+      const mesh::Sphere& sp = b.scene.spheres[j];
+      if (!within(sp.center) || !(std::abs(sp.radius) <= turtle::kMaxCoordinate))
+        return At(path, key.line, key.column,
+                  "'sphere' has a centre or radius that is not a finite number within +-1e+15 "
+                  "units");
     }
   }
   return std::move(b.scene);

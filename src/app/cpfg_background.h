@@ -29,7 +29,11 @@
 //
 // Errors (a diagnostic at the file's line and column): an unknown keyword,
 // a primitive with too few numbers, a `popmatrix` without its
-// `pushmatrix`, a preprocessor line other than #define and #undef.
+// `pushmatrix`, a preprocessor line other than #define and #undef, a
+// primitive placed at a point that is not finite or beyond +-1e15 (as the
+// turtle's), a sphere radius that is not finite, and the limits below (a
+// #define used many times, or a file of many cylinders, would otherwise
+// take more memory than the machine has).
 #pragma once
 
 #include <array>
@@ -43,6 +47,12 @@
 #include "mesh/plant_geometry.h"
 
 namespace sylva::app {
+
+// Words after #define substitution (a 16 MiB file holds at most 8M words
+// without #defines), vertices of the primitives, and materials.
+inline constexpr size_t kMaxBackgroundWords = size_t(8) << 20;
+inline constexpr size_t kMaxBackgroundVertices = size_t(4) << 20;
+inline constexpr size_t kMaxBackgroundMaterials = 32768;
 
 struct BackgroundScene {
   std::string path;

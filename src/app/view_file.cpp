@@ -554,14 +554,15 @@ void Reader::Read(const app::Line& line) {
     c.from = path_;
     c.line = line_;
     c.column = tokens_[0].column;
+    // A bad number of samples is an error here, and the curve is still
+    // counted: without it curveX(1, t) said the view file had no 'curve:'
+    // line, and that error hid this one.
     if (tokens_.size() > 1) {
       const std::optional<double> n = Number(1, "a number of samples");
-      if (!n) return;
-      if (*n < 2 || *n > 1000000 || *n != std::floor(*n)) {
+      if (n && (*n < 2 || *n > 1000000 || *n != std::floor(*n)))
         Error(tokens_[1].column, "a curve's samples must be a whole number from 2 to 1000000");
-        return;
-      }
-      c.samples = int(*n);
+      else if (n)
+        c.samples = int(*n);
     }
     v_.curves.push_back(std::move(c));
     ExtraValues(2);
@@ -786,7 +787,9 @@ void Reader::ContourLine() {
   fs::path file(name.text);
   if (!file.is_absolute()) file = (fs::path(path_).parent_path() / file).lexically_normal();
   std::error_code ec;
-  if (!fs::exists(file, ec)) {
+  // A link that leads nowhere (dangling, or a loop) is a name that exists:
+  // the reader below says what is wrong with it.
+  if (!fs::exists(file, ec) && !fs::is_symlink(file, ec)) {
     // The same name in another case, if the folder has exactly one.
     fs::path found;
     int matches = 0;
@@ -984,7 +987,10 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
     before.items.insert(before.items.end(), v->diagnostics.items.begin(),
                         v->diagnostics.items.end());
     v->diagnostics.items = std::move(before.items);
-    // The background scenes the view file names (app/cpfg_background.h).
+    // The background scenes the view file names (app/cpfg_background.h),
+    // their vertices within kMaxBackgroundVertices in all (the same file
+    // named 200 times was read 200 times and exhausted memory).
+    size_t backgroundVertices = 0;
     for (const ViewFile::NamedFile& f : v->backgroundFiles) {
       auto text = ReadRegular(f.file, kMaxBackgroundBytes);
       if (!text) {
@@ -999,6 +1005,16 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
         v->diagnostics.Add(scene.error());
         continue;
       }
+      size_t vertices = 0;
+      for (const mesh::Polygon& p : scene->polygons) vertices += p.vertices.size();
+      if (vertices > kMaxBackgroundVertices - backgroundVertices) {
+        v->diagnostics.Add(MakeError(SourceLoc{viewPath.string(), f.line, f.column},
+                                     "background scene: the scenes have more than " +
+                                         std::to_string(kMaxBackgroundVertices) +
+                                         " vertices in all with this one"));
+        break;
+      }
+      backgroundVertices += vertices;
       v->backgrounds.push_back(std::make_shared<const BackgroundScene>(std::move(*scene)));
     }
   }

@@ -1,6 +1,7 @@
 // cpfg curve files: reading and evaluating (see cpfg_curve.h).
 #include "lsys/cpfg_curve.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -63,8 +64,12 @@ Vec3 CpfgCurve::AtParameter(double t) const {
       return r;
     }
     case Type::kBsplineEndpoint: {
+      // Only the four basis functions of u's knot span, k = floor(u) ..
+      // floor(u) + 3, are non-zero (the others are exactly 0): summing all
+      // n made a curve of 10^6 control points take 10^6 steps a sample.
       const double u = t * (n - 3.000001);
-      for (int k = 0; k < n; ++k) r += ClampedBasis(k, 4, u, n) * p_[size_t(k)];
+      const int first = std::clamp(int(u), 0, n - 4);
+      for (int k = first; k < first + 4; ++k) r += ClampedBasis(k, 4, u, n) * p_[size_t(k)];
       return r;
     }
     default: {
@@ -176,6 +181,8 @@ Expected<CpfgCurve> CpfgCurve::Parse(const std::string& text, const std::string&
       const double x = std::strtod(word.c_str(), &end);
       if (*end != '\0' || !std::isfinite(x))
         return FileError(path, number, "'" + word + "' is not a number");
+      // The turtle's range: larger coordinates made the length infinite.
+      if (std::abs(x) > 1e15) return FileError(path, number, "'" + word + "' is beyond +-1e15");
       v.push_back(x);
     }
     if (int(v.size()) != dimension)

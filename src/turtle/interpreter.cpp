@@ -391,13 +391,15 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
 [[gnu::noinline]] static void SetHeading(const double* p, uint32_t np, const Vec3& prevHeading,
                                          const Vec3& prevUp, Frame& f) {
   Vec3 h(p[0], p[1], np >= 3 ? p[2] : 0.0);
-  const double hn = h.norm();
+  // stableNorm: norm() overflows to inf past 1e154 (the heading became 0)
+  // and underflows to 0 below 1e-154 (it became +Y).
+  const double hn = h.stableNorm();
   h = hn == 0 ? Vec3(0, 1, 0) : Vec3(h / hn);  // NaN stays NaN: the range check names it
   Vec3 up = f.up;
   bool given = false;
   if (np >= 6) {
     const Vec3 u(p[3], p[4], p[5]);
-    const double un = u.norm();
+    const double un = u.stableNorm();
     if (un > 0 && std::abs(u.dot(h)) <= 1e-9 * un) {
       up = u / un;
       given = true;

@@ -98,6 +98,45 @@ TEST(CpfgBackground, ErrorsAreLocated) {
   EXPECT_EQ(FirstError("#include \"x.dat\"\n"),
             "1:1 preprocessor line '#include' is not supported in a background scene (#define "
             "and #undef are)");
+  // Was read as a scene with nothing after the '/*' (the box not drawn).
+  EXPECT_EQ(FirstError("sphere 1\n  /* never closed\nbox 1 1 1\n"),
+            "2:3 a '/*' comment that is never closed with '*/'");
+}
+
+// Hostile scenes end in a located error, not in memory exhaustion or a
+// mesh whose points are not finite (unlocated "vertex 0 is not finite").
+TEST(CpfgBackground, HugeScenesAreLocatedErrors) {
+  // A #define of 1,000 words used 9,000 times: 9M words (was accepted,
+  // ~0.4 GB; 200,000 uses took 1.3 GB and ran out of memory, unlocated).
+  std::string bomb = "#define A";
+  for (int i = 0; i < 1000; ++i) bomb += " 1";
+  bomb += "\nsphere A\n";
+  for (int i = 0; i < 9000; ++i) bomb += "A ";
+  const std::string words = FirstError(bomb);
+  EXPECT_EQ(words.rfind("3:", 0), 0u) << words;
+  EXPECT_NE(words.find("more than 8388608 words"), std::string::npos) << words;
+  // 30,000 cylinders: 144 vertices each, 4.32M in all (1.2M cylinders took
+  // over 4 GB before).
+  std::string cylinders;
+  for (int i = 0; i < 30000; ++i) cylinders += "cylinder 1 1\n";
+  const std::string many = FirstError(cylinders);
+  EXPECT_EQ(many.rfind("29128:1 the background scene has more than 4194304 vertices", 0), 0u)
+      << many;
+}
+
+TEST(CpfgBackground, PointsBeyondTheTurtlesRangeAreLocatedErrors) {
+  EXPECT_EQ(FirstError("scale 1e300 1e300 1e300\nscale 1e300 1 1\nbox 1 1 1\n"),
+            "3:1 'box' places a point that is not a finite number within +-1e+15 units (the "
+            "matrix or the numbers are too large)");
+  EXPECT_EQ(FirstError("box 1 1 1\n  polygon 0 0 0 1 0 0 0 1e16 0\n"),
+            "2:3 'polygon' places a point that is not a finite number within +-1e+15 units (the "
+            "matrix or the numbers are too large)");
+  EXPECT_EQ(FirstError("sphere 1e308\n"),
+            "1:1 'sphere' has a centre or radius that is not a finite number within +-1e+15 "
+            "units");
+  std::string materials;
+  for (int i = 0; i <= 32768; ++i) materials += "material 0 0 0 1 1 1 1 1\n";
+  EXPECT_EQ(FirstError(materials), "32769:1 more than 32768 materials in a background scene");
 }
 
 }  // namespace

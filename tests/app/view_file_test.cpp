@@ -400,6 +400,30 @@ TEST(ViewFile, CurveLinesGiveCurveXTheirFilesAndSamples) {
   EXPECT_NEAR(r.plant->word.params[1], 1.5, 1e-3) << r.plant->word.params[1];
 }
 
+// A curve: line with a bad number of samples is an error at that number,
+// and the curve is still counted: before, the line was dropped and the
+// grammar's curveX(1, t) failed with "the view file has no 'curve:' line",
+// the only error shown.
+TEST(ViewFile, BadCurveSamplesIsTheErrorShownNotAMissingCurve) {
+  const std::string grammar = WriteFile("vcs.l", "axiom: A(curveX(1, 0.5))\n");
+  WriteFile("vcs.v", "curve: vc.con 1000000000000\n");
+  WriteFile("vc.con", "points: 4\ndimension: 4\n0 0 0 3\n0 1 0 1\n0 2 0 1\n0 3 0 3\n");
+  auto view = LoadViewFiles(grammar, "");
+  ASSERT_TRUE(view != nullptr);
+  EXPECT_EQ(view->curves.size(), 1u) << Messages(view->diagnostics);
+  plant::PlantSpec spec;
+  spec.path = grammar;
+  spec.until = plant::Stage::kWord;
+  AttachViewFile(view, spec);
+  plant::PlantResult r = plant::BuildPlant(spec);
+  EXPECT_FALSE(r.plant.has_value());
+  const std::string all = r.diagnostics.FormatAll();
+  EXPECT_NE(all.find("vcs.v:1:15: error: a curve's samples must be a whole number"),
+            std::string::npos)
+      << all;
+  EXPECT_EQ(all.find("no 'curve:' line"), std::string::npos) << all;
+}
+
 TEST(ViewFile, BackgroundSceneIsDrawnWithThePlant) {
   const std::string grammar = WriteFile("bgs.l", "axiom: F(3)\n");
   WriteFile("bgs.v", "background scene: bgs.dat\n");
@@ -426,6 +450,26 @@ TEST(ViewFile, BackgroundSceneIsDrawnWithThePlant) {
   ASSERT_NE(view, nullptr);
   EXPECT_NE(Messages(view->diagnostics).find("2:19 error: background scene:"), std::string::npos)
       << Messages(view->diagnostics);
+}
+
+// The background scenes of a view file have at most 4,194,304 vertices in
+// all: a scene of 20,000 cylinders (2.88M vertices) named twice is an
+// error at the second name (before: both read; 200 names of a 29,000
+// cylinder scene ran out of memory).
+TEST(ViewFile, BackgroundScenesHaveALimitOnVerticesInAll) {
+  const std::string grammar = WriteFile("bgm.l", "axiom: F(3)\n");
+  WriteFile("bgm.v", "background scene: bgm.dat\nbackground scene: x.dat;bgm.dat\n");
+  std::string scene;
+  for (int i = 0; i < 20000; ++i) scene += "cylinder 1 1\n";
+  WriteFile("bgm.dat", scene);
+  WriteFile("x.dat", "box 1 1 1\n");
+  auto view = LoadViewFiles(grammar, "");
+  ASSERT_NE(view, nullptr);
+  const std::string all = Messages(view->diagnostics);
+  EXPECT_NE(all.find("2:25 error: background scene: the scenes have more than 4194304 vertices"),
+            std::string::npos)
+      << all;
+  EXPECT_EQ(view->backgrounds.size(), 2u) << all;
 }
 
 TEST(ViewFile, AFunctionSetLineGivesFuncItsFunctionsByName) {
@@ -595,6 +639,22 @@ TEST(ViewFile, BadContourFileIsAnErrorAtItsOwnLine) {
   EXPECT_EQ(d.loc.line, 3);
   EXPECT_EQ(d.loc.column, 3);
   EXPECT_NE(d.message.find("expected a number"), std::string::npos) << d.message;
+}
+
+// A contour name that is a symbolic link to itself: one error saying so,
+// not also a warning that the file "does not exist" and was found in
+// another case (as the same name) before.
+TEST(ViewFile, ContourSymlinkLoopIsOneErrorAtItsName) {
+  const std::filesystem::path link = testing::Scratch() / "ct_loop.con";
+  std::error_code ec;
+  std::filesystem::remove(link, ec);
+  std::filesystem::create_symlink("ct_loop.con", link);
+  const std::string path = (testing::Scratch() / "ctl.v").string();
+  ViewFile v = ParseViewFile("line style: cylinder\ncontour: 1 ct_loop.con\n", path, true);
+  const std::string all = Messages(v.diagnostics);
+  ASSERT_EQ(v.diagnostics.items.size(), 1u) << all;
+  EXPECT_EQ(all.rfind("2:12 error: contour file ", 0), 0u) << all;
+  EXPECT_NE(all.find("symbolic links"), std::string::npos) << all;
 }
 
 TEST(ViewFile, ContoursWithoutCylinderLineStyleWarnAndAreNotUsed) {

@@ -75,6 +75,32 @@ TEST(CpfgCurve, ClosedAndEndpointSplinesFollowTheirTypes) {
   EXPECT_NEAR((a - b).norm(), 0, 1e-5) << a.transpose() << " / " << b.transpose();
 }
 
+// A bspline-endpoint curve sums only the four basis functions of a span:
+// 10^6 control points (10^5 lines, each 10 times) at 10^5 samples used to
+// take 10^11 basis evaluations (hours); now 4 a sample.
+TEST(CpfgCurve, LongEndpointCurveEvaluatesOnlyItsSpan) {
+  std::string text = "points: 100000\ntype: bspline-endpoint\ndimension: 4\n";
+  for (int i = 0; i < 100000; ++i) text += std::to_string(i) + " 0 0 10\n";
+  auto c = CpfgCurve::Parse(text, "long.con", 100000);
+  ASSERT_TRUE(c) << c.error().Format();
+  EXPECT_EQ(c->points(), 1000000u);
+  EXPECT_NEAR(c->Length(), 99999, 1e-3) << c->Length();
+  EXPECT_NEAR(c->AtLength(0.5).x(), 49999.5, 1.0) << c->AtLength(0.5).transpose();
+  EXPECT_NEAR(c->AtParameter(1).x(), 99999, 1e-3) << c->AtParameter(1).transpose();
+}
+
+// Coordinates beyond the turtle's +-1e15 are an error at their line: the
+// fuzzer found points at +-1e308 accepted with an infinite length.
+TEST(CpfgCurve, CoordinatesBeyondTheTurtlesRangeAreErrors) {
+  auto c = CpfgCurve::Parse("points: 4\n-1e308 0\n1e308 0\n-1e308 1\n1e308 1\n", "h.con");
+  ASSERT_FALSE(c) << c->Length();
+  EXPECT_EQ(c.error().loc.line, 2) << c.error().Format();
+  EXPECT_EQ(c.error().message, "'-1e308' is beyond +-1e15") << c.error().Format();
+  auto ok = CpfgCurve::Parse("points: 4\n-1e15 0\n1e15 0\n-1e15 1\n1e15 1\n", "k.con");
+  ASSERT_TRUE(ok) << ok.error().Format();
+  EXPECT_TRUE(std::isfinite(ok->Length())) << ok->Length();
+}
+
 TEST(CpfgCurve, ViewFileCurvesServeCurveXYAndGal) {
   const std::string g =
       "Start: {L = curveGAL(1);}\naxiom: A(L, curveX(1, 0.25), curveY(2, 0.5))\n"

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "core/atomic_file.h"
@@ -797,6 +798,26 @@ TEST(TurtleSetHeading, HeadingIsNormalisedAndFMovesAlongIt) {
     EXPECT_NEAR(f.up.norm(), 1, 1e-12);
     EXPECT_NEAR(f.heading.dot(f.up), 0, 1e-12);
     EXPECT_VEC_NEAR(f.left, f.heading.cross(f.up), 1e-12);
+  }
+}
+
+// Components past 1e154 (their squares overflow) or below 1e-154 (they
+// underflow) still give a unit heading: before, @R(1e200,0,0) made it 0
+// (F moved nowhere) and @R(1e-200,0,0) made it +Y.
+TEST(TurtleSetHeading, HugeAndTinyHeadingsAreNormalised) {
+  const Frame big = FinalFrame("@R(1e200,0,0)");
+  EXPECT_VEC_NEAR(big.heading, Vec3(1, 0, 0), 1e-12);
+  const Frame huge = FinalFrame("@R(1e308,1e308,0)");
+  EXPECT_VEC_NEAR(huge.heading, Vec3(std::sqrt(0.5), std::sqrt(0.5), 0), 1e-12);
+  const Frame tiny = FinalFrame("@R(1e-200,0,0)");
+  EXPECT_VEC_NEAR(tiny.heading, Vec3(1, 0, 0), 1e-12);
+  // A huge up vector perpendicular to the heading is used.
+  const Frame up = FinalFrame("@R(0,0,1,1e200,0,0)");
+  EXPECT_VEC_NEAR(up.up, Vec3(1, 0, 0), 1e-12);
+  for (const Frame& f : {big, huge, tiny, up}) {
+    EXPECT_NEAR(f.heading.norm(), 1, 1e-12) << f.heading.transpose();
+    EXPECT_NEAR(f.up.norm(), 1, 1e-12) << f.up.transpose();
+    EXPECT_NEAR(f.heading.dot(f.up), 0, 1e-12) << f.up.transpose();
   }
 }
 
