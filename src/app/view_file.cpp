@@ -992,6 +992,20 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
     // named 200 times was read 200 times and exhausted memory).
     size_t backgroundVertices = 0;
     for (const ViewFile::NamedFile& f : v->backgroundFiles) {
+      // A scene file that is not there (objects are copied without their
+      // files; vlab's soil3d names `from_env.dat`, which its environment
+      // program writes while cpfg runs) is not drawn, with a warning, as a
+      // missing surface or contour; --strict fails. One that cannot be read
+      // is an error.
+      std::error_code ec;
+      if (!fs::exists(f.file, ec) && !fs::is_symlink(f.file, ec)) {
+        Diagnostic d =
+            MakeError(SourceLoc{viewPath.string(), f.line, f.column},
+                      "background scene " + f.file + " is not drawn: the file does not exist");
+        d.severity = Severity::kWarning;
+        v->diagnostics.Add(std::move(d));
+        continue;
+      }
       auto text = ReadRegular(f.file, kMaxBackgroundBytes);
       if (!text) {
         Diagnostic d = text.error();

@@ -444,8 +444,18 @@ TEST(ViewFile, BackgroundSceneIsDrawnWithThePlant) {
   const uint16_t c = r.plant->geometry.polygons[0].color;
   ASSERT_LT(c, r.plant->palette.size());
   EXPECT_NEAR(r.plant->palette[c].y(), mesh::SrgbToLinear(0.5f), 1e-6) << c;
-  // A scene file that is not there: an error at the view file's line.
+  // A scene file that is not there (vlab's soil3d names one its environment
+  // program writes): a warning at the view file's line, nothing drawn.
   WriteFile("bgs.v", "\nbackground scene: gone.dat\n");
+  view = LoadViewFiles(grammar, "");
+  ASSERT_NE(view, nullptr);
+  EXPECT_NE(Messages(view->diagnostics).find("2:19 warning: background scene "), std::string::npos)
+      << Messages(view->diagnostics);
+  EXPECT_FALSE(view->diagnostics.HasErrors()) << Messages(view->diagnostics);
+  EXPECT_TRUE(view->backgrounds.empty());
+  // One that cannot be read (a directory): an error there.
+  std::filesystem::create_directories(Scratch() / "bgdir.dat");
+  WriteFile("bgs.v", "\nbackground scene: bgdir.dat\n");
   view = LoadViewFiles(grammar, "");
   ASSERT_NE(view, nullptr);
   EXPECT_NE(Messages(view->diagnostics).find("2:19 error: background scene:"), std::string::npos)
