@@ -919,10 +919,33 @@ Expected<std::vector<std::array<float, 3>>> ParseMaterials(const std::string& by
   return colors;
 }
 
+// L-studio finds an object's files by their extension (one `.v`, one
+// `.map` or `.mat` in the object's folder), whatever their names: the one
+// regular file of `dir` ending in `ext`; empty when there is none, and when
+// there are several (their names in *several). At most 4096 entries are
+// looked at (a folder that large is not an object's).
+static fs::path OnlyFileWithExtension(const fs::path& dir, const std::string& ext,
+                                      std::vector<std::string>* several = nullptr) {
+  std::error_code ec;
+  fs::directory_iterator it(dir.empty() ? fs::path(".") : dir, ec), end;
+  std::vector<fs::path> found;
+  for (int n = 0; !ec && it != end && n < 4096; it.increment(ec), ++n) {
+    const fs::path& p = it->path();
+    if (p.extension() == ext && IsFile(p)) found.push_back(p);
+  }
+  if (found.size() == 1) return found[0];
+  if (several) {
+    for (const fs::path& p : found) several->push_back(p.filename().string());
+    std::sort(several->begin(), several->end());
+  }
+  return {};
+}
+
 std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
                                               const std::string& explicitView) {
   auto v = std::make_shared<ViewFile>();
   fs::path viewPath;
+  bool lstudio = false;  // no NAME.v, no `specifications`: L-studio's rules
   // Colour files named by the object's cpfg command (`-M x.mat`, `-m x.map`).
   std::vector<std::pair<fs::path, bool>> named;  // path, is a material file
   if (!explicitView.empty()) {
@@ -971,6 +994,23 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
         add(c.materialWins ? c.colormap : c.material, !c.materialWins);
         for (const std::string& o : c.unknownOptions)
           warn("the cpfg command's option '" + o + "' is not one cpfg has: ignored");
+      } else {
+        // No `specifications` either: an L-studio object, whose view file
+        // is the folder's one `.v` (view.v beside lsystem.l).
+        std::vector<std::string> several;
+        viewPath = OnlyFileWithExtension(fs::path(grammarPath).parent_path(), ".v", &several);
+        if (!several.empty()) {
+          std::string names;
+          for (const std::string& n : several) names += (names.empty() ? "" : ", ") + n;
+          Diagnostic d;
+          d.severity = Severity::kWarning;
+          d.loc = SourceLoc{grammarPath, 0, 0};
+          d.message = "no " + beside.filename().string() + " beside the grammar and " +
+                      std::to_string(several.size()) + " view files in its folder (" + names +
+                      "): none is used; name one with --view";
+          v->diagnostics.Add(std::move(d));
+        }
+        lstudio = true;
       }
     }
   }
@@ -1054,6 +1094,13 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
   for (const fs::path& stem : stems) {
     candidates.emplace_back(fs::path(stem).replace_extension(".mat"), true);
     candidates.emplace_back(fs::path(stem).replace_extension(".map"), false);
+  }
+  if (lstudio) {  // and then the folder's one material file or colour map
+    const fs::path dir = fs::path(grammarPath).parent_path();
+    if (fs::path m = OnlyFileWithExtension(dir, ".mat"); !m.empty())
+      candidates.emplace_back(m, true);
+    if (fs::path m = OnlyFileWithExtension(dir, ".map"); !m.empty())
+      candidates.emplace_back(m, false);
   }
   for (const auto& [candidate, material] : candidates) {
     if (!IsFile(candidate)) continue;

@@ -339,7 +339,10 @@ TEST(ViewFile, HostileFilesAreClearErrors) {
   ASSERT_TRUE(dir != nullptr);
   EXPECT_NE(Messages(dir->diagnostics).find("is a directory"), std::string::npos);
   std::filesystem::remove(Scratch() / "hostile.v");
-  EXPECT_EQ(LoadViewFiles(grammar, ""), nullptr);  // nothing beside it
+  // No hostile.v: the scratch folder's several other .v files are not used
+  // either (L-studio's one-.v rule, AnLStudioObjectUsesItsFoldersOnlyViewFile).
+  auto none = LoadViewFiles(grammar, "");
+  EXPECT_TRUE(!none || none->path.empty()) << none->path;
 }
 
 TEST(ViewFile, FunctionLinesGiveFuncItsFilesInOrder) {
@@ -422,6 +425,29 @@ TEST(ViewFile, BadCurveSamplesIsTheErrorShownNotAMissingCurve) {
             std::string::npos)
       << all;
   EXPECT_EQ(all.find("no 'curve:' line"), std::string::npos) << all;
+}
+
+// An L-studio object (no NAME.v, no vlab `specifications`) finds its view
+// file and colours by extension: the folder's one `.v` (view.v beside
+// lsystem.l; RebeccaKuo's cloud objects were drawn without theirs, no
+// word said). Several `.v` files: none is used, with a warning.
+TEST(ViewFile, AnLStudioObjectUsesItsFoldersOnlyViewFile) {
+  const std::filesystem::path dir = Scratch() / "lstudio";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "lsystem.l") << "axiom: F\n";
+  std::ofstream(dir / "view.v") << "angle increment: 30\n";
+  const std::string grammar = (dir / "lsystem.l").string();
+  auto view = LoadViewFiles(grammar, "");
+  ASSERT_NE(view, nullptr);
+  EXPECT_EQ(view->path, (dir / "view.v").string()) << Messages(view->diagnostics);
+  EXPECT_FALSE(view->diagnostics.HasErrors()) << Messages(view->diagnostics);
+  std::ofstream(dir / "other.v") << "angle increment: 45\n";
+  view = LoadViewFiles(grammar, "");
+  ASSERT_NE(view, nullptr);
+  EXPECT_TRUE(view->path.empty()) << view->path;
+  EXPECT_NE(Messages(view->diagnostics).find("2 view files in its folder (other.v, view.v)"),
+            std::string::npos)
+      << Messages(view->diagnostics);
 }
 
 TEST(ViewFile, BackgroundSceneIsDrawnWithThePlant) {
