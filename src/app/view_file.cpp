@@ -279,8 +279,11 @@ void Reader::Read(const app::Line& line) {
   const std::string& L = label_;
   if (L == "angle factor:") {
     if (auto x = Number(0, "a number of steps in a full turn")) {
-      if (*x == 0)
-        Error(tokens_[0].column, "'angle factor:' must not be 0");
+      if (*x == 0)  // cpfg divides 360 by it; a file whose turns all give their angle runs
+        Warn(tokens_[0].column,
+             "'angle factor: 0' gives no angle increment (cpfg divides 360 by it): ignored, "
+             "the angle increment stays as it was (L-studio's dynamic3 turns only by "
+             "explicit angles)");
       else
         v_.angle = 360.0 / *x;
     }

@@ -28,10 +28,14 @@ PlantGeometry ResolvePixelWidths(const PlantGeometry& g, const ScreenView* view)
   if (!g.widthInPixels) return out;
   out.widthInPixels = false;
   if (view) {
+    // A line is at least one pixel wide, as cpfg's pixel lines are (OpenGL
+    // draws a glLineWidth under 1 one pixel wide): L-studio's cloud_I(line)
+    // asks for 0.05 pixels and was drawn as faint coverage lines.
     for (Segment& s : out.segments) {
       const Vec3 axis = s.end - s.start;
-      s.radiusStart = float(s.radiusStart * UnitsPerPixel(*view, s.start, axis));
-      s.radiusEnd = float(s.radiusEnd * UnitsPerPixel(*view, s.end, axis));
+      s.radiusStart =
+          float(std::max(double(s.radiusStart), 0.5) * UnitsPerPixel(*view, s.start, axis));
+      s.radiusEnd = float(std::max(double(s.radiusEnd), 0.5) * UnitsPerPixel(*view, s.end, axis));
     }
     return out;
   }

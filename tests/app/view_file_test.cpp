@@ -251,7 +251,9 @@ TEST(ViewFile, BadValuesAreErrorsAtTheirColumn) {
   EXPECT_EQ(first("viewpoint: 1,2\n").rfind("1:15 error: expected x,y,z after 'viewpoint:'", 0),
             0u);
   EXPECT_EQ(first("initial color: 2.5\n").rfind("1:16 error: expected a whole number", 0), 0u);
-  EXPECT_EQ(first("angle factor: 0\n").rfind("1:15 error", 0), 0u);
+  EXPECT_EQ(first("angle factor: 0\n").rfind("1:15 warning: 'angle factor: 0' gives no angle", 0),
+            0u);
+  EXPECT_FALSE(ParseViewFile("angle factor: 0\n", "p.v").angle.has_value());
   EXPECT_EQ(first("tropism: E 0.2\n").rfind("1:1 error: 'tropism:' needs its vector", 0), 0u);
   EXPECT_EQ(first("tropism: T 0,0,0 E 1\n").rfind("1:12 error", 0), 0u);
   EXPECT_EQ(first("tropism: T 0,1,0 A 30\n").rfind("1:20 warning: a tropism at an angle", 0), 0u);

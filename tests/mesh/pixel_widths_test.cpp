@@ -35,6 +35,29 @@ Segment Horizontal(const Vec3& start, double length, float radiusPx, uint32_t br
   return s;
 }
 
+// A width under one pixel is drawn one pixel wide, as cpfg's GL lines are
+// (L-studio's cloud_I(line): 0.05 pixels, drawn before as faint coverage).
+TEST(PixelWidths, AWidthUnderOnePixelIsOnePixelWide) {
+  PlantGeometry g;
+  g.segments.push_back(Horizontal(Vec3(-1, 0, 0), 2, 0.025f, 0));  // 0.05 px wide
+  g.segments.push_back(Horizontal(Vec3(-1, 1, 0), 2, 1.5f, 1));    // 3 px: unchanged
+  g.widthInPixels = true;
+  g.boundsMin = Vec3(-1, 0, 0);
+  g.boundsMax = Vec3(1, 1, 0);
+  ScreenView view;
+  view.width = 400;
+  view.height = 300;
+  view.viewProjection = testing::LookAtPerspective(Vec3(0, 0, 5), Vec3(0, 0, 0), 35, 4.0 / 3.0);
+  const PlantGeometry out = ResolvePixelWidths(g, &view);
+  ASSERT_EQ(out.segments.size(), 2u);
+  // Pixels per world unit near the segments (z = 0; within 3 % across them).
+  const double ppu = (Pixel(view, Vec3(0, 1, 0)) - Pixel(view, Vec3(0, 0, 0))).norm();
+  EXPECT_NEAR(2 * out.segments[0].radiusStart * ppu, 1.0, 0.03)
+      << "a 0.05 px line drawn " << 2 * out.segments[0].radiusStart * ppu << " px wide";
+  EXPECT_NEAR(2 * out.segments[1].radiusStart * ppu, 3.0, 0.09)
+      << 2 * out.segments[1].radiusStart * ppu;
+}
+
 TEST(PixelWidths, SegmentsAreTheirWidthInPixelsNearAndFar) {
   // Two segments 2 px wide (radius 1 px), one 5 units from the eye and one
   // 45: drawn as world units they would differ ninefold on screen.
