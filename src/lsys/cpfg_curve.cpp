@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "lsys/clamped_bspline.h"
+
 namespace sylva::lsys {
 namespace {
 
@@ -25,24 +27,6 @@ void UniformWeights(double s, double w[4]) {
   w[1] = (3 * s3 - 6 * s2 + 4) / 6;
   w[2] = (-3 * s3 + 3 * s2 + 3 * s + 1) / 6;
   w[3] = s3 / 6;
-}
-
-// cpfg's clamped knots for n control points: 0 0 0 0 1 2 ... n-3 n-3 n-3 n-3.
-double ClampedKnot(int k, int n) {
-  if (k < 4) return 0;
-  if (k > n - 1) return n - 3;
-  return k - 3;
-}
-
-// Cox-de Boor basis of order `order` over the clamped knots (0/0 taken as 0).
-double ClampedBasis(int k, int order, double u, int n) {
-  if (order == 1) return ClampedKnot(k, n) <= u && u < ClampedKnot(k + 1, n) ? 1.0 : 0.0;
-  double sum = 0;
-  double div = ClampedKnot(k + order - 1, n) - ClampedKnot(k, n);
-  if (div != 0) sum = (u - ClampedKnot(k, n)) / div * ClampedBasis(k, order - 1, u, n);
-  div = ClampedKnot(k + order, n) - ClampedKnot(k + 1, n);
-  if (div != 0) sum += (ClampedKnot(k + order, n) - u) / div * ClampedBasis(k + 1, order - 1, u, n);
-  return sum;
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "lsys/clamped_bspline.h"
+
 namespace sylva::lsys {
 namespace {
 
@@ -18,25 +20,6 @@ Diagnostic FileError(const std::string& path, int line, const std::string& msg) 
   return d;
 }
 
-// The clamped uniform knots of a cubic B-spline with n + 1 control points.
-int Knot(int j, int n) {
-  constexpr int t = 4;
-  if (j < t) return 0;
-  if (j > n) return n - t + 2;
-  return j - t + 1;
-}
-
-// Cox-de Boor basis N(k, t) at u.
-double Basis(int k, int t, double u, int n) {
-  if (t == 1) return Knot(k, n) <= u && u < Knot(k + 1, n) ? 1.0 : 0.0;
-  double sum = 0;
-  int div = Knot(k + t - 1, n) - Knot(k, n);
-  if (div != 0) sum = (u - Knot(k, n)) / div * Basis(k, t - 1, u, n);
-  div = Knot(k + t, n) - Knot(k + 1, n);
-  if (div != 0) sum += (Knot(k + t, n) - u) / div * Basis(k + 1, t - 1, u, n);
-  return sum;
-}
-
 }  // namespace
 
 void CpfgFunction::Point(double d, double* x, double* y) const {
@@ -44,7 +27,7 @@ void CpfgFunction::Point(double d, double* x, double* y) const {
   const double u = d * (n - 2);
   *x = *y = 0;
   for (int k = 0; k <= n; ++k) {
-    const double b = Basis(k, 4, u, n);
+    const double b = ClampedBasis(k, 4, u, n + 1);
     *x += px_[size_t(k)] * b;
     *y += py_[size_t(k)] * b;
   }
