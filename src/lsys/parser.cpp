@@ -2768,8 +2768,13 @@ void GrammarParser::BeginLsystem(const Line& l, int col, size_t after, size_t en
   const std::string label = l.text.substr(after, end - after);
   LsystemBlock b;
   b.name = label;
-  b.id = int(std::strtod(label.c_str(), nullptr));
+  const double number = std::strtod(label.c_str(), nullptr);
   b.loc = Loc(l, col);
+  if (!(std::fabs(number) <= double(std::numeric_limits<int>::max()))) {
+    Error(l, col, "L-system label '" + label + "' is a number out of range", 7);
+    return;
+  }
+  b.id = int(number);
   if (g_.lsystems.empty()) {
     g_.name = label;
     g_.lsystems.push_back(std::move(b));

@@ -278,7 +278,11 @@ bool ReadCloverSpec(const std::string& path, const std::string& text, const Read
       out[1] = convert(pair[1].first);
     };
     if (d->key == "grid size") {
-      two(def.size, [](const std::string& w) { return int(std::atof(w.c_str())); });
+      two(def.size, [](const std::string& w) {
+        // Out of int's range (or NaN) reads 0: the size check below warns.
+        const double v = std::atof(w.c_str());
+        return v >= 1 && v <= double(1 << 30) ? int(v) : 0;
+      });
     } else if (d->key == "grid position") {
       two(def.pos, [](const std::string& w) { return float(std::atof(w.c_str())); });
     } else if (d->key == "grid range") {

@@ -106,6 +106,11 @@ TEST(SubLsystem, HeaderErrorsHaveLocations) {
   EXPECT_EQ(FirstError("lsystem: 1\naxiom: F\nendlsystem\nlsystem: 1.5\naxiom: G\nendlsystem\n"),
             "4:1 two L-systems numbered 1 (the other at line 1): ?(id, scale) could not tell "
             "them apart");
+  // Found by fuzz_grammar: a label beyond int's range was converted anyway (UB).
+  EXPECT_EQ(FirstError("lsystem: 1\naxiom: F\nendlsystem\nlsystem: 1e123\naxiom: G\nendlsystem\n"),
+            "4:1 L-system label '1e123' is a number out of range");
+  EXPECT_EQ(FirstError("lsystem: 1e123\naxiom: F\nendlsystem\n"),
+            "1:1 L-system label '1e123' is a number out of range");
 }
 
 TEST(SubLsystem, DefinesOfALaterBlockAreRead) {
