@@ -1059,10 +1059,11 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           if (inPolygon) {
             if (op == Op::kForwardDraw || op == Op::kForwardMove)
               openPolygons.back().vertices.push_back(t.pos);
-          } else if (kCpfg && x.cylinder >= 0) {
-            // Inside a generalized cylinder F draws nothing: the tube through
-            // the control points is the drawing (cpfg).
           } else if (op == Op::kForwardDraw || op == Op::kForwardDrawNoVertex) {
+            // Inside a generalized cylinder too: cpfg's F draws its segment
+            // whatever @Gs says (interpret.c calls StartNode and EndNode for
+            // every F and G; start_spline's spline_flag 2 only keeps F and f
+            // from adding control points), beside the tube.
             Segment sg;
             sg.start = start;
             sg.end = t.pos;

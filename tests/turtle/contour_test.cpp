@@ -50,7 +50,7 @@ double Extent(const mesh::ContourTube& t, size_t r, const Vec3& d) {
 TEST(TurtleContour, FlatContourMakesACylinderWideAlongUpAndThinAlongLeft) {
   // Width 2 (radius 1); the turtle starts with H = +y, L = -x, U = -z.
   // cpfg puts the contour's x along U and its y along -L.
-  mesh::PlantGeometry g = Draw("#(2)@#(1)@Gs F(1) @Gc(4) F(1) @Ge(4)", WithContours(false));
+  mesh::PlantGeometry g = Draw("#(2)@#(1)@Gs f(1) @Gc(4) f(1) @Ge(4)", WithContours(false));
   ASSERT_EQ(g.tubes.size(), 1u) << "the two pieces make one tube";
   EXPECT_TRUE(g.segments.empty());
   const mesh::ContourTube& t = g.tubes[0];
@@ -70,7 +70,7 @@ TEST(TurtleContour, FlatContourMakesACylinderWideAlongUpAndThinAlongLeft) {
 TEST(TurtleContour, ContoursAreInterpolatedAlongAPiece) {
   // Contour 1 is 2 wide, contour 2 half as wide: the middle ring (t = 0.5)
   // is between.
-  mesh::PlantGeometry g = Draw("#(2)@#(1)@Gs F(1) @#(2)@Ge(2)", WithContours(false));
+  mesh::PlantGeometry g = Draw("#(2)@#(1)@Gs f(1) @#(2)@Ge(2)", WithContours(false));
   ASSERT_EQ(g.tubes.size(), 1u);
   const mesh::ContourTube& t = g.tubes[0];
   ASSERT_EQ(t.rings(), 3u);
@@ -82,7 +82,7 @@ TEST(TurtleContour, ContoursAreInterpolatedAlongAPiece) {
 
 TEST(TurtleContour, TwistOfCylindersDecidesWhetherARollTurnsTheCrossSection) {
   // /(90) between the control points turns U from -z to +x.
-  const std::string axiom = "#(2)@#(1)@Gs F(1) /(90) @Ge(2)";
+  const std::string axiom = "#(2)@#(1)@Gs f(1) /(90) @Ge(2)";
   mesh::PlantGeometry off = Draw(axiom, WithContours(false));
   mesh::PlantGeometry on = Draw(axiom, WithContours(true));
   ASSERT_EQ(off.tubes.size(), 1u);
@@ -111,7 +111,7 @@ TEST(TurtleContour, SidesComeFromTheViewFileAndFromTheBang) {
 }
 
 TEST(TurtleContour, UnknownContourWarnsAndDrawsRound) {
-  mesh::PlantGeometry g = Draw("@#(7)@Gs F @Ge(2)", WithContours(false));
+  mesh::PlantGeometry g = Draw("@#(7)@Gs f @Ge(2)", WithContours(false));
   EXPECT_TRUE(g.tubes.empty());
   EXPECT_EQ(g.segments.size(), 2u);
   ASSERT_EQ(g.warnings.size(), 1u);
@@ -129,7 +129,7 @@ TEST(TurtleContour, UnknownContourWarnsAndDrawsRound) {
 }
 
 TEST(TurtleContour, ContourTubesTessellateIntoQuadsWithUnitNormals) {
-  mesh::PlantGeometry g = Draw("#(2)@#(1)@Gs F(1) @Gc(4) F(1) @Ge(4)", WithContours(false));
+  mesh::PlantGeometry g = Draw("#(2)@#(1)@Gs f(1) @Gc(4) f(1) @Ge(4)", WithContours(false));
   mesh::TriangleMesh m;
   mesh::TessellateOptions opt;
   ASSERT_TRUE(mesh::Tessellate(g, opt, m).ok());

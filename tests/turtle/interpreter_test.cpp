@@ -421,8 +421,8 @@ TEST(Turtle, RollToVerticalIsDollar) {
 
 TEST(Turtle, GeneralizedCylinderAlongALineIsEvenlyCutAndTapers) {
   // @Gt(1): tangents as long as the chord, so a straight piece is cut evenly.
-  Drawn d = Draw("axiom: !(1) @Gt(1) @Gs F(3) !(2) @Ge(6)\n");
-  ASSERT_EQ(d.geometry.segments.size(), 6u);  // F inside draws nothing
+  Drawn d = Draw("axiom: !(1) @Gt(1) @Gs f(3) !(2) @Ge(6)\n");
+  ASSERT_EQ(d.geometry.segments.size(), 6u);
   for (size_t k = 0; k < 6; ++k) {
     const Segment& s = d.geometry.segments[k];
     EXPECT_VEC_NEAR(s.end, Vec3(0, 0.5 * double(k + 1), 0), 1e-12);
@@ -431,11 +431,47 @@ TEST(Turtle, GeneralizedCylinderAlongALineIsEvenlyCutAndTapers) {
   }
 }
 
+TEST(Turtle, ForwardInsideAGeneralizedCylinderDrawsItsSegmentAsCpfgDoes) {
+  // cpfg's interpret.c draws every F (StartNode, EndNode) whatever @Gs
+  // says; start_spline only keeps F and f from adding control points. So
+  // `@Gs F @Gc F @Ge` is the tube through the control points and the two F
+  // segments beside it, each with the width the turtle has at its F; f and
+  // the turns draw nothing of their own. Word: 0 !(0.4), 1 @Gs, 2 F,
+  // 3 @Gc(2), 4 !(0.8), 5 -(90), 6 F(2), 7 f, 8 @Ge(2).
+  Drawn d = Draw("axiom: !(0.4) @Gs F @Gc(2) !(0.8) -(90) F(2) f @Ge(2)\n");
+  const auto& s = d.geometry.segments;
+  ASSERT_EQ(s.size(), 1u + 2u + 1u + 2u) << "two F segments and two pieces of 2 rings";
+  std::vector<const Segment*> forward, tube;
+  for (const Segment& x : s) (x.module == 2 || x.module == 6 ? forward : tube).push_back(&x);
+  ASSERT_EQ(forward.size(), 2u);
+  ASSERT_EQ(tube.size(), 4u);
+  // The first F: from the origin up one step, radius 0.4 / 2.
+  EXPECT_VEC_NEAR(forward[0]->start, Vec3(0, 0, 0), 1e-12);
+  EXPECT_VEC_NEAR(forward[0]->end, Vec3(0, 1, 0), 1e-12);
+  EXPECT_NEAR(forward[0]->radiusStart, 0.2, 1e-6) << forward[0]->radiusStart;
+  EXPECT_NEAR(forward[0]->radiusEnd, 0.2, 1e-6) << forward[0]->radiusEnd;
+  // The second, after the turn: along +x for 2, with the new width.
+  EXPECT_VEC_NEAR(forward[1]->start, Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(forward[1]->end, Vec3(2, 1, 0), 1e-12);
+  EXPECT_NEAR((forward[1]->end - forward[1]->start).norm(), 2.0, 1e-12);
+  EXPECT_NEAR(forward[1]->radiusStart, 0.4, 1e-6) << forward[1]->radiusStart;
+  // The tube goes through the control points only (@Gs, @Gc, @Ge: f moved
+  // the last one to x = 3), its radius from 0.2 to 0.4 on the last piece.
+  EXPECT_VEC_NEAR(tube[1]->end, Vec3(0, 1, 0), 1e-12);
+  EXPECT_NEAR(tube[1]->radiusEnd, 0.2, 1e-6) << tube[1]->radiusEnd;
+  EXPECT_VEC_NEAR(tube[3]->end, Vec3(3, 1, 0), 1e-12);
+  EXPECT_NEAR(tube[3]->radiusEnd, 0.4, 1e-6) << tube[3]->radiusEnd;
+  // The same F outside a cylinder draws the same segment.
+  Drawn plain = Draw("axiom: !(0.4) F\n");
+  ASSERT_EQ(plain.geometry.segments.size(), 1u);
+  EXPECT_EQ(plain.geometry.segments[0].radiusEnd, forward[0]->radiusEnd);
+}
+
 TEST(Turtle, GeneralizedCylinderFollowsTheHermiteCurveOfTheHeadings) {
   // From (0,0,0) heading +y to (1,1,0) heading +x: at t = 1/2 the cubic
   // Hermite curve with tangents 1.2 H |p1 - p0| (cpfg's default @Gt) is
   // (p0 + p1)/2 + 1.2 |p1 - p0| (H0 - H1)/8.
-  Drawn d = Draw("axiom: @Gs F -(90) F @Gc(2) F @Ge\n");
+  Drawn d = Draw("axiom: @Gs f -(90) f @Gc(2) f @Ge\n");
   ASSERT_EQ(d.geometry.segments.size(), 2u + 8u);
   const double c = 1.2 * std::sqrt(2.0) / 8;
   EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(0.5 - c, 0.5 + c, 0), 1e-12);
@@ -447,12 +483,12 @@ TEST(Turtle, GeneralizedCylinderTangentFactorsOfGt) {
   // @Gt(a, b): b scales the tangent leaving a control point, a the one
   // arriving. Same curve as above with factors 2 (leaving the start) and
   // 0.5 (arriving at the end): midpoint offset |p1 - p0| (2 H0 - 0.5 H1)/8.
-  Drawn d = Draw("axiom: @Gt(0.5,2) @Gs F -(90) F @Gc(2)\n");
+  Drawn d = Draw("axiom: @Gt(0.5,2) @Gs f -(90) f @Gc(2)\n");
   ASSERT_EQ(d.geometry.segments.size(), 2u);
   const double q = std::sqrt(2.0) / 8;
   EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(0.5 - 0.5 * q, 0.5 + 2 * q, 0), 1e-12);
   // One factor: both.
-  Drawn e = Draw("axiom: @Gt(1) @Gs F -(90) F @Gc(2)\n");
+  Drawn e = Draw("axiom: @Gt(1) @Gs f -(90) f @Gc(2)\n");
   EXPECT_VEC_NEAR(e.geometry.segments[0].end, Vec3(0.5 - q, 0.5 + q, 0), 1e-12);
 }
 
@@ -469,30 +505,30 @@ TEST(Turtle, GeneralizedCylinderRadiusTangentsOfGr) {
     const double t2 = t * t, t3 = t2 * t;
     return 4 * (3 * t2 - 2 * t3) + 4.8 * (t3 - 2 * t2 + t) + 4.8 * (t3 - t2);
   };
-  Drawn d = Draw("axiom: !(2) @Gr(90, 3, 0, 1) @Gs F(4) !(4) @Ge(2)\n");
+  Drawn d = Draw("axiom: !(2) @Gr(90, 3, 0, 1) @Gs f(4) !(4) @Ge(2)\n");
   ASSERT_EQ(d.geometry.segments.size(), 2u);
   EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(0, along(0.625), 0), 1e-12);
   EXPECT_NEAR(d.geometry.segments[0].radiusEnd, 1.125, 1e-6);
   EXPECT_NEAR(d.geometry.segments[1].radiusEnd, 2.0, 1e-6);
   // Without @Gr: t = r and the radius runs linearly.
-  Drawn plain = Draw("axiom: !(2) @Gs F(4) !(4) @Ge(2)\n");
+  Drawn plain = Draw("axiom: !(2) @Gs f(4) !(4) @Ge(2)\n");
   EXPECT_VEC_NEAR(plain.geometry.segments[0].end, Vec3(0, along(0.5), 0), 1e-12);
   EXPECT_NEAR(plain.geometry.segments[0].radiusEnd, 1.5, 1e-6);
   // @Gr(1) multiplies the radius parts by the chord (4): (1, 0) and (0, 12):
   // radius = 1 + (3 - 12) / 4 + (-2 + 12) / 8 = 0; t is unchanged.
-  Drawn s = Draw("axiom: !(2) @Gr(90, 3, 0, 1) @Gr(1) @Gs F(4) !(4) @Ge(2)\n");
+  Drawn s = Draw("axiom: !(2) @Gr(90, 3, 0, 1) @Gr(1) @Gs f(4) !(4) @Ge(2)\n");
   EXPECT_NEAR(s.geometry.segments[0].radiusEnd, 0.0, 1e-6);
   EXPECT_VEC_NEAR(s.geometry.segments[0].end, Vec3(0, along(0.625), 0), 1e-12);
 }
 
 TEST(Turtle, GeneralizedCylinderIsOneTubeAndBranchesDrawOnTheirOwn) {
-  Drawn d = Draw("axiom: @Gs F [+F] F @Ge(4)\n");
+  Drawn d = Draw("axiom: @Gs f [+F] f @Ge(4)\n");
   ASSERT_EQ(d.geometry.segments.size(), 5u);
   EXPECT_VEC_NEAR(d.geometry.segments[0].start, Vec3(0, 1, 0), 1e-12);  // the branch
   EXPECT_VEC_NEAR(d.geometry.segments[0].end, Vec3(-1, 1, 0), 1e-12);
   EXPECT_VEC_NEAR(d.geometry.segments[4].end, Vec3(0, 2, 0), 1e-12);
   // Tessellated as one tube: the same triangles as four steps of F.
-  auto tube = testing::PlantFromText("axiom: @Gs F(2) @Ge(4)\n", -1, plant::Stage::kMesh);
+  auto tube = testing::PlantFromText("axiom: @Gs f(2) @Ge(4)\n", -1, plant::Stage::kMesh);
   auto steps = testing::PlantFromText("axiom: F(.5)F(.5)F(.5)F(.5)\n", -1, plant::Stage::kMesh);
   ASSERT_TRUE(tube && steps);
   EXPECT_EQ(tube->mesh.triangleCount(), steps->mesh.triangleCount());
@@ -510,7 +546,7 @@ TEST(Turtle, BranchOfAGeneralizedCylinderContinuesItFromItsLastControlPoint) {
   EXPECT_NE(d.geometry.segments[0].branch, d.geometry.segments[4].branch);
   EXPECT_VEC_NEAR(d.geometry.segments[5].end, Vec3(0, 1, 0), 1e-12);
   // Nested branches inherit the start; a branch without @Gc draws its F.
-  Drawn n = Draw("axiom: @Gs [[+ f @Ge(1)]] [-F] F @Ge(1)\n");
+  Drawn n = Draw("axiom: @Gs [[+ f @Ge(1)]] [-F] f @Ge(1)\n");
   ASSERT_EQ(n.geometry.segments.size(), 3u);
   EXPECT_VEC_NEAR(n.geometry.segments[0].start, Vec3(0, 0, 0), 1e-12);
   EXPECT_VEC_NEAR(n.geometry.segments[0].end, Vec3(-1, 0, 0), 1e-12);
@@ -519,7 +555,7 @@ TEST(Turtle, BranchOfAGeneralizedCylinderContinuesItFromItsLastControlPoint) {
 }
 
 TEST(Turtle, GeneralizedCylinderLeftOpenWarnsAndHugeRingCountsStopEarly) {
-  Drawn d = Draw("axiom: @Gs F @Gc(2) F\n");
+  Drawn d = Draw("axiom: @Gs f @Gc(2) f\n");
   EXPECT_EQ(d.geometry.segments.size(), 2u);
   ASSERT_EQ(d.geometry.warnings.size(), 1u);
   EXPECT_NE(d.geometry.warnings[0].find("never ended"), std::string::npos)
