@@ -80,6 +80,10 @@ struct PlantGeometry {
   std::vector<SurfaceInstance> surfaces;
   std::vector<Sphere> spheres;
   std::vector<ContourTube> tubes;  // generalized cylinders with a contour
+  // Branch ids of closed curves (cpfg's closed splines `{(2)`, `{(4)`):
+  // where such a branch's run of segments ends where it began, the
+  // tessellator joins the tube's end to its start (no caps, one ring).
+  std::vector<uint32_t> loops;
   uint32_t branchCount = 0;
   Vec3 boundsMin{0, 0, 0}, boundsMax{0, 0, 0};  // of every point drawn or visited
   bool planar = true;  // every point lies in the z = 0 plane (ABOP's 2D figures)

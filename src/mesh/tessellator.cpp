@@ -47,6 +47,9 @@ int ClampSides(int s) {
 struct Chains {
   std::vector<uint32_t> start;     // chain c is segments [start[c], start[c + 1])
   std::vector<uint32_t> segments;  // indices into g.segments
+  // 1: chain c is a loop (a branch of g.loops whose last segment ends where
+  // its first began): its end is joined to its start, without caps.
+  std::vector<uint8_t> loop;
   size_t size() const { return start.empty() ? 0 : start.size() - 1; }
   std::span<const uint32_t> operator[](size_t c) const {
     return {segments.data() + start[c], segments.data() + start[c + 1]};
@@ -88,6 +91,19 @@ Chains BuildChains(const PlantGeometry& g) {
   for (uint32_t k = 0; k < g.segments.size(); ++k) {
     if (chainOf[k] >= 0) chains.segments[at[size_t(chainOf[k])]++] = k;
   }
+  chains.loop.assign(chains.size(), 0);
+  if (!g.loops.empty()) {
+    std::vector<uint8_t> closed(open.size(), 0);
+    for (uint32_t b : g.loops)
+      if (b < closed.size()) closed[b] = 1;
+    for (size_t c = 0; c < chains.size(); ++c) {
+      const auto chain = chains[c];
+      const Segment& first = g.segments[chain.front()];
+      const Segment& last = g.segments[chain.back()];
+      chains.loop[c] = chain.size() >= 2 && closed[first.branch] &&
+                       (last.end - first.start).norm() <= 1e-9 * (1 + first.start.norm());
+    }
+  }
   return chains;
 }
 
@@ -103,8 +119,12 @@ struct ChainFrames {
 // with tangents and lengths (T, V) for a ribbon, everything for a tube.
 enum class FramePart { kAxis, kTangents, kAll };
 
-void BuildFrames(const PlantGeometry& g, std::span<const uint32_t> chain, ChainFrames& f,
-                 FramePart part = FramePart::kAll) {
+// A loop (Chains::loop) ends with the frame it starts with: the last joint
+// is the first, its tangent the mean of the two segments' there, and the
+// normals carried round are turned back by the angle they miss the first
+// by, spread along the chain by length, so the last ring is the first.
+void BuildFrames(const PlantGeometry& g, std::span<const uint32_t> chain, bool loop,
+                 ChainFrames& f, FramePart part = FramePart::kAll) {
   const size_t m = chain.size();
   auto& P = f.P;
   auto& T = f.T;
@@ -118,6 +138,10 @@ void BuildFrames(const PlantGeometry& g, std::span<const uint32_t> chain, ChainF
   R[0] = g.segments[chain[0]].radiusStart;
   for (size_t k = 1; k < m; ++k) R[k] = g.segments[chain[k]].radiusStart;
   R[m] = g.segments[chain[m - 1]].radiusEnd;
+  if (loop) {
+    P[m] = P[0];
+    R[m] = R[0];
+  }
   double rmax = *std::max_element(R.begin(), R.end());
   for (double& r : R) r = std::max(r, rmax * 1e-3);
   if (part == FramePart::kAxis) return;
@@ -126,6 +150,10 @@ void BuildFrames(const PlantGeometry& g, std::span<const uint32_t> chain, ChainF
   auto dir = [&](size_t k) { return (P[k + 1] - P[k]).normalized(); };
   T[0] = dir(0);
   T[m] = dir(m - 1);
+  if (loop) {
+    const Vec3 t = dir(m - 1) + dir(0);
+    T[0] = T[m] = t.norm() > 1e-9 ? Vec3(t.normalized()) : dir(0);
+  }
   for (size_t k = 1; k < m; ++k) {
     Vec3 t = dir(k - 1) + dir(k);
     T[k] = t.norm() > 1e-9 ? t.normalized() : dir(k);
@@ -150,6 +178,15 @@ void BuildFrames(const PlantGeometry& g, std::span<const uint32_t> chain, ChainF
     Vec3 n = c2 > 1e-18 ? Vec3(rL - (2 / c2) * v2.dot(rL) * v2) : rL;
     n -= T[k + 1] * T[k + 1].dot(n);
     N[k + 1] = n.norm() > 1e-9 ? n.normalized() : AnyPerpendicular(T[k + 1]);
+  }
+  if (loop && V[m] > 0) {
+    // The carried normal comes back turned by `miss` about T[0].
+    const double miss = std::atan2(T[0].dot(N[m].cross(N[0])), N[m].dot(N[0]));
+    for (size_t k = 1; k < m; ++k) {
+      const double a = miss * V[k] / V[m], c = std::cos(a), s = std::sin(a);
+      N[k] = N[k] * c + T[k].cross(N[k]) * s;  // N[k] is perpendicular to T[k]
+    }
+    N[m] = N[0];
   }
 }
 
@@ -758,11 +795,13 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
     for (uint32_t k : chain) rmax = std::max<double>(rmax, g.segments[k].radiusStart);
     if (!(rmax > 0) || !shown(c)) return;  // zero width, or culled: nothing to draw
     if (view) {
-      BuildFrames(g, chain, frames, FramePart::kAxis);
+      BuildFrames(g, chain, chains.loop[c], frames, FramePart::kAxis);
       PlanChain(g, chain, frames, *view, shadowOnly(c), history ? &history->level[c] : nullptr,
                 history ? &history->rings[c] : nullptr, plans[c]);
+      if (chains.loop[c]) plans[c].caps = false;  // joined end to start
       return;
     }
+    plans[c].caps = !chains.loop[c];
     Vec3 lo = g.segments[chain[0]].start, hi = lo;
     for (uint32_t k : chain) {
       lo = lo.cwiseMin(g.segments[k].end);
@@ -851,7 +890,7 @@ Status Tessellate(const PlantGeometry& g, const TessellateOptions& options, Tria
                 ChainFrames frames;
                 for (size_t c = first + begin; c < first + end; ++c) {
                   if (!plans[c].sides) continue;
-                  BuildFrames(g, chains[c], frames,
+                  BuildFrames(g, chains[c], chains.loop[c], frames,
                               plans[c].ribbon ? FramePart::kTangents : FramePart::kAll);
                   if (plans[c].ribbon) {
                     EmitRibbon(g, chains[c], frames, plans[c], *view, vOffset[c] - vShift,

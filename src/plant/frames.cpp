@@ -28,6 +28,7 @@ void Append(const mesh::PlantGeometry& frame, bool first, mesh::PlantGeometry& a
   all.surfaces.insert(all.surfaces.end(), frame.surfaces.begin(), frame.surfaces.end());
   all.spheres.insert(all.spheres.end(), frame.spheres.begin(), frame.spheres.end());
   all.tubes.insert(all.tubes.end(), frame.tubes.begin(), frame.tubes.end());
+  for (uint32_t b : frame.loops) all.loops.push_back(b + offset);
   all.branchCount += std::max<uint32_t>(frame.branchCount, 1);
   if (first) {
     all.boundsMin = frame.boundsMin;

@@ -793,6 +793,7 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   g.surfaces.clear();
   g.spheres.clear();
   g.tubes.clear();
+  g.loops.clear();
   g.warnings.clear();
   g.modulePosition.clear();
   g.moduleFrame.clear();
@@ -1248,6 +1249,8 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
                 const ControlPoint first[3] = {sp.first[0], sp.first[1], sp.first[2]};
                 for (uint32_t k = 0; k < (sp.bspline ? 3u : 1u); ++k)
                   splinePoint(first[k], sp.rings, i);
+                // Its tube ends where it began: joined, not capped.
+                if (sp.branch != kNoBranch) g.loops.push_back(sp.branch);
               }
               x.spline = -1;
               break;

@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <map>
 #include <random>
+#include <set>
 
 #include "core/atomic_file.h"
 #include "plant/plant_test_util.h"
@@ -728,6 +731,55 @@ TEST(TurtleSpline, ClosedHermiteCurveReturnsToItsFirstPoint) {
   // (0, 0.5, 0) + 1.2 (+x - +y)/8.
   const double c = 1.2 / 8.0;
   EXPECT_VEC_NEAR(s[13].end, Vec3(0 + c, 0.5 - c, 0), 1e-12);
+}
+
+TEST(TurtleSpline, ClosedSplineTubeIsJoinedEndToStartNotCapped) {
+  // A closed spline's tube ends where it began: the tessellator joins the
+  // two (the last ring is the first, bit for bit, normals too), so the
+  // surface is a torus, Euler characteristic V - E + F = 0 once coincident
+  // vertices are merged; capped ends would make it a sphere's 2. An open
+  // spline keeps its caps.
+  auto euler = [](const mesh::TriangleMesh& m) {
+    std::map<std::array<float, 3>, uint32_t> id;
+    std::vector<uint32_t> merged(m.positions.size());
+    for (size_t i = 0; i < m.positions.size(); ++i) {
+      const Vec3f& p = m.positions[i];
+      merged[i] = id.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, uint32_t(id.size()))
+                      .first->second;
+    }
+    std::set<std::pair<uint32_t, uint32_t>> edges;
+    for (size_t t = 0; t + 2 < m.indices.size(); t += 3)
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = merged[m.indices[t + e]], b = merged[m.indices[t + (e + 1) % 3]];
+        edges.insert({std::min(a, b), std::max(a, b)});
+      }
+    return int64_t(id.size()) - int64_t(edges.size()) + int64_t(m.triangleCount());
+  };
+  for (const char* type : {"2", "4"}) {
+    const std::string text = std::string("axiom: {(") + type + ") f +(90) f +(90) f +(90) f }(" +
+                             type + ")\n";
+    auto p = testing::PlantFromText(text, -1, plant::Stage::kMesh);
+    ASSERT_TRUE(p.has_value()) << text;
+    ASSERT_EQ(p->geometry.loops.size(), 1u) << text;
+    const mesh::TriangleMesh& m = p->mesh;
+    const size_t segments = p->geometry.segments.size();  // 16: 4 pieces of 4 rings
+    ASSERT_EQ(segments, 16u) << text;
+    const size_t sides = m.triangleCount() / (2 * segments);
+    ASSERT_GE(sides, 3u) << text;
+    EXPECT_EQ(m.triangleCount(), 2 * sides * segments) << text << ": no cap triangles";
+    const size_t ring = sides + 1;
+    ASSERT_EQ(m.positions.size(), (segments + 1) * ring) << text;
+    for (size_t j = 0; j < ring; ++j) {
+      EXPECT_EQ(m.positions[j], m.positions[segments * ring + j]) << text << " vertex " << j;
+      EXPECT_EQ(m.normals[j], m.normals[segments * ring + j]) << text << " vertex " << j;
+    }
+    EXPECT_EQ(euler(m), 0) << text;
+  }
+  auto open = testing::PlantFromText("axiom: {(1) f +(90) f +(90) f +(90) f }(1)\n", -1,
+                                     plant::Stage::kMesh);
+  ASSERT_TRUE(open.has_value());
+  EXPECT_TRUE(open->geometry.loops.empty());
+  EXPECT_EQ(euler(open->mesh), 2) << "an open spline's tube is capped at both ends";
 }
 
 TEST(TurtleSpline, BSplinesFollowTheUniformCubicBasis) {
