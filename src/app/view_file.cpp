@@ -60,7 +60,6 @@ constexpr Ignored kIgnored[] = {
     {"font:", kNotActed},
     {"winfont:", kNotActed},
     {"blob:", kNotActed},
-    {"torque:", "torque tropism is not implemented"},
     {"texture:", "textures are not implemented"},
     {"tapered lines:", "Sylva's tubes taper to the width of the next segment"},
     {"interpretation step:", kNotActed},
@@ -209,7 +208,7 @@ class Reader {
       Warn(tokens_[used].column, "'" + label_ + "': Sylva uses " + std::to_string(used) +
                                      (used == 1 ? " value" : " values") + "; the rest is ignored");
   }
-  void Tropism();
+  void Movement(bool torque);
   void Surface();
   void Light();
   void ContourLine();
@@ -223,7 +222,6 @@ class Reader {
   int labelColumn_ = 1;
   std::vector<Token> tokens_;
   std::set<std::string> warned_;
-  bool tropismSeen_ = false;
   enum class LineStyle { kUnset, kPixel, kWorld };
   LineStyle lineStyle_ = LineStyle::kUnset;
   bool cylinder_ = false;                    // cpfg's line style cylinder
@@ -422,7 +420,7 @@ void Reader::Read(const app::Line& line) {
     if (auto p = Vector(0, "x,y,z")) {
       // 0,0,0: no direction, so no bending (as in cpfg, whose tropism is
       // the cross product with it).
-      if (p->norm() > 0) v_.tropism = p->normalized();
+      v_.tropism = p->norm() > 0 ? Vec3(p->normalized()) : Vec3::Zero();
     }
     ExtraValues(3);
   } else if (L == "initial elasticity:") {
@@ -443,8 +441,8 @@ void Reader::Read(const app::Line& line) {
     ExtraValues(3);
   } else if (L == "light:") {
     Light();
-  } else if (L == "tropism:") {
-    Tropism();
+  } else if (L == "tropism:" || L == "torque:") {
+    Movement(L == "torque:");
   } else if (L == "surface:") {
     Surface();
   } else if (L == "contour:") {
@@ -581,14 +579,10 @@ void Reader::Read(const app::Line& line) {
   }
 }
 
-// `tropism: T x,y,z A angle E elasticity S step I intensity` (cpfg's
-// movements.c): Sylva has one tropism, towards T (A 0).
-void Reader::Tropism() {
-  if (tropismSeen_) {
-    Warn(labelColumn_, "a second 'tropism:': Sylva has one tropism; this one is ignored");
-    return;
-  }
-  tropismSeen_ = true;
+// `tropism: T x,y,z A angle E elasticity S step I intensity` and `torque:`
+// with the same letters (vlab cpfg movements.c, read_movement): one
+// lsys::Movement each, in the order given; @Ts(i, e) addresses the i-th.
+void Reader::Movement(bool torque) {
   // cpfg writes the letters bare (`T 0,1,0 E 0.2`) or with a colon, the
   // value apart or attached (`T: 0 1 0  A:90`).
   std::vector<Token> split;
@@ -602,42 +596,64 @@ void Reader::Tropism() {
     }
   }
   tokens_ = std::move(split);
+  lsys::Movement m;
+  m.torque = torque;
   std::optional<Vec3> dir;
-  double elasticity = 0, intensity = 1;
+  double scale = 0;  // cpfg: the inverse length of T, times I, within [-1, 1]
   for (size_t k = 0; k < tokens_.size();) {
     const std::string& t = tokens_[k].text;
     const char c = t[0];
     if (t.size() != 1 || !std::strchr("TAESI", c)) {
-      Error(tokens_[k].column, "expected T, A, E, S or I in 'tropism:', not '" + t + "'");
+      Error(tokens_[k].column, "expected T, A, E, S or I in '" + label_ + "', not '" + t + "'");
       return;
     }
     if (c == 'T') {
       dir = Vector(k + 1, "x,y,z");
       if (!dir) return;
       if (dir->norm() == 0) {
-        Error(tokens_[k + 1].column, "the tropism vector must not be 0,0,0");
+        Error(tokens_[k + 1].column,
+              "the " + std::string(torque ? "torque" : "tropism") + " vector must not be 0,0,0");
         return;
       }
+      scale = 1 / dir->norm();
       k += 4;
       continue;
     }
     auto x = Number(k + 1, "a number");
     if (!x) return;
-    if (c == 'A' && *x != 0)
-      Warn(
-          tokens_[k + 1].column,
-          "a tropism at an angle A to its vector (plagiotropism) is not implemented: drawn as A 0");
-    if (c == 'E') elasticity = *x;
-    if (c == 'S') v_.elasticityIncrement = *x;
-    if (c == 'I') intensity = std::clamp(*x, -1.0, 1.0);
+    if (c == 'I') {
+      // cpfg multiplies the inverse length of T read so far: before T, or
+      // 0, it drops the line ("Tropism with 0 intensity!").
+      scale = std::clamp(scale * *x, -1.0, 1.0);
+      if (scale == 0) {
+        Warn(tokens_[k].column, std::string(dir ? "an intensity of 0" : "'I' before 'T'") +
+                                    ": cpfg drops this '" + label_ + "' line, and so does Sylva");
+        return;
+      }
+    }
+    if (c == 'A') {
+      if (torque && *x != 0)
+        Warn(tokens_[k].column, "'torque:' does not use an angle A (cpfg reads it and ignores it)");
+      m.angle = *x;
+    }
+    if (c == 'E') m.elasticity = *x;
+    if (c == 'S') m.elasticityStep = *x;
     k += 2;
   }
   if (!dir) {
-    Error(labelColumn_, "'tropism:' needs its vector: T x,y,z");
+    Error(labelColumn_, "'" + label_ + "' needs its vector: T x,y,z");
     return;
   }
-  v_.tropism = dir->normalized();
-  v_.elasticity = elasticity * intensity;
+  if (v_.movements.size() >= size_t(lsys::kMaxMovements)) {
+    Warn(labelColumn_, "cpfg keeps at most " + std::to_string(lsys::kMaxMovements) +
+                           " 'tropism:' and 'torque:' lines: this one is ignored, as in cpfg");
+    return;
+  }
+  const Vec3 d = *dir * scale;
+  m.x = d.x();
+  m.y = d.y();
+  m.z = d.z();
+  v_.movements.push_back(m);
 }
 
 // `light: V: x y z  D: r g b ...` (cpfg's irisGL.c read_light): an OpenGL
@@ -1208,7 +1224,8 @@ void ApplyViewFile(const ViewFile& v, lsys::Grammar& g) {
   if (v.initialColor) g.initialColor = *v.initialColor;
   if (v.colorIncrement) g.colorIncrement = *v.colorIncrement;
   if (v.tropism || v.elasticity) {
-    lsys::Tropism t = g.tropism.value_or(lsys::Tropism{});
+    // cpfg's default `tropism direction:` is up (interpret.c InitializeParameters).
+    lsys::Tropism t = g.tropism.value_or(lsys::Tropism{0, 1, 0, 0});
     if (v.tropism) {
       t.x = v.tropism->x();
       t.y = v.tropism->y();
@@ -1218,6 +1235,7 @@ void ApplyViewFile(const ViewFile& v, lsys::Grammar& g) {
     g.tropism = t;
   }
   if (v.elasticityIncrement) g.elasticityIncrement = *v.elasticityIncrement;
+  if (!v.movements.empty()) g.movements = v.movements;
   if (!v.palette.empty()) g.palette = v.palette;
 }
 

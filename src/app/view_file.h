@@ -48,13 +48,16 @@ struct ViewFile {
   std::optional<double> widthIncrement;       // `line width increment:`
   std::optional<int> initialColor;            // `initial color:`
   std::optional<int> colorIncrement;          // `color increment:`
-  std::optional<Vec3> tropism;                // unit: `tropism direction:` or `tropism: T`
-  std::optional<double> elasticity;           // `initial elasticity:` or `tropism: E`
-  std::optional<double> elasticityIncrement;  // `elasticity increment:` or `tropism: S`
+  std::optional<Vec3> tropism;                // `tropism direction:` (unit; 0 for 0,0,0)
+  std::optional<double> elasticity;           // `initial elasticity:` (cpfg's older tropism)
+  std::optional<double> elasticityIncrement;  // `elasticity increment:` (its `_` step)
   std::optional<Vec3> viewpoint;              // `viewpoint:` (the eye)
   std::optional<Vec3> target;                 // `view reference point:`
   std::optional<double> scale;                // `scale factor:` (> 0)
   std::optional<double> viewingAngle;         // `viewing angle:` (degrees, 0..180): perspective
+  // cpfg's newer tropisms and torques: the `tropism:` and `torque:` lines in
+  // order (at most lsys::kMaxMovements); @Ts @Ti @Td(i, ...) address them.
+  std::vector<lsys::Movement> movements;
   // `box: x: x0,x1 y: y0,y1 z: z0,z1`: cpfg's fixed view volume, framed by
   // a parallel view instead of the plant's bounds (low corner, high corner).
   std::optional<std::array<Vec3, 2>> box;

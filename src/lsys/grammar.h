@@ -130,6 +130,21 @@ struct Tropism {
   double x = 0, y = -1, z = 0, susceptibility = 0;
 };
 
+// One of cpfg's newer tropisms (vlab cpfg movements.c), from a view file's
+// `tropism:` or `torque:` line, in the order the file gives them: @Ts(i, e),
+// @Ti(i, d) and @Td(i, d) address the i-th (from 1). cpfg keeps at most
+// kMaxMovements.
+struct Movement {
+  bool torque = false;  // `torque:`: turns U about H (else `tropism:`: turns H)
+  // T normalised, times the intensity I when the line gives one (cpfg clamps
+  // I / |T| to [-1, 1]).
+  double x = 0, y = -1, z = 0;
+  double angle = 0;           // A: degrees between T and the direction H bends toward
+  double elasticity = 0;      // E: at the start of each interpretation
+  double elasticityStep = 0;  // S: what @Ti(i) and @Td(i) add and subtract
+};
+inline constexpr int kMaxMovements = 10;  // cpfg's MAXMOVEMENTS
+
 // One `lsystem:` block of a file (cpfg's sub-L-systems): the first is the
 // main L-system, whose axiom and derivation length are used; each later
 // one has the number its `lsystem:` line gives. In a word, `?(id, scale)`
@@ -160,6 +175,7 @@ struct Grammar {
   double widthIncrement = 0;  // `width increment:` (cpfg): ! and # subtract/add it; 0: factor
   double widthScale = 1;      // drawing: diameter = width x widthScale (cpfg's pixel widths)
   std::optional<Tropism> tropism;
+  std::vector<Movement> movements;  // a cpfg view file's `tropism:` and `torque:` lines
   std::optional<EnvironmentStatement> environment;  // `environment:`
   // From a cpfg view file (app/view_file.h): the colour index the turtle
   // starts with, the step of `;` and `,`, and of @Ti/@Td.

@@ -99,6 +99,14 @@ struct PlantGeometry {
   // Problems that do not stop the drawing (an unmatched `}`, a polygon with
   // fewer than 3 vertices), each naming the module.
   std::vector<std::string> warnings;
+  // The same about a module the grammar writes (`@Ts(4, 0.2)` naming a
+  // tropism the view file does not define): reported at the place the
+  // grammar first writes that module name (lsys::Grammar::symbolLoc).
+  struct ModuleWarning {
+    std::string symbol;  // the module's name, as the grammar writes it
+    std::string message;
+  };
+  std::vector<ModuleWarning> moduleWarnings;
 
   // Optional per-module state (DrawOptions::recordModules): the turtle's
   // position and frame after each module.

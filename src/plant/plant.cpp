@@ -32,6 +32,25 @@ void AddWarnings(const std::vector<std::string>& warnings, const std::string& pa
   }
 }
 
+// The turtle's warnings: those about a module written in the grammar are
+// placed where the grammar first writes that module's name.
+void AddTurtleWarnings(const mesh::PlantGeometry& geometry, const lsys::Grammar& g,
+                       DiagnosticList& out) {
+  AddWarnings(geometry.warnings, g.path, out);
+  for (const mesh::PlantGeometry::ModuleWarning& w : geometry.moduleWarnings) {
+    Diagnostic d;
+    d.severity = Severity::kWarning;
+    d.loc.file = g.path;
+    if (auto it = g.symbolLoc.find(w.symbol); it != g.symbolLoc.end()) {
+      d.loc = it->second.loc;
+      SetExcerpt(d, g.SourceLine(d.loc));
+      d.length = int(w.symbol.size());
+    }
+    d.message = w.message;
+    out.Add(std::move(d));
+  }
+}
+
 // cpfg and ABOP grammars give widths in pixels of their renderer (Fig. 2.6
 // starts at !(10) on unit internodes): drawn as world units, a tree becomes
 // a cone. When most segments are far wider than long and the grammar has no
@@ -329,7 +348,7 @@ Expected<mesh::PlantGeometry> Grower::Draw(DiagnosticList* warnings) const {
   }
   auto geometry = turtle::Interpret(interpreted ? *interpreted : word(), g.symbols,
                                     turtle::TurtleDefFrom(g), DrawOptionsOf(spec_));
-  if (geometry && warnings) AddWarnings(geometry->warnings, g.path, *warnings);
+  if (geometry && warnings) AddTurtleWarnings(*geometry, g, *warnings);
   return geometry;
 }
 
@@ -375,7 +394,7 @@ PlantResult Grower::Finish() && {
       return r;
     }
     p.geometry = std::move(*geometry);
-    AddWarnings(p.geometry.warnings, g.path, r.diagnostics);
+    AddTurtleWarnings(p.geometry, g, r.diagnostics);
     if (spec_.amendGeometry) spec_.amendGeometry(p.geometry, p.palette);
     p.time.turtle = MsSince(t0);
   }

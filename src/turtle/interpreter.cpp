@@ -2,6 +2,8 @@
 
 #include <math.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -172,7 +174,10 @@ struct CylinderShape {
 constexpr int32_t kCircle = std::numeric_limits<int32_t>::min();
 
 struct CpfgState {
-  double elasticity = 0;  // tropism susceptibility (cpfg: elasticity), @Ts @Ti @Td change it
+  double elasticity = 0;  // the older tropism's susceptibility (cpfg: elasticity), `_` changes it
+  // The elasticity of each of TurtleDef::movements (cpfg: the turtle's
+  // movements[i].elasticity), @Ts @Ti @Td change them.
+  std::array<double, lsys::kMaxMovements> movement{};
   int32_t cylinder = -1;  // the open generalized cylinder (@Gs), or -1
   // In a branch opened inside a generalized cylinder: that cylinder, whose
   // last control point starts the branch's first @Gc/@Ge piece (cpfg's `[`
@@ -333,6 +338,8 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   d.initialColor = g.initialColor;
   d.colorIncrement = g.colorIncrement;
   d.elasticityIncrement = g.elasticityIncrement;
+  d.movements = g.movements;
+  if (d.movements.size() > size_t(lsys::kMaxMovements)) d.movements.resize(lsys::kMaxMovements);
   d.subLsystems = g.subLsystems;
   d.quoteIsColor = !g.cpfgFile;
   return d;
@@ -379,6 +386,30 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
   return true;
 }
 
+// Rodrigues' rotation of v about the unit axis k by the angle whose sine and
+// cosine are sa and ca.
+static inline Vec3 Turned(const Vec3& v, const Vec3& k, double sa, double ca) {
+  return v * ca + k.cross(v) * sa + k * (k.dot(v) * (1 - ca));
+}
+
+// cpfg's "no twist" rule (adjust_up_and_left): the up vector after the last
+// F or G (or @Tf), turned by the rotation that takes the heading there to
+// h; `up` when the two headings are parallel (|H0 x h| <= 1e-6). Made
+// exactly perpendicular to h.
+static Vec3 NoTwistUp(const Vec3& prevHeading, const Vec3& prevUp, const Vec3& h, Vec3 up) {
+  const Vec3 axis = prevHeading.cross(h);
+  const double sinA = axis.norm();
+  if (sinA > 1e-6) {
+    const double cosA = prevHeading.dot(h);
+    up = Turned(prevUp, axis / sinA, sinA, cosA);
+  }
+  up -= h * up.dot(h);
+  const double n = up.norm();
+  if (n > 1e-12) return up / n;
+  // U along H: any perpendicular
+  return h.cross(std::abs(h.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitZ()).normalized();
+}
+
 // @R(hx, hy[, hz[, ux, uy, uz]]): cpfg's set heading (vlab cpfg
 // blackbox.c, 'R'). The heading becomes (hx, hy, hz) normalised (hz = 0
 // when not given; (0, 1, 0) when all are 0). With 6 parameters, a non-zero
@@ -405,25 +436,77 @@ static inline bool ApplyTropism(const Vec3& tropismVector, double e, Frame& f) {
       given = true;
     }
   }
-  if (!given) {
-    const Vec3 axis = prevHeading.cross(h);
-    const double sinA = axis.norm();
-    if (sinA > 1e-6) {
-      const double cosA = prevHeading.dot(h);
-      const Vec3 k = axis / sinA;
-      up = prevUp * cosA + k.cross(prevUp) * sinA + k * (k.dot(prevUp) * (1 - cosA));
-    }
-    up -= h * up.dot(h);
-    const double n = up.norm();
-    if (n > 1e-12) {
-      up /= n;
-    } else {  // U along H: any perpendicular
-      up = h.cross(std::abs(h.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitZ()).normalized();
-    }
-  }
+  if (!given) up = NoTwistUp(prevHeading, prevUp, h, up);
   f.heading = h;
   f.up = up;
   f.left = h.cross(up);
+}
+
+// cpfg's tropisms and torques, before a move (vlab cpfg movements.c,
+// movement_adjust; interpreter.h has the formulas): the first `count`
+// movements, `e` holding the elasticity of each. True when the frame turned.
+[[gnu::noinline]] static bool ApplyMovements(const lsys::Movement* movements, size_t count,
+                                             const double* e, Vec3& prevHeading, Vec3& prevUp,
+                                             Frame& f) {
+  // The direction H bends toward: each tropism's T, or at an angle A from it.
+  Vec3 v = Vec3::Zero(), w = Vec3::Zero();
+  for (size_t k = 0; k < count; ++k) {
+    const lsys::Movement& m = movements[k];
+    const Vec3 t(m.x, m.y, m.z);
+    if (m.torque) {
+      w += e[k] * t;
+      continue;
+    }
+    if (e[k] == 0) continue;
+    double sa, ca;
+    SinCosRadians(m.angle * kDegToRad, &sa, &ca);
+    v += (ca * e[k]) * t;
+    if (sa != 0) {
+      // T x (H x T) / |H x T|: perpendicular to T, toward H (cpfg takes L
+      // for H x T when H is parallel to T).
+      Vec3 r = f.heading.cross(t);
+      double rn = r.norm();
+      if (rn < 1e-7) {
+        r = f.left;
+        rn = 1;
+      }
+      v += (sa * e[k] / rn) * t.cross(r);
+    }
+  }
+  bool turned = false;
+  // H turns toward V about H x V by |H x V| (at most 1 rad); U follows by
+  // the no-twist rule (cpfg's adjust_up_and_left).
+  const Vec3 axis = f.heading.cross(v);
+  const double an = axis.norm();
+  if (an >= 1e-6) {
+    double sa, ca;
+    SinCosSmall(std::min(an, 1.0), &sa, &ca);
+    f.heading = Turned(f.heading, axis / an, sa, ca);
+    f.up = NoTwistUp(prevHeading, prevUp, f.heading, f.up);
+    f.left = f.heading.cross(f.up);
+    turned = true;
+  }
+  // Torque: U turns about H away from the part of W perpendicular to H.
+  const double wn = w.norm();
+  if (wn > 0) {
+    const Vec3 hw = f.heading.cross(w / wn);
+    if (hw.squaredNorm() > 1e-8) {
+      const Vec3 d = hw.cross(f.heading) * wn;
+      const Vec3 ud = f.up.cross(d);
+      const double un = ud.norm();
+      if (un >= 1e-7) {
+        double sa, ca;
+        SinCosSmall(std::min(un, 1.0), &sa, &ca);
+        f.up = Turned(f.up, ud / un, -sa, ca);
+        f.left = f.heading.cross(f.up);
+        turned = true;
+      }
+      // cpfg: this twist is wanted; the no-twist rule turns from here.
+      prevHeading = f.heading;
+      prevUp = f.up;
+    }
+  }
+  return turned;
 }
 
 // @o and @c: a disc of diameter `diameter` centred at `centre` in the plane
@@ -795,6 +878,7 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   g.tubes.clear();
   g.loops.clear();
   g.warnings.clear();
+  g.moduleWarnings.clear();
   g.modulePosition.clear();
   g.moduleFrame.clear();
   // How often each symbol occurs (one increment a module), then what each draws.
@@ -915,6 +999,10 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
   t.width = def.width;
   CpfgState x;
   x.elasticity = def.susceptibility;
+  const size_t movementCount = std::min(def.movements.size(), size_t(lsys::kMaxMovements));
+  for (size_t k = 0; k < movementCount; ++k) x.movement[k] = def.movements[k].elasticity;
+  // @Ts @Ti @Td naming a movement beyond them: warned once per name and index.
+  std::set<std::pair<lsys::SymbolId, int64_t>> warnedMovements;
   // cpfg's contours (@#, @!): drawn only when the view file gives them.
   const CylinderContours* contours = options.contours.get();
   if (contours) x.sides = std::clamp(contours->sides, 3, mesh::kMaxContourSides);
@@ -958,8 +1046,10 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
                       op == Op::kSplineEnd || op == Op::kSetHeading || op == Op::kTwistForce ||
                       op == Op::kContour || op == Op::kContourSides;
   }
-  const bool cpfgState = changesTropism || drawsCylinders || def.subLsystems;
-  const bool tropism = def.susceptibility != 0 || changesTropism;
+  const bool movements = movementCount > 0;
+  const bool cpfgState = changesTropism || drawsCylinders || def.subLsystems || movements;
+  // The older tropism: @Ts @Ti @Td change it only when there are no movements.
+  const bool tropism = def.susceptibility != 0 || underscore || (changesTropism && !movements);
   // cpfg's `_` bends toward the view file's `tropism direction:`, which is
   // up (0, 1, 0) when the file gives none (interpret.c InitializeParameters).
   const Vec3 tropismDir = underscore && !def.tropismGiven ? Vec3(0, 1, 0) : def.tropism;
@@ -1052,7 +1142,13 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kForwardDrawNoVertex:
         case Op::kForwardMoveNoVertex: {
           double len = np ? p[0] : def.step;
-          if constexpr (kCpfg) len *= x.scale;
+          if constexpr (kCpfg) {
+            len *= x.scale;
+            // cpfg turns the frame by its tropisms and torques before the move.
+            if (movements && ApplyMovements(def.movements.data(), movementCount, x.movement.data(),
+                                            x.prevHeading, x.prevUp, t.frame))
+              ++turnsSinceOrtho;
+          }
           const Vec3 start = t.pos;
           t.pos += t.frame.heading * len;
           visit(t.pos);
@@ -1376,7 +1472,34 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
         case Op::kTropismDown: {
           // @Ts(i, e) sets the elasticity of tropism i to e (0 without e);
           // @Ti(i, d) and @Td(i, d) add and subtract d (default: the
-          // elasticity increment). Sylva has one tropism, i = 1.
+          // movement's step S, or the elasticity increment).
+          if (movements) {
+            // cpfg blackbox.c 'T': nothing without parameters; i truncated
+            // toward zero; one out of range changes nothing.
+            if (np == 0) break;
+            const double at = p[0] - 1;
+            const int64_t k = std::isfinite(at) && std::abs(at) < 1e9 ? int64_t(at) : -1;
+            if (k < 0 || k >= int64_t(movementCount)) {
+              if (warnedMovements.insert({sym, k < 0 ? int64_t(-1) : k}).second) {
+                char index[32];
+                std::snprintf(index, sizeof index, "%g", p[0]);
+                g.moduleWarnings.push_back(
+                    {symbols.name(sym), "'" + ModuleText(word, symbols, i) + "' (module " +
+                                            std::to_string(i + 1) + ") names tropism " + index +
+                                            ", but the view file defines " +
+                                            std::to_string(movementCount) +
+                                            " ('tropism:' and 'torque:' lines): it changes "
+                                            "nothing, as in cpfg"});
+              }
+              break;
+            }
+            double& e = x.movement[size_t(k)];
+            const double step = np >= 2 ? p[1] : def.movements[size_t(k)].elasticityStep;
+            if (op == Op::kTropismSet) e = np >= 2 ? p[1] : 0;
+            if (op == Op::kTropismUp) e += step;
+            if (op == Op::kTropismDown) e -= step;
+            break;
+          }
           if (np >= 1 && p[0] != 1) {
             g.warnings.push_back("module " + std::to_string(i + 1) + " (" +
                                  ModuleText(word, symbols, i) +

@@ -18,7 +18,7 @@
 // the colour index, ' and ; add 1, , subtracts 1 (never below 0); ~name(s) places a surface scaled
 // by s (default 1), ~name(sx,sy,sz) scaled along L, H, U; @O(d) a sphere of diameter d (default:
 // the width); @M(x,y,z) moves to (x,y,z) drawing nothing. Tropism (ABOP eq. 2.3): after every F and
-// f, the frame turns about H x T by e |H x T|.
+// f moves, the frame turns about H x T by e |H x T| (cpfg's older tropism).
 //
 // cpfg's commands (its manual, and vlab's blackbox.c):
 //   @o(d)  a disc of diameter d (default: the width) in the world's xy
@@ -40,9 +40,25 @@
 //          @Gr(k), k != 0, multiplies their radius parts by the chord
 //   _(e) _  set the elasticity to e, or add the elasticity increment
 //          (cpfg's old tropism; the same one tropism as @Ts)
-//   @Ts(i, e) @Ti(i, d) @Td(i, d)  set, raise and lower the tropism
-//          susceptibility e (cpfg's elasticity) of the turtle (kept by [ ]);
-//          i must be 1
+//   @Ts(i, e) @Ti(i, d) @Td(i, d)  set, raise and lower the elasticity of
+//          tropism i (kept by [ ]): with TurtleDef::movements, the i-th of
+//          them (d: its step S by default; an i beyond them: a warning, once
+//          per module name and i); without, the one tropism above, i = 1
+//
+// cpfg's tropisms and torques (vlab cpfg movements.c, movement_adjust),
+// before each F f G g moves, with e_k the elasticities of the turtle:
+//   tropisms: V = sum over tropisms k of e_k (cos A_k T_k + sin A_k P_k),
+//          P_k the unit vector perpendicular to T_k in the plane of H and
+//          T_k, on H's side (L when H is parallel to T_k); H turns toward V
+//          about H x V by min(|H x V|, 1) rad, and U is the up vector after
+//          the last F or G (or @Tf) carried by the rotation that takes that
+//          heading to H (cpfg's no-twist rule), L = H x U. A = 90 bends H
+//          toward the plane perpendicular to T (plagiotropism).
+//   torques: W = sum of e_k T_k over torques; with D the part of W/|W|
+//          perpendicular to H times |W|, U turns about H away from D, by
+//          min(|U x D|, 1) rad (cpfg's rot_by_quat turns by the negative
+//          of its quaternion's angle), L = H x U; that frame is then the one
+//          @R and the no-twist rule turn from.
 //   @Tf    records the frame @R turns from; nothing else: Sylva's tubes
 //          never twist
 //   @R(hx, hy[, hz[, ux, uy, uz]])  set the heading (normalised), and U
@@ -98,8 +114,13 @@ struct TurtleDef {
   bool tropismGiven = false;  // the grammar or view file names it; else cpfg's `_` bends up (0,1,0)
   double susceptibility = 0;  // 0: no tropism (until @Ts, @Ti or @Td changes it)
   double elasticityIncrement = 0;  // @Ti and @Td without a value add and subtract it
-  int initialColor = 0;            // colour index the turtle starts with
-  int colorIncrement = 1;          // ; and , without a parameter add and subtract it
+  // cpfg's newer tropisms and torques (a view file's `tropism:` and `torque:`
+  // lines, lsys::Movement), at most lsys::kMaxMovements. When there are any,
+  // @Ts(i, e) @Ti(i, d) @Td(i, d) change the elasticity of the i-th (from 1),
+  // and before each F f G g moves, they turn the frame (see Interpret).
+  std::vector<lsys::Movement> movements;
+  int initialColor = 0;    // colour index the turtle starts with
+  int colorIncrement = 1;  // ; and , without a parameter add and subtract it
   // cpfg's sub-L-systems (lsys::Grammar::subLsystems): `?(id, scale)`
   // multiplies the turtle's scale by `scale` (default 1) and `$` restores it
   // (instead of rolling the turtle); the scale multiplies F f G g lengths,

@@ -44,10 +44,12 @@ TEST(ViewFile, ReadsWhatTheTurtleUses) {
   EXPECT_EQ(v.width.value_or(-1), 0.4);
   EXPECT_EQ(v.widthIncrement.value_or(-1), 0.05);
   EXPECT_EQ(v.scale.value_or(-1), 0.8);
-  ASSERT_TRUE(v.tropism.has_value());
-  EXPECT_LT((*v.tropism - Vec3(0, -1, 0)).norm(), 1e-15);  // unit, as cpfg
-  EXPECT_EQ(v.elasticity.value_or(-1), 0.15);              // E times I
-  EXPECT_EQ(v.elasticityIncrement.value_or(-1), 0.01);
+  ASSERT_EQ(v.movements.size(), 1u);
+  // T normalised times I (cpfg scales by I / |T|).
+  EXPECT_EQ(Vec3(v.movements[0].x, v.movements[0].y, v.movements[0].z), Vec3(0, -0.5, 0));
+  EXPECT_EQ(v.movements[0].elasticity, 0.3);
+  EXPECT_EQ(v.movements[0].elasticityStep, 0.01);
+  EXPECT_FALSE(v.tropism || v.elasticity || v.elasticityIncrement);  // cpfg's older tropism
   auto dir = ViewDirection(v);
   ASSERT_TRUE(dir.has_value());
   EXPECT_NEAR((*dir)[0], 90, 1e-12);  // from +X
@@ -173,17 +175,72 @@ TEST(ViewFile, TropismLettersMayCarryAColonAndAnAttachedValue) {
   // As vlab's published view files write them.
   ViewFile v = ParseViewFile("tropism: T: 0.0 -1.0 0.0  A:0 E: 0.3\n", "p.v");
   EXPECT_TRUE(v.diagnostics.items.empty()) << Messages(v.diagnostics);
-  ASSERT_TRUE(v.tropism.has_value());
-  EXPECT_LT((*v.tropism - Vec3(0, -1, 0)).norm(), 1e-15) << v.tropism->transpose();
-  EXPECT_EQ(v.elasticity.value_or(-1), 0.3);
+  ASSERT_EQ(v.movements.size(), 1u);
+  EXPECT_EQ(Vec3(v.movements[0].x, v.movements[0].y, v.movements[0].z), Vec3(0, -1, 0));
+  EXPECT_EQ(v.movements[0].elasticity, 0.3);
   ViewFile angled = ParseViewFile("tropism: T: 0 1 0  A:90\n", "p.v");
-  EXPECT_NE(Messages(angled.diagnostics).find("1:22 warning: a tropism at an angle"),
-            std::string::npos)
-      << Messages(angled.diagnostics);
-  // A zero tropism direction bends nothing, as in cpfg: no tropism, no error.
+  EXPECT_TRUE(angled.diagnostics.items.empty()) << Messages(angled.diagnostics);
+  ASSERT_EQ(angled.movements.size(), 1u);
+  EXPECT_EQ(angled.movements[0].angle, 90);
+  // A zero tropism direction bends nothing, as in cpfg: a zero vector, no error.
   ViewFile none = ParseViewFile("tropism direction: 0.0,0.0,0.0\ninitial elasticity: 0.2\n", "p.v");
   EXPECT_TRUE(none.diagnostics.items.empty()) << Messages(none.diagnostics);
-  EXPECT_FALSE(none.tropism.has_value());
+  EXPECT_EQ(none.tropism.value_or(Vec3(1, 1, 1)), Vec3(0, 0, 0));
+}
+
+TEST(ViewFile, TropismAndTorqueLinesAreMovementsInTheirOrder) {
+  // As vlab's lily, two-trees and clover write them (cpfg movements.c).
+  ViewFile v = ParseViewFile(
+      "tropism: T: 0.0 -1.0 0.0\n"
+      "tropism: T: 0.0  1.0 0.0  A:90 E: 0.2 S 0.05\n"
+      "torque:  T: 0.0  1.0 0.0 E 0.4\n"
+      "tropism: T 0,0,2 I 0.5\n",
+      "p.v");
+  EXPECT_TRUE(v.diagnostics.items.empty()) << Messages(v.diagnostics);
+  ASSERT_EQ(v.movements.size(), 4u);
+  auto dir = [&](size_t k) { return Vec3(v.movements[k].x, v.movements[k].y, v.movements[k].z); };
+  EXPECT_EQ(dir(0), Vec3(0, -1, 0));
+  EXPECT_FALSE(v.movements[0].torque);
+  EXPECT_EQ(v.movements[0].elasticity, 0);
+  EXPECT_EQ(v.movements[1].angle, 90);
+  EXPECT_EQ(v.movements[1].elasticity, 0.2);
+  EXPECT_EQ(v.movements[1].elasticityStep, 0.05);
+  EXPECT_TRUE(v.movements[2].torque);
+  EXPECT_EQ(dir(2), Vec3(0, 1, 0));
+  EXPECT_EQ(v.movements[2].elasticity, 0.4);
+  EXPECT_EQ(dir(3), Vec3(0, 0, 0.5));
+  // cpfg clamps I / |T| to [-1, 1]: a short T with I 1 keeps its length.
+  ViewFile shortT = ParseViewFile("tropism: T 0,0,0.5 I 1\n", "p.v");
+  ASSERT_EQ(shortT.movements.size(), 1u);
+  EXPECT_EQ(shortT.movements[0].z, 0.5);
+  // An intensity of 0, or I before T, drops the line as cpfg does; a torque
+  // does not use A; an 11th line is more than cpfg keeps.
+  auto first = [](const std::string& text) {
+    ViewFile w = ParseViewFile(text, "p.v");
+    return w.diagnostics.items.empty() ? std::string() : w.diagnostics.items[0].Format();
+  };
+  EXPECT_EQ(first("tropism: T 0,1,0 I 0\n").rfind("p.v:1:18: warning: an intensity of 0", 0), 0u);
+  EXPECT_TRUE(ParseViewFile("tropism: T 0,1,0 I 0\n", "p.v").movements.empty());
+  EXPECT_EQ(first("tropism: I 1 T 0,1,0\n").rfind("p.v:1:10: warning: 'I' before 'T'", 0), 0u);
+  EXPECT_EQ(first("torque: T 0,1,0 A 30\n").rfind("p.v:1:17: warning: 'torque:' does not use", 0),
+            0u);
+  std::string eleven;
+  for (int i = 0; i < 11; ++i) eleven += "tropism: T 0,1,0\n";
+  ViewFile many = ParseViewFile(eleven, "p.v");
+  EXPECT_EQ(many.movements.size(), 10u);
+  EXPECT_EQ(first(eleven).rfind("p.v:11:1: warning: cpfg keeps at most 10", 0), 0u)
+      << first(eleven);
+}
+
+TEST(ViewFile, ApplyGivesTheGrammarItsMovementsAndCpfgsDefaultTropismDirection) {
+  lsys::Grammar g;
+  ApplyViewFile(ParseViewFile("initial elasticity: 0.3\ntorque: T 1,0,0\n", "p.v"), g);
+  ASSERT_TRUE(g.tropism.has_value());
+  // cpfg's `tropism direction:` is up when the file does not say it.
+  EXPECT_EQ(Vec3(g.tropism->x, g.tropism->y, g.tropism->z), Vec3(0, 1, 0));
+  EXPECT_EQ(g.tropism->susceptibility, 0.3);
+  ASSERT_EQ(g.movements.size(), 1u);
+  EXPECT_TRUE(g.movements[0].torque);
 }
 
 TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
@@ -256,7 +313,7 @@ TEST(ViewFile, BadValuesAreErrorsAtTheirColumn) {
   EXPECT_FALSE(ParseViewFile("angle factor: 0\n", "p.v").angle.has_value());
   EXPECT_EQ(first("tropism: E 0.2\n").rfind("1:1 error: 'tropism:' needs its vector", 0), 0u);
   EXPECT_EQ(first("tropism: T 0,0,0 E 1\n").rfind("1:12 error", 0), 0u);
-  EXPECT_EQ(first("tropism: T 0,1,0 A 30\n").rfind("1:20 warning: a tropism at an angle", 0), 0u);
+  EXPECT_EQ(first("torque: E 0.2\n").rfind("1:1 error: 'torque:' needs its vector", 0), 0u);
   EXPECT_EQ(first("just words\n").rfind("1:1 error: expected 'label: values'", 0), 0u);
 }
 
