@@ -80,7 +80,24 @@ struct Line {
 struct Define {
   SourceLoc loc;
   int length = 1;
+  std::string text;  // what follows the name, blanks collapsed (a redefinition compares it)
 };
+
+// `text` with runs of blanks as one space and none at either end: C's rule
+// for when two #defines of a name are the same (no warning).
+std::string CollapseBlanks(std::string_view text) {
+  std::string r;
+  for (char c : text) {
+    const bool blank = c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+    if (!blank) {
+      r += c;
+    } else if (!r.empty() && r.back() != ' ') {
+      r += ' ';
+    }
+  }
+  while (!r.empty() && r.back() == ' ') r.pop_back();
+  return r;
+}
 
 struct ArityUse {
   int arity;
@@ -281,6 +298,16 @@ class GrammarParser {
   bool ParseCondition(const Line& l, Production& p, const ExprScope& scope, size_t condAt,
                       size_t lhsEnd);
   void ParseMacro(const Line& l, const std::string& name, int col, size_t pos);
+  // A second #define of `name` (text: what follows the name): in a cpfg
+  // file the later one holds, as C's preprocessor has it, with a warning
+  // naming the first unless both are the same (true: go on); in a .lsys
+  // file an error (false).
+  bool Redefine(const Line& l, const std::string& name, int col, const std::string& text);
+  // In a cpfg file, the names #defined more than once or #undef'd: each of
+  // their #defines is text, substituted in file order as C's preprocessor
+  // does, so a line between two #defines reads the first.
+  std::unordered_set<std::string> cppNames_;
+  void FindCppNames();
   // cpfg's preprocessor substitutes text: a #define whose value is not an
   // expression (a piece of a word) is kept as text and substituted.
   struct TextMacro {
@@ -290,7 +317,8 @@ class GrammarParser {
     int line = 0;
   };
   void ParseUndef(const Line& l, size_t after);
-  void AddTextMacro(const Line& l, const std::string& name, int col, TextMacro m);
+  void AddTextMacro(const Line& l, const std::string& name, int col, TextMacro m,
+                    const std::string& text);
   bool ExpandText(std::string_view s, std::vector<std::string>& hiding, int depth, std::string* out,
                   std::vector<Line::Expansion>* uses, size_t* problemAt, std::string* problem);
   void ExpandTextMacros(Line& l);
@@ -942,21 +970,33 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     Error(l, int(pos) + 1, "expected a space after the name of #define '" + name + "'");
     return;
   }
-  if (defines_.count(name)) {
-    Error(l, col,
-          "redefinition of '" + name + "' (first defined at line " +
-              std::to_string(defines_[name].loc.line) + ")",
-          int(name.size()));
-    return;
-  }
   while (pos < t.size() && IsSpace(t[pos])) ++pos;
-  if (pos >= t.size()) {
-    // `#define NAME` alone: defined for #ifdef, with no value.
-    defines_[name] = Define{Loc(l, col), int(name.size())};
-    return;
-  }
   size_t end = t.size();
   while (end > pos && IsSpace(t[end - 1])) --end;
+  const std::string text = CollapseBlanks(std::string_view(t).substr(pos, end - pos));
+  if (defines_.count(name) && !Redefine(l, name, col, text)) return;
+  if (cppNames_.count(name)) {
+    // Defined twice or #undef'd in a cpfg file: text, as C's preprocessor
+    // (an empty one for `#define NAME` alone). -D replaces every value.
+    TextMacro m;
+    m.body = t.substr(pos, end - pos);
+    auto ov = opt_.overrides.find(name);
+    if (ov != opt_.overrides.end()) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "(%.17g)", ov->second);
+      m.body = buf;
+      usedOverrides_.insert(name);
+    }
+    m.line = Loc(l, col).line;
+    textMacros_[name] = std::move(m);
+    defines_[name] = Define{Loc(l, col), int(name.size()), text};
+    return;
+  }
+  if (pos >= t.size()) {
+    // `#define NAME` alone: defined for #ifdef, with no value.
+    defines_[name] = Define{Loc(l, col), int(name.size()), text};
+    return;
+  }
   {
     // Not an expression (it does not parse, names what is not a constant,
     // or goes on after one), or one that draws random numbers (`nran(80,
@@ -974,7 +1014,7 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     if ((!isExpr && !err.evaluation) || (isExpr && q < end) || (isExpr && !e.IsConstant())) {
       TextMacro m;
       m.body = t.substr(pos, end - pos);
-      AddTextMacro(l, name, col, std::move(m));
+      AddTextMacro(l, name, col, std::move(m), text);
       return;
     }
   }
@@ -986,7 +1026,58 @@ void GrammarParser::ParseDefine(const Line& l, size_t pos) {
     usedOverrides_.insert(name);
   }
   g_.constants[name] = v;
-  defines_[name] = Define{Loc(l, col), int(name.size())};
+  defines_[name] = Define{Loc(l, col), int(name.size()), text};
+}
+
+bool GrammarParser::Redefine(const Line& l, const std::string& name, int col,
+                             const std::string& text) {
+  const Define& first = defines_[name];
+  const std::string where = first.loc.file + ":" + std::to_string(first.loc.line) + ":" +
+                            std::to_string(first.loc.column);
+  if (!g_.cpfgFile) {
+    Error(l, col,
+          "redefinition of '" + name + "' (first defined at line " +
+              std::to_string(first.loc.line) + ")",
+          int(name.size()));
+    return false;
+  }
+  if (text != first.text) {
+    Warn(Loc(l, col), OriginalAt(l, col),
+         "'" + name +
+             "' redefined: this definition holds from here on, as cpfg's C "
+             "preprocessor has it (the first is at " +
+             where + ")",
+         int(name.size()));
+  }
+  // Every #define of a name in cppNames_ is text; forget the first.
+  textMacros_.erase(name);
+  macros_.erase(name);
+  g_.constants.erase(name);
+  defines_.erase(name);
+  return true;
+}
+
+void GrammarParser::FindCppNames() {
+  if (!g_.cpfgFile) return;
+  std::unordered_map<std::string, int> defines;
+  for (const Line& l : lines_) {
+    const std::string& t = l.text;
+    size_t p = 0;
+    while (p < t.size() && IsSpace(t[p])) ++p;
+    if (!StartsDirective(t, p)) continue;
+    ++p;
+    while (p < t.size() && IsSpace(t[p])) ++p;
+    size_t e = p;
+    while (e < t.size() && IsIdentChar(t[e])) ++e;
+    const std::string_view word = std::string_view(t).substr(p, e - p);
+    if (word != "define" && word != "undef") continue;
+    while (e < t.size() && IsSpace(t[e])) ++e;
+    size_t n = e;
+    while (n < t.size() && IsIdentChar(t[n])) ++n;
+    if (n == e) continue;
+    std::string name = t.substr(e, n - e);
+    if (word == "undef" || ++defines[name] > 1) cppNames_.insert(std::move(name));
+  }
 }
 
 // `#define NAME(a, b) body` (the `(` right after the name, as in C): a
@@ -1026,18 +1117,25 @@ void GrammarParser::ParseMacro(const Line& l, const std::string& name, int col, 
     Error(l, int(pos) + 1, "expected ',' or ')' after a parameter of '#define " + name + "'");
     return;
   }
-  if (defines_.count(name)) {
-    Error(l, col,
-          "redefinition of '" + name + "' (first defined at line " +
-              std::to_string(defines_[name].loc.line) + ")",
-          int(name.size()));
-    return;
-  }
   while (pos < t.size() && IsSpace(t[pos])) ++pos;
   size_t end = t.size();
   while (end > pos && IsSpace(t[end - 1])) --end;
+  std::string text = "(";
+  for (const std::string& p : m.params) text += (text.size() > 1 ? "," : "") + p;
+  text += ") " + CollapseBlanks(std::string_view(t).substr(pos, end - pos));
+  if (defines_.count(name) && !Redefine(l, name, col, text)) return;
   if (pos >= end) {
     Error(l, col, "#define '" + name + "' has no body", int(name.size()));
+    return;
+  }
+  if (cppNames_.count(name)) {  // defined twice or #undef'd in a cpfg file: text
+    TextMacro tm;
+    tm.function = true;
+    tm.params = std::move(m.params);
+    tm.body = t.substr(pos, end - pos);
+    tm.line = Loc(l, col).line;
+    textMacros_[name] = std::move(tm);
+    defines_[name] = Define{Loc(l, col), int(name.size()), text};
     return;
   }
   // Check the body where it is written, its parameters standing as formals.
@@ -1061,18 +1159,19 @@ void GrammarParser::ParseMacro(const Line& l, const std::string& name, int col, 
     tm.function = true;
     tm.params = std::move(m.params);
     tm.body = t.substr(pos, end - pos);
-    AddTextMacro(l, name, col, std::move(tm));
+    AddTextMacro(l, name, col, std::move(tm), text);
     return;
   }
   m.body = t.substr(pos, end - pos);
   macros_.emplace(name, std::move(m));
-  defines_[name] = Define{Loc(l, col), int(name.size())};
+  defines_[name] = Define{Loc(l, col), int(name.size()), text};
 }
 
 // `#undef NAME`: a text #define is forgotten from here on (lines are
-// substituted in order); a name never defined is no error, as in C. A
-// constant or an expression #define is read before any production, so it
-// cannot be undone for the lines below only: an error.
+// substituted in order); a name never defined is no error, as in C. In a
+// .lsys file a constant or an expression #define is read before any
+// production, so it cannot be undone for the lines below only: an error
+// (in a cpfg file every #define of a name #undef'd is text: cppNames_).
 void GrammarParser::ParseUndef(const Line& l, size_t after) {
   const std::string& t = l.text;
   size_t q = after;
@@ -1101,7 +1200,8 @@ void GrammarParser::ParseUndef(const Line& l, size_t after) {
   }
 }
 
-void GrammarParser::AddTextMacro(const Line& l, const std::string& name, int col, TextMacro m) {
+void GrammarParser::AddTextMacro(const Line& l, const std::string& name, int col, TextMacro m,
+                                 const std::string& text) {
   if (opt_.overrides.count(name)) {
     usedOverrides_.insert(name);
     Error(l, col,
@@ -1112,7 +1212,7 @@ void GrammarParser::AddTextMacro(const Line& l, const std::string& name, int col
   }
   m.line = Loc(l, col).line;
   textMacros_[name] = std::move(m);
-  defines_[name] = Define{Loc(l, col), int(name.size())};
+  defines_[name] = Define{Loc(l, col), int(name.size()), text};
 }
 
 namespace {
@@ -1533,6 +1633,7 @@ void GrammarParser::Conditionals() {
   std::vector<Open> stack;
   std::vector<Line> kept;
   kept.reserve(lines_.size());
+  FindCppNames();
   // `lsystem:` lines still ahead: after `endlsystem`, #defines count only
   // when another block follows (they are that block's, as vlab's Sedge
   // #includes each sub-L-system's file, its #defines first); after the last
@@ -1593,6 +1694,7 @@ void GrammarParser::Conditionals() {
       t.replace(i, e - i, std::string(1, is ? '1' : '0') + std::string(e - i - 1, ' '));
       i = e;
     }
+    ExpandTextMacros(l);  // as C's #if: text #defines are substituted
     double v = 0;
     if (!ParseConstExpr(l, after, t.size(), &v)) return false;
     return v != 0;
@@ -3028,6 +3130,7 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
     r.diagnostics.Add(std::move(d));
     return r;
   }
+  g_.cpfgFile = std::filesystem::path(path).extension() == ".l";
   std::vector<std::string> stack{std::filesystem::path(path).lexically_normal().string()};
   Preprocess(std::make_shared<const std::string>(text), path, 0, stack);
   JoinContinuations();
@@ -3038,7 +3141,6 @@ ParseResult GrammarParser::Run(const std::string& text, const std::string& path)
   CollectGlobals();
   g_.path = path;
   g_.name = std::filesystem::path(path).stem().string();
-  g_.cpfgFile = std::filesystem::path(path).extension() == ".l";
   // module: declarations apply to the whole file, wherever they stand.
   for (const Line& l : lines_) {
     size_t p = 0;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <vector>
 
 #include "lsys/parser.h"
 #include "lsys_test_util.h"
@@ -11,6 +12,7 @@ namespace sylva::lsys {
 namespace {
 
 using testing::FirstError;
+using testing::Joined;
 
 using testing::DeriveText;
 
@@ -62,6 +64,81 @@ TEST(CpfgPreprocessor, DefinesAfterEndlsystemAreNotRead) {
   auto w = Derive(*r.grammar, d);
   ASSERT_TRUE(w);
   EXPECT_EQ(FormatWord(w->word, r.grammar->symbols), "A(1)");
+}
+
+// A parse of a cpfg file that must succeed; its warnings as "line:col message".
+std::vector<std::string> Warnings(const std::string& text, const ParseOptions& opt = {}) {
+  ParseResult r = ParseGrammarText(text, "c.l", opt);
+  EXPECT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  std::vector<std::string> w;
+  for (const auto& d : r.diagnostics.items)
+    if (d.severity == Severity::kWarning)
+      w.push_back(std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " +
+                  d.message);
+  return w;
+}
+
+std::string DeriveCpfg(const std::string& text, int steps, const ParseOptions& opt = {}) {
+  ParseResult r = ParseGrammarText(text, "c.l", opt);
+  if (!r.grammar) return r.diagnostics.FormatAll();
+  DeriveOptions d;
+  d.steps = steps;
+  auto w = Derive(*r.grammar, d);
+  if (!w) return w.error().Format();
+  return FormatWord(w->word, r.grammar->symbols);
+}
+
+TEST(CpfgPreprocessor, RedefinedNameHoldsFromItsLaterDefinitionWithAWarning) {
+  // C's preprocessor (cpfg's): a line between the two #defines reads the
+  // first, a line after them the second (corpus3's cloud_I(C2) defines
+  // ang2 twice).
+  const char* text =
+      "#define N 1\n"
+      "axiom: A(N)\n"
+      "#define N  2\n"
+      "A(x) --> B(x, N)\n";
+  EXPECT_EQ(DeriveCpfg(text, 1), "B(1,2)");
+  const auto w = Warnings(text);
+  ASSERT_FALSE(w.empty());
+  EXPECT_EQ(w[0],
+            "3:9 'N' redefined: this definition holds from here on, as cpfg's C preprocessor has "
+            "it (the first is at c.l:1:9)")
+      << Joined(w);
+}
+
+TEST(CpfgPreprocessor, SameRedefinitionIsNoWarning) {
+  // As in C: the same text again (blanks aside) is no redefinition.
+  const auto w = Warnings("#define N 1 +  2\n#define N 1 + 2\naxiom: A(N)\n");
+  EXPECT_TRUE(w.empty()) << Joined(w);
+  EXPECT_EQ(DeriveCpfg("#define N 1 +  2\n#define N 1 + 2\naxiom: A(N)\n", 0), "A(3)");
+}
+
+TEST(CpfgPreprocessor, RedefinedNamesReachConditionsMacrosAndOverrides) {
+  // #if sees the definition above it; a #define naming a redefined one reads
+  // it where it is used; so does a function-like #define redefined.
+  EXPECT_EQ(
+      DeriveCpfg("#define N 1\n#define N 3\n#if N > 2\naxiom: A\n#else\naxiom: B\n#endif\n", 0),
+      "A");
+  EXPECT_EQ(
+      DeriveCpfg("#define N 1\n#define M (N * 10)\naxiom: A(M)\n#define N 2\nA(x) --> B(M)\n", 1),
+      "B(20)");
+  EXPECT_EQ(DeriveCpfg("#define f(x) (x + 1)\naxiom: A(f(1))\n#define f(x) (x * 10)\n"
+                       "A(y) --> B(y, f(y))\n",
+                       1),
+            "B(2,20)");
+  // -D replaces the value of each #define of the name.
+  ParseOptions opt;
+  opt.overrides["N"] = 7;
+  EXPECT_EQ(DeriveCpfg("#define N 1\naxiom: A(N)\n#define N 2\nA(x) --> B(x, N)\n", 1, opt),
+            "B(7,7)");
+  // The same file as .lsys: an error at the second #define.
+  EXPECT_EQ(FirstError("#define N 1\naxiom: A(N)\n#define N 2\n", "c.lsys"),
+            "3:9 redefinition of 'N' (first defined at line 1)");
+}
+
+TEST(CpfgPreprocessor, UndefOfANumberHoldsFromThere) {
+  EXPECT_EQ(DeriveCpfg("#define N 2\naxiom: A(N)\n#undef N\n#define N 3\nA(x) --> B(x, N)\n", 1),
+            "B(2,3)");
 }
 
 TEST(CpfgPreprocessor, UnbalancedDirectivesAreErrorsWithLocations) {
