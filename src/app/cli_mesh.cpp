@@ -7,6 +7,7 @@
 #include "app/cli.h"
 #include "app/commands.h"
 #include "mesh/export.h"
+#include "mesh/plant_geometry.h"
 #include "mesh/tessellator.h"
 
 namespace sylva::app {
@@ -72,12 +73,15 @@ int TessellateAndWrite(const MeshCommand& cmd, plant::Plant& plant, const plant:
     std::snprintf(times, sizeof times, "tessellate %.1f ms, write %.1f ms", t.tessellate,
                   ms - t.tessellate);
   }
-  char line[400];
+  // Every primitive the turtle emits is counted (mesh/plant_geometry.h).
+  const mesh::PlantGeometry& g = plant.geometry;
+  char line[600];
   std::snprintf(line, sizeof line,
-                "%s: %zu vertices, %zu triangles, %zu segments, %zu polygons (%llu modules)\n"
+                "%s: %zu vertices, %zu triangles, %zu segments, %zu polygons, %zu spheres, %zu "
+                "surfaces, %zu contour tubes (%llu modules)\n"
                 "time: derive %.1f ms, turtle %.1f ms, %s\n",
-                cmd.output.c_str(), counts.vertices, counts.triangles,
-                plant.geometry.segments.size(), plant.geometry.polygons.size(),
+                cmd.output.c_str(), counts.vertices, counts.triangles, g.segments.size(),
+                g.polygons.size(), g.spheres.size(), g.surfaces.size(), g.tubes.size(),
                 static_cast<unsigned long long>(plant.DrawnWord().size()),
                 t.parse + t.derive + t.interpret, t.turtle, times);
   err << line;

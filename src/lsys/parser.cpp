@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <map>
 #include <set>
 #include <unordered_set>
 
@@ -99,9 +100,10 @@ std::string CollapseBlanks(std::string_view text) {
   return r;
 }
 
+// The first use of a module name with each number of parameters, in the
+// order the names were first used with a second number.
 struct ArityUse {
-  int arity;
-  SourceLoc loc;
+  std::map<int, SourceLoc> first;  // arity -> its first use
 };
 
 bool IsSpace(char c) {
@@ -365,6 +367,7 @@ class GrammarParser {
   void WarnAfterEnd(const Line& l);
   void Finish();
   void WarnUnmatchable();
+  void WarnMixedArity();
 
   const ParseOptions& opt_;
   std::vector<std::string> files_;
@@ -409,6 +412,7 @@ class GrammarParser {
   bool functionFilesFailed_ = false;  // a view file's function file could not be read
   bool curveFilesFailed_ = false;     // a view file's curve file could not be read
   std::unordered_map<std::string, ArityUse> arityUse_;
+  std::vector<std::string> arityMixed_;  // names used with two or more arities, in that order
   std::unordered_set<std::string> unsupportedWarned_;  // name + reason
   // In a cpfg file (`.l`), a name nothing defines reads 0 with a warning
   // (once per name), as cpfg does; in Sylva's own `.lsys` files it stays an
@@ -695,21 +699,71 @@ std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std:
     if (unsupportedWarned_.insert(name + '\x01' + *why).second)
       Warn(Loc(l, col), OriginalAt(l, col), *why, int(name.size()));
   }
-  auto it = arityUse_.find(name);
-  if (it == arityUse_.end()) {
-    arityUse_.emplace(name, ArityUse{arity, Loc(l, col)});
-  } else if (it->second.arity != arity && name != "[" && name != "]" && !IsQueryName(name)) {
-    // One warning per name.
-    if (it->second.arity >= 0) {
-      Warn(Loc(l, col), OriginalAt(l, col),
-           "module '" + name + "' is used with " + std::to_string(arity) + " parameter" +
-               (arity == 1 ? "" : "s") + " here and with " + std::to_string(it->second.arity) +
-               " at line " + std::to_string(it->second.loc.line) + "; they are different modules",
-           int(name.size()));
-      it->second.arity = -1;
-    }
+  // Numbers of parameters per name, for WarnMixedArity once every
+  // production is known.
+  if (name != "[" && name != "]" && !IsQueryName(name)) {
+    ArityUse& use = arityUse_[name];
+    if (use.first.emplace(arity, Loc(l, col)).second && use.first.size() == 2)
+      arityMixed_.push_back(name);
   }
   return id;
+}
+
+// The turtle's commands, which read the parameters they have whatever their
+// number (cpfg's `+(20,0)` turns as `+(20)` does).
+static bool IsTurtleCommand(const std::string& name) {
+  static const std::set<std::string> kCommands = {
+      "F", "f", "G", "g", "+", "-", "&", "^", "/", "\\", "|", "$", "{", "}",
+      ".", "!", "#", ";", ",", "%", "_", "'"};
+  return name[0] == '@' || name[0] == '~' || kCommands.count(name) > 0;
+}
+
+// One name used with different numbers of parameters is two modules, to
+// Sylva as to cpfg's matching (PredDiff compares the count): a production
+// naming one does not match the other. That matters only where a
+// production's predecessor or context names the module: a warning, at the
+// first use with a number that no production names, says so. A name no
+// production names (the turtle's `+(20,0)` beside `+(x)`, `{(4)` beside
+// `{(2,8)`) is drawn the same either way: no warning.
+void GrammarParser::WarnMixedArity() {
+  // name -> arity -> the first production naming it so.
+  std::unordered_map<std::string, std::map<int, SourceLoc>> named;
+  for (const auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation}) {
+    for (const Production& p : sec->productions) {
+      auto add = [&](SymbolId sym) {
+        named[g_.symbols.name(sym)].emplace(g_.symbols.arity(sym), p.loc);
+      };
+      add(p.pred.symbol);
+      for (const FormalModule& m : p.predTail) add(m.symbol);
+      for (const FormalModule& m : p.left) add(m.symbol);
+      for (const FormalModule& m : p.right) add(m.symbol);
+    }
+  }
+  auto params = [](int n) { return std::to_string(n) + " parameter" + (n == 1 ? "" : "s"); };
+  for (const std::string& name : arityMixed_) {
+    const auto found = named.find(name);
+    if (found == named.end()) continue;  // no production looks at it
+    const std::map<int, SourceLoc>& uses = arityUse_.at(name).first;
+    // The first use with a number no production names.
+    const std::pair<const int, SourceLoc>* odd = nullptr;
+    for (const auto& use : uses) {
+      if (found->second.count(use.first)) continue;
+      if (!odd || std::make_pair(use.second.line, use.second.column) <
+                      std::make_pair(odd->second.line, odd->second.column))
+        odd = &use;
+    }
+    if (!odd) continue;  // a production for every number it is used with
+    const auto& [arity, loc] = *found->second.begin();
+    std::string msg = "module '" + name + "' is used with " + params(odd->first) +
+                      " here, and the production at line " + std::to_string(loc.line) +
+                      " names it with " + params(arity) +
+                      ": a production matches only the number of parameters it names (as "
+                      "cpfg's does), so no production matches this '" +
+                      name + "'";
+    if (IsTurtleCommand(name)) msg += " (the turtle draws it either way, reading its first "
+                                      "parameters)";
+    Warn(odd->second, g_.SourceLine(odd->second), msg, int(name.size()));
+  }
 }
 
 bool GrammarParser::CheckBrackets(const Line& l, const std::vector<SymbolId>& syms,
@@ -3013,6 +3067,7 @@ void GrammarParser::Finish() {
   }
   if (diags_.HasErrors()) return;
   WarnUnmatchable();
+  WarnMixedArity();
   // ?E is answered by the environment that `environment:` names; without
   // one its parameters keep the values written in the grammar.
   if (!g_.environment && !opt_.environmentGiven) {

@@ -200,11 +200,11 @@ std::unordered_map<std::string, mesh::TriangleMesh> SurfacesOf(const plant::Plan
   return library.meshes();
 }
 
-// Tips, segment points and leaves of `g` through the transform `t`; the
-// surfaces it places (`surfaces`, by name) collide as their triangles.
-void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t,
-               const std::unordered_map<std::string, mesh::TriangleMesh>& surfaces,
-               PlantPoints& out) {
+}  // namespace
+
+void AddPlantPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t,
+                    const std::unordered_map<std::string, mesh::TriangleMesh>& surfaces,
+                    PlantPoints& out) {
   const Eigen::Matrix4d m = t.cast<double>();
   auto world = [&](const Vec3& p) { return Vec3((m * p.homogeneous()).head<3>()); };
   struct Hash {
@@ -249,9 +249,43 @@ void AddPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t,
                                    place(sm.positions[sm.indices[k + 1]]),
                                    place(sm.positions[sm.indices[k + 2]])});
   }
+  for (const mesh::Sphere& s : g.spheres) {
+    // A sphere (@O: a bud, a fruit) is an organ where it sits, as a surface
+    // is: a leaf point; it collides as a capsule of no length.
+    out.leaves.push_back(world(s.center));
+    out.capsules.push_back(
+        particles::Capsule{world(s.center), world(s.center), s.radius * scale});
+  }
+  for (const mesh::ContourTube& tube : g.tubes) {
+    // A generalized cylinder with a contour (a leaf blade, a petal, a
+    // shell): its quads collide as two triangles each, as EmitTube draws
+    // them; the stretches between its ring centres are segments, its
+    // centre a leaf point, its last ring's centre a tip.
+    const size_t R = tube.rings(), W = tube.ringSize;
+    if (R < 2 || W < 2) continue;
+    const size_t around = tube.closed ? W - 1 : W;  // a closed ring repeats its first point
+    std::vector<Vec3> centre(R, Vec3::Zero());
+    Vec3 all = Vec3::Zero();
+    for (size_t i = 0; i < R; ++i) {
+      for (size_t j = 0; j < around; ++j) centre[i] += tube.points[i * W + j];
+      all += centre[i];
+      centre[i] /= double(around);
+    }
+    out.leaves.push_back(world(all / double(R * around)));
+    for (size_t i = 0; i + 1 < R; ++i) {
+      out.segmentPoints.push_back(world((centre[i] + centre[i + 1]) / 2));
+      out.segmentLengths.push_back((centre[i + 1] - centre[i]).norm() * scale);
+      for (size_t j = 0; j + 1 < W; ++j) {
+        const size_t a = i * W + j, b = a + 1, d = a + W, c = d + 1;
+        const Vec3 pa = world(tube.points[a]), pc = world(tube.points[c]);
+        out.leafTriangles.push_back({pa, world(tube.points[b]), pc});
+        out.leafTriangles.push_back({pa, pc, world(tube.points[d])});
+      }
+    }
+    if (!starts.count(centre[R - 1])) out.tips.push_back(world(centre[R - 1]));
+  }
 }
 
-}  // namespace
 
 terrain::TerrainDef TerrainDefOf(const TerrainDef& t, uint64_t seed) {
   terrain::TerrainDef d;
@@ -397,7 +431,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     GrowBounds(*m.mesh, m.instances[0].transform, built.lo, built.hi, any);
     built.trianglesDrawn += m.mesh->triangleCount();
     if (!p.id.empty()) {
-      AddPoints(grown->geometry, m.instances[0].transform, SurfacesOf(*grown, spec),
+      AddPlantPoints(grown->geometry, m.instances[0].transform, SurfacesOf(*grown, spec),
                 built.points[p.id]);
       built.meshesOf[p.id].push_back(built.meshes.size());
     }
@@ -469,7 +503,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       GrowBounds(*m.mesh, m.instances.back().transform, built.lo, built.hi, any);
       built.trianglesDrawn += m.mesh->triangleCount();
       if (!f.id.empty())
-        AddPoints(geometry[size_t(v)], m.instances.back().transform, surfaces[size_t(v)],
+        AddPlantPoints(geometry[size_t(v)], m.instances.back().transform, surfaces[size_t(v)],
                   built.points[f.id]);
     }
   }

@@ -15,6 +15,8 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "core/diagnostic.h"
@@ -55,17 +57,28 @@ struct BuiltMesh {
 };
 
 // Points of a plant (or of every tree of a forest) in world space, where
-// emitters place particles: branch tips, points along the segments (their
-// midpoints, with the segments' lengths as weights), leaves (polygon and
-// surface centres).
+// emitters place particles: branch tips (segment ends where nothing grows
+// on, and the far ends of contour tubes), points along the segments and
+// along the axes of contour tubes (midpoints, with their lengths as
+// weights), leaves (polygon and surface centres, sphere centres, contour
+// tube centres). Every primitive the turtle emits is in them.
 struct PlantPoints {
   std::vector<Vec3> tips, segmentPoints, leaves;
   std::vector<double> segmentLengths;
-  // What particles collide with: a capsule per segment (its larger end
-  // radius) and the leaves' polygons as triangles, in world space.
+  // What particles collide with, in world space: a capsule per segment (its
+  // larger end radius) and per sphere (of no length), and as triangles the
+  // polygons, the surfaces placed with `~` and the contour tubes' quads
+  // (two triangles each, as the tessellator draws them).
   std::vector<particles::Capsule> capsules;
   std::vector<std::array<Vec3, 3>> leafTriangles;
 };
+
+// Adds the points of `g`, placed by `transform`, to `out`; `surfaces` are
+// the meshes of the surfaces it places, by name (missing ones do not
+// collide). Build calls it for every plant and forest instance with an id.
+void AddPlantPoints(const mesh::PlantGeometry& g, const draw::Mat4f& transform,
+                    const std::unordered_map<std::string, mesh::TriangleMesh>& surfaces,
+                    PlantPoints& out);
 
 struct BuiltScene {
   std::vector<terrain::HeightField> terrains;  // in the order of scene.terrains

@@ -252,6 +252,23 @@ TEST(CliMesh, CpfgOneLetterSurfaceBesideTheGrammar) {
   EXPECT_NE(r.err.find("1 segments"), std::string::npos) << r.err;
 }
 
+TEST(CliMesh, SummaryCountsContourTubesAndTheirTriangles) {
+  // A cpfg generalized cylinder with a contour (ctube.v beside the file:
+  // cylinder line style): one contour tube of 2 + 1 rings of 8 sides + 1
+  // points (an open contour), whose 2 x 8 quads are the mesh's only
+  // triangles; no segment.
+  WriteFile("ctube.con", "5 3 open\n-1 0 0\n-1 0 0\n0 0.2 0\n1 0 0\n1 0 0\n");
+  WriteFile("ctube.v", "line style: cylinder\ncontour: 1 ctube.con\n");
+  std::string f = WriteFile("ctube.l", "axiom: #(2) @#(1) @Gs f(2) @Ge(2)\n");
+  std::string out = (Scratch() / "ctube.obj").string();
+  auto r = RunSylva({"mesh", "--strict", f, "-o", out});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find(" 32 triangles, 0 segments, 0 polygons, 0 spheres, 0 surfaces, 1 contour "
+                       "tubes (5 modules)"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST(CliMesh, UnknownLongSurfaceNameMentionsCpfgOneLetterNames) {
   std::string f = WriteFile("lq.l", "axiom: ~qF\n");
   std::string out = (Scratch() / "lq.obj").string();

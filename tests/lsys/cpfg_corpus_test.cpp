@@ -64,7 +64,8 @@ TEST(CpfgQueries, OneQueryWithDifferentParameterCountsIsNotWarnedAbout) {
   bool lWarned = false;
   for (const std::string& line : d)
     lWarned |=
-        line.find("module 'L' is used with 1 parameter here and with 0") != std::string::npos;
+        line.find("module 'L' is used with 1 parameter here, and the production at line 4 names "
+                  "it with 0") != std::string::npos;
   EXPECT_TRUE(lWarned) << Joined(d);
 }
 

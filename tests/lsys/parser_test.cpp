@@ -181,8 +181,32 @@ TEST(Parser, WarnsAboutModuleWithTwoParameterCounts) {
   auto w = Warnings("axiom: A(1)\nA(x) --> A(x+1)B\nB --> A\n");
   ASSERT_EQ(w.size(), 1u) << ::testing::PrintToString(w);
   EXPECT_EQ(w[0],
-            "3:7 module 'A' is used with 0 parameters here and with 1 at line 1; they are "
-            "different modules");
+            "3:7 module 'A' is used with 0 parameters here, and the production at line 2 names "
+            "it with 1 parameter: a production matches only the number of parameters it names "
+            "(as cpfg's does), so no production matches this 'A'");
+}
+
+TEST(Parser, MixedArityWarnsOnlyWhereAProductionNamesTheModule) {
+  // cpfg files turn with +(20,0) beside +(x) and open splines with {(4)
+  // beside {(2,8): no production names them, the turtle reads their first
+  // parameters either way, and matching cannot be affected: no warning.
+  EXPECT_TRUE(Warnings("axiom: A(1)\nA(x) --> +(20,0) F +(x) {(4) f }(4) {(2,8) f }(2) A(x)\n")
+                  .empty());
+  // A module used with a count no production names, where one names it with
+  // another: a real mismatch, in a context too, and said of a turtle command.
+  auto ctx = Warnings("axiom: B F(1) F\nB > F(x) --> B\n");
+  ASSERT_EQ(ctx.size(), 1u) << ::testing::PrintToString(ctx);
+  EXPECT_EQ(ctx[0].rfind("1:15 module 'F' is used with 0 parameters here, and the production at "
+                         "line 2 names it with 1 parameter",
+                         0),
+            0u)
+      << ctx[0];
+  EXPECT_NE(ctx[0].find("(the turtle draws it either way, reading its first parameters)"),
+            std::string::npos)
+      << ctx[0];
+  // Productions for every count it is used with: deliberate, no warning
+  // (vlab's two-trees rewrites -(a), -(a,step) and -(a,step,t)).
+  EXPECT_TRUE(Warnings("axiom: -(1) -(1,2)\n-(a) --> -(a,1)\n-(a,s) --> -(a)\n").empty());
 }
 
 TEST(Parser, WarnsAboutAlwaysFalseCondition) {
