@@ -342,6 +342,7 @@ TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   if (d.movements.size() > size_t(lsys::kMaxMovements)) d.movements.resize(lsys::kMaxMovements);
   d.subLsystems = g.subLsystems;
   d.quoteIsColor = !g.cpfgFile;
+  d.cpfgBend = g.cpfgFile;
   return d;
 }
 
@@ -408,6 +409,18 @@ static Vec3 NoTwistUp(const Vec3& prevHeading, const Vec3& prevUp, const Vec3& h
   if (n > 1e-12) return up / n;
   // U along H: any perpendicular
   return h.cross(std::abs(h.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitZ()).normalized();
+}
+
+// cpfg's older tropism after a move (vlab cpfg interpret.c, bend): H turns
+// toward U by asin(e T.U), then toward L by asin(e T.L). True when it
+// turned.
+static bool CpfgBend(const Vec3& tropismVector, double e, Frame& f) {
+  if (e == 0) return false;
+  const double towardUp = std::clamp(e * tropismVector.dot(f.up), -1.0, 1.0);
+  Rotate(f.heading, f.up, std::sqrt(1 - towardUp * towardUp), towardUp);
+  const double towardLeft = std::clamp(e * tropismVector.dot(f.left), -1.0, 1.0);
+  Rotate(f.heading, f.left, std::sqrt(1 - towardLeft * towardLeft), towardLeft);
+  return towardUp != 0 || towardLeft != 0;
 }
 
 // @R(hx, hy[, hz[, ux, uy, uz]]): cpfg's set heading (vlab cpfg
@@ -1173,7 +1186,9 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
             sg.module = uint32_t(i);
             g.segments.push_back(sg);
           }
-          if (tropism && ApplyTropism(tropismDir, x.elasticity, t.frame)) ++turnsSinceOrtho;
+          if (tropism && (def.cpfgBend ? CpfgBend(tropismDir, x.elasticity, t.frame)
+                                       : ApplyTropism(tropismDir, x.elasticity, t.frame)))
+            ++turnsSinceOrtho;
           if constexpr (kCpfg) {
             // cpfg: F and f add a control point to an open `{(n)` spline
             // (G and g do not); F and G set the frame @R turns from.

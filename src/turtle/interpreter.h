@@ -130,6 +130,13 @@ struct TurtleDef {
   // for a cpfg file (lsys::Grammar::cpfgFile), whose turtle has no `'`:
   // it is a module that draws nothing.
   bool quoteIsColor = true;
+  // The tropism above bends as cpfg's older tropism does (interpret.c,
+  // bend): after a move, H turns toward U by asin(e T.U), then toward L by
+  // asin(e T.L) (each sine kept within [-1, 1]), instead of ABOP's turn
+  // about H x T by e |H x T|; the two agree to first order in e. True for
+  // a cpfg file (lsys::Grammar::cpfgFile), whose tropism comes from its
+  // view file's `tropism direction:` and `initial elasticity:`.
+  bool cpfgBend = false;
 };
 
 TurtleDef TurtleDefFrom(const lsys::Grammar& g);

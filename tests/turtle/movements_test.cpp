@@ -73,6 +73,38 @@ TEST(Movements, OneSegmentBendsByTheElasticityTimesTheSineBeforeItMoves) {
   }
 }
 
+TEST(Movements, CpfgsOlderTropismTurnsByTheArcsineAfterTheMove) {
+  // A cpfg file's `tropism direction:` and `initial elasticity:` (interpret.c,
+  // bend): after F, H turns toward U by asin(e T.U), then toward L by
+  // asin(e T.L). T = U = (0,0,-1), e = 0.4: the first segment is straight,
+  // the turn is asin 0.4 (ABOP's formula turns by 0.4).
+  auto p = testing::PlantFromText("axiom: F\n", 0, plant::Stage::kInterpreted);
+  ASSERT_TRUE(p.has_value());
+  TurtleDef def = TurtleDefFrom(p->grammar);
+  def.tropism = Vec3(0, 0, -1);
+  def.tropismGiven = true;
+  def.susceptibility = 0.4;
+  def.cpfgBend = true;
+  DrawOptions opt;
+  opt.recordModules = true;
+  auto g = Interpret(p->DrawnWord(), p->grammar.symbols, def, opt);
+  ASSERT_TRUE(g.ok());
+  EXPECT_VEC_NEAR(g->segments[0].end, Vec3(0, 1, 0), 1e-12);
+  EXPECT_VEC_NEAR(g->moduleFrame.back().heading, Vec3(0, std::sqrt(1 - 0.16), -0.4), 1e-12);
+  def.cpfgBend = false;
+  g = Interpret(p->DrawnWord(), p->grammar.symbols, def, opt);
+  ASSERT_TRUE(g.ok());
+  EXPECT_VEC_NEAR(g->moduleFrame.back().heading, Vec3(0, std::cos(0.4), -std::sin(0.4)), 1e-12);
+  // T half along U, half along L: the two turns in turn.
+  def.cpfgBend = true;
+  def.tropism = Vec3(-1, 0, -1).normalized();
+  g = Interpret(p->DrawnWord(), p->grammar.symbols, def, opt);
+  ASSERT_TRUE(g.ok());
+  const double c = 0.4 * std::sqrt(0.5), s = std::sqrt(1 - c * c);
+  const Vec3 h1 = Vec3(0, 1, 0) * s + Vec3(0, 0, -1) * c;
+  EXPECT_VEC_NEAR(g->moduleFrame.back().heading, Vec3(h1 * s + Vec3(-1, 0, 0) * c), 1e-12);
+}
+
 TEST(Movements, TwoTropismsAddAsElasticityWeightedVectors) {
   // cpfg sums e_k T_k into one V and turns H toward it by |H x V|:
   // T1 = (1,0,0) e 0.2 and T2 = (0,0,1) e 0.1 give V = (0.2, 0, 0.1).
