@@ -296,8 +296,9 @@ TEST(Bulk, SleepingGivesTheWholeStepsBits) {
   // Snow settling on a field: the flakes a step leaves unchanged sleep
   // (BulkSystem::Still), and the run is the same bits as one where every
   // flake takes every step, on 1 and 2 threads; through a change of wind
-  // (which wakes everyone), flakes moved by hand (woken by their floats) and
-  // a second collider added (wakes everyone).
+  // (which wakes everyone), flakes moved by hand (woken by their floats),
+  // dead flakes removed (the rest move down the arrays) and a second
+  // collider added (wakes everyone).
   BulkSystem sleeping(2), awake(1);
   awake.SetSleeping(false);
   SnowOnAField(&sleeping);
@@ -311,6 +312,14 @@ TEST(Bulk, SleepingGivesTheWholeStepsBits) {
       for (BulkSystem* b : {&sleeping, &awake}) {
         for (size_t i = 0; i < b->state.size(); i += 7)
           b->state.SetPosition(i, b->state.position(i) + Vec3(0, 0.02, 0));
+      }
+    }
+    if (k == 180) {
+      // Every fifth flake dies: the records stay by index, now facing
+      // other flakes.
+      for (BulkSystem* b : {&sleeping, &awake}) {
+        for (size_t i = 0; i < b->state.size(); i += 5) b->state.lifetime[i] = 0;
+        EXPECT_EQ(b->RemoveDead(), 600u);
       }
     }
     if (k == 200) {
