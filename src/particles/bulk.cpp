@@ -114,7 +114,8 @@ int BulkSystem::threads() const {
   return pools_.threads();
 }
 
-void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::BulkParams& q) {
+void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::BulkParams& q,
+                           bool sleep) {
   BulkState& s = state;
   const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
                               s.vy.data(), s.vz.data(), s.invMass.data()};
@@ -159,6 +160,26 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
                                                 a, s.radius.data(), c, ce, idx);
       } else {
         std::memset(flags, 0, m);
+        // The sleepers: back to the state they started the step in (see
+        // BulkSystem::Still), and no collider sees them.
+        if (sleep) {
+          size_t slept = 0;
+          for (size_t j = 0; j < m; ++j) {
+            if (!asleep_[c + j]) continue;
+            const Still& st = still_[c + j];
+            const float now[8] = {old[0][j], old[1][j], old[2][j],       old[3][j],
+                                  old[4][j], old[5][j], s.radius[c + j], s.invMass[c + j]};
+            if (std::memcmp(now, &st, sizeof now) != 0) {
+              asleep_[c + j] = 0;
+              continue;
+            }
+            s.px[c + j] = st.s[0], s.py[c + j] = st.s[1], s.pz[c + j] = st.s[2];
+            s.vx[c + j] = st.s[3], s.vy[c + j] = st.s[4], s.vz[c + j] = st.s[5];
+            flags[j] = 2;
+            ++slept;
+          }
+          sleepers_.fetch_add(slept, std::memory_order_relaxed);
+        }
         for (const Collider& col : colliders_) {
           if (col.kind == Collider::Kind::kPlane && !col.moving()) {
             kernels::BulkPlaneCandidates(kernel_, col.normal.data(), col.point.data(), a,
@@ -169,6 +190,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
           // start of the step).
           const Vec3 shift = h * col.velocity;
           for (size_t j = 0; j < m; ++j) {
+            if (flags[j] & 2) continue;  // asleep
             flags[j] |=
                 col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
                            double(s.radius[c + j]), memos_.empty() ? nullptr : &memos_[c + j]);
@@ -185,7 +207,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
               continue;
             }
           }
-          if (flags[j] && s.invMass[c + j] != 0) idx[count++] = uint16_t(j);
+          if (flags[j] == 1 && s.invMass[c + j] != 0) idx[count++] = uint16_t(j);
         }
       }
       // A lone static floor: its resting contacts four at a time (the same
@@ -219,7 +241,17 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       const Vec3f xf = RoundOutside(colliders_, x, r, h, memo);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
-      if (!MaybeWithinLimit(xf.cast<double>(), v, faults_.limit2())) faults_.Flag();
+      const bool within = MaybeWithinLimit(xf.cast<double>(), v, faults_.limit2());
+      if (!within) faults_.Flag();
+      if (sleep && out == ContactOutcome::kResponded && within) {
+        // Unchanged by the step: asleep from the next one on.
+        Still st{{s.px[i], s.py[i], s.pz[i], s.vx[i], s.vy[i], s.vz[i]}, s.radius[i], s.invMass[i]};
+        const float before[6] = {old[0][j], old[1][j], old[2][j], old[3][j], old[4][j], old[5][j]};
+        if (std::memcmp(before, st.s, sizeof before) == 0) {
+          still_[i] = st;
+          asleep_[i] = 1;
+        }
+      }
     }
   }
 }
@@ -236,6 +268,7 @@ Status Validate(const BulkFields& f) {
 Status BulkSystem::AddCollider(Collider c) {
   SYLVA_CHECK_OK(Validate(c));
   colliders_.push_back(std::move(c));
+  std::fill(asleep_.begin(), asleep_.end(), 0);  // new inputs: everyone awake
   return {};
 }
 
@@ -270,11 +303,36 @@ Status BulkSystem::Step(double h) {
     return c.kind == Collider::Kind::kMesh;
   });
   if (meshes && meshMemos_ && memos_.size() != n) memos_.resize(n);
+  // Sleeping (see Still): where the step takes the general contact path
+  // (not a lone static plane's) and no collider moves. The step's inputs
+  // as bits; any change wakes every particle.
+  const bool lonePlane = colliders_.size() == 1 && colliders_[0].kind == Collider::Kind::kPlane;
+  const bool sleep = sleeping_ && !colliders_.empty() && !lonePlane &&
+                     std::none_of(colliders_.begin(), colliders_.end(),
+                                  [](const Collider& c) { return c.moving(); });
+  sleepers_.store(0, std::memory_order_relaxed);
+  if (sleep) {
+    std::array<uint64_t, 8> key{};
+    static_assert(sizeof q <= 6 * sizeof(uint64_t));
+    std::memcpy(key.data(), &q, sizeof q);
+    const double limit2 = faults_.limit2();
+    std::memcpy(&key[6], &limit2, sizeof limit2);
+    key[7] = uint64_t(colliders_.size());
+    if (key != key_ || asleep_.size() != n) {
+      // Records are kept by index (after RemoveDead one may face another
+      // particle: its floats, radius and inverse mass decide, so that is
+      // safe), but new inputs wake everyone.
+      if (key != key_) std::fill(asleep_.begin(), asleep_.end(), 0);
+      asleep_.resize(n, 0);
+      still_.resize(n);
+      key_ = key;
+    }
+  }
   ThreadPool* const pool = pools_.pool();
   // Ranges of whole chunks, a few a thread.
   const size_t grain = (BalancedGrain(pool, n, kChunk, 64 * kChunk) + kChunk - 1) / kChunk * kChunk;
   // Contacts see the step the kernel took (h rounded to a float).
-  ForRanges(pool, n, grain, [&](size_t b, size_t e) { StepRange(b, e, double(q.h), q); });
+  ForRanges(pool, n, grain, [&](size_t b, size_t e) { StepRange(b, e, double(q.h), q, sleep); });
   for (Collider& c : colliders_) {
     if (c.moving()) c.Translate(double(q.h) * c.velocity);
   }

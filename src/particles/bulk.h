@@ -153,6 +153,17 @@ class BulkSystem {
     memos_.clear();
   }
 
+  // Whether a particle at an exact fixed point of the step sleeps (on by
+  // default; see Still below): off, every particle takes the whole step.
+  // The same bits either way (tests compare them), only slower.
+  void SetSleeping(bool on) {
+    sleeping_ = on;
+    asleep_.clear();
+    still_.clear();
+  }
+  // Particles that slept (skipped the step) in the last Step.
+  size_t sleepers() const { return sleepers_.load(std::memory_order_relaxed); }
+
   // Chooses the vector kernel (tests compare AVX with its scalar twin).
   // AVX only where the processor has it. restLanes: the lanes of the
   // resting-floor path with AVX: 4 (a kernel after the advance), or 8 where
@@ -166,7 +177,7 @@ class BulkSystem {
   }
 
  private:
-  void StepRange(size_t begin, size_t end, double h, const kernels::BulkParams& q);
+  void StepRange(size_t begin, size_t end, double h, const kernels::BulkParams& q, bool sleep);
   Status Fault();
 
   std::vector<Collider> colliders_;
@@ -178,6 +189,26 @@ class BulkSystem {
   // collider is a mesh; empty otherwise.
   std::vector<MeshMemo> memos_;
   bool meshMemos_ = true;
+  // Sleeping, exact. A particle's step is a function of its six floats,
+  // its radius and inverse mass and of the step's inputs alone (fields, h,
+  // the magnitude limit, colliders; the memos change only how fast the
+  // answer comes): where the last step, through the contact response, left
+  // all six unchanged (a flake lying on a mesh), the same inputs give the
+  // same step again. still_[i] records the particle's floats then (32
+  // bytes), asleep_[i] that it is valid; while the step's inputs (key_) do
+  // not change and no collider moves, a particle whose floats, radius and
+  // inverse mass equal its record skips the collision work and keeps its
+  // state: the bits the whole step would give. A change of the inputs
+  // wakes every particle.
+  struct Still {
+    float s[6];  // px, py, pz, vx, vy, vz
+    float radius, invMass;
+  };
+  std::vector<Still> still_;
+  std::vector<uint8_t> asleep_;
+  std::array<uint64_t, 8> key_{};
+  bool sleeping_ = true;
+  std::atomic<size_t> sleepers_{0};
 };
 
 }  // namespace sylva::particles

@@ -198,6 +198,16 @@ TriangleBvh::TriangleBvh(std::vector<Vec3> vertices, std::vector<std::array<uint
     Build(0, uint32_t(tris_.size()), 1);
     BuildGrid();
   }
+  faces_.resize(tris_.size());
+  for (size_t i = 0; i < tris_.size(); ++i) {
+    Face& f = faces_[i];
+    for (int k = 0; k < 3; ++k) f.v[k] = v_[tris_[i][k]];
+    f.n = (f.v[1] - f.v[0]).cross(f.v[2] - f.v[0]);
+    f.nn = f.n.squaredNorm();
+    f.unit = f.nn > 0 ? Vec3(f.n / std::sqrt(f.nn)) : Vec3::Zero();
+    f.lo = f.v[0].cwiseMin(f.v[1]).cwiseMin(f.v[2]);
+    f.hi = f.v[0].cwiseMax(f.v[1]).cwiseMax(f.v[2]);
+  }
 }
 
 uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
@@ -261,23 +271,17 @@ bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r, const MeshMemo* m
 // if below `best`, with the normal (and, for r > 0, the point).
 bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r, double best,
                               Contact* c) const {
-  const Vec3 &v0 = v_[tris_[i][0]], &v1 = v_[tris_[i][1]], &v2 = v_[tris_[i][2]];
+  const Face& f = faces_[i];
   if (r > 0) {
-    // The triangle's box against the path's box grown by r, before the
-    // normal (most of a cell's triangles miss a short path's box).
+    // The triangle's box against the path's box grown by r (most of a
+    // cell's triangles miss a short path's box).
     const Vec3 plo = a.cwiseMin(b) - Vec3::Constant(r), phi = a.cwiseMax(b) + Vec3::Constant(r);
-    if ((v0.cwiseMin(v1).cwiseMin(v2).array() > phi.array()).any() ||
-        (v0.cwiseMax(v1).cwiseMax(v2).array() < plo.array()).any()) {
-      return false;
-    }
+    if ((f.lo.array() > phi.array()).any() || (f.hi.array() < plo.array()).any()) return false;
   }
-  const Vec3 n = (v1 - v0).cross(v2 - v0);
-  const double nn = n.squaredNorm();
+  const Vec3 &v0 = f.v[0], &v1 = f.v[1], &v2 = f.v[2], &n = f.n;
+  const double nn = f.nn;
   if (!(nn > 0)) return false;  // degenerate
-  if (r > 0) {
-    const Vec3 tri[3] = {v0, v1, v2};
-    return IntersectGrown(tri, 3, n / std::sqrt(nn), a, b, r, best, c);
-  }
+  if (r > 0) return IntersectGrown(f.v, 3, f.unit, a, b, r, best, c);
   double s, side;
   if (!CrossPlane(a, b, v0, n, &s, &side) || s >= best) return false;
   const Vec3 q = a + s * (b - a);
@@ -287,7 +291,7 @@ bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r
     return false;
   }
   c->s = s;
-  c->normal = side * n / std::sqrt(nn);
+  c->normal = side * f.unit;  // side * n / sqrt(nn): the same bits (side is +-1)
   return true;
 }
 

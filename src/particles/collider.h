@@ -122,9 +122,20 @@ class TriangleBvh {
                      double r, const int l[3], const int h[3]) const;
   // Lists in `memo` the triangles near `centre` for a ball of radius r.
   void Remember(const Vec3& centre, double r, MeshMemo* memo) const;
+  // What a triangle test reads, in one place (176 bytes): the corners,
+  // the normal n = (v1 - v0) x (v2 - v0) and nn = |n|^2, n / sqrt(nn) (the
+  // bits the test computed from the corners before), and the box.
+  struct Face {
+    Vec3 v[3];
+    Vec3 n;
+    double nn;
+    Vec3 unit;
+    Vec3 lo, hi;
+  };
   uint64_t serial_ = 0;
   std::vector<Vec3> v_;
   std::vector<std::array<uint32_t, 3>> tris_;
+  std::vector<Face> faces_;  // by triangle, in tris_'s order
   std::vector<Node> nodes_;
   int depth_ = 0;
   // A uniform grid (about eight cells a triangle, at most 256 an axis) for

@@ -263,6 +263,170 @@ TEST(Bulk, SnowOnAMeshIsTheSameWithAndWithoutMemos) {
   EXPECT_GT(resting, 1500) << "flakes at rest or sliding slowly on the field";
 }
 
+// The bumpy field of SnowOnAMeshIsTheSameWithAndWithoutMemos with 3,000
+// flakes (points, 1 cm and 5 cm balls) above it, wind and friction 0.4.
+void SnowOnAField(BulkSystem* b) {
+  std::vector<Vec3> v;
+  std::vector<std::array<uint32_t, 3>> t;
+  const int n = 39;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      v.emplace_back(i * 0.1, 0.2 * std::sin(i * 0.7) * std::cos(j * 0.5), j * 0.1);
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const uint32_t a = uint32_t(j * n + i), c = a + uint32_t(n);
+      t.push_back({a, c, a + 1});
+      t.push_back({a + 1, c, c + 1});
+    }
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(0.1, 3.7), up(0.01, 0.6);
+  for (int i = 0; i < 3000; ++i) {
+    const double x = u(rng), z = u(rng);
+    b->state.Add(Vec3(x, 0.25 + up(rng), z), Vec3(0, -1, 0));
+    b->state.radius.back() = i % 3 == 0 ? 0.0f : i % 3 == 1 ? 0.01f : 0.05f;
+  }
+  b->fields.gravity = Vec3(0, -kG, 0);
+  b->fields.linearDrag = 2;
+  b->fields.wind = Vec3(0.5, 0, 0.2);
+  EXPECT_OK(b->AddCollider(
+      Collider::Mesh(std::make_shared<TriangleBvh>(v, t)).Restitution(0).Friction(0.4)));
+}
+
+TEST(Bulk, SleepingGivesTheWholeStepsBits) {
+  // Snow settling on a field: the flakes a step leaves unchanged sleep
+  // (BulkSystem::Still), and the run is the same bits as one where every
+  // flake takes every step, on 1 and 2 threads; through a change of wind
+  // (which wakes everyone), flakes moved by hand (woken by their floats),
+  // dead flakes removed (the rest move down the arrays) and a second
+  // collider added (wakes everyone).
+  BulkSystem sleeping(2), awake(1);
+  awake.SetSleeping(false);
+  SnowOnAField(&sleeping);
+  SnowOnAField(&awake);
+  size_t most = 0;
+  for (int k = 0; k < 240; ++k) {
+    if (k == 120) {
+      for (BulkSystem* b : {&sleeping, &awake}) b->fields.wind = Vec3(0.2, 0, -0.3);
+    }
+    if (k == 160) {
+      for (BulkSystem* b : {&sleeping, &awake}) {
+        for (size_t i = 0; i < b->state.size(); i += 7)
+          b->state.SetPosition(i, b->state.position(i) + Vec3(0, 0.02, 0));
+      }
+    }
+    if (k == 180) {
+      // Every fifth flake dies: the records stay by index, now facing
+      // other flakes.
+      for (BulkSystem* b : {&sleeping, &awake}) {
+        for (size_t i = 0; i < b->state.size(); i += 5) b->state.lifetime[i] = 0;
+        EXPECT_EQ(b->RemoveDead(), 600u);
+      }
+    }
+    if (k == 200) {
+      for (BulkSystem* b : {&sleeping, &awake})
+        EXPECT_OK(b->AddCollider(Collider::Plane(Vec3(0, -0.1, 0), Vec3(0, 1, 0))));
+    }
+    BULK_STEP_OK(sleeping, 1.0 / 60);
+    BULK_STEP_OK(awake, 1.0 / 60);
+    ASSERT_EQ(sleeping.Hash(), awake.Hash()) << "states differ after step " << k;
+    EXPECT_EQ(awake.sleepers(), 0u) << "step " << k;
+    if (k == 120 || k == 200) {
+      EXPECT_EQ(sleeping.sleepers(), 0u) << "woken at step " << k;
+    }
+    if (k == 119) most = sleeping.sleepers();
+  }
+  EXPECT_GT(most, 1000u) << "flakes asleep after two seconds of snow";
+  EXPECT_GT(sleeping.sleepers(), 200u) << "flakes asleep again at the end";
+}
+
+// A flake of radius 1 cm put at rest on a two-triangle mesh `ground`
+// (friction 0.8), at `at` plus r along the unit normal n: it neither moves
+// nor sinks over 600 steps at 60 Hz, and falls asleep (the same bits as a
+// flake that takes every step).
+void RestsAndSleeps(const std::vector<Vec3>& v, const Vec3& at, const Vec3& n, const char* what) {
+  const auto ground =
+      std::make_shared<TriangleBvh>(v, std::vector<std::array<uint32_t, 3>>{{0, 1, 2}, {0, 2, 3}});
+  BulkSystem sleeping, awake;
+  awake.SetSleeping(false);
+  for (BulkSystem* b : {&sleeping, &awake}) {
+    b->state.Add(at + 0.01 * n, Vec3::Zero());
+    b->state.radius.back() = 0.01f;
+    b->fields.gravity = Vec3(0, -kG, 0);
+    ASSERT_OK(b->AddCollider(Collider::Mesh(ground).Restitution(0).Friction(0.8)));
+  }
+  const Vec3 start = sleeping.state.position(0);
+  double lowest = 1, moved = 0;
+  int asleep = 0;
+  for (int k = 0; k < 600; ++k) {
+    BULK_STEP_OK(sleeping, 1.0 / 60);
+    BULK_STEP_OK(awake, 1.0 / 60);
+    ASSERT_EQ(sleeping.Hash(), awake.Hash()) << what << ": states differ after step " << k;
+    const Vec3 p = sleeping.state.position(0);
+    lowest = std::min(lowest, n.dot(p - at));
+    moved = std::max(moved, (p - start).norm());
+    asleep += int(sleeping.sleepers());
+  }
+  EXPECT_GE(lowest, 0.01 - 1e-6) << what << ": the centre came within " << lowest
+                                 << " m of the surface";
+  EXPECT_LT(moved, 1e-5) << what << ": moved " << moved << " m";
+  EXPECT_GT(asleep, 500) << what << ": asleep for " << asleep << " of 600 steps";
+}
+
+TEST(Bulk, AFlakeRestingOnATiltedTriangleStaysPutAndSleeps) {
+  // A square tilted 20 degrees about z (tan 20 deg = 0.36 < 0.8), two
+  // triangles; the flake in the middle of one.
+  const double t = 20 * M_PI / 180;
+  const Vec3 u(std::cos(t), -std::sin(t), 0), w(0, 0, 1), n = w.cross(u);
+  const Vec3 o(0.3, 0.7, -0.2);
+  const std::vector<Vec3> v = {o - u - w, o + u - w, o + u + w, o - u + w};
+  RestsAndSleeps(v, o + 0.4 * u - 0.5 * w, n.normalized(), "on the face");
+  // On the diagonal the two triangles share, and 1 mm from the mesh's rim.
+  RestsAndSleeps(v, o + 0.3 * u + 0.3 * w, n.normalized(), "on the shared edge");
+  RestsAndSleeps(v, o + 0.2 * u - 0.999 * w, n.normalized(), "at the rim");
+}
+
+TEST(Bulk, AMovingMeshPushesFlakesThatSlept) {
+  // 1 cm flakes asleep on a flat mesh (friction 0.8); then a wall (a
+  // moving mesh, 1 m/s along x) is added: it wakes them and sweeps those in
+  // its way along the floor.
+  const auto floor = std::make_shared<TriangleBvh>(
+      std::vector<Vec3>{Vec3(-1, 0, -1), Vec3(3, 0, -1), Vec3(3, 0, 3), Vec3(-1, 0, 3)},
+      std::vector<std::array<uint32_t, 3>>{{0, 2, 1}, {0, 3, 2}});
+  BulkSystem b(2);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(0.1, 1.9), up(0.02, 0.3);
+  for (int i = 0; i < 1000; ++i) {
+    b.state.Add(Vec3(u(rng), up(rng), u(rng)), Vec3::Zero());
+    b.state.radius.back() = 0.01f;
+  }
+  b.fields.gravity = Vec3(0, -kG, 0);
+  ASSERT_OK(b.AddCollider(Collider::Mesh(floor).Restitution(0).Friction(0.8)));
+  for (int k = 0; k < 60; ++k) BULK_STEP_OK(b, 1.0 / 60);
+  ASSERT_GT(b.sleepers(), 900u) << "flakes asleep before the wall comes";
+  const auto wall = std::make_shared<TriangleBvh>(
+      std::vector<Vec3>{Vec3(0, -1, -1), Vec3(0, -1, 3), Vec3(0, 2, 3), Vec3(0, 2, -1)},
+      std::vector<std::array<uint32_t, 3>>{{0, 1, 2}, {0, 2, 3}});
+  ASSERT_OK(b.AddCollider(Collider::Mesh(wall).Restitution(0).Velocity(Vec3(1, 0, 0))));
+  std::vector<double> x0(b.state.size());
+  for (size_t i = 0; i < x0.size(); ++i) x0[i] = double(b.state.px[i]);
+  for (int k = 0; k < 60; ++k) {
+    BULK_STEP_OK(b, 1.0 / 60);
+    EXPECT_EQ(b.sleepers(), 0u) << "a moving collider: nobody sleeps, step " << k;
+  }
+  // After a second the wall is at x = 1: every flake that began behind it
+  // (x0 < 1) is ahead of it now, touching it or beyond.
+  const double wallX = b.colliders().back().offset.x();
+  int swept = 0, behind = 0;
+  for (size_t i = 0; i < x0.size(); ++i) {
+    if (x0[i] >= 1) continue;
+    ++swept;
+    behind += double(b.state.px[i]) < wallX + 0.01 - 1e-5;
+  }
+  EXPECT_NEAR(wallX, 1.0, 1e-5);
+  EXPECT_GT(swept, 300) << "flakes in the wall's way";
+  EXPECT_EQ(behind, 0) << "of " << swept << " flakes in its way, left behind the wall";
+}
+
 TEST(Bulk, ElasticBallReturnsToItsHeightAsTheDoubleSystemDoes) {
   const double h = 1e-4;
   const Collider floor = Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0)).Restitution(1);
