@@ -483,7 +483,7 @@ template <int G>
     const __m512d up = Max(en[g], k.zero);
     __m512d x1p[3];
     for (int c = 0; c < 3; ++c) {
-      const __m512d f = _mm512_mask_blend_pd(stops, _mm512_mul_pd(vt[g][c], keep), k.zero);
+      const __m512d f = _mm512_maskz_mul_pd(__mmask8(~stops), vt[g][c], keep);  // 0 where stops
       out[g][c] = _mm512_add_pd(f, _mm512_mul_pd(up, k.n[c]));
       x1[g][c] = _mm512_add_pd(point[g][c], _mm512_mul_pd(k.h, out[g][c]));
       x1p[c] = _mm512_sub_pd(x1[g][c], k.p[c]);
