@@ -15,6 +15,7 @@ namespace {
 // Particles a chunk: the chunk's previous state (6 floats a particle) and
 // candidate flags stay in L1.
 constexpr size_t kChunk = 512;
+static_assert(kChunk <= kernels::kRestRange);
 
 Vec3f Round(const Vec3& x) {
   return Vec3f(float(x.x()), float(x.y()), float(x.z()));
@@ -145,9 +146,9 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
     const size_t ce = std::min(end, c + kChunk), m = ce - c;
     size_t count = 0;
     if (floor && restLanes_ == 8) {
-      // A lone static floor on eight lanes: the advance, the floor's
-      // candidates and its resting contacts in one pass; what is left of
-      // the candidates to the general path below.
+      // A lone static floor on eight lanes: the advance and the floor's
+      // candidates, then its resting contacts, over the chunk; what is
+      // left of the candidates to the general path below.
       bool ok = true;
       count = kernels::BulkAdvanceRestOnPlane(q, *floor, a, s.radius.data(), c, ce, olds, idx, &ok);
       if (!ok) faults_.Flag();

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/assert.h"
+
 namespace sylva::particles::kernels {
 namespace {
 
@@ -396,12 +398,140 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   return _mm512_max_pd(b, a);
 }
 
+// The plane and the step on eight lanes, for RestGroupsAvx512.
+struct Rest8 {
+  __m512d n[3], p[3], h, mh, half, mu, zero, one, tiny, tol, mtol, limit2;
+};
+
+// The resting kernel on the candidates of G groups of eight consecutive
+// particles, group g starting at first + at[g] (its start state in
+// old[..][at[g]], its advanced state in the arrays, its candidates the
+// lanes of cand[g]). Each group's chain of dependent operations is long
+// (about 40 deep, through a square root and a division), longer than the
+// processor's scheduler can look ahead past, so the groups' computations
+// are interleaved, statement by statement, for the vector units to work
+// on G chains at once. Writes the particles it resolves to the arrays and
+// appends the other candidates' offsets (at[g] + lane) to idx.
+template <int G>
+[[SYLVA_AVX512]] void RestGroupsAvx512(const Rest8& k, const BulkArrays& ar, const float* radius,
+                                       const float* const* old, size_t first, const uint16_t* at,
+                                       const __mmask8* cand, uint16_t* idx, size_t* listed) {
+  float* const to[6] = {ar.px + first, ar.py + first, ar.pz + first,
+                        ar.vx + first, ar.vy + first, ar.vz + first};
+  __m512d a[G][3], va[G][3], v[G][3], x[G][3], r[G];
+  for (int g = 0; g < G; ++g) {
+    for (int c = 0; c < 3; ++c) {
+      a[g][c] = _mm512_cvtps_pd(_mm256_loadu_ps(old[c] + at[g]));
+      va[g][c] = _mm512_cvtps_pd(_mm256_loadu_ps(old[3 + c] + at[g]));
+      x[g][c] = _mm512_cvtps_pd(_mm256_loadu_ps(to[c] + at[g]));
+      v[g][c] = _mm512_cvtps_pd(_mm256_loadu_ps(to[3 + c] + at[g]));
+    }
+    r[g] = _mm512_cvtps_pd(_mm256_loadu_ps(radius + first + at[g]));
+  }
+  __m512d dv[G][3], A[G][3], u[G][3], ap[G][3];
+  for (int g = 0; g < G; ++g) {
+    for (int c = 0; c < 3; ++c) {
+      dv[g][c] = _mm512_sub_pd(v[g][c], va[g][c]);
+      A[g][c] = _mm512_mul_pd(k.h, dv[g][c]);
+      u[g][c] = _mm512_sub_pd(_mm512_sub_pd(x[g][c], a[g][c]), _mm512_mul_pd(k.half, A[g][c]));
+      ap[g][c] = _mm512_sub_pd(a[g][c], k.p[c]);
+    }
+  }
+  // The plane's contact at the start (a candidate ends the step inside:
+  // d1 < 0): d0 <= 0 (s = 0).
+  __m512d d0[G], point[G][3], un[G];
+  __mmask8 ok[G], along[G], grazes = 0;
+  for (int g = 0; g < G; ++g) {
+    d0[g] = _mm512_sub_pd(Dot3(k.n, ap[g][0], ap[g][1], ap[g][2]), r[g]);
+    ok[g] = _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ);
+    for (int c = 0; c < 3; ++c) point[g][c] = _mm512_sub_pd(a[g][c], _mm512_mul_pd(d0[g], k.n[c]));
+    // Not a graze (sliding along the plane within rounding): a path not
+    // into the plane (rare for a candidate), ending on it.
+    const __m512d umax = Max(k.tiny, Max(Max(Abs(u[g][0]), Abs(u[g][1])), Abs(u[g][2])));
+    un[g] = Dot3(k.n, u[g][0], u[g][1], u[g][2]);
+    along[g] = _mm512_cmp_pd_mask(un[g], _mm512_mul_pd(k.mtol, umax), _CMP_GE_OQ);
+    grazes |= along[g] & ok[g];
+  }
+  if (grazes) {
+    for (int g = 0; g < G; ++g) {
+      __m512d px[3];
+      for (int c = 0; c < 3; ++c) px[c] = _mm512_sub_pd(point[g][c], x[g][c]);
+      const __m512d xmax = Max(k.one, Max(Max(Abs(x[g][0]), Abs(x[g][1])), Abs(x[g][2])));
+      ok[g] &= ~(_mm512_cmp_pd_mask(Dot3(k.n, px[0], px[1], px[2]), _mm512_mul_pd(k.tol, xmax),
+                                    _CMP_LE_OQ) &
+                 along[g]);
+    }
+  }
+  // Resting: no faster toward the plane than the step's forces made it.
+  // The response.
+  __m512d en[G], vt[G][3], change[G], len[G];
+  for (int g = 0; g < G; ++g) {
+    const __m512d gained =
+        Max(k.zero, _mm512_mul_pd(k.mh, Dot3(k.n, dv[g][0], dv[g][1], dv[g][2])));
+    ok[g] &= ~_mm512_cmp_pd_mask(Neg(un[g]), gained, _CMP_GT_OQ);
+    en[g] = Dot3(k.n, v[g][0], v[g][1], v[g][2]);
+    for (int c = 0; c < 3; ++c) vt[g][c] = _mm512_sub_pd(v[g][c], _mm512_mul_pd(en[g], k.n[c]));
+    change[g] = _mm512_mul_pd(k.mu, Max(k.zero, Neg(en[g])));
+    len[g] = _mm512_sqrt_pd(_mm512_add_pd(
+        _mm512_add_pd(_mm512_mul_pd(vt[g][0], vt[g][0]), _mm512_mul_pd(vt[g][1], vt[g][1])),
+        _mm512_mul_pd(vt[g][2], vt[g][2])));
+  }
+  __m512d out[G][3], x1[G][3];
+  for (int g = 0; g < G; ++g) {
+    const __mmask8 stops = _mm512_cmp_pd_mask(len[g], change[g], _CMP_LE_OQ);
+    const __m512d keep = _mm512_sub_pd(k.one, _mm512_div_pd(change[g], len[g]));
+    const __m512d up = Max(en[g], k.zero);
+    __m512d x1p[3];
+    for (int c = 0; c < 3; ++c) {
+      const __m512d f = _mm512_maskz_mul_pd(__mmask8(~stops), vt[g][c], keep);  // 0 where stops
+      out[g][c] = _mm512_add_pd(f, _mm512_mul_pd(up, k.n[c]));
+      x1[g][c] = _mm512_add_pd(point[g][c], _mm512_mul_pd(k.h, out[g][c]));
+      x1p[c] = _mm512_sub_pd(x1[g][c], k.p[c]);
+    }
+    // Ends on the plane: no second contact, nothing to project.
+    ok[g] &= _mm512_cmp_pd_mask(_mm512_sub_pd(Dot3(k.n, x1p[0], x1p[1], x1p[2]), r[g]), k.zero,
+                                _CMP_GE_OQ);
+  }
+  for (int g = 0; g < G; ++g) {
+    // Rounded to floats on the plane's side: a rounding's displacement,
+    // doubled, must not cross it. (A rounding that changes nothing passes
+    // here too: its doubled displacement is 0, the test above.)
+    __m256 xf[3];
+    __m512d rx[3], by[3];
+    for (int c = 0; c < 3; ++c) {
+      xf[c] = _mm512_cvtpd_ps(x1[g][c]);
+      rx[c] = _mm512_cvtps_pd(xf[c]);
+      by[c] = _mm512_sub_pd(_mm512_add_pd(rx[c], _mm512_sub_pd(rx[c], x1[g][c])), k.p[c]);
+    }
+    const __m512d db = _mm512_sub_pd(Dot3(k.n, by[0], by[1], by[2]), r[g]);
+    ok[g] &= _mm512_cmp_pd_mask(db, k.zero, _CMP_GE_OQ);
+    // Within the magnitude limit.
+    const __m512d xx =
+        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(rx[0], rx[0]), _mm512_mul_pd(rx[1], rx[1])),
+                      _mm512_mul_pd(rx[2], rx[2]));
+    const __m512d vv = _mm512_add_pd(
+        _mm512_add_pd(_mm512_mul_pd(out[g][0], out[g][0]), _mm512_mul_pd(out[g][1], out[g][1])),
+        _mm512_mul_pd(out[g][2], out[g][2]));
+    ok[g] &= _mm512_cmp_pd_mask(_mm512_add_pd(xx, vv), k.limit2, _CMP_LE_OQ);
+    const __mmask8 done = ok[g] & cand[g];
+    for (int c = 0; c < 3; ++c) {
+      _mm256_mask_storeu_ps(to[c] + at[g], done, xf[c]);
+      _mm256_mask_storeu_ps(to[3 + c] + at[g], done, _mm512_cvtpd_ps(out[g][c]));
+    }
+    // The rest to the general path.
+    for (unsigned left = unsigned(cand[g] & ~done); left; left &= left - 1)
+      idx[(*listed)++] = uint16_t(at[g] + unsigned(__builtin_ctz(left)));
+  }
+}
+
 // BulkAdvanceAvx's step, the plane's candidate test (PlaneListAvx's) and
-// the resting kernel in one pass over eight particles at a time, each value
-// in registers from its load to its store: the same operations on the same
-// values as the three passes in turn. Returns the first index it did not
-// do; the candidates the resting kernel leaves go to idx (relative to
-// first), *count counting them.
+// the resting kernel over [i, e), eight particles at a time, in two passes
+// over that range (at most a chunk, which stays in L1): the advance and
+// the candidate test, listing the groups of eight with candidates, then
+// the resting kernel on those groups four at a time (RestGroupsAvx512): the
+// same operations on the same values as the three kernels in turn. Returns
+// the first index it did not do; the candidates the resting kernel leaves
+// go to idx (relative to first), in order, *count counting them.
 [[SYLVA_AVX512]] size_t AdvanceRestAvx512(const BulkParams& q, const PlaneRest& rq,
                                           const BulkArrays& ar, const float* radius, size_t i,
                                           size_t e, size_t first, float* const* old, uint16_t* idx,
@@ -414,12 +544,11 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   __m256 within = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
   const __m512d n[3] = {_mm512_set1_pd(rq.n[0]), _mm512_set1_pd(rq.n[1]), _mm512_set1_pd(rq.n[2])};
   const __m512d p[3] = {_mm512_set1_pd(rq.p[0]), _mm512_set1_pd(rq.p[1]), _mm512_set1_pd(rq.p[2])};
-  const __m512d h = _mm512_set1_pd(rq.h), mh = _mm512_set1_pd(-q.h), half = _mm512_set1_pd(0.5);
-  const __m512d mu = _mm512_set1_pd(rq.friction), zero = _mm512_setzero_pd();
-  const __m512d one = _mm512_set1_pd(1.0), tiny = _mm512_set1_pd(1e-300);
-  const __m512d tol = _mm512_set1_pd(1e-12), mtol = _mm512_set1_pd(-1e-12);
-  const __m512d limit2 = _mm512_set1_pd(rq.limit2);
-  size_t listed = *count;
+  // The groups with candidates: their offsets from first and candidates.
+  uint16_t at[kRestRange / 8];
+  __mmask8 cand[kRestRange / 8];
+  size_t groups = 0;
+  SYLVA_ASSERT(e - i <= kRestRange);
   for (; i + 8 <= e; i += 8) {
     const size_t o = i - first;
     // The advance (BulkAdvanceAvx).
@@ -449,105 +578,32 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
         within, _mm256_and_ps(_mm256_and_ps(Within(x1f, absf, limit), Within(y1f, absf, limit)),
                               _mm256_and_ps(Within(z1f, absf, limit), Within(u1, absf, limit))));
     within = _mm256_and_ps(within, _mm256_and_ps(Within(v1, absf, limit), Within(s1, absf, limit)));
-    __m256 values[6] = {x1f, y1f, z1f, u1, v1, s1};
-    // The candidates (PlaneListAvx): movable particles that end behind the plane.
-    const __m512d x[3] = {_mm512_cvtps_pd(x1f), _mm512_cvtps_pd(y1f), _mm512_cvtps_pd(z1f)};
+    _mm256_storeu_ps(ar.px + i, x1f), _mm256_storeu_ps(ar.py + i, y1f);
+    _mm256_storeu_ps(ar.pz + i, z1f), _mm256_storeu_ps(ar.vx + i, u1);
+    _mm256_storeu_ps(ar.vy + i, v1), _mm256_storeu_ps(ar.vz + i, s1);
+    // The candidates (PlaneListAvx): movable particles that end behind the
+    // plane; the group listed if it has any (without a branch).
     const __m512d r = _mm512_cvtps_pd(_mm256_loadu_ps(radius + i));
-    const __mmask8 below = _mm512_cmp_pd_mask(
-        Dot3(n, _mm512_sub_pd(x[0], p[0]), _mm512_sub_pd(x[1], p[1]), _mm512_sub_pd(x[2], p[2])), r,
-        _CMP_LT_OQ);
-    const __mmask8 candidates = below & _mm256_cmp_ps_mask(w, zerof, _CMP_NEQ_UQ);
-    if (candidates) {
-      // The resting kernel on them.
-      const __m512d a[3] = {_mm512_cvtps_pd(x0), _mm512_cvtps_pd(y0), _mm512_cvtps_pd(z0)};
-      const __m512d va[3] = {_mm512_cvtps_pd(u0), _mm512_cvtps_pd(v0), _mm512_cvtps_pd(s0)};
-      const __m512d v[3] = {_mm512_cvtps_pd(u1), _mm512_cvtps_pd(v1), _mm512_cvtps_pd(s1)};
-      __m512d dv[3], A[3], u[3], ap[3];
-      for (int c = 0; c < 3; ++c) {
-        dv[c] = _mm512_sub_pd(v[c], va[c]);
-        A[c] = _mm512_mul_pd(h, dv[c]);
-        u[c] = _mm512_sub_pd(_mm512_sub_pd(x[c], a[c]), _mm512_mul_pd(half, A[c]));
-        ap[c] = _mm512_sub_pd(a[c], p[c]);
-      }
-      // The plane's contact at the start (a candidate ends the step inside:
-      // d1 < 0): d0 <= 0 (s = 0).
-      const __m512d d0 = _mm512_sub_pd(Dot3(n, ap[0], ap[1], ap[2]), r);
-      __mmask8 ok = _mm512_cmp_pd_mask(d0, zero, _CMP_LE_OQ);
-      __m512d point[3], px[3];
-      for (int c = 0; c < 3; ++c) point[c] = _mm512_sub_pd(a[c], _mm512_mul_pd(d0, n[c]));
-      // Not a graze (sliding along the plane within rounding): a path not
-      // into the plane (rare for a candidate), ending on it.
-      const __m512d umax = Max(tiny, Max(Max(Abs(u[0]), Abs(u[1])), Abs(u[2])));
-      const __m512d un = Dot3(n, u[0], u[1], u[2]);
-      const __mmask8 along = _mm512_cmp_pd_mask(un, _mm512_mul_pd(mtol, umax), _CMP_GE_OQ);
-      if (along & ok) {
-        for (int c = 0; c < 3; ++c) px[c] = _mm512_sub_pd(point[c], x[c]);
-        const __m512d xmax = Max(one, Max(Max(Abs(x[0]), Abs(x[1])), Abs(x[2])));
-        ok &= ~(
-            _mm512_cmp_pd_mask(Dot3(n, px[0], px[1], px[2]), _mm512_mul_pd(tol, xmax), _CMP_LE_OQ) &
-            along);
-      }
-      // Resting: no faster toward the plane than the step's forces made it.
-      const __m512d gained = Max(zero, _mm512_mul_pd(mh, Dot3(n, dv[0], dv[1], dv[2])));
-      ok &= ~_mm512_cmp_pd_mask(Neg(un), gained, _CMP_GT_OQ);
-      // The response.
-      const __m512d en = Dot3(n, v[0], v[1], v[2]);
-      const __m512d jn = Max(zero, Neg(en));
-      __m512d vt[3];
-      for (int c = 0; c < 3; ++c) vt[c] = _mm512_sub_pd(v[c], _mm512_mul_pd(en, n[c]));
-      const __m512d change = _mm512_mul_pd(mu, jn);
-      const __m512d len = _mm512_sqrt_pd(
-          _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(vt[0], vt[0]), _mm512_mul_pd(vt[1], vt[1])),
-                        _mm512_mul_pd(vt[2], vt[2])));
-      const __mmask8 stops = _mm512_cmp_pd_mask(len, change, _CMP_LE_OQ);
-      const __m512d keep = _mm512_sub_pd(one, _mm512_div_pd(change, len));
-      const __m512d up = Max(en, zero);
-      __m512d out[3], x1[3], x1p[3];
-      for (int c = 0; c < 3; ++c) {
-        const __m512d f = _mm512_mask_blend_pd(stops, _mm512_mul_pd(vt[c], keep), zero);
-        out[c] = _mm512_add_pd(f, _mm512_mul_pd(up, n[c]));
-        x1[c] = _mm512_add_pd(point[c], _mm512_mul_pd(h, out[c]));
-        x1p[c] = _mm512_sub_pd(x1[c], p[c]);
-      }
-      // Ends on the plane: no second contact, nothing to project.
-      ok &= _mm512_cmp_pd_mask(_mm512_sub_pd(Dot3(n, x1p[0], x1p[1], x1p[2]), r), zero, _CMP_GE_OQ);
-      // Rounded to floats on the plane's side: a rounding's displacement,
-      // doubled, must not cross it. (A rounding that changes nothing passes
-      // here too: its doubled displacement is 0, the test above.)
-      __m256 xf[3];
-      __m512d rx[3], by[3];
-      for (int c = 0; c < 3; ++c) {
-        xf[c] = _mm512_cvtpd_ps(x1[c]);
-        rx[c] = _mm512_cvtps_pd(xf[c]);
-        by[c] = _mm512_sub_pd(_mm512_add_pd(rx[c], _mm512_sub_pd(rx[c], x1[c])), p[c]);
-      }
-      const __m512d db = _mm512_sub_pd(Dot3(n, by[0], by[1], by[2]), r);
-      ok &= _mm512_cmp_pd_mask(db, zero, _CMP_GE_OQ);
-      // Within the magnitude limit.
-      const __m512d xx =
-          _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(rx[0], rx[0]), _mm512_mul_pd(rx[1], rx[1])),
-                        _mm512_mul_pd(rx[2], rx[2]));
-      const __m512d vv =
-          _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(out[0], out[0]), _mm512_mul_pd(out[1], out[1])),
-                        _mm512_mul_pd(out[2], out[2]));
-      ok &= _mm512_cmp_pd_mask(_mm512_add_pd(xx, vv), limit2, _CMP_LE_OQ);
-      const __mmask8 done = ok & candidates;
-      const __m256 rested[6] = {xf[0],
-                                xf[1],
-                                xf[2],
-                                _mm512_cvtpd_ps(out[0]),
-                                _mm512_cvtpd_ps(out[1]),
-                                _mm512_cvtpd_ps(out[2])};
-      for (int c = 0; c < 6; ++c) values[c] = _mm256_mask_blend_ps(done, values[c], rested[c]);
-      // The rest to the general path.
-      for (unsigned left = unsigned(candidates & ~done); left; left &= left - 1)
-        idx[listed++] = uint16_t(o + unsigned(__builtin_ctz(left)));
-    }
-    float* const to[6] = {ar.px, ar.py, ar.pz, ar.vx, ar.vy, ar.vz};
-    for (int c = 0; c < 6; ++c) _mm256_storeu_ps(to[c] + i, values[c]);
+    const __m512d d =
+        Dot3(n, _mm512_sub_pd(_mm512_cvtps_pd(x1f), p[0]),
+             _mm512_sub_pd(_mm512_cvtps_pd(y1f), p[1]), _mm512_sub_pd(_mm512_cvtps_pd(z1f), p[2]));
+    const __mmask8 candidates =
+        _mm512_cmp_pd_mask(d, r, _CMP_LT_OQ) & _mm256_cmp_ps_mask(w, zerof, _CMP_NEQ_UQ);
+    at[groups] = uint16_t(o);
+    cand[groups] = candidates;
+    groups += candidates != 0;
   }
-  *count = listed;
   *good = *good && _mm256_movemask_ps(within) == 0xff;
+  // The resting kernel on the listed groups.
+  const Rest8 k{{n[0], n[1], n[2]},    {p[0], p[1], p[2]},     _mm512_set1_pd(rq.h),
+                _mm512_set1_pd(-q.h),  _mm512_set1_pd(0.5),    _mm512_set1_pd(rq.friction),
+                _mm512_setzero_pd(),   _mm512_set1_pd(1.0),    _mm512_set1_pd(1e-300),
+                _mm512_set1_pd(1e-12), _mm512_set1_pd(-1e-12), _mm512_set1_pd(rq.limit2)};
+  size_t g = 0;
+  for (; g + 4 <= groups; g += 4)
+    RestGroupsAvx512<4>(k, ar, radius, old, first, at + g, cand + g, idx, count);
+  for (; g < groups; ++g)
+    RestGroupsAvx512<1>(k, ar, radius, old, first, at + g, cand + g, idx, count);
   return i;
 }
 

@@ -133,12 +133,15 @@ struct PlaneRest {
 void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radius,
                      const float* const* old, size_t begin, const uint16_t* idx, size_t count,
                      uint8_t* done);
-// BulkAdvance (AVX), BulkPlaneCandidateList and BulkRestOnPlane in one
-// pass over [begin, end), each particle's values kept in registers from
-// its load to its store (8 lanes; only where RestLanes() is 8): the same
-// bits as the three in turn. Writes to idx the candidates the resting
-// kernel leaves (for the general path), as BulkPlaneCandidateList, and
-// returns their count; ANDs BulkAdvance's check into *ok.
+// BulkAdvance (AVX), BulkPlaneCandidateList and BulkRestOnPlane over
+// [begin, end), at most kRestRange particles (8 lanes; only where
+// RestLanes() is 8): the same bits as the three in turn. Two passes over
+// the range, which stays in L1: the advance and the candidate test, then
+// the resting kernel on the groups of eight with candidates, four groups
+// at a time. Writes to idx the candidates the resting kernel leaves (for the
+// general path), as BulkPlaneCandidateList, and returns their count; ANDs
+// BulkAdvance's check into *ok.
+constexpr size_t kRestRange = 512;
 size_t BulkAdvanceRestOnPlane(const BulkParams& q, const PlaneRest& rest, const BulkArrays& a,
                               const float* radius, size_t begin, size_t end, float* const* old,
                               uint16_t* idx, bool* ok);

@@ -156,6 +156,113 @@ TEST(Bulk, RestingFloorKernelMatchesTheScalarPathBitForBit) {
   }
 }
 
+// Particles for RestingFloorGroupsInAnyNumberMatchTheScalarPath: chunks of
+// 512 (the bulk step's) over the floor y = -1, chunk c with c + 1 groups of
+// eight (every seventh group) whose lanes rest on it in every way, every
+// other particle in the air; then a ragged tail of five.
+void FillGroups(BulkState& s, int chunks) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int c = 0; c < chunks; ++c) {
+    for (int j = 0; j < 512; ++j) {
+      const int group = j / 8;
+      const double x = u(rng), z = u(rng), vx = u(rng), vz = u(rng);
+      if (group % 7 != 0 || group / 7 > c) {
+        s.Add(Vec3(x, 0.5 + 0.4 * u(rng), z), Vec3(vx, u(rng), vz));
+        continue;
+      }
+      switch (j % 8) {
+        case 0:  // sliding, on a signed zero
+          s.Add(Vec3(j % 16 ? -0.0 : 0.0, -1, z), Vec3(vx, 0, vz));
+          break;
+        case 1:  // at rest, velocity of negative zeros
+          s.Add(Vec3(x, -1, z), Vec3(-0.0, -0.0, -0.0));
+          break;
+        case 2:  // slow enough for friction to stop it
+          s.Add(Vec3(x, -1, z), Vec3(1e-4 * vx, 0, 1e-4 * vz));
+          break;
+        case 3:  // falling fast onto it: a bounce, for the general path
+          s.Add(Vec3(x, -0.999, z), Vec3(vx, -5, vz));
+          break;
+        case 4:  // immovable, on it
+          s.AddPinned(Vec3(x, -1, z));
+          break;
+        case 5:  // in the air
+          s.Add(Vec3(x, 0.25, z), Vec3(vx, 0, vz));
+          break;
+        case 6:
+          if (group % 2 == 0) {  // a ball resting at its radius, exactly
+            s.Add(Vec3(x, -1 + 0.0078125, z), Vec3(vx, 0, vz));
+            s.radius.back() = 0.0078125f;
+          } else {  // a hair inside (in floats): its rounding goes back inside
+            s.Add(Vec3(x, -0.99, z), Vec3(vx, 0, vz));
+            s.radius.back() = 0.01f;
+          }
+          break;
+        default:  // sliding along x, zeros of both signs
+          s.Add(Vec3(x, -1, -0.0), Vec3(vx, -0.0, 0.0));
+      }
+    }
+  }
+  for (int i = 0; i < 5; ++i) s.Add(Vec3(u(rng), -1, u(rng)), Vec3(u(rng), 0, u(rng)));
+}
+
+TEST(Bulk, RestingFloorGroupsInAnyNumberMatchTheScalarPath) {
+  if (kernels::RestLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  // The 8-lane path lists a chunk's groups of eight with candidates and
+  // resolves them four at a time, then one at a time: chunks with 1 to 9
+  // such groups (every remainder), on an axis-aligned floor, each group
+  // mixing resting, sliding and stopping lanes, a bounce, an immovable lane
+  // and one in the air.
+  constexpr int kChunks = 9;
+  for (double mu : {0.1, 3.0}) {
+    BulkSystem avx, scalar;
+    for (BulkSystem* b : {&avx, &scalar}) {
+      FillGroups(b->state, kChunks);
+      b->fields.gravity = Vec3(0, -kG, 0);
+      b->fields.linearDrag = 0.1;
+      b->fields.quadraticDrag = 0.01;
+      EXPECT_OK(b->AddCollider(
+          Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.8).Friction(mu)));
+    }
+    // The kernel itself, on the first step of each chunk: it resolves every
+    // resting lane and leaves to the general path each group's bounce, and
+    // the ball whose rounding would put it inside (every other group).
+    {
+      BulkState s = avx.state;
+      const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
+                                  s.vy.data(), s.vz.data(), s.invMass.data()};
+      const double h = double(float(1.0 / 240));
+      const kernels::BulkParams q{0, float(-kG), 0, 0, 0, 0, 0.1f, 0.01f, float(h), 1e30f};
+      const kernels::PlaneRest rest{{0, 1, 0}, {0, -1, 0}, mu, h, 1e300};
+      std::vector<float> old(6 * 512);
+      float* const olds[6] = {&old[0], &old[512], &old[1024], &old[1536], &old[2048], &old[2560]};
+      std::vector<uint16_t> idx(512 + 4);
+      for (int c = 0; c < kChunks; ++c) {
+        bool ok = true;
+        const size_t left =
+            kernels::BulkAdvanceRestOnPlane(q, rest, a, s.radius.data(), size_t(512 * c),
+                                            size_t(512 * (c + 1)), olds, idx.data(), &ok);
+        EXPECT_TRUE(ok);
+        std::vector<uint16_t> expected;
+        for (int g = 0; g <= 7 * c; g += 7) {
+          expected.push_back(uint16_t(8 * g + 3));
+          if (g % 2) expected.push_back(uint16_t(8 * g + 6));
+        }
+        EXPECT_EQ(std::vector<uint16_t>(idx.begin(), idx.begin() + ptrdiff_t(left)), expected)
+            << "mu " << mu << ", chunk " << c << ": the candidates left";
+      }
+    }
+    avx.SetKernel(kernels::Kernel::kAvx, 8);
+    scalar.SetKernel(kernels::Kernel::kScalar);
+    for (int k = 0; k < 60; ++k) {
+      BULK_STEP_OK(avx, 1.0 / 240);
+      BULK_STEP_OK(scalar, 1.0 / 240);
+      ASSERT_EQ(avx.Hash(), scalar.Hash()) << "mu " << mu << ": states differ after step " << k;
+    }
+  }
+}
+
 TEST(Bulk, PlaneCandidatesAreExactlyTheColliderTest) {
   if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
   // Points on, just above and just below a tilted plane through a point
