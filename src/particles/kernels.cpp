@@ -610,6 +610,70 @@ template <int G>
 #pragma GCC diagnostic pop
 #undef SYLVA_AVX512
 
+// --- Pair screen (System, pairs.cpp) ---
+
+uint32_t ScreenScalar(const double* __restrict x, uint32_t k, uint32_t to,
+                      const double* __restrict p, double reach2, uint32_t* __restrict out) {
+  const double px = p[0], py = p[1], pz = p[2];
+  uint32_t m = 0;
+  for (; k < to; ++k) {
+    const double* xk = x + 3 * size_t(k);
+    const double dx = xk[0] - px, dy = xk[1] - py, dz = xk[2] - pz;
+    out[m] = k;  // without a branch: kept where it passes
+    m += uint32_t(dx * dx + dy * dy + dz * dz <= reach2);
+  }
+  return m;
+}
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+// Eight points a step: their 24 doubles in three registers, split into
+// x, y and z by two permutes each.
+[[gnu::target("avx512f,avx512vl")]] uint32_t ScreenAvx512(const double* __restrict x, uint32_t k,
+                                                         uint32_t to, const double* __restrict p,
+                                                         double reach2,
+                                                         uint32_t* __restrict out) {
+  const __m512i ax = _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0);
+  const __m512i bx = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13);
+  const __m512i ay = _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0);
+  const __m512i by = _mm512_setr_epi64(0, 1, 2, 3, 4, 8, 11, 14);
+  const __m512i az = _mm512_setr_epi64(2, 5, 8, 11, 14, 0, 0, 0);
+  const __m512i bz = _mm512_setr_epi64(0, 1, 2, 3, 4, 9, 12, 15);
+  const __m512d px = _mm512_set1_pd(p[0]), py = _mm512_set1_pd(p[1]), pz = _mm512_set1_pd(p[2]);
+  const __m512d r2 = _mm512_set1_pd(reach2);
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  uint32_t m = 0;
+  for (; k < to; k += 8) {
+    const uint32_t left = std::min<uint32_t>(8, to - k);
+    const double* xk = x + 3 * size_t(k);
+    __m512d a, b, c;
+    if (left == 8) {
+      a = _mm512_loadu_pd(xk);
+      b = _mm512_loadu_pd(xk + 8);
+      c = _mm512_loadu_pd(xk + 16);
+    } else {
+      // The 3 left doubles, masked: lanes past the end read nothing.
+      const uint32_t d = 3 * left;
+      a = _mm512_maskz_loadu_pd(__mmask8((1u << std::min(d, 8u)) - 1), xk);
+      b = _mm512_maskz_loadu_pd(__mmask8((1u << (d > 8 ? std::min(d - 8, 8u) : 0u)) - 1), xk + 8);
+      c = _mm512_maskz_loadu_pd(__mmask8((1u << (d > 16 ? d - 16 : 0u)) - 1), xk + 16);
+    }
+    const __m512d X = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, ax, b), bx, c);
+    const __m512d Y = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, ay, b), by, c);
+    const __m512d Z = _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, az, b), bz, c);
+    const __m512d dx = _mm512_sub_pd(X, px), dy = _mm512_sub_pd(Y, py), dz = _mm512_sub_pd(Z, pz);
+    const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                                     _mm512_mul_pd(dz, dz));
+    const __mmask8 in =
+        _mm512_cmp_pd_mask(d2, r2, _CMP_LE_OQ) & __mmask8((1u << left) - 1);
+    _mm256_mask_compressstoreu_epi32(out + m, in,
+                                     _mm256_add_epi32(_mm256_set1_epi32(int(k)), lane));
+    m += uint32_t(__builtin_popcount(in));
+  }
+  return m;
+}
+#pragma GCC diagnostic pop
+
 }  // namespace
 
 double Dot(Kernel kernel, const double* a, const double* b, size_t begin, size_t end) {
@@ -705,6 +769,22 @@ void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radiu
                      const float* const* old, size_t begin, const uint16_t* idx, size_t count,
                      uint8_t* done) {
   RestOnPlaneAvx(q, a, radius, old, begin, idx, count, done);
+}
+
+
+int ScreenLanes() {
+  static const int lanes = (__builtin_cpu_init(), __builtin_cpu_supports("avx512f") &&
+                                                      __builtin_cpu_supports("avx512vl"))
+                               ? 8
+                               : 0;
+  return lanes;
+}
+
+uint32_t ScreenCandidates(Kernel kernel, const double* x, uint32_t from, uint32_t to,
+                          const double* p, double reach2, uint32_t* out) {
+  if (kernel == Kernel::kAvx && ScreenLanes() == 8)
+    return ScreenAvx512(x, from, to, p, reach2, out);
+  return ScreenScalar(x, from, to, p, reach2, out);
 }
 
 }  // namespace sylva::particles::kernels

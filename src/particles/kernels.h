@@ -150,4 +150,18 @@ size_t BulkAdvanceRestOnPlane(const BulkParams& q, const PlaneRest& rest, const 
 // (BulkRestOnPlane) with AVX, 0 without AVX (no vector path).
 int RestLanes();
 
+// --- System's particle-particle contacts (pairs.cpp) ---
+
+// A pair screen: of the points x[from, to) (3 doubles each), writes to out
+// the indices k (in order) of those within reach of p,
+//   (d_x d_x + d_y d_y) + d_z d_z <= reach2,  d = x[k] - p
+// (a NaN is not within), and returns how many. out has room for to - from.
+// The vector path (kAvx where AVX-512 F and VL run: ScreenLanes() 8) takes
+// eight points a step: three loads, deinterleaved by permutes, the indices
+// compress-stored; the same indices as the scalar loop.
+uint32_t ScreenCandidates(Kernel kernel, const double* x, uint32_t from, uint32_t to,
+                          const double* p, double reach2, uint32_t* out);
+// 8 where ScreenCandidates has its vector path, else 0.
+int ScreenLanes();
+
 }  // namespace sylva::particles::kernels

@@ -89,8 +89,10 @@ constexpr double kConverged = 1e-12;
 constexpr int kPositionPasses = 4;
 constexpr double kRestFraction = 0.5;
 // Candidates of one particle gathered before their contacts are computed:
-// the distance screen runs without a branch a candidate.
-constexpr uint32_t kCandidates = 64;
+// the distance screen runs without a branch a candidate. The buffer's
+// contacts are computed when fewer than kScreenRoom places are left (the
+// order of the contacts does not depend on when).
+constexpr uint32_t kCandidates = 64, kScreenRoom = 16;
 
 // The first t in [0, 1] where |d0 + t dd| = R, or -1; 0 when |d0| < R.
 double TimeOfImpact(const Vec3& d0, const Vec3& dd, double R) {
@@ -174,6 +176,9 @@ double VelocityOwners(size_t pb, size_t pe, const uint32_t* __restrict begin,
   }
   return worst;
 }
+
+// The screen reads positions as 3 doubles a particle.
+static_assert(sizeof(Vec3) == 3 * sizeof(double));
 
 // fn(begin, end) over ranges of [0, n), on the pool if there is one.
 template <typename Fn>
@@ -308,7 +313,8 @@ void System::ParticleCollisions(double h) {
       resting[p] = 0;
       begin[p] = uint32_t(ch.contacts.size());
       // The candidates: the grid's ranges, screened by distance without a
-      // branch, kCandidates at a time.
+      // branch (kernels::ScreenCandidates), into a buffer of kCandidates,
+      // whose contacts are computed when fewer than kScreenRoom are left.
       uint32_t from[14], to[14];
       int ranges = 0;
       pw.grid.ForEachHalfCandidateRange(x0[p], uint32_t(p), [&](uint32_t f, uint32_t t) {
@@ -316,20 +322,19 @@ void System::ParticleCollisions(double h) {
         to[ranges] = t;
         ++ranges;
       });
-      const Vec3* const sx = x0;  // locals: the loop keeps them in registers
       // p's own reach: its radius and step with the largest of the others
       // (no pair that can meet is farther; the margin covers rounding).
       const double reachP = ((r[p] + maxR) + (move[p] + maxMove)) * (1 + 1e-9);
       const double reach2 = std::min(r2, reachP * reachP);
-      const double px = sx[p].x(), py = sx[p].y(), pz = sx[p].z();
       uint32_t cand[kCandidates];
       uint32_t m = 0;
       for (int g = 0; g < ranges; ++g) {
-        for (uint32_t k = from[g]; k < to[g]; ++k) {
-          const double dx = sx[k].x() - px, dy = sx[k].y() - py, dz = sx[k].z() - pz;
-          cand[m] = k;
-          m += uint32_t(dx * dx + dy * dy + dz * dz <= reach2);
-          if (m == kCandidates) {
+        for (uint32_t f = from[g]; f < to[g];) {
+          const uint32_t t = std::min(to[g], f + (kCandidates - m));
+          m += kernels::ScreenCandidates(kernel_, x0[0].data(), f, t, x0[p].data(), reach2,
+                                         cand + m);
+          f = t;
+          if (kCandidates - m < kScreenRoom) {
             contacts(p, cand, m);
             m = 0;
           }

@@ -324,6 +324,11 @@ class System {
 
   // 0 = every hardware thread. Starts a pool of the system's own.
   void SetThreads(int threads);
+  // Chooses the vector kernels (kernels.h; tests compare them with their
+  // scalar twins): kAvx takes the widest this processor runs.
+  void SetKernel(kernels::Kernel k) {
+    kernel_ = k == kernels::Kernel::kAvx ? kernels::Best() : kernels::Kernel::kScalar;
+  }
   // Runs on `pool` (not owned; it must outlive the system), shared with the
   // rest of the process (core/parallel.h SharedPool); null: serial. The
   // results are the same as with SetThreads of any count.

@@ -6,8 +6,10 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "helpers.h"
+#include "particles/kernels.h"
 #include "particles/system.h"
 
 namespace sylva::particles {
@@ -98,6 +100,72 @@ TEST(PairContacts, APileOf2880BallsComesToRest) {
   EXPECT_LT(speed, 0.05) << "the fastest ball still moves at " << speed << " m/s after 5 s";
   EXPECT_LT(drift, 0.05) << "a ball moved " << drift << " m between 4 s and 5 s";
   EXPECT_GE(lowest, 0.05 - 1e-9) << "a centre came down to y = " << lowest;
+}
+
+// The pair screen's vector path (kernels::ScreenCandidates, AVX-512) keeps
+// the same points as the scalar loop, in the same order: ranges of every
+// length 0..40 from every start 0..8 (ragged tails), points exactly at the
+// reach, points with a NaN coordinate (never within).
+TEST(PairContacts, VectorScreenKeepsTheScalarScreensPoints) {
+  if (kernels::ScreenLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double p[3] = {0.1, -0.2, 0.3};
+  std::vector<double> x;
+  for (int k = 0; k < 64; ++k) {
+    if (k % 7 == 3) {  // at the reach 0.5: 0.25 exactly
+      x.insert(x.end(), {p[0] + (k % 2 ? 0.5 : -0.5), p[1], p[2]});
+    } else if (k % 11 == 5) {
+      x.insert(x.end(), {p[0], std::nan(""), p[2]});
+    } else {
+      x.insert(x.end(), {u(rng), u(rng), u(rng)});
+    }
+  }
+  int kept = 0;
+  for (uint32_t from = 0; from <= 8; ++from) {
+    for (uint32_t len = 0; len <= 40; ++len) {
+      uint32_t a[64], b[64];
+      const uint32_t na = kernels::ScreenCandidates(kernels::Kernel::kScalar, x.data(), from,
+                                                    from + len, p, 0.25, a);
+      const uint32_t nb = kernels::ScreenCandidates(kernels::Kernel::kAvx, x.data(), from,
+                                                    from + len, p, 0.25, b);
+      ASSERT_EQ(na, nb) << "points [" << from << ", " << from + len << "): " << na
+                        << " kept by the scalar screen, " << nb << " by the vector one";
+      for (uint32_t k = 0; k < na; ++k)
+        ASSERT_EQ(a[k], b[k]) << "points [" << from << ", " << from + len << "), place " << k;
+      kept += int(na);
+    }
+  }
+  EXPECT_GT(kept, 1000) << "too few points within reach to compare";
+}
+
+// A falling pile stepped with the vector kernels and with their scalar
+// twins (System::SetKernel) gives the same bits at every step.
+TEST(PairContacts, VectorKernelsGiveTheScalarKernelsBits) {
+  if (kernels::ScreenLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  System avx(1), scalar(1);
+  scalar.SetKernel(kernels::Kernel::kScalar);
+  for (System* s : {&avx, &scalar}) {
+    s->AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
+    EXPECT_OK(s->AddCollider(Collider::Box(Vec3(-0.4, 0, -0.4), Vec3(0.4, 10, 0.4), true)
+                                 .Restitution(0.3)
+                                 .Friction(0.5)));
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> jitter(-0.005, 0.005);
+    for (int k = 0; k < 600; ++k) {
+      const int x = k % 8, z = (k / 8) % 8, y = k / 64;
+      s->state.Add(
+          Vec3(-0.35 + 0.1 * x + jitter(rng), 0.1 + 0.11 * y, -0.35 + 0.1 * z + jitter(rng)),
+          Vec3(jitter(rng), 0, jitter(rng)));
+      s->state.radius.back() = k % 5 == 0 ? 0.04f : 0.05f;
+    }
+    EXPECT_OK(s->EnableParticleCollisions(0.05, 0.3));
+  }
+  for (int k = 0; k < 120; ++k) {
+    STEP_OK(avx, 1.0 / 60, Integrator::kSymplecticEuler);
+    STEP_OK(scalar, 1.0 / 60, Integrator::kSymplecticEuler);
+    ASSERT_EQ(avx.Hash(), scalar.Hash()) << "states differ after step " << k;
+  }
 }
 
 // A step with no resting contact (a gas) runs its velocity passes until
