@@ -6,7 +6,7 @@
 #                                  runs each target a fixed number of inputs
 #                                  (-runs) from -seed=1 on a fresh corpus, so
 #                                  the same commit finds the same thing on every
-#                                  machine; about 65 s on a 2-core machine
+#                                  machine; about 72 s on a 2-core machine
 #   scripts/fuzz.sh --hunt SECONDS [TARGET...]
 #                                  long random hunting: replays the regressions,
 #                                  then random seeds for SECONDS in all (split
@@ -68,7 +68,8 @@ for t in "${targets[@]}"; do
   mapfile -t files < <(find tests/fuzz/regressions/"$t" -type f 2>/dev/null | LC_ALL=C sort)
   ((${#files[@]})) || continue
   echo "== $t: replaying ${#files[@]} regression inputs"
-  if ! build-fuzz/tests/fuzz/"$t" "${options[@]}" "${files[@]}" >build-fuzz/"$t".log 2>&1; then
+  if ! build-fuzz/tests/fuzz/"$t" "${options[@]}" -artifact_prefix=build-fuzz/"$t"- "${files[@]}" \
+    >build-fuzz/"$t".log 2>&1; then
     tail -n 80 build-fuzz/"$t".log
     echo "FAIL: a regression input of $t fails again"
     exit 1
@@ -122,9 +123,9 @@ run() {  # target, then -runs=N or -max_total_time=S
   cat build-fuzz/"$t".time
 }
 
-# Runs measured on a 2-core machine (Debian 12, clang 14): CPU time about
-# 49 s for fuzz_plant (25 s of it its 50 seeds), 5 to 7 s for each other
-# target. An idle machine runs them in about that wall time.
+# Runs measured on a 2-core machine (Debian 12, clang 14), CPU time: 52 s
+# for fuzz_plant (25 s of it its 50 seeds), 10 s fuzz_grammar, 7 s fuzz_obj,
+# 3 s fuzz_cpfg_files. An idle machine runs them in about that wall time.
 declare -A runs=([fuzz_plant]=250 [fuzz_grammar]=4000 [fuzz_obj]=20000 [fuzz_cpfg_files]=40000)
 declare -A share=([fuzz_plant]=3 [fuzz_grammar]=1 [fuzz_obj]=1 [fuzz_cpfg_files]=1)
 total_share=0
