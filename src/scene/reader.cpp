@@ -1233,12 +1233,14 @@ ClothDef Reader::ReadCloth(const Elem& e) {
       a.Error("size", "'size' is 'width height' in metres, both above 0");
   }
   if (a.Numbers("resolution", v, 2)) {
-    if (v[0] >= 2 && v[1] >= 2 && v[0] == std::floor(v[0]) && v[1] == std::floor(v[1]) &&
-        v[0] * v[1] <= double(uint64_t(1) << 32)) {
+    // ClothDef's range for each: a product bound alone let 2^31 columns by
+    // 2 rows through to the conversion to int (undefined behaviour).
+    if (v[0] >= 2 && v[1] >= 2 && v[0] <= 10000 && v[1] <= 10000 && v[0] == std::floor(v[0]) &&
+        v[1] == std::floor(v[1])) {
       c.columns = int(v[0]);
       c.rows = int(v[1]);
     } else {
-      a.Error("resolution", "'resolution' is 'columns rows', whole numbers of 2 or more");
+      a.Error("resolution", "'resolution' is 'columns rows', whole numbers from 2 to 10000");
     }
   }
   a.Vector("position", c.position);

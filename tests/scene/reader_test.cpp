@@ -107,6 +107,11 @@ std::vector<BadCase> BadCases() {
        "needs 'of'"},
       {"draw_mesh_needs_mesh", "<particles><emitter/><draw as=\"mesh\"/></particles>\n", "2:22",
        "needs 'mesh'"},
+      // Each below 2^32 in product, 2^31 columns reached the conversion to int.
+      {"cloth_resolution_beyond_int", "<cloth resolution=\"2147483648 2\"/>\n", "2:8",
+       "whole numbers from 2 to 10000"},
+      {"cloth_resolution_above_10000", "<cloth resolution=\"10001 2\"/>\n", "2:8",
+       "whole numbers from 2 to 10000"},
       // Past these the renderer's floats overflowed: an error with no location.
       {"light_intensity_huge", "<light intensity=\"1e300\"/>\n", "2:19", "between 0 and"},
       {"draw_size_huge", "<particles><emitter/><draw size=\"1e300\"/></particles>\n", "2:34",
