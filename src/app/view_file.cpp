@@ -1175,14 +1175,14 @@ void ParseAnimationFile(const std::string& text, const std::string& path, ViewFi
     }
     char* end = nullptr;
     const long x = std::strtol(v->text.c_str(), &end, 10);
-    if (v->text.empty() || *end != '\0' || x < lo || x > lsys::kMaxDerivationLengthForDerive) {
+    if (v->text.empty() || *end != '\0' || x < lo || x > lsys::kMaxAnimationSteps) {
       Diagnostic d;
       d.loc.file = path;
       d.loc.line = v->line;
       d.loc.column = v->column;
       d.message = std::string("'") + label + ":' expects a whole number from " +
-                  std::to_string(lo) + " to " +
-                  std::to_string(lsys::kMaxDerivationLengthForDerive) + ", not '" + v->text + "'";
+                  std::to_string(lo) + " to " + std::to_string(lsys::kMaxAnimationSteps) +
+                  ", not '" + v->text + "'";
       view.diagnostics.Add(std::move(d));
       return false;
     }
