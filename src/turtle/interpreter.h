@@ -109,6 +109,10 @@ struct TurtleDef {
   // for a cpfg file (lsys::Grammar::cpfgFile), whose turtle has no `'`:
   // it is a module that draws nothing.
   bool quoteIsColor = true;
+  // The grammar the word comes from (TurtleDefFrom sets it; it must outlive
+  // the Interpret call), or null: an error about a module is located where
+  // the grammar first writes that module's name (Grammar::symbolLoc).
+  const lsys::Grammar* grammar = nullptr;
 };
 
 TurtleDef TurtleDefFrom(const lsys::Grammar& g);
