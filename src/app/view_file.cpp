@@ -775,8 +775,9 @@ void Reader::ContourLine() {
   }
   auto id = Number(0, "a contour id (the n of @#(n))");
   if (!id) return;
-  if (*id != std::floor(*id) || std::abs(*id) > 1e9) {
-    Error(tokens_[0].column, "a contour id is a whole number, not '" + tokens_[0].text + "'");
+  if (*id != std::floor(*id) || *id < 0 || *id > 1e9) {
+    Error(tokens_[0].column,
+          "a contour id is a whole number from 0 (the n of @#(n)), not '" + tokens_[0].text + "'");
     return;
   }
   ExtraValues(2);
