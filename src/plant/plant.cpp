@@ -403,6 +403,7 @@ PlantResult BuildPlant(const PlantSpec& spec) {
   DiagnosticList diagnostics;
   std::optional<Grower> grower = Grower::Start(spec, diagnostics);
   if (!grower) return PlantResult{std::nullopt, std::move(diagnostics)};
+  std::optional<Diagnostic> note;  // Finish() hands on the Grower's own diagnostics
   while (!grower->done()) {
     const int from = grower->step();
     if (const int skipped = grower->SkipSettled(); skipped > 0) {
@@ -411,11 +412,11 @@ PlantResult BuildPlant(const PlantSpec& spec) {
         Diagnostic d;
         d.severity = Severity::kNote;
         d.loc.file = grower->grammar().path;
-        d.message = "the word stops changing at step " + std::to_string(from) + " of " +
-                    std::to_string(grower->steps()) +
-                    " (no random numbers, no global variable changed): the remaining " +
+        d.message = "step " + std::to_string(from) + " of " + std::to_string(grower->steps()) +
+                    " changed nothing (no random numbers, no global variable changed): the "
+                    "remaining " +
                     std::to_string(skipped) + " steps give the same word and are skipped";
-        diagnostics.Add(std::move(d));
+        note = std::move(d);
       }
       break;
     }
@@ -426,7 +427,9 @@ PlantResult BuildPlant(const PlantSpec& spec) {
       return PlantResult{std::nullopt, std::move(diagnostics)};
     }
   }
-  return std::move(*grower).Finish();
+  PlantResult r = std::move(*grower).Finish();
+  if (note) r.diagnostics.Add(std::move(*note));
+  return r;
 }
 
 }  // namespace sylva::plant
