@@ -64,7 +64,7 @@ static void AddMaxTrianglesFlag(CLI::App* cmd, DeriveFlags& f) {
 static void AddDeriveFlags(CLI::App* cmd, DeriveFlags& f) {
   cmd->add_option("file", f.file, "grammar file (.lsys)")->required();
   cmd->add_option("-n,--steps", f.steps, "derivation steps (default: the grammar's)")
-      ->check(CLI::Range(0, lsys::kMaxDerivationLengthForDerive));
+      ->check(CLI::Range(0, lsys::kMaxDerivationLength));
   cmd->add_option("--seed", f.seed, "seed of the random numbers (default: the grammar's)");
   cmd->add_option("-D,--define", f.defines, "override a #define: NAME=VALUE (repeatable)");
   cmd->add_option("--threads", f.threads, "worker threads (default: all cores)")
@@ -196,7 +196,7 @@ int RunCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   vi->add_option("--threads", view.threads, "worker threads (default: all cores)")
       ->check(CLI::Range(0, 256));
   vi->add_option("-n,--steps", view.steps, "grammars: the derivation step to start at")
-      ->check(CLI::Range(0, lsys::kMaxDerivationLengthForDerive));
+      ->check(CLI::Range(0, lsys::kMaxDerivationLength));
   vi->add_option("--seed", view.seed, "grammars: the seed to start with");
   vi->add_option("--view", view.view,
                  "grammars: cpfg view file (.v): angle, widths, colours, view direction, "

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <optional>
@@ -214,6 +215,17 @@ Expected<BackgroundScene> ParseBackgroundScene(const std::string& text, const st
                 "'" + key.text + "' needs " + std::to_string(count) + " numbers (" + form +
                     "), given " + std::to_string(n.size()));
     };
+    // The first `count` numbers are radii: 0 or more.
+    auto radii = [&](size_t count) -> std::optional<Diagnostic> {
+      for (size_t j = 0; j < count; ++j) {
+        if (n[j] >= 0) continue;
+        char v[32];
+        std::snprintf(v, sizeof v, "%g", n[j]);
+        return At(path, key.line, key.column,
+                  "'" + key.text + "' has a negative radius (" + v + "): a radius is 0 or more");
+      }
+      return std::nullopt;
+    };
     const std::string& k = key.text;
     if (k == "material") {
       if (auto e = need(8, "ambient RGBA, diffuse RGBA, ...")) return *e;
@@ -262,12 +274,15 @@ Expected<BackgroundScene> ParseBackgroundScene(const std::string& text, const st
       b.Quad(c[0][1][0], c[1][1][0], c[1][1][1], c[0][1][1]);
     } else if (k == "cylinder") {
       if (auto e = need(2, "radius and height")) return *e;
+      if (auto e = radii(1)) return *e;
       b.Frustum(n[0], n[0], n[1]);
     } else if (k == "cone") {
       if (auto e = need(3, "two radii and height")) return *e;
+      if (auto e = radii(2)) return *e;
       b.Frustum(n[0], n[1], n[2]);
     } else if (k == "sphere") {
       if (auto e = need(1, "radius")) return *e;
+      if (auto e = radii(1)) return *e;
       mesh::Sphere s;
       s.center = b.Point(0, 0, 0);
       s.radius = n[0];

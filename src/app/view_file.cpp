@@ -791,8 +791,9 @@ void Reader::ContourLine() {
   }
   auto id = Number(0, "a contour id (the n of @#(n))");
   if (!id) return;
-  if (*id != std::floor(*id) || std::abs(*id) > 1e9) {
-    Error(tokens_[0].column, "a contour id is a whole number, not '" + tokens_[0].text + "'");
+  if (*id != std::floor(*id) || *id < 0 || *id > 1e9) {
+    Error(tokens_[0].column,
+          "a contour id is a whole number from 0 (the n of @#(n)), not '" + tokens_[0].text + "'");
     return;
   }
   ExtraValues(2);
@@ -1191,14 +1192,14 @@ void ParseAnimationFile(const std::string& text, const std::string& path, ViewFi
     }
     char* end = nullptr;
     const long x = std::strtol(v->text.c_str(), &end, 10);
-    if (v->text.empty() || *end != '\0' || x < lo || x > lsys::kMaxDerivationLengthForDerive) {
+    if (v->text.empty() || *end != '\0' || x < lo || x > lsys::kMaxAnimationSteps) {
       Diagnostic d;
       d.loc.file = path;
       d.loc.line = v->line;
       d.loc.column = v->column;
       d.message = std::string("'") + label + ":' expects a whole number from " +
-                  std::to_string(lo) + " to " +
-                  std::to_string(lsys::kMaxDerivationLengthForDerive) + ", not '" + v->text + "'";
+                  std::to_string(lo) + " to " + std::to_string(lsys::kMaxAnimationSteps) +
+                  ", not '" + v->text + "'";
       view.diagnostics.Add(std::move(d));
       return false;
     }

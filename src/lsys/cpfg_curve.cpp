@@ -175,8 +175,9 @@ Expected<CpfgCurve> CpfgCurve::Parse(const std::string& text, const std::string&
                            std::to_string(dimension) + "' asks for " + std::to_string(dimension));
     int m = 1;
     if (dimension == 4) {
-      if (v[3] < 1 || v[3] > 100)
-        return FileError(path, number, "a point's multiplicity must be from 1 to 100");
+      if (v[3] < 1 || v[3] > 100 || v[3] != std::floor(v[3]))
+        return FileError(path, number,
+                         "a point's multiplicity must be a whole number from 1 to 100");
       m = int(v[3]);
     }
     read.emplace_back(Vec3(v[0], v[1], dimension > 2 ? v[2] : 0.0), m);

@@ -1088,6 +1088,7 @@ struct Derivation::State {
       : g(grammar),
         seed(o.seed.value_or(grammar.seed)),
         maxModules(std::min(o.maxModules, kMaxModulesCap)),
+        maxChangingSteps(o.maxChangingSteps),
         ownPool(o.pool ? 1 : o.threads),
         pool(o.pool ? *o.pool : ownPool),
         table(BuildStaticTable(grammar, grammar.main)) {}
@@ -1095,6 +1096,7 @@ struct Derivation::State {
   const Grammar& g;
   uint64_t seed;  // srand(s) in Start: may set it (Derivation::Start)
   const uint64_t maxModules;
+  const int maxChangingSteps;
   ThreadPool ownPool;  // unused (one thread, no workers) with a shared pool
   ThreadPool& pool;
   const StaticTable table;
@@ -1102,10 +1104,30 @@ struct Derivation::State {
   Word word, next;
   std::vector<double> globals;  // the grammar's global variables
   int step = 0;
+  int changingSteps = 0;  // steps taken that were not at the fixed point
+  // Every later step gives this same word (and global variables): each is
+  // free, and Derive() skips them (SkipToStep).
   bool fixedPoint = false;
+  bool edited = false;   // the caller changed the word between steps (MutableWord)
   bool stopped = false;  // cpfg's stop(v), v not 1, was called
   std::vector<StepStats> stats;
 };
+
+namespace {
+
+template <typename T>
+bool SameBytes(const PodBuffer<T>& a, const PodBuffer<T>& b) {
+  return a.size() == b.size() &&
+         (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+// The same modules with the same parameters, bit for bit.
+bool SameWord(const Word& a, const Word& b) {
+  return SameBytes(a.symbols, b.symbols) && SameBytes(a.paramStart, b.paramStart) &&
+         SameBytes(a.params, b.params);
+}
+
+}  // namespace
 
 Derivation::Derivation(std::unique_ptr<State> state) : state_(std::move(state)) {}
 Derivation::Derivation(Derivation&&) noexcept = default;
@@ -1136,15 +1158,24 @@ Expected<Derivation> Derivation::Start(const Grammar& g, const DeriveOptions& op
 
 Status Derivation::Step() {
   State& s = *state_;
-  if (s.step >= kMaxDerivationLengthForDerive) {
-    return LimitError("derivation length " + std::to_string(s.step + 1) +
-                      " is more than the limit of " +
-                      std::to_string(kMaxDerivationLengthForDerive));
+  if (s.step == std::numeric_limits<int>::max()) {
+    return LimitError("derivation length " + std::to_string(s.step) + " reached: no step follows");
+  }
+  if (!s.fixedPoint && s.changingSteps >= s.maxChangingSteps) {
+    return LimitError("step " + std::to_string(s.step + 1) + ": the word still changes after " +
+                      std::to_string(s.maxChangingSteps) +
+                      " steps, the most Sylva takes (steps that change nothing are free)");
   }
   const auto ts = Clock::now();
   const int step = s.step + 1;
   if (!s.fixedPoint) {
+    ++s.changingSteps;
     bool changed = false;
+    // A step is a function of the word and the global variables unless it
+    // draws random numbers: with both unchanged after it, so is every later one.
+    const bool canSettle = !s.g.usesRandom && !s.edited;
+    std::vector<double> globalsBefore;
+    if (canSettle) globalsBefore = s.globals;
     double* globals = s.globals.data();
     if (Status st =
             RunGlobalBlock(s.g, s.g.startEachBlock, "StartEach", s.seed, uint64_t(step), s.globals);
@@ -1172,6 +1203,12 @@ Status Derivation::Step() {
     // between steps breaks this: MutableWord() clears it.)
     if (!changed && s.g.decomposition.empty() && !s.g.usesRandom && s.g.globals.empty())
       s.fixedPoint = true;
+    // s.next holds the word the step started from.
+    if (canSettle && !s.fixedPoint && s.word.size() == s.next.size() &&
+        (globalsBefore.empty() || std::memcmp(globalsBefore.data(), s.globals.data(),
+                                              globalsBefore.size() * sizeof(double)) == 0) &&
+        SameWord(s.word, s.next))
+      s.fixedPoint = true;
     s.stopped = s.stopped || StopCalled(s.g, s.globals);
   }
   s.step = step;
@@ -1191,7 +1228,18 @@ const Word& Derivation::word() const {
 }
 Word& Derivation::MutableWord() {
   state_->fixedPoint = false;
+  state_->edited = true;
   return state_->word;
+}
+bool Derivation::settled() const {
+  return state_->fixedPoint;
+}
+void Derivation::SkipToStep(int step) {
+  State& s = *state_;
+  SYLVA_ASSERT(s.fixedPoint && !s.stopped && step >= s.step);
+  if (step == s.step) return;
+  s.step = step;
+  s.stats.push_back(StepStats{step, s.word.size(), 0});
 }
 const std::vector<StepStats>& Derivation::stats() const {
   return state_->stats;
@@ -1230,15 +1278,13 @@ DeriveResult Derivation::Finish() && {
 Expected<DeriveResult> Derive(const Grammar& g, const DeriveOptions& options) {
   const auto t0 = Clock::now();
   const int steps = options.steps >= 0 ? options.steps : g.derivationLength;
-  if (steps > kMaxDerivationLengthForDerive) {
-    Diagnostic d;
-    d.message = "derivation length " + std::to_string(steps) + " is more than the limit of " +
-                std::to_string(kMaxDerivationLengthForDerive);
-    return d;
-  }
   auto derivation = Derivation::Start(g, options);
   if (!derivation) return derivation.error();
   while (derivation->step() < steps && !derivation->stopped()) {
+    if (derivation->settled()) {
+      derivation->SkipToStep(steps);
+      break;
+    }
     if (Status s = derivation->Step(); !s.ok()) return s.error();
     if (options.progress) options.progress(derivation->step(), steps, derivation->word().size());
   }

@@ -47,7 +47,14 @@ inline constexpr uint64_t kDefaultMaxModules = uint64_t(1) << 28;
 // 2^29 parameters: 4 GiB of doubles.
 inline constexpr uint64_t kMaxParams = uint64_t(1) << 29;
 inline constexpr uint64_t kMaxModulesCap = 0xFFFFFFF0ull;
-inline constexpr int kMaxDerivationLengthForDerive = 100000;  // steps
+// A derivation length may be any int (lsys::kMaxDerivationLength, as
+// cpfg's): once a step changes neither the word nor the global variables,
+// and the grammar draws no random numbers, every later step gives the same
+// word and is skipped. At most this many steps that do change something
+// are taken (a derivation of 1000-module words this long takes seconds).
+inline constexpr int kMaxChangingSteps = 1000000;
+// Animation frames are drawn one step at a time (plant/frames.h).
+inline constexpr int kMaxAnimationSteps = 100000;
 
 struct DeriveOptions {
   int steps = -1;                // -1: the grammar's derivation length
@@ -58,6 +65,8 @@ struct DeriveOptions {
   // `threads` is not used. The word is the same either way.
   ThreadPool* pool = nullptr;
   uint64_t maxModules = kDefaultMaxModules;
+  // Steps that change the word (or the global variables) taken at most.
+  int maxChangingSteps = kMaxChangingSteps;
   // Called after each step (from the calling thread).
   std::function<void(int step, int steps, uint64_t modules)> progress;
 };
@@ -97,6 +106,12 @@ class Derivation {
   // last step): as cpfg's animation halts there, Derive() takes no further
   // step, nor do the plant library's growers.
   bool stopped() const;
+  // The last step changed neither the word nor the global variables and
+  // the grammar draws no random numbers (nor did the caller edit the word
+  // between steps): every later step gives this word. SkipToStep(n) then
+  // takes the derivation to step n at no cost (one StepStats entry for it).
+  bool settled() const;
+  void SkipToStep(int step);
   const Word& word() const;
   // The word, for a caller that fills query parameters between steps.
   Word& MutableWord();

@@ -414,6 +414,8 @@ class GrammarParser {
   std::unordered_map<std::string, ArityUse> arityUse_;
   std::vector<std::string> arityMixed_;  // names used with two or more arities, in that order
   std::unordered_set<std::string> unsupportedWarned_;  // name + reason
+  bool unbalancedWarned_ = false;                      // CheckBrackets in a cpfg file
+  int ringLine_ = 0;                                   // of the first `ring lsystem`
   // In a cpfg file (`.l`), a name nothing defines reads 0 with a warning
   // (once per name), as cpfg does; in Sylva's own `.lsys` files it stays an
   // error (a typo). Lenient() lets a scope note such names in undefined_;
@@ -766,24 +768,39 @@ void GrammarParser::WarnMixedArity() {
   }
 }
 
+// In a cpfg file an unbalanced bracket is a warning (the first one only):
+// cpfg reads such a production, and its turtle ignores a `]` with no `[`
+// open (interpret.c), as Sylva's does; a `[` never closed ends with the word.
 bool GrammarParser::CheckBrackets(const Line& l, const std::vector<SymbolId>& syms,
                                   const std::vector<int>& cols, const char* what) {
   std::vector<int> open;
+  auto problem = [&](int col, const std::string& msg) {
+    if (!g_.cpfgFile) {
+      Error(l, col, msg);
+      return false;
+    }
+    if (!unbalancedWarned_) {
+      unbalancedWarned_ = true;
+      Warn(Loc(l, col), OriginalAt(l, col),
+           msg +
+               " (cpfg reads it: its turtle ignores a ']' with no '[' open, and so does "
+               "Sylva's; said once)");
+    }
+    return true;
+  };
   for (size_t i = 0; i < syms.size(); ++i) {
     if (syms[i] == kOpenBracket) {
       open.push_back(cols[i]);
     } else if (syms[i] == kCloseBracket) {
       if (open.empty()) {
-        Error(l, cols[i], std::string("unbalanced ']' in ") + what);
-        return false;
+        if (!problem(cols[i], std::string("unbalanced ']' in ") + what)) return false;
+        continue;
       }
       open.pop_back();
     }
   }
-  if (!open.empty()) {
-    Error(l, open.back(), std::string("unbalanced '[' in ") + what + ": no matching ']'");
-    return false;
-  }
+  if (!open.empty())
+    return problem(open.back(), std::string("unbalanced '[' in ") + what + ": no matching ']'");
   return true;
 }
 
@@ -2891,6 +2908,14 @@ void GrammarParser::ParseLine(const Line& l) {
               int(t.size() - pos));
         return;
       }
+      if (ringLine_) {
+        Warn(Loc(l, int(pos) + 1), OriginalAt(l, int(pos) + 1),
+             "second 'ring lsystem' (the first is at line " + std::to_string(ringLine_) +
+                 "): it changes nothing",
+             int(t.size() - pos));
+        return;
+      }
+      ringLine_ = Loc(l, int(pos) + 1).line;
       g_.ring = true;
       return;
     }

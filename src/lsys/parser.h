@@ -10,6 +10,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -28,7 +29,7 @@ inline constexpr int kMaxIncludeDepth = 16;
 inline constexpr size_t kMaxGrammarFileBytes = size_t(64) << 20;
 inline constexpr size_t kMaxGrammarBytes = size_t(256) << 20;
 inline constexpr int kMaxIncludedFiles = 1000;
-inline constexpr int kMaxDerivationLength = 100000;
+inline constexpr int kMaxDerivationLength = std::numeric_limits<int>::max();  // cpfg's int
 inline constexpr size_t kMaxProductionsPerSection = 65000;
 
 struct ParseOptions {

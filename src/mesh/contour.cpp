@@ -300,6 +300,14 @@ Expected<Contour> Parser::Versioned(int version, const Word& at) {
   return c;
 }
 
+// The largest |x| or |y| of the points (1 when there is none, or it is not
+// finite): dividing by it keeps squared lengths from under- or overflowing.
+double XyScale(const Contour& c) {
+  double m = 0;
+  for (const Vec3& p : c.points) m = std::max({m, std::abs(p.x()), std::abs(p.y())});
+  return m > 0 && std::isfinite(m) ? m : 1;
+}
+
 // Enough points for a cubic B-spline, and a curve with a length in (x, y).
 Status Parser::Check(const Contour& c, int line, int column) const {
   const size_t need = c.closed ? 3 : 4;
@@ -309,9 +317,12 @@ Status Parser::Check(const Contour& c, int line, int column) const {
                   std::to_string(need) + " points (a cubic B-spline); this one has " +
                   std::to_string(c.points.size()));
   }
+  // Measured with the points scaled to at most 1 in x and y: a contour of
+  // 1e-300 units (whose squared lengths underflow to 0) has a length too.
+  const double scale = XyScale(c);
   double extent = 0;
   for (const Vec3& p : c.points)
-    extent = std::max(extent, (p.head<2>() - c.points[0].head<2>()).norm());
+    extent = std::max(extent, ((p.head<2>() - c.points[0].head<2>()) / scale).norm());
   if (!(extent > 0)) {
     return At(line, column,
               "every point of the contour is at the same (x, y): it has no length to draw");
@@ -354,9 +365,14 @@ std::vector<Vec3> CircleContour(int sides) {
   return r;
 }
 
-std::vector<Vec3> SampleContour(const Contour& c, int sides) {
+std::vector<Vec3> SampleContour(const Contour& contour, int sides) {
   SYLVA_ASSERT(sides >= 3 && sides <= kMaxContourSides);
-  SYLVA_ASSERT(c.points.size() >= (c.closed ? 3u : 4u));
+  SYLVA_ASSERT(contour.points.size() >= (contour.closed ? 3u : 4u));
+  // Sampled at unit scale (XyScale), then scaled back: the B-spline, its
+  // arc length parameter and the turn below all commute with scaling.
+  const double scale = XyScale(contour);
+  Contour c = contour;
+  for (Vec3& p : c.points) p /= scale;
   // Arc length in (x, y) tabulated at kPerSpan steps a span (cpfg: 10),
   // then inverted piecewise linearly. cpfg's table of an open contour
   // stops a tenth of a span before its end; this one runs to the end.
@@ -404,6 +420,7 @@ std::vector<Vec3> SampleContour(const Contour& c, int sides) {
     }
     r[size_t(sides)] = r[0];
   }
+  for (Vec3& p : r) p *= scale;
   return r;
 }
 

@@ -63,12 +63,11 @@ Expected<mesh::PlantGeometry> DrawFrames(const PlantSpec& spec, const FrameRange
     frames.last = probe->steps();
   }
   if (frames.first < 0 || frames.last < frames.first || frames.step < 1 ||
-      frames.last > lsys::kMaxDerivationLengthForDerive) {
+      frames.last > lsys::kMaxAnimationSteps) {
     return Error(path, "animation frames " + std::to_string(frames.first) + " to " +
                            std::to_string(frames.last) + " every " + std::to_string(frames.step) +
                            ": expected 0 <= first <= last <= " +
-                           std::to_string(lsys::kMaxDerivationLengthForDerive) +
-                           " and a step of at least 1");
+                           std::to_string(lsys::kMaxAnimationSteps) + " and a step of at least 1");
   }
   PlantSpec s = spec;
   s.steps = frames.last;

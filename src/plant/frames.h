@@ -25,7 +25,7 @@ struct FrameRange {
 // plant, branch ids renumbered so the frames never share a branch. Errors:
 // a bad range (first < 0, last < first (after a negative last becomes the
 // derivation length), step < 1, last beyond
-// lsys::kMaxDerivationLengthForDerive), the grammar's errors, a step's
+// lsys::kMaxAnimationSteps), the grammar's errors, a step's
 // error, and more drawn primitives in all than spec.limits allows (a
 // quarter of maxTriangles). Warnings (the grammar's, the turtle's once
 // each) go to `diagnostics`.

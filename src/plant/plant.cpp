@@ -101,9 +101,9 @@ lsys::DeriveOptions DeriveOptionsOf(const PlantSpec& spec) {
 DiagnosticList Validate(const PlantSpec& spec) {
   DiagnosticList list;
   if (!spec.text && spec.path.empty()) list.Add(SpecError("no grammar: give a file or a text"));
-  if (spec.steps && (*spec.steps < 0 || *spec.steps > lsys::kMaxDerivationLengthForDerive)) {
+  if (spec.steps && (*spec.steps < 0 || *spec.steps > lsys::kMaxDerivationLength)) {
     list.Add(SpecError("steps " + std::to_string(*spec.steps) + " is outside 0.." +
-                       std::to_string(lsys::kMaxDerivationLengthForDerive)));
+                       std::to_string(lsys::kMaxDerivationLength)));
   }
   if (spec.threads < 0 || spec.threads > 256) {
     list.Add(SpecError("threads " + std::to_string(spec.threads) + " is outside 0..256"));
@@ -328,6 +328,13 @@ bool Grower::done() const {
   return step() >= steps() || (derivation_ && derivation_->stopped());
 }
 
+int Grower::SkipSettled() {
+  if (!derivation_ || done() || !derivation_->settled()) return 0;
+  const int from = step();
+  derivation_->SkipToStep(steps_);
+  return steps_ - from;
+}
+
 Status Grower::Step() {
   SYLVA_ASSERT(derivation_.has_value());
   const auto t0 = Clock::now();
@@ -408,11 +415,30 @@ PlantResult Grower::Finish() && {
   return r;
 }
 
+// BuildPlant notes skipped steps (Grower::SkipSettled) from this many on.
+constexpr int kSkippedStepsNoted = 1000;
+
 PlantResult BuildPlant(const PlantSpec& spec) {
   DiagnosticList diagnostics;
   std::optional<Grower> grower = Grower::Start(spec, diagnostics);
   if (!grower) return PlantResult{std::nullopt, std::move(diagnostics)};
+  std::optional<Diagnostic> note;  // Finish() hands on the Grower's own diagnostics
   while (!grower->done()) {
+    const int from = grower->step();
+    if (const int skipped = grower->SkipSettled(); skipped > 0) {
+      // Said when it is many (cpfg files ask for 1000000 steps and stop(0)).
+      if (skipped >= kSkippedStepsNoted) {
+        Diagnostic d;
+        d.severity = Severity::kNote;
+        d.loc.file = grower->grammar().path;
+        d.message = "step " + std::to_string(from) + " of " + std::to_string(grower->steps()) +
+                    " changed nothing (no random numbers, no global variable changed): the "
+                    "remaining " +
+                    std::to_string(skipped) + " steps give the same word and are skipped";
+        note = std::move(d);
+      }
+      break;
+    }
     if (Status s = grower->Step(); !s.ok()) {
       Diagnostic d = s.error();
       if (d.loc.file.empty()) d.loc.file = grower->grammar().path;
@@ -420,7 +446,9 @@ PlantResult BuildPlant(const PlantSpec& spec) {
       return PlantResult{std::nullopt, std::move(diagnostics)};
     }
   }
-  return std::move(*grower).Finish();
+  PlantResult r = std::move(*grower).Finish();
+  if (note) r.diagnostics.Add(std::move(*note));
+  return r;
 }
 
 }  // namespace sylva::plant

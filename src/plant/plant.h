@@ -72,7 +72,7 @@ using FileReader = std::function<std::optional<std::string>(const std::string& p
 struct PlantSpec {
   std::string path;                 // the grammar file; with `text`, the name used in diagnostics
   std::optional<std::string> text;  // grammar source; when set, `path` is not read
-  std::optional<int> steps;         // default: the grammar's derivation length; 0..100000
+  std::optional<int> steps;         // default: the grammar's derivation length; 0..2^31-1
   std::optional<uint64_t> seed;     // default: the grammar's `seed:`
   std::map<std::string, double> defines;  // -D NAME=VALUE: overrides `#define NAME`
   // Folders searched for NAME.obj before the grammar's own folder, its
@@ -204,6 +204,10 @@ class Grower {
   int steps() const;  // the length asked for (spec.steps or the grammar's)
   // The length is reached, or the grammar called cpfg's stop(v), v not 1.
   bool done() const;
+  // When the word has stopped changing (lsys::Derivation::settled), takes
+  // the growth to steps() at once and returns the steps skipped; else 0.
+  // BuildPlant does; a caller that draws each step steps instead.
+  int SkipSettled();
 
   const lsys::Grammar& grammar() const { return *grammar_; }
   const lsys::Word& word() const;

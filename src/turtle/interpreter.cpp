@@ -324,6 +324,7 @@ inline void Orthonormalise(Frame& f) {
 
 TurtleDef TurtleDefFrom(const lsys::Grammar& g) {
   TurtleDef d;
+  d.grammar = &g;
   d.angle = g.angle;
   d.step = g.step;
   d.width = g.width;
@@ -844,7 +845,7 @@ static double SplineSegmentBound(const lsys::Word& word, const std::vector<Op>& 
 // lengths included): each component of every point, every radius and
 // scale. NaN is caught in any component (no max(|x|), which drops NaN).
 static Status CheckRange(const PlantGeometry& g, const lsys::Word& word,
-                         const lsys::SymbolTable& symbols) {
+                         const lsys::SymbolTable& symbols, const lsys::Grammar* grammar) {
   auto ok = [](double v) { return v >= -kMaxCoordinate && v <= kMaxCoordinate; };  // false for NaN
   auto okPoint = [&](const Vec3& p) { return ok(p.x()) && ok(p.y()) && ok(p.z()); };
   auto fail = [&](uint32_t module, const char* what) -> Status {
@@ -853,8 +854,19 @@ static Status CheckRange(const PlantGeometry& g, const lsys::Word& word,
     std::string where = module < word.size() ? "module " + std::to_string(module + 1) + " (" +
                                                    ModuleText(word, symbols, module) + ")"
                                              : "a module";
-    return MakeError(
-        {}, where + " gives " + what + " that is not a finite number within +-" + limit + " units");
+    std::string message =
+        where + " gives " + what + " that is not a finite number within +-" + limit + " units";
+    // Located where the grammar first writes the module's name.
+    if (grammar && module < word.size()) {
+      const std::string& name = symbols.name(word.symbols[module]);
+      auto it = grammar->symbolLoc.find(name);
+      if (it != grammar->symbolLoc.end()) {
+        message += " ('" + name + "' is first written here)";
+        return MakeError(it->second.loc, std::move(message), int(name.size()),
+                         grammar->SourceLine(it->second.loc));
+      }
+    }
+    return MakeError({}, std::move(message));
   };
   for (const Segment& sg : g.segments) {
     if (!okPoint(sg.start) || !okPoint(sg.end)) return fail(sg.module, "a segment end");
@@ -1043,7 +1055,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
       if (count++ == 0) module = uint32_t(i);
     }
   };
-  Problem badSplineType, strayEnd, fewPoints, neverEnded;
+  Problem badSplineType, strayEnd, fewPoints, neverEnded, strayClose;
   t.color = uint16_t(std::clamp(def.initialColor, 0, 65535));
   const int colorStep = def.colorIncrement;
   SinCos sincos;
@@ -1255,10 +1267,9 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
           }
           break;
         case Op::kPop:
-          if (stack.empty()) {
-            g = PlantGeometry();
-            return MakeError({},
-                             "unmatched ']' at module " + std::to_string(i + 1) + " of the word");
+          if (stack.empty()) {  // cpfg's interpret.c: "unmatched ] ignored"
+            strayClose.Add(i);
+            break;
           }
           t = stack.back();
           stack.pop_back();
@@ -1655,6 +1666,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
          ": a spline's type is 1 to 4 (1 open and 2 closed Hermite curve, 3 open and 4 closed "
          "B-spline); nothing is drawn for it");
   report(strayEnd, ": ends no spline; ignored");
+  report(strayClose, ": a ']' with no '[' open; ignored, as cpfg's turtle does");
   report(fewPoints,
          " opens a spline with too few control points to draw (a Hermite curve needs 2, an open "
          "B-spline 4, a closed one 3): nothing is drawn for it");
@@ -1670,7 +1682,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
     g.warnings.push_back("polygon opened at module " + std::to_string(poly.module + 1) +
                          " is never closed; skipped");
   }
-  if (Status s = CheckRange(g, word, symbols); !s.ok()) {
+  if (Status s = CheckRange(g, word, symbols, def.grammar); !s.ok()) {
     g = PlantGeometry();
     return s;
   }

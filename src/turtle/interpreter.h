@@ -137,6 +137,10 @@ struct TurtleDef {
   // a cpfg file (lsys::Grammar::cpfgFile), whose tropism comes from its
   // view file's `tropism direction:` and `initial elasticity:`.
   bool cpfgBend = false;
+  // The grammar the word comes from (TurtleDefFrom sets it; it must outlive
+  // the Interpret call), or null: an error about a module is located where
+  // the grammar first writes that module's name (Grammar::symbolLoc).
+  const lsys::Grammar* grammar = nullptr;
 };
 
 TurtleDef TurtleDefFrom(const lsys::Grammar& g);

@@ -95,6 +95,13 @@ TEST(CpfgBackground, ErrorsAreLocated) {
   EXPECT_EQ(FirstError("box 1 1 1\n  teapot 2\n"), "2:3 unknown background scene keyword 'teapot'");
   EXPECT_EQ(FirstError("popmatrix\n"), "1:1 'popmatrix' without its 'pushmatrix'");
   EXPECT_EQ(FirstError("\nsphere\n"), "2:1 'sphere' needs 1 numbers (radius), given 0");
+  // Negative radii were drawn (inside-out frustums, spheres of radius -1).
+  EXPECT_EQ(FirstError("sphere -1\n"),
+            "1:1 'sphere' has a negative radius (-1): a radius is 0 or more");
+  EXPECT_EQ(FirstError("box 1 1 1\n cylinder -0.5 2\n"),
+            "2:2 'cylinder' has a negative radius (-0.5): a radius is 0 or more");
+  EXPECT_EQ(FirstError("cone 1 -2 3\n"),
+            "1:1 'cone' has a negative radius (-2): a radius is 0 or more");
   EXPECT_EQ(FirstError("#include \"x.dat\"\n"),
             "1:1 preprocessor line '#include' is not supported in a background scene (#define "
             "and #undef are)");

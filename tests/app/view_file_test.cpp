@@ -769,6 +769,14 @@ TEST(ViewFile, ContoursWithoutCylinderLineStyleWarnAndAreNotUsed) {
       ParseViewFile("line style: cylinder\npolygonization level: 3\ncontour: 1 x.con\n", "l.v");
   EXPECT_TRUE(level.diagnostics.items.empty()) << Messages(level.diagnostics);
   EXPECT_EQ(level.contours.sides, 16);
+  // A negative id (no @#(n) can name it) was accepted without a word.
+  ViewFile negative = ParseViewFile("line style: cylinder\ncontour: -1 x.con\n", "n.v");
+  ASSERT_EQ(negative.diagnostics.items.size(), 1u) << Messages(negative.diagnostics);
+  EXPECT_EQ(
+      negative.diagnostics.items[0].Format().rfind(
+          "n.v:2:10: error: a contour id is a whole number from 0 (the n of @#(n)), not '-1'", 0),
+      0u)
+      << Messages(negative.diagnostics);
   // `contour sides:` alone (no contour) is read but not acted on.
   ViewFile s = ParseViewFile("contour sides: 16\n", "s.v");
   ASSERT_EQ(s.diagnostics.items.size(), 1u) << Messages(s.diagnostics);

@@ -125,6 +125,17 @@ TEST(CpfgRing, LastModuleIsTheFirstOnesLeftNeighbour) {
   EXPECT_EQ(DeriveText(ring, 2), "BBAB");
 }
 
+TEST(CpfgRing, SecondRingStatementIsAWarning) {
+  ParseResult r = ParseGrammarText("ring lsystem\naxiom: A\nRing  lsystem\n", "c.l");
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  EXPECT_TRUE(r.grammar->ring);
+  ASSERT_EQ(r.diagnostics.items.size(), 1u) << r.diagnostics.FormatAll();
+  const Diagnostic& d = r.diagnostics.items[0];
+  EXPECT_EQ(d.severity, Severity::kWarning);
+  EXPECT_EQ(std::to_string(d.loc.line) + ":" + std::to_string(d.loc.column) + " " + d.message,
+            "3:1 second 'ring lsystem' (the first is at line 1): it changes nothing");
+}
+
 TEST(CpfgRing, ContextsWrapOnceAndSkipIgnoredModules) {
   // Ignored modules are passed over across the seam; a context longer than
   // the word reads the ring round again, one module at a time.

@@ -162,6 +162,12 @@ TEST(CpfgCurve, ErrorsAreLocated) {
   bad.curveFiles = {{"short.con", "p.v", 3, 8}};
   EXPECT_EQ(first("axiom: A\n", bad),
             "p.v:3:8 in curve file short.con:1: 'points: 4' but the file gives 3");
+  // A multiplicity of 1.5 was read as 1 without a word.
+  auto half = CpfgCurve::Parse(
+      "points: 4\ndimension: 4\ntype: bspline\n0 0 0 1\n1 0 0 1.5\n2 0 0 1\n3 0 0 1\n", "h.con");
+  ASSERT_FALSE(half);
+  EXPECT_EQ(half.error().loc.line, 5) << half.error().Format();
+  EXPECT_EQ(half.error().message, "a point's multiplicity must be a whole number from 1 to 100");
   auto surface = CpfgCurve::Parse("points: 16\ntype: bezier-surface\n", "s.con");
   ASSERT_FALSE(surface);
   EXPECT_EQ(surface.error().loc.line, 2) << surface.error().Format();

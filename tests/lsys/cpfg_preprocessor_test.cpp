@@ -141,6 +141,19 @@ TEST(CpfgPreprocessor, UndefOfANumberHoldsFromThere) {
             "B(2,3)");
 }
 
+TEST(CpfgBrackets, UnbalancedSuccessorIsOneWarningInACpfgFile) {
+  // corpus3's dynamic4: `... SYM(...)]]]` with one `]` too many. cpfg reads
+  // it (its turtle ignores the `]`); a .lsys file keeps the error.
+  const char* text = "axiom: A B C\nA --> F]F\nB --> [F\nC --> G]\n";
+  const auto w = Warnings(text);
+  ASSERT_EQ(w.size(), 1u) << Joined(w);
+  EXPECT_EQ(w[0],
+            "2:8 unbalanced ']' in word (cpfg reads it: its turtle ignores a ']' with no '[' open, "
+            "and so does Sylva's; said once)");
+  EXPECT_EQ(DeriveCpfg(text, 1), "F]F[FG]");
+  EXPECT_EQ(FirstError(text, "c.lsys"), "2:8 unbalanced ']' in word");
+}
+
 TEST(CpfgPreprocessor, UnbalancedDirectivesAreErrorsWithLocations) {
   EXPECT_EQ(FirstError("#if 1\naxiom: A\n"), "1:1 #if without #endif");
   EXPECT_EQ(FirstError("axiom: A\n#endif\n"), "2:1 #endif without #if");

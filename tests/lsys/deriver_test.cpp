@@ -142,10 +142,46 @@ TEST(Deriver, ZeroStepsGivesTheAxiom) {
 }
 
 TEST(Deriver, LongDerivationOfAFixedPointFinishes) {
+  // B --> B applies at each step but changes nothing: the steps after the
+  // first are skipped (one StepStats entry for the last).
   Grammar g = MustParse("derivation length: 100000\naxiom: AB\nB --> B\n");
   auto r = MustDerive(g);
   EXPECT_EQ(r.word.size(), 2u);
-  EXPECT_EQ(r.steps.size(), 100001u);
+  ASSERT_EQ(r.steps.size(), 3u);
+  EXPECT_EQ(r.steps.back().step, 100000);
+}
+
+TEST(Deriver, DerivationLengthOfCpfgsIntRangeEndsWhenTheWordSettles) {
+  // cpfg files write `derivation length: 1000000` (corpus3's tree.l) and
+  // more for "until it stops".
+  Grammar g = MustParse("derivation length: 2147483647\naxiom: A(0)\nA(n) : n < 5 --> A(n+1)\n");
+  EXPECT_EQ(g.derivationLength, 2147483647);
+  auto r = MustDerive(g);
+  EXPECT_EQ(FormatWord(r.word, g.symbols), "A(5)");
+  EXPECT_EQ(r.steps.back().step, 2147483647);
+  EXPECT_LE(r.steps.size(), 9u) << "the unchanging steps are skipped";
+  // Global variables that change keep it going; stop(0) ends it.
+  Grammar h = MustParse(
+      "Start: {n = 0;}\nEndEach: {n = n + 1; if (n == 40) {stop(0);}}\n"
+      "derivation length: 1000000\naxiom: A\nA --> A\n");
+  auto rh = MustDerive(h);
+  EXPECT_EQ(rh.steps.back().step, 40);
+}
+
+TEST(Deriver, StepsThatChangeTheWordHaveALimit) {
+  Grammar g = MustParse("derivation length: 1000\naxiom: A(0)\nA(n) --> A(n+1)\n");
+  DeriveOptions opt;
+  opt.maxChangingSteps = 100;
+  auto r = Derive(g, opt);
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().message,
+            "step 101: the word still changes after 100 steps, the most Sylva takes (steps that "
+            "change nothing are free)");
+  EXPECT_EQ(r.error().kind, ErrorKind::kRuntime);
+  // Random draws make every step new: no skipping, the limit holds.
+  Grammar s = MustParse("derivation length: 1000\naxiom: A\nA --> A : 1\nA --> A : 1\n");
+  auto rs = Derive(s, opt);
+  ASSERT_FALSE(rs);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace sylva::mesh {
 namespace {
@@ -115,6 +116,30 @@ TEST(Contour, ClosedContourIsTurnedToStartOnPlusXAndCloses) {
   const std::vector<Vec3> circle = CircleContour(4);
   EXPECT_EQ(circle.size(), 5u);
   EXPECT_NEAR((circle[1] - Vec3(0, 1, 0)).norm(), 0, 1e-12);
+}
+
+TEST(Contour, TinyAndHugeContoursAreMeasuredAtUnitScale) {
+  // A contour of 1e-300 units: its squared lengths underflow to 0, and it
+  // was rejected as "every point at the same (x, y)". It is read, and
+  // sampled as the same shape at unit size, scaled.
+  const std::string unit = "4 3 closed\n1 0 0\n0 1 0\n-1 0 0\n0 -1 0\n";
+  auto a = ParseContour(unit, "u.con");
+  ASSERT_TRUE(a) << a.error().Format();
+  const std::vector<Vec3> ref = SampleContour(*a, 8);
+  for (double scale : {1e-300, 1e300}) {
+    Contour c = *a;
+    for (Vec3& p : c.points) p *= scale;
+    char text[256];
+    std::snprintf(text, sizeof text, "4 3 closed\n%g 0 0\n0 %g 0\n%g 0 0\n0 %g 0\n", scale, scale,
+                  -scale, -scale);
+    auto parsed = ParseContour(text, "s.con");
+    ASSERT_TRUE(parsed) << "scale " << scale << ": " << parsed.error().Format();
+    const std::vector<Vec3> got = SampleContour(c, 8);
+    ASSERT_EQ(got.size(), ref.size());
+    for (size_t i = 0; i < got.size(); ++i)
+      EXPECT_LT((got[i] / scale - ref[i]).norm(), 1e-12)
+          << "scale " << scale << " point " << i << ": " << got[i].transpose() / scale;
+  }
 }
 
 }  // namespace

@@ -154,6 +154,24 @@ TEST(Plant, ModuleLimitStopsTheDerivation) {
   EXPECT_NE(r.diagnostics.FormatAll().find("1000"), std::string::npos) << r.diagnostics.FormatAll();
 }
 
+TEST(Plant, StepsAfterTheWordSettlesAreSkippedWithANote) {
+  // cpfg files ask for `derivation length: 1000000` and mean "until it stops".
+  PlantSpec spec;
+  spec.path = "long.l";
+  spec.text = "derivation length: 1000000\naxiom: A(0)\nA(n) : n < 3 --> A(n+1)\n";
+  spec.until = Stage::kWord;
+  PlantResult r = BuildPlant(spec);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
+  ASSERT_FALSE(r.plant->steps.empty());
+  EXPECT_EQ(r.plant->steps.back().step, 1000000);
+  EXPECT_NE(r.diagnostics.FormatAll().find("long.l: note: step 4 of 1000000 changed nothing (no "
+                                           "random numbers, no global variable changed): the "
+                                           "remaining 999996 steps give the same word and are "
+                                           "skipped"),
+            std::string::npos)
+      << r.diagnostics.FormatAll();
+}
+
 TEST(Plant, FilesComeThroughTheReaderWhenOneIsGiven) {
   // Includes and surfaces from memory: what fuzzers and embedders use.
   std::map<std::string, std::string> files = {

@@ -9,6 +9,8 @@
 #include <set>
 
 #include "core/atomic_file.h"
+#include "lsys/deriver.h"
+#include "lsys/parser.h"
 #include "plant/plant_test_util.h"
 
 namespace sylva::turtle {
@@ -182,6 +184,23 @@ TEST(Turtle, DegeneratePolygonsAndStrayBracesAreWarnings) {
   EXPECT_EQ(d.geometry.warnings[2], "polygon opened at module 6 is never closed; skipped");
 }
 
+TEST(Turtle, UnmatchedCloseBracketIsIgnoredWithOneWarning) {
+  // cpfg's interpret.c: "unmatched ] ignored". corpus3's dynamic4 writes
+  // one `]` too many in a successor (a warning where the .l file has it).
+  lsys::ParseResult r = lsys::ParseGrammarText("axiom: F]+F]F\n", "c.l");
+  ASSERT_TRUE(r.grammar) << r.diagnostics.FormatAll();
+  auto word = lsys::Derive(*r.grammar, lsys::DeriveOptions{.steps = 0});
+  ASSERT_TRUE(word);
+  auto g = Interpret(word->word, r.grammar->symbols, TurtleDefFrom(*r.grammar));
+  ASSERT_TRUE(g) << g.error().message;
+  ASSERT_EQ(g->segments.size(), 3u);
+  EXPECT_VEC_NEAR(g->segments[2].end, Vec3(-2, 1, 0), 1e-12);  // the turn is kept
+  ASSERT_EQ(g->warnings.size(), 1u);
+  EXPECT_EQ(g->warnings[0],
+            "module 2 (]): a ']' with no '[' open; ignored, as cpfg's turtle does (and 1 more "
+            "like it)");
+}
+
 TEST(Turtle, SurfacesAndSpheres) {
   Drawn d = Draw("axiom: F~leaf(2)!(3)@O@O(1)\n");
   ASSERT_EQ(d.geometry.surfaces.size(), 1u);
@@ -298,6 +317,18 @@ TEST(Turtle, OutOfRangeGeometryIsAnErrorNamingTheModule) {
   // Large but representable is fine.
   auto p = testing::PlantFromText("axiom: F(1e14)!(1e10)F\n", -1, plant::Stage::kGeometry);
   EXPECT_TRUE(p);
+  // The error is located where the grammar first writes the module's name.
+  auto q = testing::PlantFromText("axiom: A\nA --> B F(1e308) F(1e308)\n", 1,
+                                  plant::Stage::kInterpreted);
+  ASSERT_TRUE(q);
+  auto g = Interpret(q->DrawnWord(), q->grammar.symbols, TurtleDefFrom(q->grammar));
+  ASSERT_FALSE(g.ok());
+  EXPECT_EQ(std::to_string(g.error().loc.line) + ":" + std::to_string(g.error().loc.column), "2:9")
+      << g.error().Format();
+  EXPECT_NE(g.error().message.find("module 2 (F(1e+308)) gives a segment end"), std::string::npos)
+      << g.error().message;
+  EXPECT_NE(g.error().Format().find("2 | A --> B F(1e308) F(1e308)"), std::string::npos)
+      << g.error().Format();
 }
 
 TEST(Turtle, SurfaceWithThreeScalesScalesEachAxis) {
