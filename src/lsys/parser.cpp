@@ -15,8 +15,8 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
-#include <memory>
 #include <map>
+#include <memory>
 #include <set>
 #include <unordered_set>
 
@@ -714,9 +714,9 @@ std::optional<SymbolId> GrammarParser::Intern(const Line& l, int col, const std:
 // The turtle's commands, which read the parameters they have whatever their
 // number (cpfg's `+(20,0)` turns as `+(20)` does).
 static bool IsTurtleCommand(const std::string& name) {
-  static const std::set<std::string> kCommands = {
-      "F", "f", "G", "g", "+", "-", "&", "^", "/", "\\", "|", "$", "{", "}",
-      ".", "!", "#", ";", ",", "%", "_", "'"};
+  static const std::set<std::string> kCommands = {"F", "f",  "G", "g", "+", "-", "&", "^",
+                                                  "/", "\\", "|", "$", "{", "}", ".", "!",
+                                                  "#", ";",  ",", "%", "_", "'"};
   return name[0] == '@' || name[0] == '~' || kCommands.count(name) > 0;
 }
 
@@ -762,8 +762,10 @@ void GrammarParser::WarnMixedArity() {
                       ": a production matches only the number of parameters it names (as "
                       "cpfg's does), so no production matches this '" +
                       name + "'";
-    if (IsTurtleCommand(name)) msg += " (the turtle draws it either way, reading its first "
-                                      "parameters)";
+    if (IsTurtleCommand(name))
+      msg +=
+          " (the turtle draws it either way, reading its first "
+          "parameters)";
     Warn(odd->second, g_.SourceLine(odd->second), msg, int(name.size()));
   }
 }

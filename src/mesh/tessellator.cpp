@@ -123,8 +123,8 @@ enum class FramePart { kAxis, kTangents, kAll };
 // is the first, its tangent the mean of the two segments' there, and the
 // normals carried round are turned back by the angle they miss the first
 // by, spread along the chain by length, so the last ring is the first.
-void BuildFrames(const PlantGeometry& g, std::span<const uint32_t> chain, bool loop,
-                 ChainFrames& f, FramePart part = FramePart::kAll) {
+void BuildFrames(const PlantGeometry& g, std::span<const uint32_t> chain, bool loop, ChainFrames& f,
+                 FramePart part = FramePart::kAll) {
   const size_t m = chain.size();
   auto& P = f.P;
   auto& T = f.T;

@@ -630,9 +630,8 @@ uint32_t ScreenScalar(const double* __restrict x, uint32_t k, uint32_t to,
 // Eight points a step: their 24 doubles in three registers, split into
 // x, y and z by two permutes each.
 [[gnu::target("avx512f,avx512vl")]] uint32_t ScreenAvx512(const double* __restrict x, uint32_t k,
-                                                         uint32_t to, const double* __restrict p,
-                                                         double reach2,
-                                                         uint32_t* __restrict out) {
+                                                          uint32_t to, const double* __restrict p,
+                                                          double reach2, uint32_t* __restrict out) {
   const __m512i ax = _mm512_setr_epi64(0, 3, 6, 9, 12, 15, 0, 0);
   const __m512i bx = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 10, 13);
   const __m512i ay = _mm512_setr_epi64(1, 4, 7, 10, 13, 0, 0, 0);
@@ -664,8 +663,7 @@ uint32_t ScreenScalar(const double* __restrict x, uint32_t k, uint32_t to,
     const __m512d dx = _mm512_sub_pd(X, px), dy = _mm512_sub_pd(Y, py), dz = _mm512_sub_pd(Z, pz);
     const __m512d d2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
                                      _mm512_mul_pd(dz, dz));
-    const __mmask8 in =
-        _mm512_cmp_pd_mask(d2, r2, _CMP_LE_OQ) & __mmask8((1u << left) - 1);
+    const __mmask8 in = _mm512_cmp_pd_mask(d2, r2, _CMP_LE_OQ) & __mmask8((1u << left) - 1);
     _mm256_mask_compressstoreu_epi32(out + m, in,
                                      _mm256_add_epi32(_mm256_set1_epi32(int(k)), lane));
     m += uint32_t(__builtin_popcount(in));
@@ -771,10 +769,9 @@ void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radiu
   RestOnPlaneAvx(q, a, radius, old, begin, idx, count, done);
 }
 
-
 int ScreenLanes() {
-  static const int lanes = (__builtin_cpu_init(), __builtin_cpu_supports("avx512f") &&
-                                                      __builtin_cpu_supports("avx512vl"))
+  static const int lanes = (__builtin_cpu_init(),
+                            __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl"))
                                ? 8
                                : 0;
   return lanes;

@@ -253,8 +253,7 @@ void AddPlantPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t,
     // A sphere (@O: a bud, a fruit) is an organ where it sits, as a surface
     // is: a leaf point; it collides as a capsule of no length.
     out.leaves.push_back(world(s.center));
-    out.capsules.push_back(
-        particles::Capsule{world(s.center), world(s.center), s.radius * scale});
+    out.capsules.push_back(particles::Capsule{world(s.center), world(s.center), s.radius * scale});
   }
   for (const mesh::ContourTube& tube : g.tubes) {
     // A generalized cylinder with a contour (a leaf blade, a petal, a
@@ -285,7 +284,6 @@ void AddPlantPoints(const mesh::PlantGeometry& g, const draw::Mat4f& t,
     if (!starts.count(centre[R - 1])) out.tips.push_back(world(centre[R - 1]));
   }
 }
-
 
 terrain::TerrainDef TerrainDefOf(const TerrainDef& t, uint64_t seed) {
   terrain::TerrainDef d;
@@ -432,7 +430,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
     built.trianglesDrawn += m.mesh->triangleCount();
     if (!p.id.empty()) {
       AddPlantPoints(grown->geometry, m.instances[0].transform, SurfacesOf(*grown, spec),
-                built.points[p.id]);
+                     built.points[p.id]);
       built.meshesOf[p.id].push_back(built.meshes.size());
     }
     m.plant = std::make_shared<plant::Plant>(std::move(*grown));
@@ -504,7 +502,7 @@ BuildResult Build(const Scene& scene, const BuildOptions& options) {
       built.trianglesDrawn += m.mesh->triangleCount();
       if (!f.id.empty())
         AddPlantPoints(geometry[size_t(v)], m.instances.back().transform, surfaces[size_t(v)],
-                  built.points[f.id]);
+                       built.points[f.id]);
     }
   }
 

@@ -63,9 +63,9 @@ TEST(CpfgQueries, OneQueryWithDifferentParameterCountsIsNotWarnedAbout) {
     EXPECT_EQ(line.find("'?E' is used with"), std::string::npos) << Joined(d);
   bool lWarned = false;
   for (const std::string& line : d)
-    lWarned |=
-        line.find("module 'L' is used with 1 parameter here, and the production at line 4 names "
-                  "it with 0") != std::string::npos;
+    lWarned |= line.find(
+                   "module 'L' is used with 1 parameter here, and the production at line 4 names "
+                   "it with 0") != std::string::npos;
   EXPECT_TRUE(lWarned) << Joined(d);
 }
 

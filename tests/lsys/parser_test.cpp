@@ -190,8 +190,8 @@ TEST(Parser, MixedArityWarnsOnlyWhereAProductionNamesTheModule) {
   // cpfg files turn with +(20,0) beside +(x) and open splines with {(4)
   // beside {(2,8): no production names them, the turtle reads their first
   // parameters either way, and matching cannot be affected: no warning.
-  EXPECT_TRUE(Warnings("axiom: A(1)\nA(x) --> +(20,0) F +(x) {(4) f }(4) {(2,8) f }(2) A(x)\n")
-                  .empty());
+  EXPECT_TRUE(
+      Warnings("axiom: A(1)\nA(x) --> +(20,0) F +(x) {(4) f }(4) {(2,8) f }(2) A(x)\n").empty());
   // A module used with a count no production names, where one names it with
   // another: a real mismatch, in a context too, and said of a turtle command.
   auto ctx = Warnings("axiom: B F(1) F\nB > F(x) --> B\n");

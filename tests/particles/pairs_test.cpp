@@ -127,8 +127,8 @@ TEST(PairContacts, VectorScreenKeepsTheScalarScreensPoints) {
       uint32_t a[64], b[64];
       const uint32_t na = kernels::ScreenCandidates(kernels::Kernel::kScalar, x.data(), from,
                                                     from + len, p, 0.25, a);
-      const uint32_t nb = kernels::ScreenCandidates(kernels::Kernel::kAvx, x.data(), from,
-                                                    from + len, p, 0.25, b);
+      const uint32_t nb =
+          kernels::ScreenCandidates(kernels::Kernel::kAvx, x.data(), from, from + len, p, 0.25, b);
       ASSERT_EQ(na, nb) << "points [" << from << ", " << from + len << "): " << na
                         << " kept by the scalar screen, " << nb << " by the vector one";
       for (uint32_t k = 0; k < na; ++k)

@@ -775,8 +775,8 @@ TEST(TurtleSpline, ClosedSplineTubeIsJoinedEndToStartNotCapped) {
     std::vector<uint32_t> merged(m.positions.size());
     for (size_t i = 0; i < m.positions.size(); ++i) {
       const Vec3f& p = m.positions[i];
-      merged[i] = id.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, uint32_t(id.size()))
-                      .first->second;
+      merged[i] =
+          id.emplace(std::array<float, 3>{p.x(), p.y(), p.z()}, uint32_t(id.size())).first->second;
     }
     std::set<std::pair<uint32_t, uint32_t>> edges;
     for (size_t t = 0; t + 2 < m.indices.size(); t += 3)
@@ -787,8 +787,8 @@ TEST(TurtleSpline, ClosedSplineTubeIsJoinedEndToStartNotCapped) {
     return int64_t(id.size()) - int64_t(edges.size()) + int64_t(m.triangleCount());
   };
   for (const char* type : {"2", "4"}) {
-    const std::string text = std::string("axiom: {(") + type + ") f +(90) f +(90) f +(90) f }(" +
-                             type + ")\n";
+    const std::string text =
+        std::string("axiom: {(") + type + ") f +(90) f +(90) f +(90) f }(" + type + ")\n";
     auto p = testing::PlantFromText(text, -1, plant::Stage::kMesh);
     ASSERT_TRUE(p.has_value()) << text;
     ASSERT_EQ(p->geometry.loops.size(), 1u) << text;
