@@ -4,8 +4,8 @@ initial color: 1
 color increment: 1
 initial line width: 0.3 polygons
 line width increment: 0.12
-viewpoint: 0.3,0.35,1
-view reference point: 0,0,0
+viewpoint: 3,6.7,8.5
+view reference point: 0,3.2,-1.5
 twist: 0
 projection: perspective
 z buffer: on
