@@ -1015,10 +1015,16 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
         for (const std::string& o : c.unknownOptions)
           warn("the cpfg command's option '" + o + "' is not one cpfg has: ignored");
       } else {
-        // No `specifications` either: an L-studio object, whose view file
-        // is the folder's one `.v` (view.v beside lsystem.l).
+        // No `specifications` either: an L-studio object, one folder with
+        // one `.l`, whose view file is the folder's one `.v` (view.v beside
+        // lsystem.l). A folder of several grammars is not an object: each
+        // needs its own NAME.v (grammars/cpfg's sub_lsystem.l was drawn
+        // with flower.v's camera).
+        const fs::path dir = fs::path(grammarPath).parent_path();
+        std::vector<std::string> grammars;
+        OnlyFileWithExtension(dir, ".l", &grammars);
         std::vector<std::string> several;
-        viewPath = OnlyFileWithExtension(fs::path(grammarPath).parent_path(), ".v", &several);
+        if (grammars.empty()) viewPath = OnlyFileWithExtension(dir, ".v", &several);
         if (!several.empty()) {
           std::string names;
           for (const std::string& n : several) names += (names.empty() ? "" : ", ") + n;
@@ -1030,7 +1036,7 @@ std::shared_ptr<const ViewFile> LoadViewFiles(const std::string& grammarPath,
                       "): none is used; name one with --view";
           v->diagnostics.Add(std::move(d));
         }
-        lstudio = true;
+        lstudio = grammars.empty();
       }
     }
   }

@@ -733,6 +733,7 @@ void GrammarParser::WarnMixedArity() {
   for (const auto* sec : {&g_.main, &g_.decomposition, &g_.interpretation}) {
     for (const Production& p : sec->productions) {
       auto add = [&](SymbolId sym) {
+        if (sym == kRestOfBranch) return;  // cpfg's `=`: no module
         named[g_.symbols.name(sym)].emplace(g_.symbols.arity(sym), p.loc);
       };
       add(p.pred.symbol);

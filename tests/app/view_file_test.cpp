@@ -509,6 +509,21 @@ TEST(ViewFile, AnLStudioObjectUsesItsFoldersOnlyViewFile) {
       << Messages(view->diagnostics);
 }
 
+TEST(ViewFile, AFolderOfSeveralGrammarsIsNoLStudioObject) {
+  // grammars/cpfg holds flower.l with flower.v beside sub_lsystem.l: the
+  // one .v is flower's, not the folder's (sub_lsystem.l was drawn with it).
+  const std::filesystem::path dir = Scratch() / "several_grammars";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "flower.l") << "axiom: F\n";
+  std::ofstream(dir / "flower.v") << "angle increment: 30\n";
+  std::ofstream(dir / "other.l") << "axiom: F\n";
+  auto view = LoadViewFiles((dir / "other.l").string(), "");
+  EXPECT_TRUE(!view || view->path.empty()) << view->path;
+  view = LoadViewFiles((dir / "flower.l").string(), "");
+  ASSERT_NE(view, nullptr);
+  EXPECT_EQ(view->path, (dir / "flower.v").string()) << Messages(view->diagnostics);
+}
+
 TEST(ViewFile, BackgroundSceneIsDrawnWithThePlant) {
   const std::string grammar = WriteFile("bgs.l", "axiom: F(3)\n");
   WriteFile("bgs.v", "background scene: bgs.dat\n");
