@@ -42,6 +42,7 @@ scripts/deps.sh --fuzz
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DSYLVA_BUILD_TESTS=OFF -DSYLVA_BUILD_BENCH=OFF -DSYLVA_BUILD_EXAMPLES=OFF -DSYLVA_BUILD_FUZZ=ON \
   -DCMAKE_CXX_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=all -fsanitize=fuzzer-no-link" \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
   >/dev/null
 cmake --build build-fuzz -j"$(nproc)" --target "${targets[@]}"
 

@@ -4,9 +4,12 @@
 # suppressions are for third-party code, in tests/sanitizer/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -O1 -g"
+# -O2 as RelWithDebInfo has it (the tests run faster than at -O1); -g1 keeps
+# the line tables the reports need and compiles 2-3x faster than -g.
+flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSYLVA_BUILD_BENCH=OFF \
-  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+  -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1 -DNDEBUG" \
+  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
 cmake --build build-asan -j"$(nproc)"
 supp="$PWD/tests/sanitizer"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:halt_on_error=1"
@@ -16,5 +19,6 @@ cd build-asan
 # Everything that does not draw, with LeakSanitizer; then what draws through
 # Mesa (label "gl") without it: the driver is unloaded before the leak
 # report, so its allocations carry no module name a suppression could match.
-ctest --output-on-failure -j"$(nproc)" -LE gl
+# (Label "source", the format check, ran in the Release build.)
+ctest --output-on-failure -j"$(nproc)" -LE "gl|source"
 ASAN_OPTIONS="detect_leaks=0:halt_on_error=1" ctest --output-on-failure -j"$(nproc)" -L gl

@@ -12,18 +12,10 @@
 #include "lsys/deriver.h"
 #include "lsys/parser.h"
 #include "plant/plant_test_util.h"
+#include "turtle/vec_expect.h"
 
 namespace sylva::turtle {
 namespace {
-
-std::string Str(const Vec3& v) {
-  char b[96];
-  std::snprintf(b, sizeof b, "(%.9g, %.9g, %.9g)", v.x(), v.y(), v.z());
-  return b;
-}
-
-#define EXPECT_VEC_NEAR(a, b, tol) \
-  EXPECT_LT(((a) - (b)).norm(), tol) << "got " << Str(a) << ", want " << Str(b)
 
 struct Drawn {
   lsys::Grammar grammar;

@@ -6,18 +6,10 @@
 
 #include "plant/plant_test_util.h"
 #include "turtle/interpreter.h"
+#include "turtle/vec_expect.h"
 
 namespace sylva::turtle {
 namespace {
-
-std::string Str(const Vec3& v) {
-  char b[96];
-  std::snprintf(b, sizeof b, "(%.12g, %.12g, %.12g)", v.x(), v.y(), v.z());
-  return b;
-}
-
-#define EXPECT_VEC_NEAR(a, b, tol) \
-  EXPECT_LT(((a) - (b)).norm(), tol) << "got " << Str(a) << ", want " << Str(b)
 
 lsys::Movement Tropism(const Vec3& t, double e, double angle = 0, double step = 0) {
   lsys::Movement m;
