@@ -285,7 +285,10 @@ Status BulkSystem::Step(double h) {
       [&](size_t i) { return state.pinned(i); }, [&](size_t i) { return state.id[i]; }));
   const Vec3& g = fields.gravity;
   const Vec3& w = fields.wind;
-  const float limit = float(std::min(maxMagnitude, double(FLT_MAX)));
+  // Rounded toward zero: a component above maxMagnitude must not pass the
+  // float check unflagged (the flagged are checked again in double).
+  float limit = float(std::min(maxMagnitude, double(FLT_MAX)));
+  if (double(limit) > maxMagnitude) limit = std::nextafter(limit, 0.0f);
   const kernels::BulkParams q{float(g.x()),
                               float(g.y()),
                               float(g.z()),

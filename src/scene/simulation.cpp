@@ -99,6 +99,7 @@ struct WindGrid {
     lo.array() -= 2 * spacing;  // room for a step's motion
     hi.array() += 2 * spacing;
     const Vec3 extent = hi - lo;
+    if (!extent.allFinite()) return;  // beyond double's range: sampled exactly
     if (extent.maxCoeff() / spacing > 47) spacing = extent.maxCoeff() / 47;
     nx = int(std::ceil(extent.x() / spacing)) + 1;
     ny = int(std::ceil(extent.y() / spacing)) + 1;

@@ -132,6 +132,30 @@ TEST(Faults, BulkReportsNonFiniteInAnyComponent) {
   }
 }
 
+// BulkSystem checks its float state against maxMagnitude in float: the limit
+// is rounded toward zero, so a component just above maxMagnitude, which the
+// limit rounded to nearest would let through, is still reported.
+TEST(Faults, BulkReportsAComponentJustBeyondALimitThatFloatRoundsUp) {
+  const double limit = 1.0000001;  // float(limit) is 1 + 2^-23, above it
+  ASSERT_GT(double(float(limit)), limit);
+  const float beyond = 1.0f + 0x1p-23f;
+  ASSERT_GT(double(beyond), limit);
+  for (int a = 0; a < 6; ++a) {
+    BulkSystem b;
+    b.maxMagnitude = limit;
+    for (int i = 0; i < 20; ++i) b.state.Add(Vec3::Zero(), Vec3::Zero());
+    ASSERT_OK(b.Step(0.01));
+    (*b.state.FloatArrays()[size_t(a)])[13] = beyond;
+    ExpectError(b.Step(0.01), {"step 1", "particle id 13", "beyond the limit"},
+                "array " + std::to_string(a));
+  }
+  // A component at the limit rounded down passes.
+  BulkSystem b;
+  b.maxMagnitude = limit;
+  b.state.Add(Vec3(1, 1, 1), Vec3(1, 1, 1));
+  ASSERT_OK(b.Step(1e-9));
+}
+
 ClothDef SmallCloth(ClothSolver solver) {
   ClothDef def;
   def.columns = def.rows = 6;
