@@ -64,6 +64,7 @@ void BM_FrameMillionTrianglePlant(benchmark::State& state) {
     gl.renderer->Finish();
   }
   gl.renderer->SetMesh({}, {});
+  state.SetLabel(gl.context->Renderer());
   state.counters["triangles"] = double(m.triangleCount());
   state.counters["fps"] =
       benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
@@ -92,6 +93,7 @@ void BM_FrameMillionPoints(benchmark::State& state) {
     gl.renderer->Finish();
   }
   (void)gl.renderer->SetPoints({});
+  state.SetLabel(gl.context->Renderer());
   state.counters["points"] = 1e6;
   state.counters["fps"] =
       benchmark::Counter(double(state.iterations()), benchmark::Counter::kIsRate);
