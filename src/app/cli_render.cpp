@@ -196,6 +196,15 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
     if (!s.ok()) return Report(s.error(), err);
     if (exit != kExitOk) return exit;
   }
+  // cpfg's own camera may look away from the plant: an empty picture is
+  // said, not written silently.
+  if (auto unseen = UnseenPlantWarning(view, viewFile.get(), camera, double(v.width) / v.height,
+                                       *bounds, plant->mesh, figure)) {
+    DiagnosticList warnings;
+    warnings.Add(*unseen);
+    exit = Report(warnings, err, cmd.derive.maxErrors, cmd.derive.strict);
+    if (exit != kExitOk) return exit;
+  }
   const size_t lineCount = figure.points.size() / 2;
   const auto m = std::make_shared<const mesh::TriangleMesh>(std::move(plant->mesh));
 

@@ -90,6 +90,29 @@ Expected<mesh::Box> FramedBox(const PlantView& view, const plant::Plant& plant,
 // framed from the view's direction, its projection, its zoom.
 render::Camera FramePlant(const PlantView& view, const mesh::Box& box, double aspect);
 
+// Whether any of `box` lies inside the camera's view (its frustum at
+// `aspect`): false when all eight corners are beyond one clip plane, as for
+// a cpfg perspective camera that looks away from the plant or a `box:`
+// that holds none of it (the picture would be empty).
+bool SeesBox(const render::Camera& camera, double aspect, const mesh::Box& box);
+
+// Whether any triangle of `mesh` or segment of `lines` may show in the
+// camera's view: one whose corners all lie beyond one clip plane does not
+// (a conservative test: a primitive that only crosses a corner of the
+// frustum counts as seen).
+bool SeesAnyOf(const render::Camera& camera, double aspect, const mesh::TriangleMesh& mesh,
+               const draw::Lines& lines);
+
+// A warning at the view file's camera line when the camera does not frame
+// the plant (cpfg's perspective camera, a parallel view's `box:`) and sees
+// none of the drawn `mesh` and `lines` (whose bounds are `box`): `sylva
+// render` would write an empty picture. Nullopt when the camera sees some
+// of it or frames it.
+std::optional<Diagnostic> UnseenPlantWarning(const PlantView& view, const ViewFile* viewFile,
+                                             const render::Camera& camera, double aspect,
+                                             const mesh::Box& box, const mesh::TriangleMesh& mesh,
+                                             const draw::Lines& lines);
+
 // The box framed from another direction, in the view's projection at the
 // view's field of view, without the view file's zoom (everything shows):
 // the viewer's "frame all".
