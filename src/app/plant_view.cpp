@@ -142,30 +142,49 @@ bool SeesBox(const render::Camera& camera, double aspect, const mesh::Box& box) 
   return all == 0;
 }
 
-bool SeesAnyOf(const render::Camera& camera, double aspect, const mesh::TriangleMesh& mesh,
-               const draw::Lines& lines) {
+bool SeesAnyOf(const render::Camera& camera, double aspect, const mesh::PlantGeometry& g) {
+  if (!g.surfaces.empty()) return true;
   const Mat4 m = camera.ViewProjection(aspect);
-  std::vector<int> codes(mesh.positions.size());
-  for (size_t i = 0; i < codes.size(); ++i) codes[i] = Outcode(m, mesh.positions[i].cast<double>());
-  for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
-    if ((codes[mesh.indices[t]] & codes[mesh.indices[t + 1]] & codes[mesh.indices[t + 2]]) == 0)
-      return true;
-  for (size_t k = 0; k + 1 < lines.points.size(); k += 2)
-    if ((Outcode(m, lines.points[k].cast<double>()) &
-         Outcode(m, lines.points[k + 1].cast<double>())) == 0)
-      return true;
+  // The clip planes all corners of the box [lo, hi] lie beyond.
+  auto boxCode = [&m](const Vec3& lo, const Vec3& hi) {
+    int all = ~0;
+    for (int k = 0; k < 8; ++k)
+      all &= Outcode(
+          m, Vec3((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z()));
+    return all;
+  };
+  for (const mesh::Segment& s : g.segments) {
+    const double r = std::max(s.radiusStart, s.radiusEnd);
+    const Vec3 lo = s.start.cwiseMin(s.end).array() - r, hi = s.start.cwiseMax(s.end).array() + r;
+    if (boxCode(lo, hi) == 0) return true;
+  }
+  for (const mesh::Sphere& s : g.spheres)
+    if (boxCode(s.center.array() - s.radius, s.center.array() + s.radius) == 0) return true;
+  auto pointsCode = [&m](const std::vector<Vec3>& points) {
+    int all = points.empty() ? 1 : ~0;
+    for (const Vec3& p : points) all &= Outcode(m, p);
+    return all;
+  };
+  for (const mesh::Polygon& p : g.polygons)
+    if (pointsCode(p.vertices) == 0) return true;
+  for (const mesh::ContourTube& t : g.tubes)
+    if (pointsCode(t.points) == 0) return true;
   return false;
 }
 
 std::optional<Diagnostic> UnseenPlantWarning(const PlantView& view, const ViewFile* viewFile,
                                              const render::Camera& camera, double aspect,
-                                             const mesh::Box& box, const mesh::TriangleMesh& mesh,
-                                             const draw::Lines& lines) {
+                                             const mesh::Box& box, const mesh::PlantGeometry& g) {
   const bool perspective = view.cpfgDistance > 0 && !camera.orthographic;
   const bool boxed = view.orthographic && view.viewBox;
   if (!viewFile || viewFile->path.empty() || view.cameraFlag || !(perspective || boxed))
     return std::nullopt;
-  if (SeesBox(camera, aspect, box) && SeesAnyOf(camera, aspect, mesh, lines)) return std::nullopt;
+  // A plant that draws nothing has nothing to miss (its own warnings say
+  // why it is empty).
+  if (g.segments.empty() && g.polygons.empty() && g.surfaces.empty() && g.spheres.empty() &&
+      g.tubes.empty())
+    return std::nullopt;
+  if (SeesBox(camera, aspect, box) && SeesAnyOf(camera, aspect, g)) return std::nullopt;
   auto xyz = [](const Vec3& p) {
     char b[128];
     std::snprintf(b, sizeof b, "%g,%g,%g", p.x(), p.y(), p.z());

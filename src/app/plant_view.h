@@ -96,22 +96,20 @@ render::Camera FramePlant(const PlantView& view, const mesh::Box& box, double as
 // that holds none of it (the picture would be empty).
 bool SeesBox(const render::Camera& camera, double aspect, const mesh::Box& box);
 
-// Whether any triangle of `mesh` or segment of `lines` may show in the
-// camera's view: one whose corners all lie beyond one clip plane does not
-// (a conservative test: a primitive that only crosses a corner of the
-// frustum counts as seen).
-bool SeesAnyOf(const render::Camera& camera, double aspect, const mesh::TriangleMesh& mesh,
-               const draw::Lines& lines);
+// Whether any primitive of `g` may show in the camera's view (at
+// `aspect`): one whose bounding box lies wholly beyond one clip plane does
+// not. Conservative: a primitive that only crosses a corner of the view
+// counts as seen, and so does a surface (`~`), whose size is its file's.
+bool SeesAnyOf(const render::Camera& camera, double aspect, const mesh::PlantGeometry& g);
 
 // A warning at the view file's camera line when the camera does not frame
 // the plant (cpfg's perspective camera, a parallel view's `box:`) and sees
-// none of the drawn `mesh` and `lines` (whose bounds are `box`): `sylva
-// render` would write an empty picture. Nullopt when the camera sees some
-// of it or frames it.
+// none of its geometry `g` (whose bounds are `box`): `sylva render` would
+// write an empty picture. Nullopt when the camera sees some of it, frames
+// it, or the plant draws nothing at all.
 std::optional<Diagnostic> UnseenPlantWarning(const PlantView& view, const ViewFile* viewFile,
                                              const render::Camera& camera, double aspect,
-                                             const mesh::Box& box, const mesh::TriangleMesh& mesh,
-                                             const draw::Lines& lines);
+                                             const mesh::Box& box, const mesh::PlantGeometry& g);
 
 // The box framed from another direction, in the view's projection at the
 // view's field of view, without the view file's zoom (everything shows):

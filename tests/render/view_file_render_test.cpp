@@ -383,6 +383,13 @@ TEST(ViewFile, ACameraThatSeesNoneOfThePlantIsWarnedAtItsViewpoint) {
   EXPECT_NE(err.find("away.v:2:1: warning: the view file's 'box:' holds none of the plant"),
             std::string::npos)
       << err;
+  // A plant that draws nothing is not said to be out of view (vlab's
+  // 07-canalization-output draws nothing until its environment answers).
+  const std::string empty = WriteFile("nothing.l", "axiom: f(2)\n");
+  WriteFile("nothing.v", "line style: cylinder\nbox: x: 10,20 y: 10,20 z: -1,1\n");
+  ASSERT_EQ(Render(empty, png, "160x120", &err), 0) << err;
+  EXPECT_EQ(err.find("holds none"), std::string::npos) << err;
+  std::filesystem::remove(Scratch() / "nothing.v");
   // Turned toward the stem, no warning.
   WriteFile("away.v",
             "projection: perspective\nview reference point: 0,1,0\nviewpoint: 0,1,-10\n"
