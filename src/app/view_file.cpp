@@ -45,8 +45,8 @@ constexpr std::string_view kSurfaces =
 constexpr std::string_view kNotActed = "Sylva does not act on it";
 
 constexpr Ignored kIgnored[] = {
-    {"front distance:", "clipping planes: Sylva frames the plant"},
-    {"back distance:", "clipping planes: Sylva frames the plant"},
+    {"front distance:", "clipping planes: Sylva sets its own near and far planes around the plant"},
+    {"back distance:", "clipping planes: Sylva sets its own near and far planes around the plant"},
     {"shade mode:", kLighting},
     {"diffuse reflection:", kLighting},
     {"surface ambient:", kLighting},
