@@ -173,6 +173,15 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   auto bounds = FramedBox(view, *plant, *spec);
   if (!bounds) return Report(bounds.error(), err);
   const render::Camera camera = FramePlant(view, *bounds, double(v.width) / v.height);
+  // cpfg's own camera may look away from the plant: an empty picture is
+  // said, not written silently.
+  if (auto unseen = UnseenPlantWarning(view, viewFile.get(), camera, double(v.width) / v.height,
+                                       *bounds, plant->geometry)) {
+    DiagnosticList warnings;
+    warnings.Add(*unseen);
+    exit = Report(warnings, err, cmd.derive.maxErrors, cmd.derive.strict);
+    if (exit != kExitOk) return exit;
+  }
   const int W = v.width * K, H = v.height * K;
   if (plant->geometry.widthInPixels) {
     // Pixel widths are output pixels: K of the K-times larger image.

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include "render/renderer.h"
@@ -84,6 +85,19 @@ render::Camera FramePlant(const PlantView& view, const mesh::Box& box, double as
     camera.target = view.cpfgTarget;
     camera.distance = view.cpfgDistance;
     camera.fovY = view.viewingAngle.value_or(45);
+    // cpfg clips at its `back distance:` (100000 by default), far beyond
+    // a plant; Sylva's far plane (4 distances + 1 by default) reaches the
+    // box's farthest corner, so a scene larger than the eye's distance to
+    // the view reference point (corpus3's forest: 3000 units wide, seen
+    // from 200) is not cut off.
+    const Vec3 eye = camera.Eye();
+    double reach = 0;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 c((k & 1) ? box.hi.x() : box.lo.x(), (k & 2) ? box.hi.y() : box.lo.y(),
+                   (k & 4) ? box.hi.z() : box.lo.z());
+      reach = std::max(reach, (c - eye).norm());
+    }
+    if (std::isfinite(reach)) camera.farPlane = std::max(camera.distance * 4 + 1, reach * 1.01);
     return camera;
   }
   // cpfg's `viewing angle:` is the perspective's field of view: the camera
@@ -101,6 +115,98 @@ render::Camera FramePlant(const PlantView& view, const mesh::Box& box, double as
       camera.distance /= *view.scale;
   }
   return camera;
+}
+
+namespace {
+
+// The clip planes a point lies beyond, one bit each (x < -w, x > w, y < -w,
+// y > w, z < -w, z > w); 0: inside the view.
+int Outcode(const Mat4& m, const Vec3& p) {
+  const Vec4 c = m * Vec4(p.x(), p.y(), p.z(), 1.0);
+  int code = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (c[a] < -c.w()) code |= 1 << (2 * a);
+    if (c[a] > c.w()) code |= 1 << (2 * a + 1);
+  }
+  return code;
+}
+
+}  // namespace
+
+bool SeesBox(const render::Camera& camera, double aspect, const mesh::Box& box) {
+  const Mat4 m = camera.ViewProjection(aspect);
+  int all = ~0;
+  for (int k = 0; k < 8; ++k)
+    all &= Outcode(m, Vec3((k & 1) ? box.hi.x() : box.lo.x(), (k & 2) ? box.hi.y() : box.lo.y(),
+                           (k & 4) ? box.hi.z() : box.lo.z()));
+  return all == 0;
+}
+
+bool SeesAnyOf(const render::Camera& camera, double aspect, const mesh::PlantGeometry& g) {
+  if (!g.surfaces.empty()) return true;
+  const Mat4 m = camera.ViewProjection(aspect);
+  // The clip planes all corners of the box [lo, hi] lie beyond.
+  auto boxCode = [&m](const Vec3& lo, const Vec3& hi) {
+    int all = ~0;
+    for (int k = 0; k < 8; ++k)
+      all &= Outcode(
+          m, Vec3((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z()));
+    return all;
+  };
+  for (const mesh::Segment& s : g.segments) {
+    const double r = std::max(s.radiusStart, s.radiusEnd);
+    const Vec3 lo = s.start.cwiseMin(s.end).array() - r, hi = s.start.cwiseMax(s.end).array() + r;
+    if (boxCode(lo, hi) == 0) return true;
+  }
+  for (const mesh::Sphere& s : g.spheres)
+    if (boxCode(s.center.array() - s.radius, s.center.array() + s.radius) == 0) return true;
+  auto pointsCode = [&m](const std::vector<Vec3>& points) {
+    int all = points.empty() ? 1 : ~0;
+    for (const Vec3& p : points) all &= Outcode(m, p);
+    return all;
+  };
+  for (const mesh::Polygon& p : g.polygons)
+    if (pointsCode(p.vertices) == 0) return true;
+  for (const mesh::ContourTube& t : g.tubes)
+    if (pointsCode(t.points) == 0) return true;
+  return false;
+}
+
+std::optional<Diagnostic> UnseenPlantWarning(const PlantView& view, const ViewFile* viewFile,
+                                             const render::Camera& camera, double aspect,
+                                             const mesh::Box& box, const mesh::PlantGeometry& g) {
+  const bool perspective = view.cpfgDistance > 0 && !camera.orthographic;
+  const bool boxed = view.orthographic && view.viewBox;
+  if (!viewFile || viewFile->path.empty() || view.cameraFlag || !(perspective || boxed))
+    return std::nullopt;
+  // A plant that draws nothing has nothing to miss (its own warnings say
+  // why it is empty).
+  if (g.segments.empty() && g.polygons.empty() && g.surfaces.empty() && g.spheres.empty() &&
+      g.tubes.empty())
+    return std::nullopt;
+  if (SeesBox(camera, aspect, box) && SeesAnyOf(camera, aspect, g)) return std::nullopt;
+  auto xyz = [](const Vec3& p) {
+    char b[128];
+    std::snprintf(b, sizeof b, "%g,%g,%g", p.x(), p.y(), p.z());
+    return std::string(b);
+  };
+  Diagnostic d;
+  d.severity = Severity::kWarning;
+  d.loc.file = viewFile->path;
+  d.loc.line = perspective ? viewFile->cameraLine : viewFile->boxLine;
+  d.loc.column = d.loc.line > 0 ? 1 : 0;
+  const std::string plant = "the plant (from " + xyz(box.lo) + " to " + xyz(box.hi) + ")";
+  if (perspective) {
+    d.message = "the view file's camera sees none of " + plant + ": the eye at " +
+                xyz(camera.Eye()) + " looks toward the view reference point " + xyz(camera.target) +
+                " with a field of " + std::to_string(int(camera.fovY + 0.5)) +
+                " degrees, as cpfg's camera does (vrp + (viewpoint - vrp) / scale), and the "
+                "picture is empty; --camera AZIMUTH,ELEVATION,0 frames the plant";
+  } else {
+    d.message = "the view file's 'box:' holds none of " + plant +
+                ": the picture is empty; --camera AZIMUTH,ELEVATION,0 frames the plant";
+  }
+  return d;
 }
 
 render::Camera FrameAll(const PlantView& view, const mesh::Box& box, double aspect, double azimuth,

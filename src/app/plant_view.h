@@ -90,6 +90,27 @@ Expected<mesh::Box> FramedBox(const PlantView& view, const plant::Plant& plant,
 // framed from the view's direction, its projection, its zoom.
 render::Camera FramePlant(const PlantView& view, const mesh::Box& box, double aspect);
 
+// Whether any of `box` lies inside the camera's view (its frustum at
+// `aspect`): false when all eight corners are beyond one clip plane, as for
+// a cpfg perspective camera that looks away from the plant or a `box:`
+// that holds none of it (the picture would be empty).
+bool SeesBox(const render::Camera& camera, double aspect, const mesh::Box& box);
+
+// Whether any primitive of `g` may show in the camera's view (at
+// `aspect`): one whose bounding box lies wholly beyond one clip plane does
+// not. Conservative: a primitive that only crosses a corner of the view
+// counts as seen, and so does a surface (`~`), whose size is its file's.
+bool SeesAnyOf(const render::Camera& camera, double aspect, const mesh::PlantGeometry& g);
+
+// A warning at the view file's camera line when the camera does not frame
+// the plant (cpfg's perspective camera, a parallel view's `box:`) and sees
+// none of its geometry `g` (whose bounds are `box`): `sylva render` would
+// write an empty picture. Nullopt when the camera sees some of it, frames
+// it, or the plant draws nothing at all.
+std::optional<Diagnostic> UnseenPlantWarning(const PlantView& view, const ViewFile* viewFile,
+                                             const render::Camera& camera, double aspect,
+                                             const mesh::Box& box, const mesh::PlantGeometry& g);
+
 // The box framed from another direction, in the view's projection at the
 // view's field of view, without the view file's zoom (everything shows):
 // the viewer's "frame all".

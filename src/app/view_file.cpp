@@ -45,8 +45,8 @@ constexpr std::string_view kSurfaces =
 constexpr std::string_view kNotActed = "Sylva does not act on it";
 
 constexpr Ignored kIgnored[] = {
-    {"front distance:", "clipping planes: Sylva frames the plant"},
-    {"back distance:", "clipping planes: Sylva frames the plant"},
+    {"front distance:", "clipping planes: Sylva sets its own near and far planes around the plant"},
+    {"back distance:", "clipping planes: Sylva sets its own near and far planes around the plant"},
     {"shade mode:", kLighting},
     {"diffuse reflection:", kLighting},
     {"surface ambient:", kLighting},
@@ -322,7 +322,10 @@ void Reader::Read(const app::Line& line) {
     if (auto x = Number(0, "a width")) v_.widthIncrement = *x;
     ExtraValues(1);
   } else if (L == "viewpoint:" || L == "view reference point:") {
-    if (auto p = Vector(0, "x,y,z")) (L == "viewpoint:" ? v_.viewpoint : v_.target) = *p;
+    if (auto p = Vector(0, "x,y,z")) {
+      (L == "viewpoint:" ? v_.viewpoint : v_.target) = *p;
+      if (L == "viewpoint:" || !v_.viewpoint) v_.cameraLine = line_;
+    }
     ExtraValues(3);
   } else if (L == "box:") {
     // cpfg's fixed view volume, `box: x: x0,x1 y: y0,y1 z: z0,z1` (its
@@ -357,6 +360,7 @@ void Reader::Read(const app::Line& line) {
       return;
     }
     v_.box = {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2])};
+    v_.boxLine = line_;
   } else if (L == "scale factor:") {
     if (auto x = Number(0, "a scale")) {
       if (*x > 0)

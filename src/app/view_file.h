@@ -53,14 +53,18 @@ struct ViewFile {
   std::optional<double> elasticityIncrement;  // `elasticity increment:` (its `_` step)
   std::optional<Vec3> viewpoint;              // `viewpoint:` (the eye)
   std::optional<Vec3> target;                 // `view reference point:`
-  std::optional<double> scale;                // `scale factor:` (> 0)
-  std::optional<double> viewingAngle;         // `viewing angle:` (degrees, 0..180): perspective
+  // The line that places cpfg's camera: `viewpoint:`, else `view reference
+  // point:` (0: neither); warnings about what that camera sees point there.
+  int cameraLine = 0;
+  std::optional<double> scale;         // `scale factor:` (> 0)
+  std::optional<double> viewingAngle;  // `viewing angle:` (degrees, 0..180): perspective
   // cpfg's newer tropisms and torques: the `tropism:` and `torque:` lines in
   // order (at most lsys::kMaxMovements); @Ts @Ti @Td(i, ...) address them.
   std::vector<lsys::Movement> movements;
   // `box: x: x0,x1 y: y0,y1 z: z0,z1`: cpfg's fixed view volume, framed by
   // a parallel view instead of the plant's bounds (low corner, high corner).
   std::optional<std::array<Vec3, 2>> box;
+  int boxLine = 0;  // its line
   // cpfg's line style: widths in pixels on the screen (`initial line
   // width: 2 pixels`, `line style: pixel`, or neither: cpfg's default,
   // with a width of 1), not in world units (`initial line width: 0.1`,

@@ -334,5 +334,71 @@ TEST(ViewFile, PerspectiveIsCpfgsCameraNotAFramedBox) {
   std::filesystem::remove(Scratch() / "persp.v");
 }
 
+TEST(ViewFile, PerspectiveFarPlaneReachesAPlantBeyondFourDistances) {
+  // cpfg clips at its `back distance:` (100000 by default); Sylva's far
+  // plane was 4 distances + 1 from the eye, so a stem 70 units away from an
+  // eye 10 units from the view reference point was cut off (corpus3's
+  // forest, 3000 units wide seen from 200, drew only the nearest ground).
+  // Seen now: a 20-unit stem at 70 units in a 45 degree field fills about
+  // 20 / (2 * 70 * tan(22.5)) = 34 % of the picture's height.
+  const std::string grammar = WriteFile("far.l", "axiom: @M(0,-9,-60) !(0.5) F(20)\n");
+  WriteFile("far.v",
+            "viewpoint: 0,1,10\nview reference point: 0,1,0\nprojection: perspective\n"
+            "line style: cylinder\n");
+  const std::string png = (Scratch() / "far.png").string();
+  std::string err;
+  ASSERT_EQ(Render(grammar, png, "160x120", &err), 0) << err;
+  const DrawnRows r = Rows(png);
+  EXPECT_NEAR(r.rows / 120.0, 0.345, 0.05) << r.rows << " rows of 120 drawn";
+  EXPECT_EQ(err.find("sees none"), std::string::npos) << err;
+  std::filesystem::remove(Scratch() / "far.v");
+}
+
+TEST(ViewFile, ACameraThatSeesNoneOfThePlantIsWarnedAtItsViewpoint) {
+  // cpfg's perspective camera looks from the viewpoint toward the view
+  // reference point whatever the plant: here away from it (corpus3's
+  // tree.l looks toward -z from z = 0 and its forest stands at z > 0). The
+  // picture is empty, as cpfg's would be; Sylva says so at the viewpoint
+  // line, and --strict makes it an error.
+  const std::string grammar = WriteFile("away.l", "axiom: !(0.5) F(2)\n");
+  WriteFile("away.v",
+            "projection: perspective\nview reference point: 0,1,-20\nviewpoint: 0,1,-10\n"
+            "line style: cylinder\n");
+  const std::string png = (Scratch() / "away.png").string();
+  std::string err;
+  ASSERT_EQ(Render(grammar, png, "160x120", &err), 0) << err;
+  EXPECT_EQ(Rows(png).rows, 0) << "the stem is behind the eye";
+  EXPECT_NE(err.find("away.v:3:1: warning: the view file's camera sees none of the plant"),
+            std::string::npos)
+      << err;
+  std::ostringstream out, strictErr;
+  EXPECT_EQ(RunCliWithGraphics({"render", grammar, "-o", png, "--size", "160x120", "--strict"}, out,
+                               strictErr),
+            2)
+      << strictErr.str();
+  // A parallel view's `box:` is framed instead of the plant: one that holds
+  // none of it is said the same way, at the box line.
+  WriteFile("away.v", "line style: cylinder\nbox: x: 10,20 y: 10,20 z: -1,1\n");
+  ASSERT_EQ(Render(grammar, png, "160x120", &err), 0) << err;
+  EXPECT_NE(err.find("away.v:2:1: warning: the view file's 'box:' holds none of the plant"),
+            std::string::npos)
+      << err;
+  // A plant that draws nothing is not said to be out of view (vlab's
+  // 07-canalization-output draws nothing until its environment answers).
+  const std::string empty = WriteFile("nothing.l", "axiom: f(2)\n");
+  WriteFile("nothing.v", "line style: cylinder\nbox: x: 10,20 y: 10,20 z: -1,1\n");
+  ASSERT_EQ(Render(empty, png, "160x120", &err), 0) << err;
+  EXPECT_EQ(err.find("holds none"), std::string::npos) << err;
+  std::filesystem::remove(Scratch() / "nothing.v");
+  // Turned toward the stem, no warning.
+  WriteFile("away.v",
+            "projection: perspective\nview reference point: 0,1,0\nviewpoint: 0,1,-10\n"
+            "line style: cylinder\n");
+  ASSERT_EQ(Render(grammar, png, "160x120", &err), 0) << err;
+  EXPECT_EQ(err.find("sees none"), std::string::npos) << err;
+  EXPECT_GT(Rows(png).rows, 0);
+  std::filesystem::remove(Scratch() / "away.v");
+}
+
 }  // namespace
 }  // namespace sylva::app
