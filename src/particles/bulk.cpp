@@ -21,6 +21,29 @@ Vec3f Round(const Vec3& x) {
   return Vec3f(float(x.x()), float(x.y()), float(x.z()));
 }
 
+// How many single-precision roundings of the largest coordinate a
+// resting particle's start may lie from the exact answer and be kept
+// (RoundOutside).
+constexpr double kRestRoundings = 16;
+
+// Whether the rounded point r lies across, or on, a collider as seen from x:
+// the rounding's displacement, doubled (a rounded point exactly on a thin
+// surface counts as across it: from there a path could leave on either
+// side). The crossing's normal in *normal.
+bool Crosses(const std::vector<Collider>& colliders, const Vec3& x, const Vec3& r, double radius,
+             double h, MeshMemo* memo, Vec3* normal) {
+  const Vec3 beyond = r + (r - x);
+  for (const Collider& c : colliders) {
+    Contact ct;
+    const Vec3 w = h * c.velocity;  // where a moving collider ends the step
+    if (c.Intersect(x - w, beyond - w, &ct, radius, memo)) {
+      *normal = ct.normal;
+      return true;
+    }
+  }
+  return false;
+}
+
 // x rounded to single precision on the side of every collider that x (the
 // double-precision contact response) is on: rounding a point on a surface
 // may move it across or onto it (thin panels and meshes have a skin of only
@@ -28,30 +51,38 @@ Vec3f Round(const Vec3& x) {
 // on a thin one, where the next step could not tell its side. A rounded
 // point that crosses or touches one is pushed off it along the contact
 // normal by a few single-precision ulps and rounded again.
+//
+// A particle the contact response left at rest (static friction held it,
+// its velocity is exactly zero) keeps the floats it started the step with
+// (`start`) where they lie within kRestRoundings of x in every coordinate
+// and on x's side of every collider: they are as good a rounding of the
+// exact answer as any (RoundOutside's push alone moves a point by
+// 4 ulps of its largest coordinate), and a resting particle then stays
+// exactly where it is. Before, a flake at rest on a slope started each step
+// a few ulps above the surface where the push had left it, dropped back
+// onto it along its path (which leans downhill with gravity and the wind),
+// was pushed up again, and so crept downhill by a few ulps a step forever.
 Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double radius, double h,
-                   MeshMemo* memo) {
+                   MeshMemo* memo, const Vec3f* start) {
+  const double scale = double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
+  Vec3 normal;
+  if (start) {
+    // (A start equal to x is x's own rounding below, signs of zeros kept.)
+    const Vec3 s = start->cast<double>();
+    if (s != x && (s - x).cwiseAbs().maxCoeff() <= kRestRoundings * scale &&
+        !Crosses(colliders, x, s, radius, h, memo, &normal)) {
+      return *start;
+    }
+  }
   Vec3f xf = Round(x);
-  const double skin = 4 * double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
+  const double skin = 4 * scale;
   Vec3 base = x;
   for (int tries = 0; tries < 4; ++tries) {
     const Vec3 r = xf.cast<double>();
     if (r == x) return xf;
-    // The rounding's displacement, doubled: a rounded point exactly on a
-    // thin surface counts as across it (from there a path could leave on
-    // either side).
-    const Vec3 beyond = r + (r - x);
-    bool crossed = false;
-    for (const Collider& c : colliders) {
-      Contact ct;
-      const Vec3 w = h * c.velocity;  // where a moving collider ends the step
-      if (c.Intersect(x - w, beyond - w, &ct, radius, memo)) {
-        base += skin * ct.normal;
-        xf = Round(base);
-        crossed = true;
-        break;
-      }
-    }
-    if (!crossed) return xf;
+    if (!Crosses(colliders, x, r, radius, h, memo, &normal)) return xf;
+    base += skin * normal;
+    xf = Round(base);
   }
   return xf;
 }
@@ -239,7 +270,11 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       }
       if (out == ContactOutcome::kStuck) s.invMass[i] = 0;
       if (out == ContactOutcome::kUnresolved) faults_.Unresolved(i);
-      const Vec3f xf = RoundOutside(colliders_, x, r, h, memo);
+      // At rest after a resting contact (see RoundOutside): the start's
+      // floats where they round x as well.
+      const Vec3f start(old[0][j], old[1][j], old[2][j]);
+      const bool rest = out == ContactOutcome::kResponded && v == Vec3::Zero();
+      const Vec3f xf = RoundOutside(colliders_, x, r, h, memo, rest ? &start : nullptr);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
       const bool within = MaybeWithinLimit(xf.cast<double>(), v, faults_.limit2());
