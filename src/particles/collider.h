@@ -28,6 +28,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -148,6 +149,22 @@ class TriangleBvh {
   std::vector<uint32_t> start_, items_;
   // The cells each triangle is listed in: lo x, y, z, hi x, y, z.
   std::vector<std::array<uint8_t, 6>> cells_;
+  // The grid's columns along its thinnest axis up_ (a terrain's height):
+  // column (cu, cw) over the cells of the other two axes u, w (index
+  // cu + dims_[u] cw) bounds, along up_, the boxes of the triangles listed
+  // in its cells (floats rounded outward; an empty column has lo > hi).
+  // Near's cheapest screen: a path whose box, grown by r, lies above or
+  // below the bound in every column it covers touches no triangle (a flake
+  // high over a terrain). 8 bytes a column.
+  struct Column {
+    float lo, hi;
+  };
+  int up_ = 1;
+  std::vector<Column> columns_;
+  // The cell of coordinate x along axis k, clamped to the grid.
+  int CellOf(double x, int k) const {
+    return int(std::clamp(std::floor((x - gridLo_[k]) / cell_), 0.0, double(dims_[k] - 1)));
+  }
 };
 
 // A collider is a plain description; the factories below fill it, and
