@@ -52,35 +52,35 @@ bool Crosses(const std::vector<Collider>& colliders, const Vec3& x, const Vec3& 
 // point that crosses or touches one is pushed off it along the contact
 // normal by a few single-precision ulps and rounded again.
 //
-// A particle the contact response left at rest (static friction held it,
-// its velocity is exactly zero) keeps the floats it started the step with
-// (`start`) where they lie within kRestRoundings of x in every coordinate
-// and on x's side of every collider: they are as good a rounding of the
-// exact answer as any (RoundOutside's push alone moves a point by
-// 4 ulps of its largest coordinate), and a resting particle then stays
-// exactly where it is. Before, a flake at rest on a slope started each step
-// a few ulps above the surface where the push had left it, dropped back
-// onto it along its path (which leans downhill with gravity and the wind),
-// was pushed up again, and so crept downhill by a few ulps a step forever.
+// Where x's nearest floats cross a surface and the contact response left
+// the particle at rest (static friction held it: its velocity is exactly
+// zero), the floats it started the step with (`start`) serve instead, if
+// they lie within kRestRoundings of x in every coordinate and on x's side
+// of every collider: as good a rounding of the exact answer as the push
+// (which alone moves a point by 4 ulps of its largest coordinate), and a
+// resting particle then stays exactly where it is. Before, a flake at rest
+// on a slope started each step a few ulps above the surface where the push
+// had left it, dropped back onto it along its path (which leans downhill
+// with gravity and the wind), was pushed up again, and so crept downhill by
+// a few ulps a step for ever.
 Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double radius, double h,
                    MeshMemo* memo, const Vec3f* start) {
   const double scale = double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
-  Vec3 normal;
-  if (start) {
-    // (A start equal to x is x's own rounding below, signs of zeros kept.)
-    const Vec3 s = start->cast<double>();
-    if (s != x && (s - x).cwiseAbs().maxCoeff() <= kRestRoundings * scale &&
-        !Crosses(colliders, x, s, radius, h, memo, &normal)) {
-      return *start;
-    }
-  }
   Vec3f xf = Round(x);
   const double skin = 4 * scale;
-  Vec3 base = x;
+  Vec3 base = x, normal;
   for (int tries = 0; tries < 4; ++tries) {
     const Vec3 r = xf.cast<double>();
     if (r == x) return xf;
     if (!Crosses(colliders, x, r, radius, h, memo, &normal)) return xf;
+    if (tries == 0 && start) {
+      const Vec3 s = start->cast<double>();
+      Vec3 unused;
+      if ((s - x).cwiseAbs().maxCoeff() <= kRestRoundings * scale &&
+          !Crosses(colliders, x, s, radius, h, memo, &unused)) {
+        return *start;
+      }
+    }
     base += skin * normal;
     xf = Round(base);
   }
