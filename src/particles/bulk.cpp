@@ -156,6 +156,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
   alignas(32) uint8_t flags[kChunk];
   uint8_t done[kChunk];
   uint16_t idx[kChunk + 4];
+  uint16_t near[kChunk];
   // The vector path for resting contact: one static plane that bounces.
   std::optional<kernels::PlaneRest> floorRest;
   if (restLanes_ > 0 && colliders_.size() == 1 && colliders_[0].kind == Collider::Kind::kPlane &&
@@ -221,6 +222,27 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
           // Any other collider (a moving one: the path in its frame at the
           // start of the step).
           const Vec3 shift = h * col.velocity;
+          if (col.kind == Collider::Kind::kMesh && col.mesh && !memos_.empty()) {
+            // A mesh: its memo-free screen first (most flakes are in the
+            // air), then its full screen for the rest, their memos (112
+            // bytes each, of an array of them all) fetched eight ahead.
+            size_t kept = 0;
+            for (size_t j = 0; j < m; ++j) {
+              if (flags[j] & 2) continue;  // asleep
+              const Vec3 from(old[0][j], old[1][j], old[2][j]);
+              if (!col.mesh->Clear(from - col.offset, s.position(c + j) - shift - col.offset,
+                                   double(s.radius[c + j])))
+                near[kept++] = uint16_t(j);
+            }
+            for (size_t k = 0; k < kept; ++k) {
+              if (k + 8 < kept) __builtin_prefetch(&memos_[c + near[k + 8]]);
+              const size_t j = near[k];
+              flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]),
+                                     s.position(c + j) - shift, double(s.radius[c + j]),
+                                     &memos_[c + j]);
+            }
+            continue;
+          }
           for (size_t j = 0; j < m; ++j) {
             if (flags[j] & 2) continue;  // asleep
             flags[j] |=

@@ -222,8 +222,29 @@ uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
       [&](const std::array<uint32_t, 3>& t) { return Vec3(v_[t[0]] + v_[t[1]] + v_[t[2]]); });
 }
 
+bool TriangleBvh::Clear(const Vec3& a, const Vec3& b, double r) const {
+  if (nodes_.empty()) return true;
+  const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
+  // Clear of every triangle's box (a flake high above a terrain).
+  if ((lo.array() > nodes_[0].hi.array()).any() || (hi.array() < nodes_[0].lo.array()).any())
+    return true;
+  // Clear of the triangles of the columns it covers, where they are few (a
+  // flake in the air over a terrain).
+  if (columns_.empty()) return false;
+  const int u = (up_ + 1) % 3, w = (up_ + 2) % 3;
+  const int lu = CellOf(lo[u], u), hu = CellOf(hi[u], u);
+  const int lw = CellOf(lo[w], w), hw = CellOf(hi[w], w);
+  if ((hu - lu + 1) * (hw - lw + 1) > 4) return false;
+  for (int cw = lw; cw <= hw; ++cw)
+    for (int cu = lu; cu <= hu; ++cu) {
+      const Column& col = columns_[size_t(cu) + size_t(dims_[u]) * size_t(cw)];
+      if (!(lo[up_] > double(col.hi) || hi[up_] < double(col.lo))) return false;
+    }
+  return true;
+}
+
 bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r, const MeshMemo* memo) const {
-  if (nodes_.empty()) return false;
+  if (Clear(a, b, r)) return false;
   if (const double reach = MemoReach(memo, a, b, r); reach >= 0) {
     for (int k = 0; k < memo->count; ++k) {
       if (double(memo->dist[k]) <= reach) return true;
@@ -231,29 +252,6 @@ bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r, const MeshMemo* m
     return false;
   }
   const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
-  // Clear of every triangle's box (a flake high above a terrain).
-  if ((lo.array() > nodes_[0].hi.array()).any() || (hi.array() < nodes_[0].lo.array()).any())
-    return false;
-  // Clear of the triangles of the columns it covers, where they are few (a
-  // flake in the air over a terrain): before the memo, which this need not
-  // read.
-  if (!columns_.empty()) {
-    const int u = (up_ + 1) % 3, w = (up_ + 2) % 3;
-    const int lu = CellOf(lo[u], u), hu = CellOf(hi[u], u);
-    const int lw = CellOf(lo[w], w), hw = CellOf(hi[w], w);
-    if ((hu - lu + 1) * (hw - lw + 1) <= 4) {
-      bool clear = true;
-      for (int cw = lw; cw <= hw && clear; ++cw)
-        for (int cu = lu; cu <= hu; ++cu) {
-          const Column& col = columns_[size_t(cu) + size_t(dims_[u]) * size_t(cw)];
-          if (!(lo[up_] > double(col.hi) || hi[up_] < double(col.lo))) {
-            clear = false;
-            break;
-          }
-        }
-      if (clear) return false;
-    }
-  }
   if (dims_[0] > 0) {  // the grid: whether a cell the box covers lists a triangle
     const Vec3 glo = (lo - gridLo_) / cell_, ghi = (hi - gridLo_) / cell_;
     if (((ghi - glo).array() + 1).prod() <= 8.5) {

@@ -99,6 +99,12 @@ class TriangleBvh {
   // within r of the path. The broad phase of a mesh collider.
   // A memo (MeshMemo) answers for a path within its ball.
   bool Near(const Vec3& a, const Vec3& b, double r, const MeshMemo* memo = nullptr) const;
+  // Near's first and cheapest screen, which reads no memo: true where the
+  // box of the path grown by r is clear of the hierarchy's box, or of the
+  // triangles of the few grid columns it covers (see columns_); then Near
+  // is false. A caller may run it over many particles first and fetch the
+  // memos of the rest ahead of Near.
+  bool Clear(const Vec3& a, const Vec3& b, double r) const;
   size_t triangleCount() const { return tris_.size(); }
   size_t nodeCount() const { return nodes_.size(); }
   int depth() const { return depth_; }
