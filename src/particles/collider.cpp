@@ -222,12 +222,7 @@ uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
       [&](const std::array<uint32_t, 3>& t) { return Vec3(v_[t[0]] + v_[t[1]] + v_[t[2]]); });
 }
 
-bool TriangleBvh::Clear(const Vec3& a, const Vec3& b, double r) const {
-  if (nodes_.empty()) return true;
-  const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
-  // Clear of every triangle's box (a flake high above a terrain).
-  if ((lo.array() > nodes_[0].hi.array()).any() || (hi.array() < nodes_[0].lo.array()).any())
-    return true;
+bool TriangleBvh::ClearOfColumns(const Vec3& lo, const Vec3& hi) const {
   // Clear of the triangles of the columns it covers, where they are few (a
   // flake in the air over a terrain).
   if (columns_.empty()) return false;
@@ -347,7 +342,9 @@ bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r
               (size_t(z) * size_t(dims_[1]) + size_t(y)) * size_t(dims_[0]) + size_t(x);
           for (uint32_t t = start_[cell]; t < start_[cell + 1]; ++t) test(items_[t]);
         }
-    if (memo && best <= 1) Remember(a, r, memo);
+    // The memo about where the path meets the mesh, where the queries of
+    // the rest of the step start.
+    if (memo && best <= 1) Remember(a + best * d, r, memo);
   } else {
     WalkSegment(
         nodes_, a, d, best,

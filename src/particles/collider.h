@@ -104,7 +104,14 @@ class TriangleBvh {
   // triangles of the few grid columns it covers (see columns_); then Near
   // is false. A caller may run it over many particles first and fetch the
   // memos of the rest ahead of Near.
-  bool Clear(const Vec3& a, const Vec3& b, double r) const;
+  bool Clear(const Vec3& a, const Vec3& b, double r) const {
+    if (nodes_.empty()) return true;
+    const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
+    // Clear of every triangle's box (a flake high above a terrain).
+    if ((lo.array() > nodes_[0].hi.array()).any() || (hi.array() < nodes_[0].lo.array()).any())
+      return true;
+    return ClearOfColumns(lo, hi);
+  }
   size_t triangleCount() const { return tris_.size(); }
   size_t nodeCount() const { return nodes_.size(); }
   int depth() const { return depth_; }
@@ -167,6 +174,9 @@ class TriangleBvh {
   };
   int up_ = 1;
   std::vector<Column> columns_;
+  // Whether the box lo..hi is clear of the triangles of the few columns
+  // it covers (false where it covers more than four).
+  bool ClearOfColumns(const Vec3& lo, const Vec3& hi) const;
   // The cell of coordinate x along axis k, clamped to the grid.
   int CellOf(double x, int k) const {
     return int(std::clamp(std::floor((x - gridLo_[k]) / cell_), 0.0, double(dims_[k] - 1)));
