@@ -237,9 +237,9 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
             for (size_t k = 0; k < kept; ++k) {
               if (k + 8 < kept) __builtin_prefetch(&memos_[c + near[k + 8]]);
               const size_t j = near[k];
-              flags[j] |= col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]),
-                                     s.position(c + j) - shift, double(s.radius[c + j]),
-                                     &memos_[c + j]);
+              flags[j] |=
+                  col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
+                             double(s.radius[c + j]), &memos_[c + j]);
             }
             continue;
           }
