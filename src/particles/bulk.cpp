@@ -21,6 +21,29 @@ Vec3f Round(const Vec3& x) {
   return Vec3f(float(x.x()), float(x.y()), float(x.z()));
 }
 
+// How many single-precision roundings of the largest coordinate a
+// resting particle's start may lie from the exact answer and be kept
+// (RoundOutside).
+constexpr double kRestRoundings = 16;
+
+// Whether the rounded point r lies across, or on, a collider as seen from x:
+// the rounding's displacement, doubled (a rounded point exactly on a thin
+// surface counts as across it: from there a path could leave on either
+// side). The crossing's normal in *normal.
+bool Crosses(const std::vector<Collider>& colliders, const Vec3& x, const Vec3& r, double radius,
+             double h, MeshMemo* memo, Vec3* normal) {
+  const Vec3 beyond = r + (r - x);
+  for (const Collider& c : colliders) {
+    Contact ct;
+    const Vec3 w = h * c.velocity;  // where a moving collider ends the step
+    if (c.Intersect(x - w, beyond - w, &ct, radius, memo)) {
+      *normal = ct.normal;
+      return true;
+    }
+  }
+  return false;
+}
+
 // x rounded to single precision on the side of every collider that x (the
 // double-precision contact response) is on: rounding a point on a surface
 // may move it across or onto it (thin panels and meshes have a skin of only
@@ -28,30 +51,38 @@ Vec3f Round(const Vec3& x) {
 // on a thin one, where the next step could not tell its side. A rounded
 // point that crosses or touches one is pushed off it along the contact
 // normal by a few single-precision ulps and rounded again.
+//
+// Where x's nearest floats cross a surface and the contact response left
+// the particle at rest (static friction held it: its velocity is exactly
+// zero), the floats it started the step with (`start`) serve instead, if
+// they lie within kRestRoundings of x in every coordinate and on x's side
+// of every collider: as good a rounding of the exact answer as the push
+// (which alone moves a point by 4 ulps of its largest coordinate), and a
+// resting particle then stays exactly where it is. Before, a flake at rest
+// on a slope started each step a few ulps above the surface where the push
+// had left it, dropped back onto it along its path (which leans downhill
+// with gravity and the wind), was pushed up again, and so crept downhill by
+// a few ulps a step for ever.
 Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double radius, double h,
-                   MeshMemo* memo) {
+                   MeshMemo* memo, const Vec3f* start) {
+  const double scale = double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
   Vec3f xf = Round(x);
-  const double skin = 4 * double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
-  Vec3 base = x;
+  const double skin = 4 * scale;
+  Vec3 base = x, normal;
   for (int tries = 0; tries < 4; ++tries) {
     const Vec3 r = xf.cast<double>();
     if (r == x) return xf;
-    // The rounding's displacement, doubled: a rounded point exactly on a
-    // thin surface counts as across it (from there a path could leave on
-    // either side).
-    const Vec3 beyond = r + (r - x);
-    bool crossed = false;
-    for (const Collider& c : colliders) {
-      Contact ct;
-      const Vec3 w = h * c.velocity;  // where a moving collider ends the step
-      if (c.Intersect(x - w, beyond - w, &ct, radius, memo)) {
-        base += skin * ct.normal;
-        xf = Round(base);
-        crossed = true;
-        break;
+    if (!Crosses(colliders, x, r, radius, h, memo, &normal)) return xf;
+    if (tries == 0 && start) {
+      const Vec3 s = start->cast<double>();
+      Vec3 unused;
+      if ((s - x).cwiseAbs().maxCoeff() <= kRestRoundings * scale &&
+          !Crosses(colliders, x, s, radius, h, memo, &unused)) {
+        return *start;
       }
     }
-    if (!crossed) return xf;
+    base += skin * normal;
+    xf = Round(base);
   }
   return xf;
 }
@@ -125,6 +156,7 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
   alignas(32) uint8_t flags[kChunk];
   uint8_t done[kChunk];
   uint16_t idx[kChunk + 4];
+  uint16_t near[kChunk];
   // The vector path for resting contact: one static plane that bounces.
   std::optional<kernels::PlaneRest> floorRest;
   if (restLanes_ > 0 && colliders_.size() == 1 && colliders_[0].kind == Collider::Kind::kPlane &&
@@ -190,6 +222,27 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
           // Any other collider (a moving one: the path in its frame at the
           // start of the step).
           const Vec3 shift = h * col.velocity;
+          if (col.kind == Collider::Kind::kMesh && col.mesh && !memos_.empty()) {
+            // A mesh: its memo-free screen first (most flakes are in the
+            // air), then its full screen for the rest, their memos (112
+            // bytes each, of an array of them all) fetched eight ahead.
+            size_t kept = 0;
+            for (size_t j = 0; j < m; ++j) {
+              if (flags[j] & 2) continue;  // asleep
+              const Vec3 from(old[0][j], old[1][j], old[2][j]);
+              if (!col.mesh->Clear(from - col.offset, s.position(c + j) - shift - col.offset,
+                                   double(s.radius[c + j])))
+                near[kept++] = uint16_t(j);
+            }
+            for (size_t k = 0; k < kept; ++k) {
+              if (k + 8 < kept) __builtin_prefetch(&memos_[c + near[k + 8]]);
+              const size_t j = near[k];
+              flags[j] |=
+                  col.MayHit(Vec3(old[0][j], old[1][j], old[2][j]), s.position(c + j) - shift,
+                             double(s.radius[c + j]), &memos_[c + j]);
+            }
+            continue;
+          }
           for (size_t j = 0; j < m; ++j) {
             if (flags[j] & 2) continue;  // asleep
             flags[j] |=
@@ -239,7 +292,11 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       }
       if (out == ContactOutcome::kStuck) s.invMass[i] = 0;
       if (out == ContactOutcome::kUnresolved) faults_.Unresolved(i);
-      const Vec3f xf = RoundOutside(colliders_, x, r, h, memo);
+      // At rest after a resting contact (see RoundOutside): the start's
+      // floats where they round x as well.
+      const Vec3f start(old[0][j], old[1][j], old[2][j]);
+      const bool rest = out == ContactOutcome::kResponded && v == Vec3::Zero();
+      const Vec3f xf = RoundOutside(colliders_, x, r, h, memo, rest ? &start : nullptr);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
       const bool within = MaybeWithinLimit(xf.cast<double>(), v, faults_.limit2());

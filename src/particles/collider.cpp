@@ -238,8 +238,24 @@ uint32_t TriangleBvh::Build(uint32_t first, uint32_t count, int depth) {
       [&](const std::array<uint32_t, 3>& t) { return Vec3(v_[t[0]] + v_[t[1]] + v_[t[2]]); });
 }
 
+bool TriangleBvh::ClearOfColumns(const Vec3& lo, const Vec3& hi) const {
+  // Clear of the triangles of the columns it covers, where they are few (a
+  // flake in the air over a terrain).
+  if (columns_.empty()) return false;
+  const int u = (up_ + 1) % 3, w = (up_ + 2) % 3;
+  const int lu = CellOf(lo[u], u), hu = CellOf(hi[u], u);
+  const int lw = CellOf(lo[w], w), hw = CellOf(hi[w], w);
+  if ((hu - lu + 1) * (hw - lw + 1) > 4) return false;
+  for (int cw = lw; cw <= hw; ++cw)
+    for (int cu = lu; cu <= hu; ++cu) {
+      const Column& col = columns_[size_t(cu) + size_t(dims_[u]) * size_t(cw)];
+      if (!(lo[up_] > double(col.hi) || hi[up_] < double(col.lo))) return false;
+    }
+  return true;
+}
+
 bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r, const MeshMemo* memo) const {
-  if (nodes_.empty()) return false;
+  if (Clear(a, b, r)) return false;
   if (const double reach = MemoReach(memo, a, b, r); reach >= 0) {
     for (int k = 0; k < memo->count; ++k) {
       if (double(memo->dist[k]) <= reach) return true;
@@ -247,9 +263,6 @@ bool TriangleBvh::Near(const Vec3& a, const Vec3& b, double r, const MeshMemo* m
     return false;
   }
   const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
-  // Clear of every triangle's box (a flake high above a terrain).
-  if ((lo.array() > nodes_[0].hi.array()).any() || (hi.array() < nodes_[0].lo.array()).any())
-    return false;
   if (dims_[0] > 0) {  // the grid: whether a cell the box covers lists a triangle
     const Vec3 glo = (lo - gridLo_) / cell_, ghi = (hi - gridLo_) / cell_;
     if (((ghi - glo).array() + 1).prod() <= 8.5) {
@@ -345,7 +358,9 @@ bool TriangleBvh::HitTriangle(uint32_t i, const Vec3& a, const Vec3& b, double r
               (size_t(z) * size_t(dims_[1]) + size_t(y)) * size_t(dims_[0]) + size_t(x);
           for (uint32_t t = start_[cell]; t < start_[cell + 1]; ++t) test(items_[t]);
         }
-    if (memo && best <= 1) Remember(a, r, memo);
+    // The memo about where the path meets the mesh, where the queries of
+    // the rest of the step start.
+    if (memo && best <= 1) Remember(a + best * d, r, memo);
   } else {
     WalkSegment(
         nodes_, a, d, best,
@@ -506,6 +521,29 @@ void TriangleBvh::BuildGrid() {
   gridLo_ = lo;
   cell_ = cell;
   for (int k = 0; k < 3; ++k) dims_[k] = dims[k];
+  // The columns along the thinnest axis (the first of equals).
+  up_ = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (dims[k] < dims[up_]) up_ = k;
+  }
+  const int u = (up_ + 1) % 3, w = (up_ + 2) % 3;
+  columns_.assign(size_t(dims[u]) * size_t(dims[w]), Column{HUGE_VALF, -HUGE_VALF});
+  for (uint32_t ti = 0; ti < tris_.size(); ++ti) {
+    int l[3], h[3];
+    range(tris_[ti], l, h);
+    const auto& t = tris_[ti];
+    const double tl = std::min({v_[t[0]][up_], v_[t[1]][up_], v_[t[2]][up_]});
+    const double th = std::max({v_[t[0]][up_], v_[t[1]][up_], v_[t[2]][up_]});
+    float fl = float(tl), fh = float(th);  // rounded outward
+    if (double(fl) > tl) fl = std::nextafter(fl, -HUGE_VALF);
+    if (double(fh) < th) fh = std::nextafter(fh, HUGE_VALF);
+    for (int cw = l[w]; cw <= h[w]; ++cw)
+      for (int cu = l[u]; cu <= h[u]; ++cu) {
+        Column& col = columns_[size_t(cu) + size_t(dims[u]) * size_t(cw)];
+        col.lo = std::min(col.lo, fl);
+        col.hi = std::max(col.hi, fh);
+      }
+  }
 }
 
 // --- Collider ---

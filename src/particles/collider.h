@@ -28,6 +28,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -98,6 +99,19 @@ class TriangleBvh {
   // within r of the path. The broad phase of a mesh collider.
   // A memo (MeshMemo) answers for a path within its ball.
   bool Near(const Vec3& a, const Vec3& b, double r, const MeshMemo* memo = nullptr) const;
+  // Near's first and cheapest screen, which reads no memo: true where the
+  // box of the path grown by r is clear of the hierarchy's box, or of the
+  // triangles of the few grid columns it covers (see columns_); then Near
+  // is false. A caller may run it over many particles first and fetch the
+  // memos of the rest ahead of Near.
+  bool Clear(const Vec3& a, const Vec3& b, double r) const {
+    if (nodes_.empty()) return true;
+    const Vec3 lo = a.cwiseMin(b) - Vec3::Constant(r), hi = a.cwiseMax(b) + Vec3::Constant(r);
+    // Clear of every triangle's box (a flake high above a terrain).
+    if ((lo.array() > nodes_[0].hi.array()).any() || (hi.array() < nodes_[0].lo.array()).any())
+      return true;
+    return ClearOfColumns(lo, hi);
+  }
   size_t triangleCount() const { return tris_.size(); }
   size_t nodeCount() const { return nodes_.size(); }
   int depth() const { return depth_; }
@@ -148,6 +162,25 @@ class TriangleBvh {
   std::vector<uint32_t> start_, items_;
   // The cells each triangle is listed in: lo x, y, z, hi x, y, z.
   std::vector<std::array<uint8_t, 6>> cells_;
+  // The grid's columns along its thinnest axis up_ (a terrain's height):
+  // column (cu, cw) over the cells of the other two axes u, w (index
+  // cu + dims_[u] cw) bounds, along up_, the boxes of the triangles listed
+  // in its cells (floats rounded outward; an empty column has lo > hi).
+  // Near's cheapest screen: a path whose box, grown by r, lies above or
+  // below the bound in every column it covers touches no triangle (a flake
+  // high over a terrain). 8 bytes a column.
+  struct Column {
+    float lo, hi;
+  };
+  int up_ = 1;
+  std::vector<Column> columns_;
+  // Whether the box lo..hi is clear of the triangles of the few columns
+  // it covers (false where it covers more than four).
+  bool ClearOfColumns(const Vec3& lo, const Vec3& hi) const;
+  // The cell of coordinate x along axis k, clamped to the grid.
+  int CellOf(double x, int k) const {
+    return int(std::clamp(std::floor((x - gridLo_[k]) / cell_), 0.0, double(dims_[k] - 1)));
+  }
 };
 
 // A collider is a plain description; the factories below fill it, and

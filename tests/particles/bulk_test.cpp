@@ -467,6 +467,51 @@ TEST(Bulk, AFlakeRestingOnATiltedTriangleStaysPutAndSleeps) {
   RestsAndSleeps(v, o + 0.2 * u - 0.999 * w, n.normalized(), "at the rim");
 }
 
+TEST(Bulk, FlakesAtRestOnASlopeStayExactlyWhereTheyAre) {
+  // 2,000 flakes (points and 1 cm balls) snow in a wind onto a square
+  // tilted 20 degrees (friction 0.8 > tan 20 deg: static friction holds
+  // them), 15 m from the origin, where a float's ulp is about 1e-6 m.
+  // Once down, each stays exactly where it is (its floats unchanged) and
+  // sleeps, and none comes nearer the face than its radius. Before, a fifth
+  // of them crept downhill by a few ulps a step: RoundOutside's push left
+  // each a few ulps above the face, and each step dropped it back along
+  // its path, which leans downhill.
+  const double t = 20 * M_PI / 180;
+  const Vec3 u(std::cos(t), -std::sin(t), 0), w(0, 0, 1), n = w.cross(u).normalized();
+  const Vec3 o(15.3, 1.7, -14.6);
+  const auto ground = std::make_shared<TriangleBvh>(
+      std::vector<Vec3>{o - 2 * u - 2 * w, o + 2 * u - 2 * w, o + 2 * u + 2 * w, o - 2 * u + 2 * w},
+      std::vector<std::array<uint32_t, 3>>{{0, 1, 2}, {0, 2, 3}});
+  BulkSystem b(2);
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> along(-1.5, 1.5), up(0.05, 0.5);
+  for (int i = 0; i < 2000; ++i) {
+    b.state.Add(o + along(rng) * u + along(rng) * w + up(rng) * n, Vec3(0, -1, 0));
+    b.state.radius.back() = i % 2 ? 0.01f : 0.0f;
+  }
+  b.fields.gravity = Vec3(0, -kG, 0);
+  b.fields.linearDrag = 2;
+  b.fields.wind = Vec3(0.5, 0, 0.2);
+  ASSERT_OK(b.AddCollider(Collider::Mesh(ground).Restitution(0).Friction(0.8)));
+  for (int k = 0; k < 90; ++k) BULK_STEP_OK(b, 1.0 / 60);
+  const BulkState landed = b.state;
+  int moved = 0;
+  double nearest = 1;
+  for (int k = 0; k < 30; ++k) {
+    BULK_STEP_OK(b, 1.0 / 60);
+    for (size_t i = 0; i < b.state.size(); ++i)
+      nearest = std::min(nearest, n.dot(b.state.position(i) - o) - double(b.state.radius[i]));
+  }
+  for (size_t i = 0; i < b.state.size(); ++i) {
+    moved += b.state.px[i] != landed.px[i] || b.state.py[i] != landed.py[i] ||
+             b.state.pz[i] != landed.pz[i] || b.state.velocity(i) != Vec3::Zero();
+  }
+  EXPECT_EQ(moved, 0) << "of 2,000 flakes at rest, moved or moving over half a second";
+  EXPECT_EQ(b.sleepers(), 2000u) << "flakes asleep";
+  EXPECT_GE(nearest, -1e-6) << "a centre came within its radius of the face, by " << -nearest
+                            << " m";
+}
+
 TEST(Bulk, AMovingMeshPushesFlakesThatSlept) {
   // 1 cm flakes asleep on a flat mesh (friction 0.8); then a wall (a
   // moving mesh, 1 m/s along x) is added: it wakes them and sweeps those in
