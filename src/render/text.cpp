@@ -24,9 +24,9 @@ size_t DrawText(Image& image, double x, double y, const std::string& text, const
       !std::isfinite(y))
     return 0;
   scale = std::clamp(scale, 1, 16);
-  // stb_easy_font writes 4 vertices of 16 bytes a quad; a character takes
-  // at most about 30 quads, so 64 a character is room enough.
-  std::vector<char> buffer(text.size() * 64 * 4 * 16 + 1024);
+  // stb_easy_font writes 4 vertices of 16 bytes a quad; a character is
+  // drawn with fewer than 32 quads (its segments), 2 KiB a character.
+  std::vector<char> buffer(text.size() * 32 * 64 + 1024);
   // The font covers ' ' to '~' (its table is indexed by c - 32): other
   // characters are drawn as '?'.
   std::string copy = text;
