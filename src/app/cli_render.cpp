@@ -10,11 +10,13 @@
 #include "app/cli.h"
 #include "app/commands.h"
 #include "app/plant_view.h"
+#include "mesh/color.h"
 #include "mesh/export.h"
 #include "plant/frames.h"
 #include "render/camera.h"
 #include "render/headless_context.h"
 #include "render/renderer.h"
+#include "render/text.h"
 #include "scene/default_scene.h"
 
 namespace sylva::app {
@@ -153,6 +155,7 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   if (!spec) return exit;
   if (cmd.sides) spec->detail.sides = *cmd.sides;
   spec->until = plant::Stage::kGeometry;
+  spec->draw.drawsLabels = true;  // cpfg's @L: written over the picture below
   auto plant = BuildPlant(*spec, cmd.derive.maxErrors, err, &exit, cmd.derive.strict);
   if (!plant) return exit;
   if (viewFile && viewFile->overlay) {
@@ -225,6 +228,22 @@ int RunRender(const RenderCommand& cmd, std::ostream& out, std::ostream& err) {
   const double drawMs = MsSince(t0);
   t0 = Clock::now();
   if (K > 1) image = Downsample(image, K);
+  // cpfg's labels (@L, iGlLabel): the text's baseline starts where the
+  // turtle's position falls on the screen, in the turtle's colour, over
+  // the picture (cpfg draws them without depth test as bitmap text).
+  if (!plant->geometry.labels.empty()) {
+    const Mat4 vp = camera.ViewProjection(double(v.width) / v.height);
+    const int scale = std::max(1, v.height / 300);
+    for (const mesh::Label& label : plant->geometry.labels) {
+      const Vec4 c = vp * Vec4(label.position.x(), label.position.y(), label.position.z(), 1.0);
+      if (!(c.w() > 0)) continue;  // behind the eye
+      const Vec2 px = render::ToPixel(vp, label.position, v.width, v.height);
+      const Vec3f color = label.color < plant->palette.size()
+                              ? mesh::ToSrgb(plant->palette[label.color])
+                              : Vec3f(0, 0, 0);
+      render::DrawText(image, px.x(), px.y(), label.text, color, scale);
+    }
+  }
   const double downsampleMs = MsSince(t0);
   t0 = Clock::now();
   if (Status s = render::WriteImage(image, cmd.output); !s.ok()) return Report(s.error(), err);

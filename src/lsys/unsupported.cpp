@@ -11,16 +11,9 @@ struct Command {
 
 // cpfg's @ commands that Sylva lexes but does not draw.
 constexpr Command kUndrawn[] = {
-    {"@PS", "bicubic patch"},
-    {"@PD", "bicubic patch"},
-    {"@Sx", "surface command"},
-    {"@m", "move-to with drawing"},
-    {"@D", "scale factor"},
-    {"@i", "interpolation"},
-    {"@L", "label"},
-    {"@b", "bounding box"},
-    {"@Tx", "texture"},
-    {"@;", "back-side colour"},
+    {"@PS", "bicubic patch"},       {"@PD", "bicubic patch"}, {"@Sx", "surface command"},
+    {"@m", "move-to with drawing"}, {"@D", "scale factor"},   {"@i", "interpolation"},
+    {"@b", "bounding box"},         {"@Tx", "texture"},       {"@;", "back-side colour"},
 };
 
 std::string Params(int n) {
@@ -57,6 +50,7 @@ std::optional<std::string> UnsupportedModule(std::string_view name, int arity) {
         {"@Tf", "keep the twist", "none", 0},
         {"@#", "generalized cylinder contour", "the contour's id", 1},
         {"@!", "sides of a generalized cylinder's contour", "the number of sides", 1},
+        {"@L", "label", "a text and the numbers it formats", 1 << 20},
     };
     if (name == "@Gr" && arity == 3) {
       return std::string(

@@ -74,12 +74,23 @@ struct ContourTube {
   size_t rings() const { return ringSize ? points.size() / ringSize : 0; }
 };
 
+// A cpfg label (`@L("flux %.0f", v)`, blackbox.c 'L'): the text, formatted
+// with the module's numbers, drawn on the screen with its lower left corner
+// where `position` falls, in the turtle's colour.
+struct Label {
+  Vec3 position;
+  std::string text;
+  uint16_t color = 0;
+  uint32_t module = 0;
+};
+
 struct PlantGeometry {
   std::vector<Segment> segments;
   std::vector<Polygon> polygons;
   std::vector<SurfaceInstance> surfaces;
   std::vector<Sphere> spheres;
   std::vector<ContourTube> tubes;  // generalized cylinders with a contour
+  std::vector<Label> labels;       // cpfg's @L: text, drawn by `sylva render` only
   // Branch ids of closed curves (cpfg's closed splines `{(2)`, `{(4)`):
   // where such a branch's run of segments ends where it began, the
   // tessellator joins the tube's end to its start (no caps, one ring).

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -67,6 +68,7 @@ enum class Op : uint8_t {
   kSplineBegin,   // {(type[, rings]): a polygon when type is 0, else cpfg's spline
   kSplineEnd,     // }(type): the same
   kSetHeading,    // @R(hx, hy[, hz[, ux, uy, uz]])
+  kLabel,         // @L(text, values...): cpfg's label
 };
 
 Op OpFor(const std::string& name) {
@@ -137,6 +139,7 @@ Op OpFor(const std::string& name) {
   if (name == "@Td") return Op::kTropismDown;
   if (name == "@Tf") return Op::kTwistForce;
   if (name == "@R") return Op::kSetHeading;
+  if (name == "@L") return Op::kLabel;
   if (name == "@#") return Op::kContour;
   if (name == "@!") return Op::kContourSides;
   return Op::kNone;
@@ -905,6 +908,7 @@ static Status ClearAndReserve(const lsys::Word& word, const std::vector<Op>& ops
   g.warnings.clear();
   g.moduleWarnings.clear();
   g.modulePosition.clear();
+  g.labels.clear();
   g.moduleFrame.clear();
   // How often each symbol occurs (one increment a module), then what each draws.
   std::vector<size_t> count(ops.size(), 0);
@@ -993,6 +997,75 @@ static void ClosePolygon(std::vector<Polygon>& open, size_t i, PlantGeometry& g)
   g.polygons.push_back(std::move(poly));
 }
 
+std::string FormatCpfgLabel(const std::string& format, const double* values, size_t count) {
+  constexpr size_t kMaxLength = 1000;
+  std::string out;
+  size_t next = 0;  // the value the next conversion takes
+  for (size_t i = 0; i < format.size() && out.size() < kMaxLength;) {
+    if (format[i] != '%') {
+      out += format[i++];
+      continue;
+    }
+    if (i + 1 < format.size() && format[i + 1] == '%') {
+      out += '%';
+      i += 2;
+      continue;
+    }
+    // %[flags][width][.precision][length]conversion
+    size_t j = i + 1;
+    std::string flags;
+    while (j < format.size() && std::strchr("-+ #0", format[j])) flags += format[j++];
+    auto number = [&](int* n) {
+      *n = -1;
+      while (j < format.size() && std::isdigit(static_cast<unsigned char>(format[j]))) {
+        *n = std::min(99, std::max(*n, 0) * 10 + (format[j] - '0'));
+        ++j;
+      }
+    };
+    int width = -1, precision = -1;
+    number(&width);
+    bool dot = false;
+    if (j < format.size() && format[j] == '.') {
+      dot = true;
+      ++j;
+      number(&precision);
+      if (precision < 0) precision = 0;
+    }
+    while (j < format.size() && std::strchr("hlLqjzt", format[j])) ++j;
+    const char c = j < format.size() ? format[j] : '\0';
+    const bool real = c && std::strchr("fFeEgGaA", c);
+    const bool whole = c && std::strchr("diuxXoc", c);
+    if ((!real && !whole) || next >= count) {
+      out += format.substr(i, (c ? j + 1 : j) - i);  // kept as text
+      i = c ? j + 1 : j;
+      continue;
+    }
+    std::string spec = "%" + flags;
+    if (width >= 0) spec += std::to_string(width);
+    if (dot) spec += "." + std::to_string(precision);
+    const double v = values[next++];
+    char buf[256];
+    if (real) {
+      spec += c;
+      std::snprintf(buf, sizeof buf, spec.c_str(), v);
+    } else {
+      const long long w = std::isfinite(v) ? static_cast<long long>(std::clamp(v, -9e18, 9e18)) : 0;
+      if (c == 'c') {
+        spec += 'c';
+        std::snprintf(buf, sizeof buf, spec.c_str(), int(static_cast<unsigned char>(w)));
+      } else {
+        spec += "ll";
+        spec += c;
+        std::snprintf(buf, sizeof buf, spec.c_str(), w);
+      }
+    }
+    out += buf;
+    i = j + 1;
+  }
+  if (out.size() > kMaxLength) out.resize(kMaxLength);
+  return out;
+}
+
 Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, const TurtleDef& def,
                      const DrawOptions& options, PlantGeometry& g) {
   std::vector<Op> ops(symbols.size());
@@ -1055,7 +1128,7 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
       if (count++ == 0) module = uint32_t(i);
     }
   };
-  Problem badSplineType, strayEnd, fewPoints, neverEnded, strayClose;
+  Problem badSplineType, strayEnd, fewPoints, neverEnded, strayClose, badLabel, noText;
   t.color = uint16_t(std::clamp(def.initialColor, 0, 65535));
   const int colorStep = def.colorIncrement;
   SinCos sincos;
@@ -1552,6 +1625,27 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
             x.prevUp = t.frame.up;
           }
           break;
+        case Op::kLabel: {
+          // @L(text, values...) (blackbox.c 'L', irisGL.c iGlLabel): the
+          // file's text number p[0] formatted with the other numbers, at
+          // the turtle's position in its colour; no text number, or one
+          // beyond the texts, takes the last text, as cpfg does.
+          const std::vector<std::string>* texts = def.grammar ? &def.grammar->strings : nullptr;
+          if (!texts || texts->empty()) {
+            noText.Add(i);
+            break;
+          }
+          size_t k = texts->size() - 1;
+          if (np >= 1 && p[0] >= 0 && p[0] < double(texts->size()))
+            k = size_t(p[0]);
+          else
+            badLabel.Add(i);
+          g.labels.push_back(
+              {t.pos,
+               FormatCpfgLabel((*texts)[k], np > 1 ? p + 1 : nullptr, np > 1 ? size_t(np - 1) : 0),
+               t.color, uint32_t(i)});
+          break;
+        }
         case Op::kSetHeading:
           if constexpr (kCpfg) {
             if (np >= 2) SetHeading(p, np, x.prevHeading, x.prevUp, t.frame);
@@ -1667,6 +1761,16 @@ Status InterpretInto(const lsys::Word& word, const lsys::SymbolTable& symbols, c
          "B-spline); nothing is drawn for it");
   report(strayEnd, ": ends no spline; ignored");
   report(strayClose, ": a ']' with no '[' open; ignored, as cpfg's turtle does");
+  report(badLabel,
+         ": a label ('@L') whose first parameter is no text of the file; it shows the "
+         "file's last text, as cpfg does");
+  report(noText, ": a label ('@L') in a file with no text (\"...\") parameters; nothing is drawn");
+  if (!g.labels.empty() && !options.drawsLabels) {
+    g.warnings.push_back(
+        std::to_string(g.labels.size()) + (g.labels.size() == 1 ? " label" : " labels") +
+        " ('@L') not drawn: only 'sylva render' of the grammar draws text (scenes, the "
+        "viewer and mesh files have none)");
+  }
   report(fewPoints,
          " opens a spline with too few control points to draw (a Hermite curve needs 2, an open "
          "B-spline 4, a closed one 3): nothing is drawn for it");

@@ -176,7 +176,17 @@ struct DrawOptions {
   bool cylinderStyle = false;
   // cpfg's contours for @#(n) (null: none; every generalized cylinder round).
   std::shared_ptr<const CylinderContours> contours;
+  // The caller draws PlantGeometry::labels (`sylva render`); otherwise a
+  // word with @L labels gets one warning that they are not drawn.
+  bool drawsLabels = false;
 };
+
+// cpfg's MakeLabel: `format` (a text parameter of @L) with its printf
+// conversions filled from `values` in order (%f %e %g %a with a number, %d
+// %i %u %x %X %o %c with the number truncated, %% a percent sign); a
+// conversion beyond the values, or of another kind (%s), is kept as text.
+// Widths and precisions above 99 are cut to 99. At most 1,000 characters.
+std::string FormatCpfgLabel(const std::string& format, const double* values, size_t count);
 
 // Coordinates, widths and scales the turtle may produce: beyond this, float
 // meshes lose all precision and squared lengths overflow.

@@ -120,8 +120,10 @@ TEST(CpfgText, TextParameterIsTheNumberOfTheText) {
   EXPECT_EQ(FormatWord(testing::MustDerive(*r.grammar).word, r.grammar->symbols),
             "@L(0)@L(1,2)@L(0)A(1)");
   EXPECT_EQ(r.grammar->strings, (std::vector<std::string>{"a", "b"}));
-  // @L warns that it draws nothing; A that its text is a number.
+  // @L is drawn (by the turtle and `sylva render`), no warning; A warns
+  // that its text is a number.
   const std::string all = r.diagnostics.FormatAll();
+  EXPECT_EQ(all.find("'@L'"), std::string::npos) << all;
   EXPECT_NE(all.find("c.l:1:37: warning: a text parameter of 'A' is read as the number of the "
                      "text (1), as cpfg does"),
             std::string::npos)

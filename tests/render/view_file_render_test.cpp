@@ -400,5 +400,34 @@ TEST(ViewFile, ACameraThatSeesNoneOfThePlantIsWarnedAtItsViewpoint) {
   std::filesystem::remove(Scratch() / "away.v");
 }
 
+TEST(CpfgLabel, RenderWritesTheLabelRightOfWhereTheTurtleWas) {
+  // cpfg draws @L's text as bitmap text whose baseline starts at the
+  // turtle's position on the screen (irisGL.c iGlLabel, glRasterPos). A
+  // vertical line with a label at its middle: the text's pixels lie right
+  // of the line, around the middle row; without the label none are there.
+  const std::string with = WriteFile("label.l", "axiom: F(1) @L(\"HHHH %.0f\", 42) F(1)\n");
+  const std::string without = WriteFile("nolabel.l", "axiom: F(1) F(1)\n");
+  const std::string a = (Scratch() / "label.png").string(),
+                    b = (Scratch() / "nolabel.png").string();
+  std::string err;
+  ASSERT_EQ(Render(with, a, "160x120", &err), 0) << err;
+  EXPECT_EQ(err.find("'@L'"), std::string::npos) << err;
+  ASSERT_EQ(Render(without, b, "160x120", &err), 0) << err;
+  const Png pa = Load(a), pb = Load(b);
+  ASSERT_EQ(pa.px.size(), pb.px.size());
+  int changed = 0, outside = 0;
+  for (int y = 0; y < pa.h; ++y) {
+    for (int x = 0; x < pa.w; ++x) {
+      const unsigned char *p = pa.At(x, y), *q = pb.At(x, y);
+      if (p[0] == q[0] && p[1] == q[1] && p[2] == q[2]) continue;
+      ++changed;
+      // 7 pixels of text above the baseline at the middle row, right of x 80.
+      if (x < 80 || y < 60 - 9 || y > 60 + 3) ++outside;
+    }
+  }
+  EXPECT_GT(changed, 40) << "pixels of 'HHHH 42'";
+  EXPECT_EQ(outside, 0) << outside << " of " << changed << " changed pixels away from the label";
+}
+
 }  // namespace
 }  // namespace sylva::app

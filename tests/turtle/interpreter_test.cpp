@@ -958,5 +958,50 @@ TEST(TurtleSetHeading, UpFollowsTheNoTwistRuleFromTheLastF) {
   EXPECT_VEC_NEAR(t.left, Vec3(0, 1, 0), 1e-12);
 }
 
+TEST(TurtleLabel, AtLRecordsItsTextFormattedAtTheTurtle) {
+  // cpfg's @L (blackbox.c 'L', MakeLabel): the file's text number p0, its
+  // conversions filled from the other parameters, at the turtle's position
+  // in its colour (vlab's simple-alpha writes each internode's flux).
+  plant::PlantSpec spec;
+  spec.path = "lab.l";
+  spec.text =
+      "axiom: F(2) @L(\" flux %.0f of %d%%\", 41.6, 7.9) [+(90) F(1) ;(3) @L(\"tip %s %g\")] "
+      "@L(9)\n";
+  spec.until = plant::Stage::kGeometry;
+  plant::PlantResult r = plant::BuildPlant(spec);
+  ASSERT_TRUE(r.plant) << r.diagnostics.FormatAll();
+  const auto& labels = r.plant->geometry.labels;
+  ASSERT_EQ(labels.size(), 3u);
+  EXPECT_EQ(labels[0].text, " flux 42 of 7%");
+  EXPECT_VEC_NEAR(labels[0].position, Vec3(0, 2, 0), 1e-12);
+  // Conversions with no number left, and %s, stay text.
+  EXPECT_EQ(labels[1].text, "tip %s %g");
+  EXPECT_VEC_NEAR(labels[1].position, Vec3(-1, 2, 0), 1e-12);
+  EXPECT_EQ(labels[1].color, 3);
+  // A number that is no text of the file shows the last text, as cpfg.
+  EXPECT_EQ(labels[2].text, "tip %s %g");
+  const std::string all = r.diagnostics.FormatAll();
+  EXPECT_NE(all.find("shows the file's last text, as cpfg does"), std::string::npos) << all;
+  // Not drawn unless the caller says it draws them (sylva render does).
+  EXPECT_NE(all.find("3 labels ('@L') not drawn: only 'sylva render' of the grammar draws text"),
+            std::string::npos)
+      << all;
+  spec.draw.drawsLabels = true;
+  r = plant::BuildPlant(spec);
+  ASSERT_TRUE(r.plant);
+  EXPECT_EQ(r.diagnostics.FormatAll().find("not drawn"), std::string::npos)
+      << r.diagnostics.FormatAll();
+}
+
+TEST(TurtleLabel, FormatKeepsWidthsAndPrecisionsInBounds) {
+  const double v[] = {3.14159, -2.5, 65};
+  EXPECT_EQ(FormatCpfgLabel("%6.2f|%-4d|%c|%x", v, 3), "  3.14|-2  |A|%x");
+  // A width or precision past 99 is cut to 99 (no huge buffers).
+  EXPECT_EQ(FormatCpfgLabel("%1000000.3f", v, 1).size(), 99u);
+  EXPECT_EQ(FormatCpfgLabel("%.500f", v, 1).size(), 1u + 1u + 99u);
+  EXPECT_EQ(FormatCpfgLabel("100%% %", v, 0), "100% %");
+  EXPECT_EQ(FormatCpfgLabel(std::string(5000, 'a'), v, 0).size(), 1000u);
+}
+
 }  // namespace
 }  // namespace sylva::turtle
