@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/math.h"
@@ -56,6 +57,8 @@ struct PairWork {
   // changed the velocity by, scratch, a pass's sum over the particle's own
   // contacts.
   std::vector<Vec3> x, d, v, dv, scratch, own;
+  std::vector<Vec3> xv;  // position after the velocity passes
+
   std::vector<double> w, r, move, first;  // inverse mass, radius, |d|, first contact time
   std::vector<uint32_t> begin, end;       // p's own contacts: [begin, end) of its chunk's
   std::vector<uint32_t> count;            // contacts of p, its own and as partner
@@ -63,6 +66,13 @@ struct PairWork {
   // + 1]), its contacts in the order of their owners' chunks and lists.
   std::vector<uint32_t> partnerBegin;
   std::vector<Vec3> out;
+  // The support sweep (System::SupportSweep): the particles by height,
+  // (height, slot); each slot's place in that order; for the k-th in that
+  // order, the slots of the particles before it near enough to touch,
+  // near[nearBegin[k], nearBegin[k + 1]); what the sweep moved each by.
+  std::vector<std::pair<double, uint32_t>> byHeight;
+  std::vector<uint32_t> rank, nearBegin, near;
+  std::vector<Vec3> swept;
   std::vector<uint8_t> free, resting;  // v == v0 (free flight); has a resting contact
   std::vector<PairChunk> chunks;
   // The last step's velocity passes: how many ran, and for a step with no
