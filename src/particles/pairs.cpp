@@ -682,9 +682,11 @@ void System::SupportSweep(const Vec3& up, double h) {
   Vec3* swept = pw.swept.data();
   std::copy(x, x + n, swept);
   for (int pass = 0; pass < kSweeps; ++pass) {
+    bool changed = false;
     for (size_t k = 0; k < n; ++k) {
       const uint32_t p = byHeight[k].second;
       Vec3 xp = x[p];
+      bool moved = false;
       for (uint32_t a = nearBegin[k]; a < nearBegin[k + 1]; ++a) {
         const uint32_t q = nearList[a];
         const Vec3 dq = xp - x[q];
@@ -696,6 +698,7 @@ void System::SupportSweep(const Vec3& up, double h) {
         const Vec3 nrm = len > 0 ? Vec3(dq / len) : up;
         const double lift = len > 0 ? up.dot(nrm) : 1.0;
         const double depth = Rs - len;
+        moved = true;
         if (lift >= kSupport || w[q] == 0) {
           xp += depth * nrm;
         } else if (lift <= -kSupport || w[p] == 0) {
@@ -708,14 +711,17 @@ void System::SupportSweep(const Vec3& up, double h) {
           x[q] -= ((1 - share) * depth) * (lift >= 0 ? nrm : sideways);
         }
       }
+      if (!moved) continue;
+      changed = true;
       if (w[p] != 0) OutOfColliders(colliders_, h, r[p], &xp, &v[p]);
       x[p] = xp;
     }
+    if (!changed) break;  // nothing left to resolve
   }
   // A particle moved after its turn (beside a higher one) may have gone
   // into a collider.
   for (size_t p = 0; p < n; ++p) {
-    if (w[p] != 0) OutOfColliders(colliders_, h, r[p], &x[p], &v[p]);
+    if (w[p] != 0 && x[p] != swept[p]) OutOfColliders(colliders_, h, r[p], &x[p], &v[p]);
     swept[p] = x[p] - swept[p];
   }
 }
