@@ -69,9 +69,11 @@ struct PairWork {
   // The support sweep (System::SupportSweep): the particles by height,
   // (height, slot); each slot's place in that order; for the k-th in that
   // order, the slots of the particles before it near enough to touch,
-  // near[nearBegin[k], nearBegin[k + 1]); what the sweep moved each by.
+  // nearChunks[k / kPairChunk][nearBegin[k], nearEnd[k]); what the sweep
+  // moved each by.
   std::vector<std::pair<double, uint32_t>> byHeight;
-  std::vector<uint32_t> rank, nearBegin, near;
+  std::vector<uint32_t> rank, nearBegin, nearEnd;
+  std::vector<std::vector<uint32_t>> nearChunks;
   std::vector<Vec3> swept;
   std::vector<uint8_t> free, resting;  // v == v0 (free flight); has a resting contact
   std::vector<PairChunk> chunks;
