@@ -674,18 +674,31 @@ void System::SupportSweep(const Vec3& up, double h) {
   Grow(pw.nearEnd, n);
   uint32_t* nearBegin = pw.nearBegin.data();
   uint32_t* nearEnd = pw.nearEnd.data();
+  double maxR = 0;
+  for (size_t p = 0; p < n; ++p) maxR = std::max(maxR, r[p]);
+  const double screen = 2 * maxR * (1 + kSweepMargin);
   Chunks(pool_, chunks, [&](size_t c) {
     std::vector<uint32_t>& list = pw.nearChunks[c];
     list.clear();
+    uint32_t cand[kCandidates];
     for (size_t k = c * kPairChunk; k < std::min(n, (c + 1) * kPairChunk); ++k) {
       const uint32_t p = byHeight[k].second;
       nearBegin[k] = uint32_t(list.size());
       const Vec3 xp = x[p];
+      // The grid's candidates screened by distance (kernels::
+      // ScreenCandidates), then by order and each pair's own reach.
       pw.grid.ForEachCandidateRange(x0[p], [&](uint32_t f, uint32_t t) {
-        for (uint32_t q = f; q < t; ++q) {
-          if (rank[q] >= k || w[p] + w[q] == 0) continue;
-          const double near = (r[p] + r[q]) * (1 + kSweepMargin);
-          if ((xp - x[q]).squaredNorm() < near * near) list.push_back(q);
+        for (uint32_t from = f; from < t;) {
+          const uint32_t to = std::min(t, from + kCandidates);
+          const uint32_t m = kernels::ScreenCandidates(kernel_, x[0].data(), from, to, xp.data(),
+                                                       screen * screen, cand);
+          for (uint32_t a = 0; a < m; ++a) {
+            const uint32_t q = cand[a];
+            if (rank[q] >= k || w[p] + w[q] == 0) continue;
+            const double near = (r[p] + r[q]) * (1 + kSweepMargin);
+            if ((xp - x[q]).squaredNorm() < near * near) list.push_back(q);
+          }
+          from = to;
         }
       });
       nearEnd[k] = uint32_t(list.size());
