@@ -747,10 +747,12 @@ void System::SupportSweep(const Vec3& up, double h) {
   // Every particle out of the colliders (one moved after its turn, beside
   // a higher one, or by the velocities after its first contact, may be in
   // one).
-  for (size_t p = 0; p < n; ++p) {
-    if (w[p] != 0) OutOfColliders(colliders_, h, r[p], &x[p], &v[p]);
-    swept[p] = x[p] - swept[p];
-  }
+  Ranges(pool_, n, [&](size_t b, size_t e) {
+    for (size_t p = b; p < e; ++p) {
+      if (w[p] != 0) OutOfColliders(colliders_, h, r[p], &x[p], &v[p]);
+      swept[p] = x[p] - swept[p];
+    }
+  });
 }
 
 Status System::PairPassesWarning(const char* what) const {
