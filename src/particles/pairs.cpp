@@ -665,9 +665,25 @@ void System::SupportSweep(const Vec3& up, double h) {
   for (size_t p = 0; p < n; ++p) byHeight[p] = {up.dot(x[p]), uint32_t(p)};
   std::sort(byHeight, byHeight + n);
   for (size_t k = 0; k < n; ++k) rank[byHeight[k].second] = uint32_t(k);
-  // Each particle's pairs with those before it, in order of height: the
-  // k-th particle's are nearChunks[k / kPairChunk][nearBegin[k],
-  // nearEnd[k]), gathered in parallel, a chunk of that order at a time.
+  // The sweeps work in order of height (the particles they read together
+  // are near in memory): positions, inverse masses and radii copied so.
+  Grow(pw.xh, n);
+  Grow(pw.wh, n);
+  Grow(pw.rh, n);
+  Vec3* xh = pw.xh.data();
+  double *wh = pw.wh.data(), *rh = pw.rh.data();
+  Ranges(pool_, n, [&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) {
+      const uint32_t p = byHeight[k].second;
+      xh[k] = x[p];
+      wh[k] = w[p];
+      rh[k] = r[p];
+    }
+  });
+  // Each particle's pairs with those before it, in order of height (their
+  // places in it): the k-th particle's are nearChunks[k / kPairChunk]
+  // [nearBegin[k], nearEnd[k]), gathered in parallel, a chunk of that
+  // order at a time.
   const size_t chunks = (n + kPairChunk - 1) / kPairChunk;
   if (pw.nearChunks.size() < chunks) pw.nearChunks.resize(chunks);
   Grow(pw.nearBegin, n);
@@ -696,7 +712,7 @@ void System::SupportSweep(const Vec3& up, double h) {
             const uint32_t q = cand[a];
             if (rank[q] >= k || w[p] + w[q] == 0) continue;
             const double near = (r[p] + r[q]) * (1 + kSweepMargin);
-            if ((xp - x[q]).squaredNorm() < near * near) list.push_back(q);
+            if ((xp - x[q]).squaredNorm() < near * near) list.push_back(rank[q]);
           }
           from = to;
         }
@@ -709,14 +725,13 @@ void System::SupportSweep(const Vec3& up, double h) {
   for (int pass = 0; pass < kSweeps; ++pass) {
     bool changed = false;
     for (size_t k = 0; k < n; ++k) {
-      const uint32_t p = byHeight[k].second;
-      Vec3 xp = x[p];
+      Vec3 xp = xh[k];
       bool moved = false;
       const uint32_t* nearList = pw.nearChunks[k / kPairChunk].data();
       for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) {
-        const uint32_t q = nearList[a];
-        const Vec3 dq = xp - x[q];
-        const double R = r[p] + r[q], Rs = R * (1 - kSlop);
+        const uint32_t j = nearList[a];
+        const Vec3 dq = xp - xh[j];
+        const double R = rh[k] + rh[j], Rs = R * (1 - kSlop);
         const double d2 = dq.squaredNorm();
         if (d2 >= Rs * Rs) continue;
         const double len = std::sqrt(d2);
@@ -725,25 +740,28 @@ void System::SupportSweep(const Vec3& up, double h) {
         const double lift = len > 0 ? up.dot(nrm) : 1.0;
         const double depth = Rs - len;
         moved = true;
-        if (lift >= kSupport || w[q] == 0) {
+        if (lift >= kSupport || wh[j] == 0) {
           xp += depth * nrm;
-        } else if (lift <= -kSupport || w[p] == 0) {
-          x[q] -= depth * nrm;  // q has come to lie on p
+        } else if (lift <= -kSupport || wh[k] == 0) {
+          xh[j] -= depth * nrm;  // q has come to lie on p
         } else {
-          const double share = w[p] / (w[p] + w[q]);
+          const double share = wh[k] / (wh[k] + wh[j]);
           const Vec3 side = nrm - lift * up;  // |side| >= cos(asin(kSupport))
           const Vec3 sideways = side / side.squaredNorm();
           xp += (share * depth) * (lift >= 0 ? sideways : nrm);
-          x[q] -= ((1 - share) * depth) * (lift >= 0 ? nrm : sideways);
+          xh[j] -= ((1 - share) * depth) * (lift >= 0 ? nrm : sideways);
         }
       }
       if (!moved) continue;
       changed = true;
-      if (w[p] != 0) OutOfColliders(colliders_, h, r[p], &xp, &v[p]);
-      x[p] = xp;
+      if (wh[k] != 0) OutOfColliders(colliders_, h, rh[k], &xp, &v[byHeight[k].second]);
+      xh[k] = xp;
     }
     if (!changed) break;  // nothing left to resolve
   }
+  Ranges(pool_, n, [&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) x[byHeight[k].second] = xh[k];
+  });
   // Every particle out of the colliders (one moved after its turn, beside
   // a higher one, or by the velocities after its first contact, may be in
   // one).

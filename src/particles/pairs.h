@@ -68,13 +68,14 @@ struct PairWork {
   std::vector<Vec3> out;
   // The support sweep (System::SupportSweep): the particles by height,
   // (height, slot); each slot's place in that order; for the k-th in that
-  // order, the slots of the particles before it near enough to touch,
-  // nearChunks[k / kPairChunk][nearBegin[k], nearEnd[k]); what the sweep
-  // moved each by.
+  // order, the places in it of the particles before it near enough to
+  // touch, nearChunks[k / kPairChunk][nearBegin[k], nearEnd[k]); what the
+  // sweep moved each by (slot order).
   std::vector<std::pair<double, uint32_t>> byHeight;
   std::vector<uint32_t> rank, nearBegin, nearEnd;
   std::vector<std::vector<uint32_t>> nearChunks;
-  std::vector<Vec3> swept;
+  std::vector<Vec3> swept, xh;  // xh, wh, rh: x, w, r in order of height
+  std::vector<double> wh, rh;
   std::vector<uint8_t> free, resting;  // v == v0 (free flight); has a resting contact
   std::vector<PairChunk> chunks;
   // The last step's velocity passes: how many ran, and for a step with no
