@@ -107,7 +107,7 @@ TEST(PairContacts, APileOf2880BallsComesToRest) {
 // 20 x 6 lattice into a box 0.64 m wide, restitution 0.3, 60 Hz) stands on
 // its floor after 3 s: no two balls overlap by more than 15 % of a radius
 // and its mean centre is at least 0.8 m high (0.93 m at a packing of 0.64).
-// Measured 11.5 % and 0.92 m. The Jacobi passes alone could not hold it up
+// Measured 7.8 % and 0.86 m. The Jacobi passes alone could not hold it up
 // (each carries a correction one contact further): 20 layers pressed into
 // one another, 200 % (coincident centres) and 0.18 m before the support
 // sweep (pairs.cpp).
