@@ -53,18 +53,28 @@
 //             a collision the step before missed). After the passes a
 //             particle's position moves by its velocity change times the
 //             rest of the step after its first contact.
-//   position  the remaining overlap along each contact's normal is shared
-//             out by inverse mass, with the same factor; velocities are
-//             left alone (no energy is created). Then each particle is
-//             projected out of the half-space colliders again. A particle
-//             in resting contact then takes the velocity of its
-//             displacement over the step (position-based dynamics), so what
-//             the passes leave unresolved does not build up in a pile.
+//   position  where the step's forces pull the resting particles one way
+//             (a pile under gravity), the support sweep (SupportSweep):
+//             Gauss-Seidel in order of height, a particle moved out of the
+//             ones below it, which do not move, so a pile many layers deep
+//             stands. Otherwise Jacobi passes: the remaining overlap along
+//             each contact's normal is shared out by inverse mass, with
+//             the same factor. Either way velocities are left alone (no
+//             energy is created) and each particle is projected out of
+//             the colliders again. A particle held by others (in resting
+//             contact, or moved by the sweep) then takes the velocity of
+//             its displacement over the step (position-based dynamics),
+//             but no speed along the position work's move, so what the
+//             passes leave unresolved does not build up in a pile; one
+//             that barely moved is held still.
 // Every sum runs in a fixed order and each particle is written by one
-// thread: the result is bit-identical for any thread count.
+// thread (the sweep runs on one): the result is bit-identical for any
+// thread count.
 //
 // References: Mirtich, "Timewarp rigid body simulation" (swept spheres);
-// Müller et al., "Position based dynamics" (2007), Jacobi projection.
+// Müller et al., "Position based dynamics" (2007), Jacobi projection;
+// Guendelman, Bridson, Fedkiw, "Nonconvex rigid bodies with stacking"
+// (2003), shock propagation.
 #include "particles/pairs.h"
 
 #include <algorithm>
