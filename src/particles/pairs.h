@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "core/math.h"
@@ -56,6 +57,8 @@ struct PairWork {
   // changed the velocity by, scratch, a pass's sum over the particle's own
   // contacts.
   std::vector<Vec3> x, d, v, dv, scratch, own;
+  std::vector<Vec3> xv;  // position after the velocity passes
+
   std::vector<double> w, r, move, first;  // inverse mass, radius, |d|, first contact time
   std::vector<uint32_t> begin, end;       // p's own contacts: [begin, end) of its chunk's
   std::vector<uint32_t> count;            // contacts of p, its own and as partner
@@ -63,6 +66,16 @@ struct PairWork {
   // + 1]), its contacts in the order of their owners' chunks and lists.
   std::vector<uint32_t> partnerBegin;
   std::vector<Vec3> out;
+  // The support sweep (System::SupportSweep): the particles by height,
+  // (height, slot); each slot's place in that order; for the k-th in that
+  // order, the places in it of the particles before it near enough to
+  // touch, nearChunks[k / kPairChunk][nearBegin[k], nearEnd[k]); what the
+  // sweep moved each by (slot order).
+  std::vector<std::pair<double, uint32_t>> byHeight;
+  std::vector<uint32_t> rank, nearBegin, nearEnd;
+  std::vector<std::vector<uint32_t>> nearChunks;
+  std::vector<Vec3> swept, xh;  // xh, wh, rh: x, w, r in order of height
+  std::vector<double> wh, rh;
   std::vector<uint8_t> free, resting;  // v == v0 (free flight); has a resting contact
   std::vector<PairChunk> chunks;
   // The last step's velocity passes: how many ran, and for a step with no

@@ -411,6 +411,9 @@ class System {
   template <int K, typename Fn>
   std::array<double, K> SumChunks(size_t n, Fn&& fn) const;
   void ParticleCollisions(double h);
+  // Holds a pile up: its overlaps resolved in order of height along `up`
+  // (pairs.cpp).
+  void SupportSweep(const Vec3& up, double h);
   // Saves the state at the start of a step for the pair contacts.
   void SavePairStart();
   // Moves every moving collider by h times its velocity (after a step).

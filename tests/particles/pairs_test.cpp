@@ -2,6 +2,7 @@
 // on any thread count.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -100,6 +101,42 @@ TEST(PairContacts, APileOf2880BallsComesToRest) {
   EXPECT_LT(speed, 0.05) << "the fastest ball still moves at " << speed << " m/s after 5 s";
   EXPECT_LT(drift, 0.05) << "a ball moved " << drift << " m between 4 s and 5 s";
   EXPECT_GE(lowest, 0.05 - 1e-9) << "a centre came down to y = " << lowest;
+}
+
+// A pile 20 balls deep (720 balls of radius 0.05 m dropped in a loose 6 x
+// 20 x 6 lattice into a box 0.64 m wide, restitution 0.3, 60 Hz) stands on
+// its floor after 3 s: no two balls overlap by more than 15 % of a radius
+// and its mean centre is at least 0.8 m high (0.93 m at a packing of 0.64).
+// Measured 7.8 % and 0.86 m. The Jacobi passes alone could not hold it up
+// (each carries a correction one contact further): 20 layers pressed into
+// one another, 200 % (coincident centres) and 0.18 m before the support
+// sweep (pairs.cpp).
+TEST(PairContacts, ADeepPileHoldsItsBallsApart) {
+  System s(1);
+  s.AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
+  ASSERT_OK(s.AddCollider(
+      Collider::Box(Vec3(-0.32, 0, -0.32), Vec3(0.32, 10, 0.32), true).Restitution(0.3)));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> jitter(-0.005, 0.005);
+  for (int y = 0; y < 20; ++y)
+    for (int z = 0; z < 6; ++z)
+      for (int x = 0; x < 6; ++x) {
+        s.state.Add(Vec3(-0.25 + 0.1 * x + jitter(rng), 0.06 + 0.11 * y,
+                         -0.25 + 0.1 * z + jitter(rng)),
+                    Vec3::Zero());
+        s.state.radius.back() = 0.05f;
+      }
+  ASSERT_OK(s.EnableParticleCollisions(0.05, 0.3));
+  for (int k = 0; k < 180; ++k) STEP_OK(s, 1.0 / 60, Integrator::kSymplecticEuler);
+  const auto& x = s.state.position;
+  double deepest = 0, meanY = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    meanY += x[i].y() / double(x.size());
+    for (size_t j = i + 1; j < x.size(); ++j)
+      deepest = std::max(deepest, (0.1 - (x[i] - x[j]).norm()) / 0.05);
+  }
+  EXPECT_LT(deepest, 0.15) << "two balls overlap by " << 100 * deepest << " % of a radius";
+  EXPECT_GT(meanY, 0.8) << "the pile's mean centre is at y = " << meanY << " m";
 }
 
 // The pair screen's vector path (kernels::ScreenCandidates, AVX-512) keeps
