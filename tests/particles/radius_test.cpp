@@ -300,12 +300,21 @@ TEST(MeshBroadPhase, APathWithANaNIsNeverScreenedOut) {
   for (int k = 0; k < 7; ++k) {
     Vec3 from = a, to = b;
     double r = 0.01;
-    if (k < 3) from[k] = nan;
-    else if (k < 6) to[k - 3] = nan;
-    else r = nan;
-    EXPECT_FALSE(mesh.Clear(from, to, r)) << "NaN in " << (k < 3 ? "a" : k < 6 ? "b" : "r")
+    if (k < 3)
+      from[k] = nan;
+    else if (k < 6)
+      to[k - 3] = nan;
+    else
+      r = nan;
+    EXPECT_FALSE(mesh.Clear(from, to, r)) << "NaN in "
+                                          << (k < 3   ? "a"
+                                              : k < 6 ? "b"
+                                                      : "r")
                                           << (k < 6 ? "[" + std::to_string(k % 3) + "]" : "");
-    EXPECT_TRUE(mesh.Near(from, to, r)) << "NaN in " << (k < 3 ? "a" : k < 6 ? "b" : "r")
+    EXPECT_TRUE(mesh.Near(from, to, r)) << "NaN in "
+                                        << (k < 3   ? "a"
+                                            : k < 6 ? "b"
+                                                    : "r")
                                         << (k < 6 ? "[" + std::to_string(k % 3) + "]" : "");
   }
 }
