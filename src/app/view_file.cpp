@@ -137,6 +137,26 @@ class Reader {
     // light toward `light direction:`.
     v_.lightToward = firstLight_ ? firstLight_ : lightDirection_;
     v_.cylinderStyle = cylinder_;
+    // cpfg's camera looks from the viewpoint toward the view reference
+    // point (a perspective view's eye at vrp + (viewpoint - vrp) / scale):
+    // where the two coincide, or lie too far apart for double precision,
+    // it has no direction or distance, and Sylva frames the plant instead.
+    if (v_.viewpoint || v_.target) {
+      const Vec3 eye = v_.viewpoint.value_or(Vec3(0, 0, 1));
+      const Vec3 at = v_.target.value_or(Vec3(0, 0, 0));
+      const double n = (eye - at).norm();
+      const double d = parallel_ ? n : n / v_.scale.value_or(1);
+      if (!(n > 0 && std::isfinite(n) && d > 0 && std::isfinite(d))) {
+        current_ = cameraText_;
+        v_.diagnostics.Add(At(v_.cameraLine, 1, Severity::kWarning,
+                              eye == at ? "the viewpoint is the view reference point: cpfg's "
+                                          "camera looks in no direction: Sylva frames the plant "
+                                          "itself"
+                                        : "the eye's distance from the view reference point "
+                                          "under- or overflows a double: Sylva frames the plant "
+                                          "itself"));
+      }
+    }
     if (contourLine_ && !cylinder_) {
       current_ = contourText_;
       v_.diagnostics.Add(At(contourLine_, contourColumn_, Severity::kWarning,
@@ -228,6 +248,7 @@ class Reader {
   int contourLine_ = 0, contourColumn_ = 0;  // the first `contour:` line
   int sidesLine_ = 0, sidesColumn_ = 0;      // `contour sides:`
   std::string contourText_, sidesText_;      // those lines, for the excerpts
+  std::string cameraText_;                   // the camera's line (ViewFile::cameraLine)
   std::string sidesLabel_;                   // `contour sides:` or `polygonization level:`
   bool parallel_ = true;
   std::optional<Vec3> lightDirection_, firstLight_;
@@ -324,7 +345,10 @@ void Reader::Read(const app::Line& line) {
   } else if (L == "viewpoint:" || L == "view reference point:") {
     if (auto p = Vector(0, "x,y,z")) {
       (L == "viewpoint:" ? v_.viewpoint : v_.target) = *p;
-      if (L == "viewpoint:" || !v_.viewpoint) v_.cameraLine = line_;
+      if (L == "viewpoint:" || !v_.viewpoint) {
+        v_.cameraLine = line_;
+        cameraText_ = current_;
+      }
     }
     ExtraValues(3);
   } else if (L == "box:") {
@@ -358,6 +382,16 @@ void Reader::Read(const app::Line& line) {
     if (seen != 7) {
       Error(labelColumn_, "'box:' needs the ranges 'x: x0,x1 y: y0,y1 z: z0,z1'");
       return;
+    }
+    // The camera frames boxes within +-1e30 (render::Camera::Frame; a
+    // larger one would be replaced by the unit cube, silently).
+    for (int k = 0; k < 3; ++k) {
+      if (!(std::abs(lo[k]) <= 1e30 && std::abs(hi[k]) <= 1e30)) {
+        Warn(labelColumn_,
+             "'box:' reaches beyond +-1e30, more than Sylva's camera frames: "
+             "ignored (the plant is framed)");
+        return;
+      }
     }
     v_.box = {Vec3(lo[0], lo[1], lo[2]), Vec3(hi[0], hi[1], hi[2])};
     v_.boxLine = line_;

@@ -243,6 +243,9 @@ bool TriangleBvh::ClearOfColumns(const Vec3& lo, const Vec3& hi) const {
   // flake in the air over a terrain).
   if (columns_.empty()) return false;
   const int u = (up_ + 1) % 3, w = (up_ + 2) % 3;
+  // A NaN (in a point or the radius) is clear of nothing; CellOf could not
+  // place it.
+  if (!(lo[u] <= hi[u] && lo[w] <= hi[w])) return false;
   const int lu = CellOf(lo[u], u), hu = CellOf(hi[u], u);
   const int lw = CellOf(lo[w], w), hw = CellOf(hi[w], w);
   if ((hu - lu + 1) * (hw - lw + 1) > 4) return false;

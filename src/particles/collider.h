@@ -177,7 +177,7 @@ class TriangleBvh {
   // Whether the box lo..hi is clear of the triangles of the few columns
   // it covers (false where it covers more than four).
   bool ClearOfColumns(const Vec3& lo, const Vec3& hi) const;
-  // The cell of coordinate x along axis k, clamped to the grid.
+  // The cell of coordinate x along axis k, clamped to the grid (x not NaN).
   int CellOf(double x, int k) const {
     return int(std::clamp(std::floor((x - gridLo_[k]) / cell_), 0.0, double(dims_[k] - 1)));
   }

@@ -243,6 +243,42 @@ TEST(ViewFile, ApplyGivesTheGrammarItsMovementsAndCpfgsDefaultTropismDirection) 
   EXPECT_TRUE(g.movements[0].torque);
 }
 
+// cpfg's camera looks from the viewpoint toward the view reference point:
+// where they coincide, or lie too far apart for a double (or a perspective
+// scale puts the eye there), Sylva frames the plant itself, and says so at
+// the camera's line; a 'box:' beyond the +-1e30 the camera frames is
+// ignored with a warning (both were silent: the first framed the plant,
+// the second the unit cube).
+TEST(ViewFile, ACameraWithoutADirectionOrAnUnframableBoxIsWarned) {
+  struct Case {
+    const char* text;
+    const char* expected;  // "" for no diagnostic
+  } cases[] = {
+      {"projection: perspective\nview reference point: 0,1,0\nviewpoint: 0,1,0\n",
+       "3:1 warning: the viewpoint is the view reference point"},
+      {"view reference point: 0,0,0\n", ""},  // the default viewpoint 0,0,1
+      {"view reference point: 0,0,1\n", "1:1 warning: the viewpoint is the view reference point"},
+      {"viewpoint: 0,1e300,0\n", "1:1 warning: the eye's distance from the view reference point"},
+      {"viewpoint: 0,0,1e-300\nview reference point: 0,0,0\n", "1:1 warning: the eye's distance"},
+      {"projection: perspective\nviewpoint: 0,0,1e10\nscale factor: 1e-300\n",
+       "2:1 warning: the eye's distance"},
+      {"projection: parallel\nviewpoint: 0,0,1e10\nscale factor: 1e-300\n", ""},
+      {"projection: perspective\nviewpoint: 0,1,10\nview reference point: 0,1,0\n", ""},
+      {"box: x: -1e300,1e300 y: 0,2 z: -1,1\n", "1:1 warning: 'box:' reaches beyond +-1e30"},
+  };
+  for (const Case& c : cases) {
+    const ViewFile v = ParseViewFile(c.text, "p.v");
+    const std::string all = Messages(v.diagnostics);
+    if (*c.expected == 0) {
+      EXPECT_TRUE(v.diagnostics.items.empty()) << c.text << all;
+    } else {
+      EXPECT_NE(all.find(c.expected), std::string::npos) << c.text << all;
+      EXPECT_FALSE(v.diagnostics.HasErrors()) << c.text << all;
+    }
+  }
+  EXPECT_FALSE(ParseViewFile("box: x: -1e300,1e300 y: 0,2 z: -1,1\n", "p.v").box.has_value());
+}
+
 TEST(ViewFile, WarnsOncePerLabelItDoesNotActOnWithItsLocation) {
   ViewFile v = ParseViewFile(
       "twist: 0\nz buffer: on\nprojection: perspective\n"  // acted on or as Sylva draws: silent

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <random>
 #include <string>
@@ -285,6 +286,36 @@ TEST(MeshBroadPhase, OnlyPathsNearTheTrianglesGoToTheExactTest) {
       EXPECT_LT(near, paths / 2) << "turn " << turn << ", r = " << r << ": " << near << " of "
                                  << paths << " paths (" << hits << " hit) went to the exact test";
     }
+  }
+}
+
+// A NaN in any component of a path's start or end, or in its radius, is
+// clear of nothing: Near says the path may hit (before, a NaN across the
+// terrain's columns was cast to a column index and read far outside them).
+TEST(MeshBroadPhase, APathWithANaNIsNeverScreenedOut) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const Terrain g = RoughTerrain();
+  const TriangleBvh mesh(g.v, g.t);
+  const Vec3 a(0.1, 0.3, 0.1), b(0.12, 0.29, 0.11);
+  for (int k = 0; k < 7; ++k) {
+    Vec3 from = a, to = b;
+    double r = 0.01;
+    if (k < 3)
+      from[k] = nan;
+    else if (k < 6)
+      to[k - 3] = nan;
+    else
+      r = nan;
+    EXPECT_FALSE(mesh.Clear(from, to, r)) << "NaN in "
+                                          << (k < 3   ? "a"
+                                              : k < 6 ? "b"
+                                                      : "r")
+                                          << (k < 6 ? "[" + std::to_string(k % 3) + "]" : "");
+    EXPECT_TRUE(mesh.Near(from, to, r)) << "NaN in "
+                                        << (k < 3   ? "a"
+                                            : k < 6 ? "b"
+                                                    : "r")
+                                        << (k < 6 ? "[" + std::to_string(k % 3) + "]" : "");
   }
 }
 
