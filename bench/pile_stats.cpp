@@ -72,8 +72,9 @@ Stats Measure(const particles::System& sys, double r) {
 // BM_SelfCollidingBalls' scene (bench_particles.cpp).
 void Balls10k(particles::System& sys) {
   sys.AddForce(std::make_shared<particles::Gravity>(Vec3(0, -9.81, 0)));
-  (void)sys.AddCollider(
-      particles::Collider::Box(Vec3(-1, 0, -1), Vec3(1, 10, 1), true).Restitution(0.3).Friction(0.5));
+  (void)sys.AddCollider(particles::Collider::Box(Vec3(-1, 0, -1), Vec3(1, 10, 1), true)
+                            .Restitution(0.3)
+                            .Friction(0.5));
   std::mt19937 rng(4);
   std::uniform_real_distribution<double> u(-0.004, 0.004);
   for (int k = 0; k < 10000; ++k) {
@@ -109,10 +110,12 @@ void Run(const char* name, void (*make)(particles::System&), int threads, double
   particles::System sys(threads);
   make(sys);
   // Random close packing (0.64) of the balls over the box's floor.
-  const double volume = double(sys.state.size()) * 4.0 / 3.0 * 3.14159265358979 * 0.05 * 0.05 * 0.05;
-  std::printf("%s, %zu balls, %d thread(s): a pile at 0.64 packing stands %.2f m (mean centre %.2f m)\n",
-              name, sys.state.size(), threads, volume / 0.64 / (width * width),
-              volume / 0.64 / (width * width) / 2);
+  const double volume =
+      double(sys.state.size()) * 4.0 / 3.0 * 3.14159265358979 * 0.05 * 0.05 * 0.05;
+  std::printf(
+      "%s, %zu balls, %d thread(s): a pile at 0.64 packing stands %.2f m (mean centre %.2f m)\n",
+      name, sys.state.size(), threads, volume / 0.64 / (width * width),
+      volume / 0.64 / (width * width) / 2);
   std::printf(
       "   t    deepest  99th pct  mean overlap  coincident  mean y  max y  contacts/ball  "
       "max speed  moving  ms/step\n");
@@ -136,13 +139,17 @@ void Run(const char* name, void (*make)(particles::System&), int threads, double
         most = std::max(most, d);
         over += d > 0.01;
       }
-      std::printf("   over the last second: the most a ball moved %.4f m; %zu balls moved over 0.01 m\n", most, over);
+      std::printf(
+          "   over the last second: the most a ball moved %.4f m; %zu balls moved over 0.01 m\n",
+          most, over);
     }
     if (k == 60 || k == 120 || k == 300 || (steps_total > 300 && k % 300 == 0)) {
       const Stats s = Measure(sys, 0.05);
-      std::printf("%4.0f s  %6.1f %%  %6.1f %%  %10.2f %%  %10zu  %6.3f  %5.3f  %13.1f  %9.4f  %6zu  %7.2f\n",
-                  k / 60.0, 100 * s.deepest, 100 * s.p99, 100 * s.meanOverlap, s.coincident,
-                  s.meanY, s.maxY, s.contacts, s.maxSpeed, s.moving, ms / steps);
+      std::printf(
+          "%4.0f s  %6.1f %%  %6.1f %%  %10.2f %%  %10zu  %6.3f  %5.3f  %13.1f  %9.4f  %6zu  "
+          "%7.2f\n",
+          k / 60.0, 100 * s.deepest, 100 * s.p99, 100 * s.meanOverlap, s.coincident, s.meanY,
+          s.maxY, s.contacts, s.maxSpeed, s.moving, ms / steps);
       ms = 0;
       steps = 0;
     }

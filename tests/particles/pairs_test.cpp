@@ -121,9 +121,9 @@ TEST(PairContacts, ADeepPileHoldsItsBallsApart) {
   for (int y = 0; y < 20; ++y)
     for (int z = 0; z < 6; ++z)
       for (int x = 0; x < 6; ++x) {
-        s.state.Add(Vec3(-0.25 + 0.1 * x + jitter(rng), 0.06 + 0.11 * y,
-                         -0.25 + 0.1 * z + jitter(rng)),
-                    Vec3::Zero());
+        s.state.Add(
+            Vec3(-0.25 + 0.1 * x + jitter(rng), 0.06 + 0.11 * y, -0.25 + 0.1 * z + jitter(rng)),
+            Vec3::Zero());
         s.state.radius.back() = 0.05f;
       }
   ASSERT_OK(s.EnableParticleCollisions(0.05, 0.3));
