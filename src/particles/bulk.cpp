@@ -177,17 +177,28 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
   for (size_t c = begin; c < end; c += kChunk) {
     const size_t ce = std::min(end, c + kChunk), m = ce - c;
     size_t count = 0;
+    // A bad radius (see BadRadiusIn) is reported after the step: the
+    // floor's kernel checks the radii it loads anyway (a scan of its own
+    // cost that path 12 %), the other paths scan the chunk's.
+    auto checkRadii = [&] {
+      if (const size_t i = BadRadiusIn(s.radius.data(), c, ce, faults_.limit2()); i != SIZE_MAX)
+        faults_.BadRadius(i);
+    };
     if (floor && restLanes_ == 8) {
       // A lone static floor on eight lanes: the advance and the floor's
       // candidates, then its resting contacts, over the chunk; what is
       // left of the candidates to the general path below.
       bool ok = true;
       count = kernels::BulkAdvanceRestOnPlane(q, *floor, a, s.radius.data(), c, ce, olds, idx, &ok);
-      if (!ok) faults_.Flag();
+      if (!ok) {
+        faults_.Flag();
+        checkRadii();
+      }
       std::memset(done, 0, count);
     } else {
       if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds)) faults_.Flag();
-      if (colliders_.empty()) continue;
+      if (colliders_.empty()) continue;  // no contact reads a radius
+      checkRadii();
       if (plane) {
         count = kernels::BulkPlaneCandidateList(kernel_, plane->normal.data(), plane->point.data(),
                                                 a, s.radius.data(), c, ce, idx);
@@ -405,7 +416,8 @@ Status BulkSystem::Step(double h) {
 
 Status BulkSystem::Fault() {
   return faults_.Scan("in bulk", steps, state.time, state.size(), maxMagnitude, [&](size_t i) {
-    return FaultLatch::Particle{state.id[i], state.position(i), state.velocity(i)};
+    return FaultLatch::Particle{state.id[i], state.position(i), state.velocity(i),
+                                double(state.radius[i])};
   });
 }
 

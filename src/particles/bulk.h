@@ -125,9 +125,11 @@ class BulkSystem {
   // One symplectic Euler step of length h: fields, integration, collisions,
   // ageing. h in (0, 1e6] s; `fields` and maxMagnitude are checked first
   // (a Diagnostic, nothing moves). A coordinate or speed beyond maxMagnitude
-  // (or not finite, in any component), or contacts still unresolved after
-  // kMaxContacts, is reported with the step and the particle's id, and the
-  // system then refuses to step again.
+  // (or not finite, in any component), contacts still unresolved after
+  // kMaxContacts, or a radius that is negative, not finite or beyond
+  // maxMagnitude in a step with colliders (they take it as given), is
+  // reported with the step and the particle's id, and the system then
+  // refuses to step again.
   [[nodiscard]] Status Step(double h);
 
   // Appends particles [begin, size) of `born` (an Emitter's output) with

@@ -583,7 +583,11 @@ template <int G>
     _mm256_storeu_ps(ar.vy + i, v1), _mm256_storeu_ps(ar.vz + i, s1);
     // The candidates (PlaneListAvx): movable particles that end behind the
     // plane; the group listed if it has any (without a branch).
-    const __m512d r = _mm512_cvtps_pd(_mm256_loadu_ps(radius + i));
+    // The radius, in [0, limit] (a bad one clears *good: see BadRadiusIn).
+    const __m256 rf = _mm256_loadu_ps(radius + i);
+    within = _mm256_and_ps(within, _mm256_and_ps(_mm256_cmp_ps(rf, zerof, _CMP_GE_OQ),
+                                                 _mm256_cmp_ps(rf, limit, _CMP_LE_OQ)));
+    const __m512d r = _mm512_cvtps_pd(rf);
     const __m512d d =
         Dot3(n, _mm512_sub_pd(_mm512_cvtps_pd(x1f), p[0]),
              _mm512_sub_pd(_mm512_cvtps_pd(y1f), p[1]), _mm512_sub_pd(_mm512_cvtps_pd(z1f), p[2]));
@@ -755,6 +759,7 @@ size_t BulkAdvanceRestOnPlane(const BulkParams& q, const PlaneRest& rest, const 
   // general path.
   for (size_t i = tail; i < end; ++i) *ok &= BulkOne(q, a, i, old, i - begin);
   for (size_t i = tail; i < end; ++i) {
+    *ok &= radius[i] >= 0.0f && radius[i] <= q.limit;
     const double d =
         (rest.n[0] * (double(a.px[i]) - rest.p[0]) + rest.n[1] * (double(a.py[i]) - rest.p[1])) +
         rest.n[2] * (double(a.pz[i]) - rest.p[2]);

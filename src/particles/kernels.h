@@ -140,7 +140,7 @@ void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radiu
 // the resting kernel on the groups of eight with candidates, four groups
 // at a time. Writes to idx the candidates the resting kernel leaves (for the
 // general path), as BulkPlaneCandidateList, and returns their count; ANDs
-// BulkAdvance's check into *ok.
+// BulkAdvance's check and the radii's (each in [0, q.limit]) into *ok.
 constexpr size_t kRestRange = 512;
 size_t BulkAdvanceRestOnPlane(const BulkParams& q, const PlaneRest& rest, const BulkArrays& a,
                               const float* radius, size_t begin, size_t end, float* const* old,

@@ -49,6 +49,28 @@ void FaultLatch::Unresolved(size_t i) {
   Flag();
 }
 
+size_t BadRadiusIn(const float* r, size_t b, size_t e, double limit2) {
+  // lim rounded toward zero; the vector pass (an int mask, which the
+  // compiler vectorises) passes a chunk whose every radius is in [0, lim].
+  const double limit = std::min(std::sqrt(limit2), double(FLT_MAX));
+  float lim = float(limit);
+  if (double(lim) > limit) lim = std::nextafter(lim, 0.0f);
+  int ok = -1;
+  for (size_t i = b; i < e; ++i) ok &= -int((r[i] >= 0.0f) & (r[i] <= lim));
+  if (ok) return SIZE_MAX;
+  for (size_t i = b; i < e; ++i) {
+    if (!(r[i] >= 0.0f && double(r[i]) * double(r[i]) <= limit2)) return i;
+  }
+  return SIZE_MAX;  // only rounding of lim: within the limit
+}
+
+void FaultLatch::BadRadius(size_t i) {
+  size_t seen = badRadius_.load(std::memory_order_relaxed);
+  while (i < seen && !badRadius_.compare_exchange_weak(seen, i)) {
+  }
+  Flag();
+}
+
 Diagnostic BadMassDiagnostic(const char* what, uint32_t id, double mass) {
   std::ostringstream o;
   o << "particles: " << what << ": particle id " << id << " has mass " << mass
@@ -67,6 +89,18 @@ Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32
     << (finite ? " beyond the limit of " : " (not finite)");
   if (finite) o << limit;
   o << "; the state exploded: try a smaller step, a stabler integrator or softer forces";
+  Diagnostic d = MakeError({}, o.str());
+  d.kind = ErrorKind::kRuntime;
+  return d;
+}
+
+Diagnostic BadRadiusDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
+                               double radius, double limit) {
+  std::ostringstream o;
+  o << "particles: " << what << " step " << step << " (from t = " << t << " s): particle id " << id
+    << " has radius " << radius << " m, outside [0, " << limit
+    << "] m (maxMagnitude); the colliders and particle collisions met it with that radius, so "
+       "this step's contacts for it are not right";
   Diagnostic d = MakeError({}, o.str());
   d.kind = ErrorKind::kRuntime;
   return d;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -79,6 +80,9 @@ class FaultLatch {
   // Particle i's contacts are unresolved; the lowest index wins, whatever
   // the thread count.
   void Unresolved(size_t i);
+  // Particle i's radius is negative, not finite or beyond the limit (see
+  // BadRadiusIn); the lowest index wins, whatever the thread count.
+  void BadRadius(size_t i);
   const std::optional<Diagnostic>& fault() const { return fault_; }
   // Latches d and returns it.
   Diagnostic Latch(Diagnostic d) {
@@ -86,13 +90,15 @@ class FaultLatch {
     return d;
   }
   // After the step: ok, or the latched fault of the particle with the
-  // lowest index whose contacts were unresolved, else of the first whose
+  // lowest index whose radius was bad, else of the one with the lowest
+  // index whose contacts were unresolved, else of the first whose
   // position or velocity has a component that is not finite or beyond
   // `limit` (each of the six compared on its own). at(i) gives particle i's
-  // id, position and velocity.
+  // id, position, velocity and radius.
   struct Particle {
     uint32_t id;
     Vec3 x, v;
+    double radius;
   };
   template <typename At>
   Status Scan(const char* what, uint64_t step, double t, size_t n, double limit, At at);
@@ -101,8 +107,17 @@ class FaultLatch {
   std::optional<Diagnostic> fault_;
   std::atomic<bool> flagged_{false};
   std::atomic<size_t> unresolved_{SIZE_MAX};
+  std::atomic<size_t> badRadius_{SIZE_MAX};
   double limit2_ = 0;
 };
+
+// The index of the first radius in [b, e) that is negative, not finite or
+// whose square exceeds limit2 (the fault limit squared), else SIZE_MAX.
+// Every collider and particle collisions take a particle's radius as
+// given, so one of these would make them silently wrong (a negative radius
+// lets a ball sink through a mesh, a NaN one moves it anywhere). One
+// vectorised pass, then a scalar one only where a bad radius is.
+size_t BadRadiusIn(const float* r, size_t b, size_t e, double limit2);
 
 // Removes the particles for which dead(i) holds from every array, keeping
 // the order of the living; remap (when not null) gets, for each old index,
@@ -145,6 +160,8 @@ double KineticEnergyOf(size_t n, At at) {
 // Diagnostics shared by both systems (system.cpp).
 Diagnostic ExplosionDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
                                const Vec3& x, const Vec3& v, double limit);
+Diagnostic BadRadiusDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
+                               double radius, double limit);
 Diagnostic UnresolvedContactDiagnostic(const char* what, uint64_t step, double t, uint32_t id,
                                        const Vec3& x);
 Diagnostic BadMassDiagnostic(const char* what, uint32_t id, double mass);
@@ -186,6 +203,11 @@ Status CheckMasses(const char* what, MassRecord* record, size_t n, MassAt massAt
 template <typename At>
 Status FaultLatch::Scan(const char* what, uint64_t step, double t, size_t n, double limit, At at) {
   if (!flagged_.load()) return {};
+  if (const size_t i = badRadius_.exchange(SIZE_MAX); i != SIZE_MAX) {
+    unresolved_ = SIZE_MAX;
+    const Particle p = at(i);
+    return Latch(BadRadiusDiagnostic(what, step, t, p.id, p.radius, limit));
+  }
   if (const size_t i = unresolved_.exchange(SIZE_MAX); i != SIZE_MAX) {
     const Particle p = at(i);
     return Latch(UnresolvedContactDiagnostic(what, step, t, p.id, p.x));

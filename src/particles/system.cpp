@@ -513,9 +513,19 @@ uint64_t System::Hash() const {
   state.velocity[i] = v1;
 }
 
+void System::FlagBadRadii() {
+  if (colliders_.empty() && pairRadius_ <= 0) return;  // no contact reads a radius
+  const float* r = state.radius.data();
+  const double limit2 = faults_.limit2();
+  ForChunks(state.size(), [&](size_t b, size_t e) {
+    if (const size_t i = BadRadiusIn(r, b, e, limit2); i != SIZE_MAX) faults_.BadRadius(i);
+  });
+}
+
 Status System::CheckFaults(const char* what) {
   return faults_.Scan(what, state.step, state.time, state.size(), maxMagnitude, [&](size_t i) {
-    return FaultLatch::Particle{state.id[i], state.position[i], state.velocity[i]};
+    return FaultLatch::Particle{state.id[i], state.position[i], state.velocity[i],
+                                double(state.radius[i])};
   });
 }
 
@@ -551,6 +561,7 @@ Status System::Step(double h, Integrator integrator) {
   if (faults_.fault()) return *faults_.fault();
   SYLVA_CHECK_OK(CheckStep("System.Step h", h));
   faults_.Begin(maxMagnitude);
+  FlagBadRadii();
   const size_t n = state.size();
   std::vector<Vec3>& X = state.position;
   std::vector<Vec3>& V = state.velocity;
@@ -815,6 +826,7 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
   if (faults_.fault()) return *faults_.fault();
   SYLVA_CHECK_OK(CheckStep("System.StepAdaptive dt", dt));
   faults_.Begin(maxMagnitude);
+  FlagBadRadii();
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.rtol", opt.rtol, 0, 1));
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.atol", opt.atol, 0, 1e12));
   if (!(opt.rtol > 0 || opt.atol > 0))
@@ -919,6 +931,7 @@ Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats
     }
     if (err <= 1) {
       faults_.Begin(maxMagnitude);
+      FlagBadRadii();
       if (pairRadius_ > 0) SavePairStart();
       ForChunks(n, [&](size_t b, size_t e) {
         for (size_t i = b; i < e; ++i) Finish(i, X[i], V[i], x_[i], v_[i], h);

@@ -21,8 +21,10 @@
 // Faults. A step that leaves a non-finite value (in any of x, y, z of a
 // position or velocity) or a coordinate or speed beyond
 // `System::maxMagnitude`, or a particle whose contacts are still unresolved
-// after kMaxContacts (collider.h), returns an error naming the step and the
-// particle id; the system then refuses to step again. Implicit Euler also
+// after kMaxContacts (collider.h), or a particle whose radius is negative,
+// not finite or beyond maxMagnitude in a step with colliders or particle
+// collisions (they would take it as given), returns an error naming the
+// step and the particle id; the system then refuses to step again. Implicit Euler also
 // reports a system that is not positive definite (nothing moves; a smaller
 // step may succeed).
 //
@@ -418,6 +420,10 @@ class System {
   void SavePairStart();
   // Moves every moving collider by h times its velocity (after a step).
   void MoveColliders(double h);
+  // At the start of a step with colliders or particle collisions: flags
+  // the first particle whose radius is bad (BadRadiusIn); the step's fault
+  // scan reports it.
+  void FlagBadRadii();
   Status CheckFaults(const char* what);
   // The warning of a step whose gas contacts reached pairMaxPasses (pairs.cpp).
   Status PairPassesWarning(const char* what) const;
