@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "ball_scenes.h"
 #include "core/parallel.h"
 #include "particles/bulk.h"
 #include "particles/cloth.h"
@@ -177,21 +178,8 @@ BENCHMARK(BM_SnowOnGround)
 // before the timing (the balls fall and pile up); the state runs on.
 void BM_SelfCollidingBalls(benchmark::State& state) {
   particles::System sys(int(state.range(0)));
-  sys.AddForce(std::make_shared<particles::Gravity>(Vec3(0, -9.81, 0)));
-  if (!sys.AddCollider(particles::Collider::Box(Vec3(-1, 0, -1), Vec3(1, 10, 1), true)
-                           .Restitution(0.3)
-                           .Friction(0.5))
-           .ok())
-    return state.SkipWithError("bad box");
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<double> u(-0.004, 0.004);
-  for (int k = 0; k < 10000; ++k) {
-    const int x = k % 18, z = (k / 18) % 18, y = k / 324;
-    sys.state.Add(Vec3(-0.9 + 0.106 * x + u(rng), 0.06 + 0.11 * y, -0.9 + 0.106 * z + u(rng)),
-                  Vec3::Zero());
-    sys.state.radius.back() = 0.05f;
-  }
-  if (!sys.EnableParticleCollisions(0.05, 0.3).ok()) return state.SkipWithError("bad pairs");
+  if (Status st = bench::AddSelfCollidingBalls(sys); !st.ok())
+    return state.SkipWithError(st.error().message.c_str());
   for (int s = 0; s < 60; ++s) {
     if (Status st = sys.Step(1.0 / 60, particles::Integrator::kSymplecticEuler); !st.ok())
       return state.SkipWithError(st.error().message.c_str());

@@ -14,10 +14,9 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <memory>
-#include <random>
 #include <vector>
 
+#include "ball_scenes.h"
 #include "particles/grid.h"
 #include "particles/system.h"
 
@@ -69,46 +68,13 @@ Stats Measure(const particles::System& sys, double r) {
   return st;
 }
 
-// BM_SelfCollidingBalls' scene (bench_particles.cpp).
-void Balls10k(particles::System& sys) {
-  sys.AddForce(std::make_shared<particles::Gravity>(Vec3(0, -9.81, 0)));
-  (void)sys.AddCollider(particles::Collider::Box(Vec3(-1, 0, -1), Vec3(1, 10, 1), true)
-                            .Restitution(0.3)
-                            .Friction(0.5));
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<double> u(-0.004, 0.004);
-  for (int k = 0; k < 10000; ++k) {
-    const int x = k % 18, z = (k / 18) % 18, y = k / 324;
-    sys.state.Add(Vec3(-0.9 + 0.106 * x + u(rng), 0.06 + 0.11 * y, -0.9 + 0.106 * z + u(rng)),
-                  Vec3::Zero());
-    sys.state.radius.back() = 0.05f;
-  }
-  (void)sys.EnableParticleCollisions(0.05, 0.3);
-}
-
-// The pile of the PairContacts tests (pairs_test.cpp).
-void Pile2880(particles::System& sys) {
-  sys.AddForce(std::make_shared<particles::Gravity>(Vec3(0, -9.81, 0)));
-  (void)sys.AddCollider(particles::Collider::Box(Vec3(-0.6, 0, -0.6), Vec3(0.6, 10, 0.6), true)
-                            .Restitution(0.3)
-                            .Friction(0.5));
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<double> jitter(-0.005, 0.005);
-  for (int y = 0; y < 20; ++y)
-    for (int z = 0; z < 12; ++z)
-      for (int x = 0; x < 12; ++x) {
-        sys.state.Add(
-            Vec3(-0.55 + 0.1 * x + jitter(rng), 0.1 + 0.11 * y, -0.55 + 0.1 * z + jitter(rng)),
-            Vec3::Zero());
-        sys.state.radius.back() = 0.05f;
-      }
-  (void)sys.EnableParticleCollisions(0.05, 0.3);
-}
-
 int steps_total = 300;
-void Run(const char* name, void (*make)(particles::System&), int threads, double width) {
+void Run(const char* name, Status (*make)(particles::System&), int threads, double width) {
   particles::System sys(threads);
-  make(sys);
+  if (Status st = make(sys); !st.ok()) {
+    std::printf("%s: %s\n", name, st.error().message.c_str());
+    std::exit(1);
+  }
   // Random close packing (0.64) of the balls over the box's floor.
   const double volume =
       double(sys.state.size()) * 4.0 / 3.0 * 3.14159265358979 * 0.05 * 0.05 * 0.05;
@@ -162,7 +128,7 @@ int main(int argc, char** argv) {
   const int threads = argc > 1 ? std::atoi(argv[1]) : 1;
   if (argc > 2) steps_total = std::atoi(argv[2]);
   const bool onlySmall = argc > 3;
-  if (!onlySmall) Run("BM_SelfCollidingBalls", Balls10k, threads, 2.0);
-  Run("PairContacts pile", Pile2880, threads, 1.2);
+  if (!onlySmall) Run("BM_SelfCollidingBalls", bench::AddSelfCollidingBalls, threads, 2.0);
+  Run("PairContacts pile", bench::AddPile2880, threads, 1.2);
   return 0;
 }
