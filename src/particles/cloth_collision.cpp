@@ -26,11 +26,11 @@ const Collider* Collide(const std::vector<Collider>& colliders, const std::vecto
     Contact best;
     best.s = 2;
     const Collider* hit = nullptr;
-    for (size_t k = 0; k < colliders.size(); ++k) {
+    for (size_t j = 0; j < colliders.size(); ++j) {
       Contact ct;
-      if (colliders[k].Intersect(a, x, &ct, radii[k]) && ct.s < best.s) {
+      if (colliders[j].Intersect(a, x, &ct, radii[j]) && ct.s < best.s) {
         best = ct;
-        hit = &colliders[k];
+        hit = &colliders[j];
       }
     }
     if (!hit) break;

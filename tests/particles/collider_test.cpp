@@ -269,7 +269,9 @@ TEST(TriangleBvh, MemoGivesTheFullQuerysAnswerBitForBit) {
         ASSERT_EQ(fast.normal, full.normal) << "ball " << k << " path " << step;
       }
       // The broad phase with the memo never misses a contact.
-      if (hitFull) ASSERT_TRUE(bvh.Near(a, b, r, &memo)) << "ball " << k << " path " << step;
+      if (hitFull) {
+        ASSERT_TRUE(bvh.Near(a, b, r, &memo)) << "ball " << k << " path " << step;
+      }
       remembered += memo.mesh == bvh.serial() && memo.count > 1;
       if (hitFull) a = full.point;  // rests where the contact put it
     }
