@@ -78,7 +78,9 @@
 #include "particles/pairs.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <thread>
 #include <utility>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -121,6 +123,9 @@ constexpr double kSupport = 0.5;
 constexpr double kSlop = 0.002;
 constexpr double kSweepMargin = 0.5;
 constexpr int kSweeps = 4;
+// A pipelined sweep tells the one after it how far it has come every
+// kSweepBlock turns.
+constexpr size_t kSweepBlock = 32;
 // Candidates of one particle gathered before their contacts are computed:
 // the distance screen runs without a branch a candidate. The buffer's
 // contacts are computed when fewer than kScreenRoom places are left (the
@@ -735,42 +740,99 @@ void System::SupportSweep(const Vec3& up, double h) {
   });
   Vec3* swept = pw.swept.data();
   std::copy(x, x + n, swept);
-  for (int pass = 0; pass < kSweeps; ++pass) {
-    bool changed = false;
-    for (size_t k = 0; k < n; ++k) {
-      Vec3 xp = xh[k];
-      bool moved = false;
-      const uint32_t* nearList = pw.nearChunks[k / kPairChunk].data();
-      for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) {
-        const uint32_t j = nearList[a];
-        const Vec3 dq = xp - xh[j];
-        const double R = rh[k] + rh[j], Rs = R * (1 - kSlop);
-        const double d2 = dq.squaredNorm();
-        if (d2 >= Rs * Rs) continue;
-        const double len = std::sqrt(d2);
-        // Coincident centres: p goes up.
-        const Vec3 nrm = len > 0 ? Vec3(dq / len) : up;
-        const double lift = len > 0 ? up.dot(nrm) : 1.0;
-        const double depth = Rs - len;
-        moved = true;
-        if (lift >= kSupport || wh[j] == 0) {
-          xp += depth * nrm;
-        } else if (lift <= -kSupport || wh[k] == 0) {
-          xh[j] -= depth * nrm;  // q has come to lie on p
-        } else {
-          const double share = wh[k] / (wh[k] + wh[j]);
-          const Vec3 side = nrm - lift * up;  // |side| >= cos(asin(kSupport))
-          const Vec3 sideways = side / side.squaredNorm();
-          xp += (share * depth) * (lift >= 0 ? sideways : nrm);
-          xh[j] -= ((1 - share) * depth) * (lift >= 0 ? nrm : sideways);
-        }
+  const std::vector<std::vector<uint32_t>>& nearChunks = pw.nearChunks;
+  // The k-th particle's turn in a sweep: its overlaps with those before it
+  // resolved. Reads and writes the places k and its list's, and v of k.
+  auto turn = [&](size_t k) {
+    Vec3 xp = xh[k];
+    bool moved = false;
+    const uint32_t* nearList = nearChunks[k / kPairChunk].data();
+    for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) {
+      const uint32_t j = nearList[a];
+      const Vec3 dq = xp - xh[j];
+      const double R = rh[k] + rh[j], Rs = R * (1 - kSlop);
+      const double d2 = dq.squaredNorm();
+      if (d2 >= Rs * Rs) continue;
+      const double len = std::sqrt(d2);
+      // Coincident centres: p goes up.
+      const Vec3 nrm = len > 0 ? Vec3(dq / len) : up;
+      const double lift = len > 0 ? up.dot(nrm) : 1.0;
+      const double depth = Rs - len;
+      moved = true;
+      if (lift >= kSupport || wh[j] == 0) {
+        xp += depth * nrm;
+      } else if (lift <= -kSupport || wh[k] == 0) {
+        xh[j] -= depth * nrm;  // q has come to lie on p
+      } else {
+        const double share = wh[k] / (wh[k] + wh[j]);
+        const Vec3 side = nrm - lift * up;  // |side| >= cos(asin(kSupport))
+        const Vec3 sideways = side / side.squaredNorm();
+        xp += (share * depth) * (lift >= 0 ? sideways : nrm);
+        xh[j] -= ((1 - share) * depth) * (lift >= 0 ? nrm : sideways);
       }
-      if (!moved) continue;
-      changed = true;
-      if (wh[k] != 0) OutOfColliders(colliders_, h, rh[k], &xp, &v[byHeight[k].second]);
-      xh[k] = xp;
     }
-    if (!changed) break;  // nothing left to resolve
+    if (!moved) return false;
+    if (wh[k] != 0) OutOfColliders(colliders_, h, rh[k], &xp, &v[byHeight[k].second]);
+    xh[k] = xp;
+    return true;
+  };
+  if (!pool_ || pool_->threads() < 2 || n < 2 * kSweepBlock) {
+    for (int pass = 0; pass < kSweeps; ++pass) {
+      bool changed = false;
+      for (size_t k = 0; k < n; ++k) changed |= turn(k);
+      if (!changed) break;  // nothing left to resolve
+    }
+  } else {
+    // The sweeps as a pipeline, one thread a sweep, each a little behind
+    // the one before: the k-th turn of a sweep waits until the sweep
+    // before has taken every turn that touches a place the k-th turn
+    // touches (up to wait[k]), so every place sees the same operations in
+    // the same order as in the serial sweeps: the same bits. A sweep that
+    // changed nothing ends the ones after it (the serial sweeps stop
+    // there; the later ones, on the same positions, change nothing
+    // either).
+    // reach: the last turn that touches each place; wait[k]: the last turn
+    // that touches a place the k-th touches.
+    Grow(pw.sweepReach, n);
+    Grow(pw.sweepWait, n);
+    uint32_t* reach = pw.sweepReach.data();
+    uint32_t* wait = pw.sweepWait.data();
+    for (size_t k = 0; k < n; ++k) {
+      reach[k] = uint32_t(k);
+      const uint32_t* nearList = nearChunks[k / kPairChunk].data();
+      for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) reach[nearList[a]] = uint32_t(k);
+    }
+    Ranges(pool_, n, [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k) {
+        uint32_t m = reach[k];
+        const uint32_t* nearList = nearChunks[k / kPairChunk].data();
+        for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) m = std::max(m, reach[nearList[a]]);
+        wait[k] = m;
+      }
+    });
+    std::atomic<size_t> done[kSweeps];
+    for (auto& d : done) d.store(0, std::memory_order_relaxed);
+    std::atomic<bool> still{false};  // a sweep has changed nothing
+    pool_->ParallelFor(kSweeps, [&](size_t pass) {
+      bool changed = false;
+      size_t ready = pass == 0 ? n : 0;  // turns known taken by the sweep before
+      for (size_t k = 0; k < n; ++k) {
+        for (int spins = 0; ready <= wait[k]; ++spins) {
+          ready = done[pass - 1].load(std::memory_order_acquire);
+          if (ready > wait[k]) break;
+          if (still.load(std::memory_order_acquire)) {
+            // Every turn so far changed nothing; none after will.
+            done[pass].store(n, std::memory_order_release);
+            return;
+          }
+          if (spins > 64) std::this_thread::yield();
+        }
+        changed |= turn(k);
+        if ((k + 1) % kSweepBlock == 0) done[pass].store(k + 1, std::memory_order_release);
+      }
+      if (!changed) still.store(true, std::memory_order_release);
+      done[pass].store(n, std::memory_order_release);
+    });
   }
   Ranges(pool_, n, [&](size_t b, size_t e) {
     for (size_t k = b; k < e; ++k) x[byHeight[k].second] = xh[k];
