@@ -80,6 +80,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <thread>
 #include <utility>
 #if defined(__SSE2__)
@@ -232,6 +233,40 @@ double OutOfColliders(const std::vector<Collider>& colliders, double h, double r
     }
   }
   return moved;
+}
+
+// Sorts a[0, n), in index order (a[p].second == p), as std::sort would
+// sort the pairs (by height, equal heights by index): a least significant
+// digit radix sort of the heights' bits, stable, so equal heights keep
+// the order of their indices. tmp: room for n.
+void SortByHeight(std::pair<double, uint32_t>* a, std::pair<double, uint32_t>* tmp, size_t n) {
+  // The height's bits, ordered as the heights (-0 as 0, as they compare).
+  auto key = [](double height) {
+    if (height == 0) height = 0;
+    uint64_t b;
+    std::memcpy(&b, &height, sizeof b);
+    return b >> 63 ? ~b : b | (uint64_t(1) << 63);
+  };
+  constexpr int kBits = 11, kDigits = (64 + kBits - 1) / kBits;
+  constexpr uint32_t kBuckets = 1u << kBits;
+  if (n < 2) return;
+  uint32_t count[kDigits][kBuckets] = {};  // 48 KiB
+  for (size_t i = 0; i < n; ++i) {
+    const uint64_t k = key(a[i].first);
+    for (int d = 0; d < kDigits; ++d) ++count[d][(k >> (d * kBits)) & (kBuckets - 1)];
+  }
+  std::pair<double, uint32_t>*from = a, *to = tmp;
+  for (int d = 0; d < kDigits; ++d) {
+    uint32_t* c = count[d];
+    // A digit shared by every height moves nothing.
+    if (c[(key(a[0].first) >> (d * kBits)) & (kBuckets - 1)] == n) continue;
+    uint32_t sum = 0;
+    for (uint32_t b = 0; b < kBuckets; ++b) sum += std::exchange(c[b], sum);
+    for (size_t i = 0; i < n; ++i)
+      to[c[(key(from[i].first) >> (d * kBits)) & (kBuckets - 1)]++] = from[i];
+    std::swap(from, to);
+  }
+  if (from != a) std::copy(from, from + n, a);
 }
 
 // The screen reads positions as 3 doubles a particle.
@@ -681,7 +716,8 @@ void System::SupportSweep(const Vec3& up, double h) {
   auto* byHeight = pw.byHeight.data();
   uint32_t* rank = pw.rank.data();
   for (size_t p = 0; p < n; ++p) byHeight[p] = {up.dot(x[p]), uint32_t(p)};
-  std::sort(byHeight, byHeight + n);
+  Grow(pw.byHeightScratch, n);
+  SortByHeight(byHeight, pw.byHeightScratch.data(), n);
   for (size_t k = 0; k < n; ++k) rank[byHeight[k].second] = uint32_t(k);
   // The sweeps work in order of height (the particles they read together
   // are near in memory): positions, inverse masses and radii copied so.

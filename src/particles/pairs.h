@@ -71,7 +71,7 @@ struct PairWork {
   // order, the places in it of the particles before it near enough to
   // touch, nearChunks[k / kPairChunk][nearBegin[k], nearEnd[k]); what the
   // sweep moved each by (slot order).
-  std::vector<std::pair<double, uint32_t>> byHeight;
+  std::vector<std::pair<double, uint32_t>> byHeight, byHeightScratch;
   std::vector<uint32_t> rank, nearBegin, nearEnd;
   // The pipelined sweeps: the last turn that touches each place, and the
   // last one the k-th turn of a sweep waits for in the sweep before.
