@@ -68,8 +68,9 @@
 //             passes leave unresolved does not build up in a pile; one
 //             that barely moved is held still.
 // Every sum runs in a fixed order and each particle is written by one
-// thread (the sweep runs on one): the result is bit-identical for any
-// thread count.
+// thread (the sweeps, pipelined over the threads, write each particle in
+// the serial sweeps' order): the result is bit-identical for any thread
+// count.
 //
 // References: Mirtich, "Timewarp rigid body simulation" (swept spheres);
 // Müller et al., "Position based dynamics" (2007), Jacobi projection;
@@ -699,7 +700,8 @@ void System::ParticleCollisions(double h) {
 // position passes, from the grid's neighbourhood of each particle's start
 // (the contacts found above miss balls that move as one: a column falling
 // together has none between its balls), gathered once, in parallel;
-// kSweeps sweeps, serial. A swept particle's own move is in
+// kSweeps sweeps, pipelined over the threads with the serial sweeps'
+// result (below). A swept particle's own move is in
 // PairWork::swept. All in an order that does not depend on the thread
 // count.
 void System::SupportSweep(const Vec3& up, double h) {
