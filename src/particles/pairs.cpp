@@ -68,8 +68,9 @@
 //             passes leave unresolved does not build up in a pile; one
 //             that barely moved is held still.
 // Every sum runs in a fixed order and each particle is written by one
-// thread (the sweep runs on one): the result is bit-identical for any
-// thread count.
+// thread (the sweeps, pipelined over the threads, write each particle in
+// the serial sweeps' order): the result is bit-identical for any thread
+// count.
 //
 // References: Mirtich, "Timewarp rigid body simulation" (swept spheres);
 // Müller et al., "Position based dynamics" (2007), Jacobi projection;
@@ -78,7 +79,10 @@
 #include "particles/pairs.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstring>
+#include <thread>
 #include <utility>
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -121,6 +125,9 @@ constexpr double kSupport = 0.5;
 constexpr double kSlop = 0.002;
 constexpr double kSweepMargin = 0.5;
 constexpr int kSweeps = 4;
+// A pipelined sweep tells the one after it how far it has come every
+// kSweepBlock turns.
+constexpr size_t kSweepBlock = 32;
 // Candidates of one particle gathered before their contacts are computed:
 // the distance screen runs without a branch a candidate. The buffer's
 // contacts are computed when fewer than kScreenRoom places are left (the
@@ -227,6 +234,40 @@ double OutOfColliders(const std::vector<Collider>& colliders, double h, double r
     }
   }
   return moved;
+}
+
+// Sorts a[0, n), in index order (a[p].second == p), as std::sort would
+// sort the pairs (by height, equal heights by index): a least significant
+// digit radix sort of the heights' bits, stable, so equal heights keep
+// the order of their indices. tmp: room for n.
+void SortByHeight(std::pair<double, uint32_t>* a, std::pair<double, uint32_t>* tmp, size_t n) {
+  // The height's bits, ordered as the heights (-0 as 0, as they compare).
+  auto key = [](double height) {
+    if (height == 0) height = 0;
+    uint64_t b;
+    std::memcpy(&b, &height, sizeof b);
+    return b >> 63 ? ~b : b | (uint64_t(1) << 63);
+  };
+  constexpr int kBits = 11, kDigits = (64 + kBits - 1) / kBits;
+  constexpr uint32_t kBuckets = 1u << kBits;
+  if (n < 2) return;
+  uint32_t count[kDigits][kBuckets] = {};  // 48 KiB
+  for (size_t i = 0; i < n; ++i) {
+    const uint64_t k = key(a[i].first);
+    for (int d = 0; d < kDigits; ++d) ++count[d][(k >> (d * kBits)) & (kBuckets - 1)];
+  }
+  std::pair<double, uint32_t>*from = a, *to = tmp;
+  for (int d = 0; d < kDigits; ++d) {
+    uint32_t* c = count[d];
+    // A digit shared by every height moves nothing.
+    if (c[(key(a[0].first) >> (d * kBits)) & (kBuckets - 1)] == n) continue;
+    uint32_t sum = 0;
+    for (uint32_t b = 0; b < kBuckets; ++b) sum += std::exchange(c[b], sum);
+    for (size_t i = 0; i < n; ++i)
+      to[c[(key(from[i].first) >> (d * kBits)) & (kBuckets - 1)]++] = from[i];
+    std::swap(from, to);
+  }
+  if (from != a) std::copy(from, from + n, a);
 }
 
 // The screen reads positions as 3 doubles a particle.
@@ -659,7 +700,8 @@ void System::ParticleCollisions(double h) {
 // position passes, from the grid's neighbourhood of each particle's start
 // (the contacts found above miss balls that move as one: a column falling
 // together has none between its balls), gathered once, in parallel;
-// kSweeps sweeps, serial. A swept particle's own move is in
+// kSweeps sweeps, pipelined over the threads with the serial sweeps'
+// result (below). A swept particle's own move is in
 // PairWork::swept. All in an order that does not depend on the thread
 // count.
 void System::SupportSweep(const Vec3& up, double h) {
@@ -676,7 +718,8 @@ void System::SupportSweep(const Vec3& up, double h) {
   auto* byHeight = pw.byHeight.data();
   uint32_t* rank = pw.rank.data();
   for (size_t p = 0; p < n; ++p) byHeight[p] = {up.dot(x[p]), uint32_t(p)};
-  std::sort(byHeight, byHeight + n);
+  Grow(pw.byHeightScratch, n);
+  SortByHeight(byHeight, pw.byHeightScratch.data(), n);
   for (size_t k = 0; k < n; ++k) rank[byHeight[k].second] = uint32_t(k);
   // The sweeps work in order of height (the particles they read together
   // are near in memory): positions, inverse masses and radii copied so.
@@ -735,42 +778,99 @@ void System::SupportSweep(const Vec3& up, double h) {
   });
   Vec3* swept = pw.swept.data();
   std::copy(x, x + n, swept);
-  for (int pass = 0; pass < kSweeps; ++pass) {
-    bool changed = false;
-    for (size_t k = 0; k < n; ++k) {
-      Vec3 xp = xh[k];
-      bool moved = false;
-      const uint32_t* nearList = pw.nearChunks[k / kPairChunk].data();
-      for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) {
-        const uint32_t j = nearList[a];
-        const Vec3 dq = xp - xh[j];
-        const double R = rh[k] + rh[j], Rs = R * (1 - kSlop);
-        const double d2 = dq.squaredNorm();
-        if (d2 >= Rs * Rs) continue;
-        const double len = std::sqrt(d2);
-        // Coincident centres: p goes up.
-        const Vec3 nrm = len > 0 ? Vec3(dq / len) : up;
-        const double lift = len > 0 ? up.dot(nrm) : 1.0;
-        const double depth = Rs - len;
-        moved = true;
-        if (lift >= kSupport || wh[j] == 0) {
-          xp += depth * nrm;
-        } else if (lift <= -kSupport || wh[k] == 0) {
-          xh[j] -= depth * nrm;  // q has come to lie on p
-        } else {
-          const double share = wh[k] / (wh[k] + wh[j]);
-          const Vec3 side = nrm - lift * up;  // |side| >= cos(asin(kSupport))
-          const Vec3 sideways = side / side.squaredNorm();
-          xp += (share * depth) * (lift >= 0 ? sideways : nrm);
-          xh[j] -= ((1 - share) * depth) * (lift >= 0 ? nrm : sideways);
-        }
+  const std::vector<std::vector<uint32_t>>& nearChunks = pw.nearChunks;
+  // The k-th particle's turn in a sweep: its overlaps with those before it
+  // resolved. Reads and writes the places k and its list's, and v of k.
+  auto turn = [&](size_t k) {
+    Vec3 xp = xh[k];
+    bool moved = false;
+    const uint32_t* nearList = nearChunks[k / kPairChunk].data();
+    for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) {
+      const uint32_t j = nearList[a];
+      const Vec3 dq = xp - xh[j];
+      const double R = rh[k] + rh[j], Rs = R * (1 - kSlop);
+      const double d2 = dq.squaredNorm();
+      if (d2 >= Rs * Rs) continue;
+      const double len = std::sqrt(d2);
+      // Coincident centres: p goes up.
+      const Vec3 nrm = len > 0 ? Vec3(dq / len) : up;
+      const double lift = len > 0 ? up.dot(nrm) : 1.0;
+      const double depth = Rs - len;
+      moved = true;
+      if (lift >= kSupport || wh[j] == 0) {
+        xp += depth * nrm;
+      } else if (lift <= -kSupport || wh[k] == 0) {
+        xh[j] -= depth * nrm;  // q has come to lie on p
+      } else {
+        const double share = wh[k] / (wh[k] + wh[j]);
+        const Vec3 side = nrm - lift * up;  // |side| >= cos(asin(kSupport))
+        const Vec3 sideways = side / side.squaredNorm();
+        xp += (share * depth) * (lift >= 0 ? sideways : nrm);
+        xh[j] -= ((1 - share) * depth) * (lift >= 0 ? nrm : sideways);
       }
-      if (!moved) continue;
-      changed = true;
-      if (wh[k] != 0) OutOfColliders(colliders_, h, rh[k], &xp, &v[byHeight[k].second]);
-      xh[k] = xp;
     }
-    if (!changed) break;  // nothing left to resolve
+    if (!moved) return false;
+    if (wh[k] != 0) OutOfColliders(colliders_, h, rh[k], &xp, &v[byHeight[k].second]);
+    xh[k] = xp;
+    return true;
+  };
+  if (!pool_ || pool_->threads() < 2 || n < 2 * kSweepBlock) {
+    for (int pass = 0; pass < kSweeps; ++pass) {
+      bool changed = false;
+      for (size_t k = 0; k < n; ++k) changed |= turn(k);
+      if (!changed) break;  // nothing left to resolve
+    }
+  } else {
+    // The sweeps as a pipeline, one thread a sweep, each a little behind
+    // the one before: the k-th turn of a sweep waits until the sweep
+    // before has taken every turn that touches a place the k-th turn
+    // touches (up to wait[k]), so every place sees the same operations in
+    // the same order as in the serial sweeps: the same bits. A sweep that
+    // changed nothing ends the ones after it (the serial sweeps stop
+    // there; the later ones, on the same positions, change nothing
+    // either).
+    // reach: the last turn that touches each place; wait[k]: the last turn
+    // that touches a place the k-th touches.
+    Grow(pw.sweepReach, n);
+    Grow(pw.sweepWait, n);
+    uint32_t* reach = pw.sweepReach.data();
+    uint32_t* wait = pw.sweepWait.data();
+    for (size_t k = 0; k < n; ++k) {
+      reach[k] = uint32_t(k);
+      const uint32_t* nearList = nearChunks[k / kPairChunk].data();
+      for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) reach[nearList[a]] = uint32_t(k);
+    }
+    Ranges(pool_, n, [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k) {
+        uint32_t m = reach[k];
+        const uint32_t* nearList = nearChunks[k / kPairChunk].data();
+        for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) m = std::max(m, reach[nearList[a]]);
+        wait[k] = m;
+      }
+    });
+    std::atomic<size_t> done[kSweeps];
+    for (auto& d : done) d.store(0, std::memory_order_relaxed);
+    std::atomic<bool> still{false};  // a sweep has changed nothing
+    pool_->ParallelFor(kSweeps, [&](size_t pass) {
+      bool changed = false;
+      size_t ready = pass == 0 ? n : 0;  // turns known taken by the sweep before
+      for (size_t k = 0; k < n; ++k) {
+        for (int spins = 0; ready <= wait[k]; ++spins) {
+          ready = done[pass - 1].load(std::memory_order_acquire);
+          if (ready > wait[k]) break;
+          if (still.load(std::memory_order_acquire)) {
+            // Every turn so far changed nothing; none after will.
+            done[pass].store(n, std::memory_order_release);
+            return;
+          }
+          if (spins > 64) std::this_thread::yield();
+        }
+        changed |= turn(k);
+        if ((k + 1) % kSweepBlock == 0) done[pass].store(k + 1, std::memory_order_release);
+      }
+      if (!changed) still.store(true, std::memory_order_release);
+      done[pass].store(n, std::memory_order_release);
+    });
   }
   Ranges(pool_, n, [&](size_t b, size_t e) {
     for (size_t k = b; k < e; ++k) x[byHeight[k].second] = xh[k];

@@ -71,8 +71,11 @@ struct PairWork {
   // order, the places in it of the particles before it near enough to
   // touch, nearChunks[k / kPairChunk][nearBegin[k], nearEnd[k]); what the
   // sweep moved each by (slot order).
-  std::vector<std::pair<double, uint32_t>> byHeight;
+  std::vector<std::pair<double, uint32_t>> byHeight, byHeightScratch;
   std::vector<uint32_t> rank, nearBegin, nearEnd;
+  // The pipelined sweeps: the last turn that touches each place, and the
+  // last one the k-th turn of a sweep waits for in the sweep before.
+  std::vector<uint32_t> sweepReach, sweepWait;
   std::vector<std::vector<uint32_t>> nearChunks;
   std::vector<Vec3> swept, xh;  // xh, wh, rh: x, w, r in order of height
   std::vector<double> wh, rh;
