@@ -39,6 +39,10 @@ double InverseMassOf(double m, uint32_t id, MassRecord* record) {
 
 void FaultLatch::Begin(double maxMagnitude) {
   flagged_ = false;
+  // A step that returned before its scan (a non-positive-definite
+  // implicit system) leaves nothing behind for the next one.
+  unresolved_ = SIZE_MAX;
+  badRadius_ = SIZE_MAX;
   limit2_ = std::min(maxMagnitude * maxMagnitude, DBL_MAX);
 }
 

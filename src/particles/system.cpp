@@ -825,8 +825,7 @@ void System::SavePairStart() {
 Status System::StepAdaptive(double dt, const AdaptiveOptions& opt, AdaptiveStats* stats) {
   if (faults_.fault()) return *faults_.fault();
   SYLVA_CHECK_OK(CheckStep("System.StepAdaptive dt", dt));
-  faults_.Begin(maxMagnitude);
-  FlagBadRadii();
+  faults_.Begin(maxMagnitude);  // the radii: at the accepted attempt, where contacts run
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.rtol", opt.rtol, 0, 1));
   SYLVA_CHECK_OK(check::Range("AdaptiveOptions.atol", opt.atol, 0, 1e12));
   if (!(opt.rtol > 0 || opt.atol > 0))
