@@ -697,9 +697,10 @@ void System::ParticleCollisions(double h) {
 // Overlaps under kSlop of the radius sum are left (correcting every last
 // one kept the surface of a pile stirring). Then p is moved out of the
 // colliders. The pairs are those within kSweepMargin of touching after the
-// position passes, from the grid's neighbourhood of each particle's start
-// (the contacts found above miss balls that move as one: a column falling
-// together has none between its balls), gathered once, in parallel;
+// position passes, from a grid of their own over those positions, its
+// cells as small as the pairs' reach (the contacts found above miss balls
+// that move as one: a column falling together has none between its
+// balls), gathered once, in parallel, each particle's in order of height;
 // kSweeps sweeps, pipelined over the threads with the serial sweeps'
 // result (below). A swept particle's own move is in
 // PairWork::swept. All in an order that does not depend on the thread
@@ -711,16 +712,12 @@ void System::SupportSweep(const Vec3& up, double h) {
   Vec3* v = pw.v.data();
   const double* w = pw.w.data();
   const double* r = pw.r.data();
-  const Vec3* x0 = pw.grid.sortedPositions().data();
   Grow(pw.byHeight, n);
-  Grow(pw.rank, n);
   Grow(pw.swept, n);
   auto* byHeight = pw.byHeight.data();
-  uint32_t* rank = pw.rank.data();
   for (size_t p = 0; p < n; ++p) byHeight[p] = {up.dot(x[p]), uint32_t(p)};
   Grow(pw.byHeightScratch, n);
   SortByHeight(byHeight, pw.byHeightScratch.data(), n);
-  for (size_t k = 0; k < n; ++k) rank[byHeight[k].second] = uint32_t(k);
   // The sweeps work in order of height (the particles they read together
   // are near in memory): positions, inverse masses and radii copied so.
   Grow(pw.xh, n);
@@ -749,30 +746,36 @@ void System::SupportSweep(const Vec3& up, double h) {
   double maxR = 0;
   for (size_t p = 0; p < n; ++p) maxR = std::max(maxR, r[p]);
   const double screen = 2 * maxR * (1 + kSweepMargin);
+  // The grid over the positions in order of height: a candidate's slot
+  // s is the particle of place sweepOrder[s], at sweepX[s].
+  pw.sweepGrid.Build(xh, n, screen, pool_, true);
+  const uint32_t* sweepOrder = pw.sweepGrid.order().data();
+  const Vec3* sweepX = pw.sweepGrid.sortedPositions().data();
   Chunks(pool_, chunks, [&](size_t c) {
     std::vector<uint32_t>& list = pw.nearChunks[c];
     list.clear();
     uint32_t cand[kCandidates];
     for (size_t k = c * kPairChunk; k < std::min(n, (c + 1) * kPairChunk); ++k) {
-      const uint32_t p = byHeight[k].second;
       nearBegin[k] = uint32_t(list.size());
-      const Vec3 xp = x[p];
+      const Vec3 xp = xh[k];
       // The grid's candidates screened by distance (kernels::
       // ScreenCandidates), then by order and each pair's own reach.
-      pw.grid.ForEachCandidateRange(x0[p], [&](uint32_t f, uint32_t t) {
+      pw.sweepGrid.ForEachCandidateRange(xp, [&](uint32_t f, uint32_t t) {
         for (uint32_t from = f; from < t;) {
           const uint32_t to = std::min(t, from + kCandidates);
-          const uint32_t m = kernels::ScreenCandidates(kernel_, x[0].data(), from, to, xp.data(),
-                                                       screen * screen, cand);
+          const uint32_t m = kernels::ScreenCandidates(kernel_, sweepX[0].data(), from, to,
+                                                       xp.data(), screen * screen, cand);
           for (uint32_t a = 0; a < m; ++a) {
-            const uint32_t q = cand[a];
-            if (rank[q] >= k || w[p] + w[q] == 0) continue;
-            const double near = (r[p] + r[q]) * (1 + kSweepMargin);
-            if ((xp - x[q]).squaredNorm() < near * near) list.push_back(rank[q]);
+            const uint32_t j = sweepOrder[cand[a]];
+            if (j >= k || wh[k] + wh[j] == 0) continue;
+            const double near = (rh[k] + rh[j]) * (1 + kSweepMargin);
+            if ((xp - xh[j]).squaredNorm() < near * near) list.push_back(j);
           }
           from = to;
         }
       });
+      // In order of height, whatever the grid's layout.
+      std::sort(list.begin() + nearBegin[k], list.end());
       nearEnd[k] = uint32_t(list.size());
     }
   });

@@ -67,16 +67,21 @@ struct PairWork {
   std::vector<uint32_t> partnerBegin;
   std::vector<Vec3> out;
   // The support sweep (System::SupportSweep): the particles by height,
-  // (height, slot); each slot's place in that order; for the k-th in that
+  // (height, slot); for the k-th in that
   // order, the places in it of the particles before it near enough to
   // touch, nearChunks[k / kPairChunk][nearBegin[k], nearEnd[k]); what the
   // sweep moved each by (slot order).
   std::vector<std::pair<double, uint32_t>> byHeight, byHeightScratch;
-  std::vector<uint32_t> rank, nearBegin, nearEnd;
+  std::vector<uint32_t> nearBegin, nearEnd;
   // The pipelined sweeps: the last turn that touches each place, and the
   // last one the k-th turn of a sweep waits for in the sweep before.
   std::vector<uint32_t> sweepReach, sweepWait;
   std::vector<std::vector<uint32_t>> nearChunks;
+  // The sweep's pairs are gathered from a grid of their own, over the
+  // positions in order of height, its cells as small as their reach (the
+  // contacts' grid, over the start positions, has cells as large as the
+  // step's fastest move: five times the candidates in a falling pile).
+  NeighbourGrid sweepGrid;
   std::vector<Vec3> swept, xh;  // xh, wh, rh: x, w, r in order of height
   std::vector<double> wh, rh;
   std::vector<uint8_t> free, resting;  // v == v0 (free flight); has a resting contact
