@@ -734,61 +734,82 @@ void System::SupportSweep(const Vec3& up, double h) {
     }
   });
   // Each particle's pairs with those before it, in order of height (their
-  // places in it): the k-th particle's are nearChunks[k / kPairChunk]
-  // [nearBegin[k], nearEnd[k]), gathered in parallel, a chunk of that
-  // order at a time.
+  // places in it): the k-th particle's are near[nearBegin[k], nearBegin[k +
+  // 1]). Each pair is found once, from the half neighbourhood of one of its
+  // particles in a grid over the positions in order of height, in
+  // parallel, a chunk of the grid's slots at a time, and goes to the list
+  // of its higher particle; each list is then sorted, so the lists do not
+  // depend on the grid's layout or on the thread count.
   const size_t chunks = (n + kPairChunk - 1) / kPairChunk;
   if (pw.nearChunks.size() < chunks) pw.nearChunks.resize(chunks);
-  Grow(pw.nearBegin, n);
+  Grow(pw.nearBegin, n + 1);
   Grow(pw.nearEnd, n);
   uint32_t* nearBegin = pw.nearBegin.data();
-  uint32_t* nearEnd = pw.nearEnd.data();
+  uint32_t* nearEnd = pw.nearEnd.data();  // counts, then cursors, then ends
+  std::fill(nearEnd, nearEnd + n, 0u);
   double maxR = 0;
   for (size_t p = 0; p < n; ++p) maxR = std::max(maxR, r[p]);
   const double screen = 2 * maxR * (1 + kSweepMargin);
-  // The grid over the positions in order of height: a candidate's slot
-  // s is the particle of place sweepOrder[s], at sweepX[s].
+  // A candidate's slot s in the grid is the particle of place
+  // sweepOrder[s], at sweepX[s].
   pw.sweepGrid.Build(xh, n, screen, pool_, true);
   const uint32_t* sweepOrder = pw.sweepGrid.order().data();
   const Vec3* sweepX = pw.sweepGrid.sortedPositions().data();
   Chunks(pool_, chunks, [&](size_t c) {
-    std::vector<uint32_t>& list = pw.nearChunks[c];
-    list.clear();
+    std::vector<uint32_t>& pairs = pw.nearChunks[c];  // (higher, lower) places
+    pairs.clear();
     uint32_t cand[kCandidates];
-    for (size_t k = c * kPairChunk; k < std::min(n, (c + 1) * kPairChunk); ++k) {
-      nearBegin[k] = uint32_t(list.size());
-      const Vec3 xp = xh[k];
+    for (size_t s = c * kPairChunk; s < std::min(n, (c + 1) * kPairChunk); ++s) {
+      const uint32_t a = sweepOrder[s];
+      const Vec3 xa = sweepX[s];
       // The grid's candidates screened by distance (kernels::
-      // ScreenCandidates), then by order and each pair's own reach.
-      pw.sweepGrid.ForEachCandidateRange(xp, [&](uint32_t f, uint32_t t) {
+      // ScreenCandidates), then by each pair's own reach.
+      pw.sweepGrid.ForEachHalfCandidateRange(xa, uint32_t(s), [&](uint32_t f, uint32_t t) {
         for (uint32_t from = f; from < t;) {
           const uint32_t to = std::min(t, from + kCandidates);
           const uint32_t m = kernels::ScreenCandidates(kernel_, sweepX[0].data(), from, to,
-                                                       xp.data(), screen * screen, cand);
-          for (uint32_t a = 0; a < m; ++a) {
-            const uint32_t j = sweepOrder[cand[a]];
-            if (j >= k || wh[k] + wh[j] == 0) continue;
-            const double near = (rh[k] + rh[j]) * (1 + kSweepMargin);
-            if ((xp - xh[j]).squaredNorm() < near * near) list.push_back(j);
+                                                       xa.data(), screen * screen, cand);
+          for (uint32_t i = 0; i < m; ++i) {
+            const uint32_t b = sweepOrder[cand[i]];
+            if (wh[a] + wh[b] == 0) continue;
+            const double near = (rh[a] + rh[b]) * (1 + kSweepMargin);
+            if ((xa - sweepX[cand[i]]).squaredNorm() >= near * near) continue;
+            const uint32_t higher = std::max(a, b);
+            pairs.push_back(higher);
+            pairs.push_back(std::min(a, b));
+            std::atomic_ref<uint32_t>(nearEnd[higher]).fetch_add(1, std::memory_order_relaxed);
           }
           from = to;
         }
       });
-      // In order of height, whatever the grid's layout.
-      std::sort(list.begin() + nearBegin[k], list.end());
-      nearEnd[k] = uint32_t(list.size());
     }
+  });
+  nearBegin[0] = 0;
+  for (size_t k = 0; k < n; ++k) {
+    nearBegin[k + 1] = nearBegin[k] + nearEnd[k];
+    nearEnd[k] = nearBegin[k];
+  }
+  Grow(pw.near, nearBegin[n]);
+  uint32_t* nearList = pw.near.data();
+  Chunks(pool_, chunks, [&](size_t c) {
+    const std::vector<uint32_t>& pairs = pw.nearChunks[c];
+    for (size_t i = 0; i < pairs.size(); i += 2) {
+      const uint32_t at =
+          std::atomic_ref<uint32_t>(nearEnd[pairs[i]]).fetch_add(1, std::memory_order_relaxed);
+      nearList[at] = pairs[i + 1];
+    }
+  });
+  Ranges(pool_, n, [&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) std::sort(nearList + nearBegin[k], nearList + nearBegin[k + 1]);
   });
   Vec3* swept = pw.swept.data();
   std::copy(x, x + n, swept);
-  const std::vector<std::vector<uint32_t>>& nearChunks = pw.nearChunks;
   // The k-th particle's turn in a sweep: its overlaps with those before it
   // resolved. Reads and writes the places k and its list's, and v of k.
   auto turn = [&](size_t k) {
     Vec3 xp = xh[k];
     bool moved = false;
-    const uint32_t* nearList = nearChunks[k / kPairChunk].data();
-    for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) {
+    for (uint32_t a = nearBegin[k]; a < nearBegin[k + 1]; ++a) {
       const uint32_t j = nearList[a];
       const Vec3 dq = xp - xh[j];
       const double R = rh[k] + rh[j], Rs = R * (1 - kSlop);
@@ -840,14 +861,13 @@ void System::SupportSweep(const Vec3& up, double h) {
     uint32_t* wait = pw.sweepWait.data();
     for (size_t k = 0; k < n; ++k) {
       reach[k] = uint32_t(k);
-      const uint32_t* nearList = nearChunks[k / kPairChunk].data();
-      for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) reach[nearList[a]] = uint32_t(k);
+      for (uint32_t a = nearBegin[k]; a < nearBegin[k + 1]; ++a) reach[nearList[a]] = uint32_t(k);
     }
     Ranges(pool_, n, [&](size_t b, size_t e) {
       for (size_t k = b; k < e; ++k) {
         uint32_t m = reach[k];
-        const uint32_t* nearList = nearChunks[k / kPairChunk].data();
-        for (uint32_t a = nearBegin[k]; a < nearEnd[k]; ++a) m = std::max(m, reach[nearList[a]]);
+        for (uint32_t a = nearBegin[k]; a < nearBegin[k + 1]; ++a)
+          m = std::max(m, reach[nearList[a]]);
         wait[k] = m;
       }
     });

@@ -67,12 +67,13 @@ struct PairWork {
   std::vector<uint32_t> partnerBegin;
   std::vector<Vec3> out;
   // The support sweep (System::SupportSweep): the particles by height,
-  // (height, slot); for the k-th in that
-  // order, the places in it of the particles before it near enough to
-  // touch, nearChunks[k / kPairChunk][nearBegin[k], nearEnd[k]); what the
-  // sweep moved each by (slot order).
+  // (height, slot); for the k-th in that order, the places in it of the
+  // particles before it near enough to touch, near[nearBegin[k],
+  // nearBegin[k + 1]), found as (higher, lower) pairs a chunk of the
+  // sweep's grid at a time (nearChunks); nearEnd: the lists' counts and
+  // cursors as they are filled; what the sweep moved each by (slot order).
   std::vector<std::pair<double, uint32_t>> byHeight, byHeightScratch;
-  std::vector<uint32_t> nearBegin, nearEnd;
+  std::vector<uint32_t> near, nearBegin, nearEnd;
   // The pipelined sweeps: the last turn that touches each place, and the
   // last one the k-th turn of a sweep waits for in the sweep before.
   std::vector<uint32_t> sweepReach, sweepWait;
