@@ -21,10 +21,13 @@
 // appends the contacts it finds (it owns them; the other ball is the
 // partner) to its chunk's array (kPairChunk particles a chunk, the unit of
 // parallel work), so no counting pass is needed. A counting sort by
-// partner then gives each contact a slot in its partner's run of pushes.
-// A pass computes each contact once, by its owner, adds it to the owner's
-// sum and puts it (negated by the partner) in that slot; then each particle
-// adds up its run, in one sweep. (Each particle kept a mirror image of
+// partner then lists, for each particle, the contacts where it is the
+// partner (PairWork::pushFrom). A pass computes each contact once, by its
+// owner, adds it to the owner's sum and stores it (negated by the partner)
+// in the contacts' order; then each particle adds up the pushes its list
+// names, in one sweep (each thread writes only its own chunks' pushes:
+// writing them into the partners' runs shared cache lines between the
+// threads). (Each particle kept a mirror image of
 // each of its contacts before: twice the time of impact, twice the passes'
 // work and memory.) The velocity passes take the positive part of an
 // impulse without a branch (its sign changes from pass to pass: a branch
@@ -178,13 +181,13 @@ void Grow(std::vector<T>& v, size_t size) {
 struct Contacts {
   const PairContact* __restrict ct;
   const uint32_t* __restrict q;
-  const uint32_t* __restrict slot;
   double* __restrict impulse;
 };
 
 // A velocity pass's first half over the contacts of owners [pb, pe): each
 // contact's impulse from the velocities vin, its push on the owner added
-// to own[p], on the partner put in push[slot]. With kGas, returns the
+// to own[p], on the partner put in push[k] (push: the chunk's part of
+// PairWork::out). With kGas, returns the
 // largest residual of the bounce contacts (else 0).
 template <bool kGas>
 double VelocityOwners(size_t pb, size_t pe, const uint32_t* __restrict begin,
@@ -210,7 +213,7 @@ double VelocityOwners(size_t pb, size_t pe, const uint32_t* __restrict begin,
       const Vec3 J = (acc - impulse) * ct.n;
       cs.impulse[k] = acc;
       sum += J;
-      push[cs.slot[k]] = J;
+      push[k] = J;
     }
     own[p] = sum;
   }
@@ -448,9 +451,7 @@ void System::ParticleCollisions(double h) {
     room(ch.first);
     room(ch.bounce);
     room(ch.impulse);
-    room(ch.slot);
     ch.impulse.assign(m, 0.0);
-    ch.slot.resize(m);
   });
   double speed = 0;
   bool anyResting = false;
@@ -459,17 +460,19 @@ void System::ParticleCollisions(double h) {
     PairChunk& ch = pw.chunks[c];
     speed = std::max(speed, ch.speed);
     anyResting |= ch.resting;
+    SYLVA_ASSERT(total + ch.contacts.size() <= UINT32_MAX);  // places are 32-bit
+    ch.base = uint32_t(total);
     total += ch.contacts.size();
   }
   if (total == 0) return;
-  SYLVA_ASSERT(total <= UINT32_MAX);  // slots are 32-bit
 
-  // Where each contact's push on its partner goes: a counting sort of the
-  // contacts by partner, in the chunks' order, so that a particle reads
-  // its pushes as a partner in one run. It also brings the partner side's
+  // The contacts of each partner: a counting sort of the contacts by
+  // partner, in the chunks' order, so that a particle reads its pushes as
+  // a partner from one list. It also brings the partner side's
   // first contact time and resting contact. count[p]: p's contacts, its own
   // and as partner. Serial (it reads 4 bytes a contact).
   Grow(pw.partnerBegin, n + 2);
+  Grow(pw.pushFrom, total);
   Grow(pw.out, total);
   uint32_t* partnerBegin = pw.partnerBegin.data();
   uint32_t* count = pw.count.data();
@@ -487,7 +490,7 @@ void System::ParticleCollisions(double h) {
     for (size_t p = pb; p < pe; ++p) {
       for (uint32_t e = begin[p]; e < end[p]; ++e) {
         const uint32_t q = ch.q[e];
-        ch.slot[e] = partnerBegin[q + 1]++;
+        pw.pushFrom[partnerBegin[q + 1]++] = ch.base + e;
         first[q] = std::min(first[q], ch.first[e]);
         resting[q] |= !ch.bounce[e];
       }
@@ -495,6 +498,7 @@ void System::ParticleCollisions(double h) {
   }
   Vec3* out = pw.out.data();
   Vec3* own = pw.own.data();
+  const uint32_t* pushFrom = pw.pushFrom.data();
 
   // Velocity passes (Jacobi), kVelocityPasses; where no contact of the
   // step is resting, on while a collision contact is off its target by more
@@ -530,18 +534,19 @@ void System::ParticleCollisions(double h) {
     Chunks(pool_, chunks, [&](size_t c) {
       PairChunk& ch = pw.chunks[c];
       const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
-      const Contacts cs{ch.contacts.data(), ch.q.data(), ch.slot.data(), ch.impulse.data()};
-      ch.residual = gas ? VelocityOwners<true>(pb, pe, begin, end, cs, vin, out, own)
-                        : VelocityOwners<false>(pb, pe, begin, end, cs, vin, out, own);
+      const Contacts cs{ch.contacts.data(), ch.q.data(), ch.impulse.data()};
+      Vec3* const push = out + ch.base;
+      ch.residual = gas ? VelocityOwners<true>(pb, pe, begin, end, cs, vin, push, own)
+                        : VelocityOwners<false>(pb, pe, begin, end, cs, vin, push, own);
     });
     Chunks(pool_, chunks, [&](size_t c) {
       const Vec3 *const push = out, *const ownSum = own, *const vi = vin;
-      const uint32_t* const run = partnerBegin;
+      const uint32_t *const run = partnerBegin, *const from = pushFrom;
       Vec3* const vo = vout;
       const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
       for (size_t p = pb; p < pe; ++p) {
         Vec3 sum = ownSum[p];
-        for (uint32_t k = run[p]; k < run[p + 1]; ++k) sum -= push[k];
+        for (uint32_t k = run[p]; k < run[p + 1]; ++k) sum -= push[from[k]];
         vo[p] = vi[p] + w[p] * sum;
       }
     });
@@ -598,11 +603,10 @@ void System::ParticleCollisions(double h) {
       const PairChunk& ch = pw.chunks[c];
       const PairContact* const cs = ch.contacts.data();
       const uint32_t* const cq = ch.q.data();
-      const uint32_t* const slot = ch.slot.data();
       const uint32_t *const b = begin, *const e = end;
       const Vec3* const xi = xin;
       const double* const rad = r;
-      Vec3 *const push = out, *const ownSum = own;
+      Vec3 *const push = out + ch.base, *const ownSum = own;
       const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
       for (size_t p = pb; p < pe; ++p) {
         Vec3 sum = Vec3::Zero();
@@ -613,7 +617,7 @@ void System::ParticleCollisions(double h) {
           const double gap = ct.n.dot(xp - xi[q]) - (rad[p] + rad[q]);
           const Vec3 s = (NegativePart(gap) * ct.k) * ct.n;
           sum += s;
-          push[slot[k]] = s;
+          push[k] = s;
         }
         ownSum[p] = sum;
       }
@@ -626,7 +630,7 @@ void System::ParticleCollisions(double h) {
           continue;
         }
         Vec3 sum = own[p];
-        for (uint32_t k = partnerBegin[p]; k < partnerBegin[p + 1]; ++k) sum -= out[k];
+        for (uint32_t k = partnerBegin[p]; k < partnerBegin[p + 1]; ++k) sum -= out[pushFrom[k]];
         Vec3 xp = xin[p] - w[p] * sum;
         OutOfColliders(colliders_, h, r[p], &xp, &v[p]);
         xout[p] = xp;

@@ -35,15 +35,15 @@ struct PairContact {
 };
 
 // A chunk's contacts, owner by owner, as parallel arrays (the passes read
-// contacts, q, slot and impulse; finding writes first and bounce for the
+// contacts, q and impulse; finding writes first and bounce for the
 // partners' sake).
 struct PairChunk {
   std::vector<PairContact> contacts;
   std::vector<uint32_t> q;      // the partner's place in slot order
-  std::vector<uint32_t> slot;   // where a pass puts its push on the partner (PairWork::out)
   std::vector<double> impulse;  // summed over the velocity passes, in units of k
   std::vector<double> first;    // time of impact in the step
   std::vector<uint8_t> bounce;  // faster than the step's forces: leaves at e times vn0
+  uint32_t base = 0;            // its first contact's place among all (PairWork::out)
   double speed = 0;             // the fastest approach |vn0| among them
   double residual = 0;          // the largest bounce residual of the last pass
   bool resting = false;         // one of them is resting contact
@@ -62,9 +62,13 @@ struct PairWork {
   std::vector<double> w, r, move, first;  // inverse mass, radius, |d|, first contact time
   std::vector<uint32_t> begin, end;       // p's own contacts: [begin, end) of its chunk's
   std::vector<uint32_t> count;            // contacts of p, its own and as partner
-  // A pass's pushes on p as a partner: out[partnerBegin[p], partnerBegin[p
-  // + 1]), its contacts in the order of their owners' chunks and lists.
-  std::vector<uint32_t> partnerBegin;
+  // A pass's push of each contact on its partner, in the contacts' order
+  // (a chunk's from its base: each thread writes its own range); p's as a
+  // partner are out[pushFrom[j]] for j in [partnerBegin[p], partnerBegin[p
+  // + 1]), in the order of their owners' chunks and lists. (Written to the
+  // partner's run instead, the two threads' random writes shared cache
+  // lines: the velocity passes took as long on two threads as on one.)
+  std::vector<uint32_t> partnerBegin, pushFrom;
   std::vector<Vec3> out;
   // The support sweep (System::SupportSweep): the particles by height,
   // (height, slot); for the k-th in that order, the places in it of the
