@@ -781,13 +781,18 @@ void System::SupportSweep(const Vec3& up, double h) {
             const uint32_t higher = std::max(a, b);
             pairs.push_back(higher);
             pairs.push_back(std::min(a, b));
-            std::atomic_ref<uint32_t>(nearEnd[higher]).fetch_add(1, std::memory_order_relaxed);
           }
           from = to;
         }
       });
     }
   });
+  // Filed serially (atomic counts from both threads fought over the
+  // counters' cache lines: the gathering scaled 1.4x on two threads).
+  for (size_t c = 0; c < chunks; ++c) {
+    const std::vector<uint32_t>& pairs = pw.nearChunks[c];
+    for (size_t i = 0; i < pairs.size(); i += 2) ++nearEnd[pairs[i]];
+  }
   nearBegin[0] = 0;
   for (size_t k = 0; k < n; ++k) {
     nearBegin[k + 1] = nearBegin[k] + nearEnd[k];
@@ -795,14 +800,10 @@ void System::SupportSweep(const Vec3& up, double h) {
   }
   Grow(pw.near, nearBegin[n]);
   uint32_t* nearList = pw.near.data();
-  Chunks(pool_, chunks, [&](size_t c) {
+  for (size_t c = 0; c < chunks; ++c) {
     const std::vector<uint32_t>& pairs = pw.nearChunks[c];
-    for (size_t i = 0; i < pairs.size(); i += 2) {
-      const uint32_t at =
-          std::atomic_ref<uint32_t>(nearEnd[pairs[i]]).fetch_add(1, std::memory_order_relaxed);
-      nearList[at] = pairs[i + 1];
-    }
-  });
+    for (size_t i = 0; i < pairs.size(); i += 2) nearList[nearEnd[pairs[i]]++] = pairs[i + 1];
+  }
   Ranges(pool_, n, [&](size_t b, size_t e) {
     for (size_t k = b; k < e; ++k) std::sort(nearList + nearBegin[k], nearList + nearBegin[k + 1]);
   });
