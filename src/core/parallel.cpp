@@ -18,6 +18,9 @@ namespace {
 // spins on the join before it yields its core.
 constexpr auto kSpin = std::chrono::microseconds(50);
 
+// A pool worker's place in its pool (ThreadPool::CurrentWorker).
+thread_local int tWorker = 0;
+
 constexpr uint32_t Gen(uint64_t word) {
   return uint32_t(word >> 32);
 }
@@ -66,7 +69,12 @@ void ThreadPool::RunTasks(uint32_t gen) {
   }
 }
 
-void ThreadPool::WorkerLoop() {
+int ThreadPool::CurrentWorker() {
+  return tWorker;
+}
+
+void ThreadPool::WorkerLoop(int index) {
+  tWorker = index;
   uint32_t seen = 0;
   for (;;) {
     // Spin a little for the next call, then sleep.
@@ -118,7 +126,7 @@ void ThreadPool::ParallelFor(size_t n, IndexFn fn) {
     ~Release() { busy.store(false, std::memory_order_release); }
   } release{busy_};
   if (workers_.empty()) {
-    for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { WorkerLoop(); });
+    for (int i = 1; i < threads_; ++i) workers_.emplace_back([this, i] { WorkerLoop(i); });
   }
   fn_.store(&fn, std::memory_order_release);
   count_.store(n, std::memory_order_release);
@@ -140,6 +148,25 @@ void ThreadPool::ParallelFor(size_t n, IndexFn fn) {
   // by a worker that read the next call's count.
   claim_.store(uint64_t(generation_) << 32 | 0xffffffffu);
   fn_.store(nullptr, std::memory_order_release);
+}
+
+void ThreadPool::ForEachPart(size_t parts, IndexFn fn) {
+  if (parts > size_t(threads_)) return ParallelFor(parts, fn);
+  // Each index claimed takes one part, its thread's own if it is free:
+  // parts indices take every part once.
+  std::atomic<bool> taken[256];
+  for (size_t i = 0; i < parts; ++i) taken[i].store(false, std::memory_order_relaxed);
+  auto take = [&](size_t) {
+    const size_t own = size_t(tWorker) % parts;
+    for (size_t k = 0; k < parts; ++k) {
+      const size_t part = (own + k) % parts;
+      if (!taken[part].exchange(true, std::memory_order_acq_rel)) {
+        fn(part);
+        return;
+      }
+    }
+  };
+  ParallelFor(parts, take);
 }
 
 }  // namespace sylva

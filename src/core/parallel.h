@@ -63,6 +63,17 @@ class ThreadPool {
   int threads() const { return threads_; }
   // Allocates nothing (fn is referred to, not copied).
   void ParallelFor(size_t n, IndexFn fn);
+  // fn(part) for every part < parts, in parallel, each part on the thread
+  // whose CurrentWorker() is part % threads() where that thread is there
+  // to take it (else on another): data a part writes in one call and
+  // reads in the next stays in one core's cache, where ParallelFor's
+  // claims would hand it to either thread (an iterative solver's passes
+  // then move their arrays between the cores every pass). parts at most
+  // threads(); more run as ParallelFor.
+  void ForEachPart(size_t parts, IndexFn fn);
+  // The calling thread's place in the pool it works for: 1 to threads() -
+  // 1 on a worker, 0 on any other thread (a ParallelFor's caller).
+  static int CurrentWorker();
 
   static int HardwareThreads();
 
@@ -71,7 +82,7 @@ class ThreadPool {
     for (size_t i = 0; i < n; ++i) fn(i);
   }
   std::atomic<bool> busy_{false};  // a ParallelFor is running
-  void WorkerLoop();
+  void WorkerLoop(int index);
   // Runs indices of generation `gen` until none is left or the pool has
   // moved on to a later call.
   void RunTasks(uint32_t gen);

@@ -499,6 +499,37 @@ void System::ParticleCollisions(double h) {
   Vec3* out = pw.out.data();
   Vec3* own = pw.own.data();
   const uint32_t* pushFrom = pw.pushFrom.data();
+  // The passes' parts: the chunks [partBegin[i], partBegin[i + 1]), of
+  // about equal work (particles and their contacts), one for each of the
+  // pool's threads, which takes it in every pass (ThreadPool::
+  // ForEachPart): what a part writes in a pass, it reads in the next from
+  // its own core's cache. (Handed to either thread, the velocity passes'
+  // arrays moved between the cores every pass: two threads took as long
+  // as one.)
+  const size_t parts = pool_ ? std::min<size_t>(size_t(pool_->threads()), chunks) : 1;
+  Grow(pw.partBegin, parts + 1);
+  size_t* partBegin = pw.partBegin.data();
+  {
+    size_t work = 0;
+    for (size_t p = 0; p < n; ++p) work += 1 + count[p];
+    size_t done = 0, part = 1;
+    partBegin[0] = 0;
+    for (size_t c = 0; c < chunks && part < parts; ++c) {
+      for (size_t p = c * kPairChunk; p < std::min(n, (c + 1) * kPairChunk); ++p)
+        done += 1 + count[p];
+      while (part < parts && done * parts >= work * part) partBegin[part++] = c + 1;
+    }
+    while (part <= parts) partBegin[part++] = chunks;
+  }
+  auto passChunks = [&](auto&& fn) {
+    if (parts < 2) {
+      for (size_t c = 0; c < chunks; ++c) fn(c);
+      return;
+    }
+    pool_->ForEachPart(parts, [&](size_t i) {
+      for (size_t c = partBegin[i]; c < partBegin[i + 1]; ++c) fn(c);
+    });
+  };
 
   // Velocity passes (Jacobi), kVelocityPasses; where no contact of the
   // step is resting, on while a collision contact is off its target by more
@@ -515,7 +546,7 @@ void System::ParticleCollisions(double h) {
   // factor.
   pw.gas = !anyResting;
   pw.tolerance = kConverged * speed;
-  Chunks(pool_, chunks, [&](size_t c) {
+  passChunks([&](size_t c) {
     PairChunk& ch = pw.chunks[c];
     const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
     for (size_t p = pb; p < pe; ++p) {
@@ -531,7 +562,7 @@ void System::ParticleCollisions(double h) {
   for (int pass = 0; pass < passes; ++pass) {
     const Vec3* vin = pw.v.data();
     Vec3* vout = pw.scratch.data();
-    Chunks(pool_, chunks, [&](size_t c) {
+    passChunks([&](size_t c) {
       PairChunk& ch = pw.chunks[c];
       const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
       const Contacts cs{ch.contacts.data(), ch.q.data(), ch.impulse.data()};
@@ -539,7 +570,7 @@ void System::ParticleCollisions(double h) {
       ch.residual = gas ? VelocityOwners<true>(pb, pe, begin, end, cs, vin, push, own)
                         : VelocityOwners<false>(pb, pe, begin, end, cs, vin, push, own);
     });
-    Chunks(pool_, chunks, [&](size_t c) {
+    passChunks([&](size_t c) {
       const Vec3 *const push = out, *const ownSum = own, *const vi = vin;
       const uint32_t *const run = partnerBegin, *const from = pushFrom;
       Vec3* const vo = vout;
@@ -599,7 +630,7 @@ void System::ParticleCollisions(double h) {
   for (int pass = 0; pass < positionPasses; ++pass) {
     const Vec3* xin = pw.x.data();
     Vec3* xout = pw.scratch.data();
-    Chunks(pool_, chunks, [&](size_t c) {
+    passChunks([&](size_t c) {
       const PairChunk& ch = pw.chunks[c];
       const PairContact* const cs = ch.contacts.data();
       const uint32_t* const cq = ch.q.data();
@@ -622,7 +653,7 @@ void System::ParticleCollisions(double h) {
         ownSum[p] = sum;
       }
     });
-    Chunks(pool_, chunks, [&](size_t c) {
+    passChunks([&](size_t c) {
       const size_t pb = c * kPairChunk, pe = std::min(n, pb + kPairChunk);
       for (size_t p = pb; p < pe; ++p) {
         if (w[p] == 0 || count[p] == 0) {

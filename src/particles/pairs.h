@@ -69,6 +69,7 @@ struct PairWork {
   // partner's run instead, the two threads' random writes shared cache
   // lines: the velocity passes took as long on two threads as on one.)
   std::vector<uint32_t> partnerBegin, pushFrom;
+  std::vector<size_t> partBegin;  // the passes' parts of the chunks, a thread each
   std::vector<Vec3> out;
   // The support sweep (System::SupportSweep): the particles by height,
   // (height, slot); for the k-th in that order, the places in it of the

@@ -24,6 +24,36 @@ TEST(ThreadPool, ParallelForRunsEveryIndexOnce) {
   }
 }
 
+// ForEachPart runs every part once a call; on a pool of two threads with
+// two parts, a part the worker runs is its own (the caller may take both;
+// then the worker finds no index left); the caller's place is 0. (With
+// three, a fast caller may take a worker's part and leave it another.)
+TEST(ThreadPool, ForEachPartRunsEveryPartOnceAndAWorkerItsOwn) {
+  EXPECT_EQ(ThreadPool::CurrentWorker(), 0);
+  for (int threads : {1, 2, 3}) {
+    ThreadPool pool(threads);
+    for (size_t parts : {size_t(1), size_t(threads), size_t(threads + 2)}) {
+      std::vector<std::atomic<int>> hits(parts);
+      std::atomic<int> foreign{0}, byWorkers{0};
+      for (int round = 0; round < 500; ++round) {
+        pool.ForEachPart(parts, [&](size_t part) {
+          hits[part].fetch_add(1);
+          const int worker = ThreadPool::CurrentWorker();
+          if (worker != 0) {
+            byWorkers.fetch_add(1);
+            if (threads == 2 && parts == 2 && part != size_t(worker)) foreign.fetch_add(1);
+          }
+        });
+      }
+      for (size_t i = 0; i < parts; ++i)
+        ASSERT_EQ(hits[i].load(), 500)
+            << "part " << i << " of " << parts << ", threads " << threads;
+      EXPECT_EQ(foreign.load(), 0) << "parts run by a worker not their own, of " << byWorkers.load()
+                                   << " run by workers; threads " << threads;
+    }
+  }
+}
+
 // Many short calls back to back (workers still spinning from the last one)
 // and calls after a pause (workers asleep): every index runs exactly once.
 TEST(ThreadPool, BackToBackAndAfterSleepCallsRunEveryIndexOnce) {
