@@ -750,7 +750,9 @@ void System::SupportSweep(const Vec3& up, double h) {
   Grow(pw.byHeight, n);
   Grow(pw.swept, n);
   auto* byHeight = pw.byHeight.data();
-  for (size_t p = 0; p < n; ++p) byHeight[p] = {up.dot(x[p]), uint32_t(p)};
+  Ranges(pool_, n, [&](size_t b, size_t e) {
+    for (size_t p = b; p < e; ++p) byHeight[p] = {up.dot(x[p]), uint32_t(p)};
+  });
   Grow(pw.byHeightScratch, n);
   SortByHeight(byHeight, pw.byHeightScratch.data(), n);
   // The sweeps work in order of height (the particles they read together
@@ -819,10 +821,23 @@ void System::SupportSweep(const Vec3& up, double h) {
     }
   });
   // Filed serially (atomic counts from both threads fought over the
-  // counters' cache lines: the gathering scaled 1.4x on two threads).
+  // counters' cache lines: the gathering scaled 1.4x on two threads). For
+  // the pipelined sweeps (below), the same loop finds the last turn that
+  // touches each place: reach[j], the highest place whose list holds j
+  // (or j).
+  const bool pipelined = pool_ && pool_->threads() >= 2 && n >= 2 * kSweepBlock;
+  uint32_t* reach = nullptr;
+  if (pipelined) {
+    Grow(pw.sweepReach, n);
+    reach = pw.sweepReach.data();
+    for (size_t k = 0; k < n; ++k) reach[k] = uint32_t(k);
+  }
   for (size_t c = 0; c < chunks; ++c) {
     const std::vector<uint32_t>& pairs = pw.nearChunks[c];
-    for (size_t i = 0; i < pairs.size(); i += 2) ++nearEnd[pairs[i]];
+    for (size_t i = 0; i < pairs.size(); i += 2) {
+      ++nearEnd[pairs[i]];
+      if (reach) reach[pairs[i + 1]] = std::max(reach[pairs[i + 1]], pairs[i]);
+    }
   }
   nearBegin[0] = 0;
   for (size_t k = 0; k < n; ++k) {
@@ -874,7 +889,7 @@ void System::SupportSweep(const Vec3& up, double h) {
     xh[k] = xp;
     return true;
   };
-  if (!pool_ || pool_->threads() < 2 || n < 2 * kSweepBlock) {
+  if (!pipelined) {
     for (int pass = 0; pass < kSweeps; ++pass) {
       bool changed = false;
       for (size_t k = 0; k < n; ++k) changed |= turn(k);
@@ -889,16 +904,10 @@ void System::SupportSweep(const Vec3& up, double h) {
     // changed nothing ends the ones after it (the serial sweeps stop
     // there; the later ones, on the same positions, change nothing
     // either).
-    // reach: the last turn that touches each place; wait[k]: the last turn
-    // that touches a place the k-th touches.
-    Grow(pw.sweepReach, n);
+    // reach (filed above): the last turn that touches each place;
+    // wait[k]: the last turn that touches a place the k-th touches.
     Grow(pw.sweepWait, n);
-    uint32_t* reach = pw.sweepReach.data();
     uint32_t* wait = pw.sweepWait.data();
-    for (size_t k = 0; k < n; ++k) {
-      reach[k] = uint32_t(k);
-      for (uint32_t a = nearBegin[k]; a < nearBegin[k + 1]; ++a) reach[nearList[a]] = uint32_t(k);
-    }
     Ranges(pool_, n, [&](size_t b, size_t e) {
       for (size_t k = b; k < e; ++k) {
         uint32_t m = reach[k];
