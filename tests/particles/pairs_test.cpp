@@ -162,7 +162,9 @@ TEST(PairContacts, ADeepPileHoldsItsBallsApart) {
 // The pair screen's vector path (kernels::ScreenCandidates, AVX-512) keeps
 // the same points as the scalar loop, in the same order: ranges of every
 // length 0..40 from every start 0..8 (ragged tails), points exactly at the
-// reach, points with a NaN coordinate (never within).
+// reach, points with a NaN coordinate (never within); and it writes
+// nothing past the to - from places its contract gives it (its full blocks
+// store 8 lanes at once).
 TEST(PairContacts, VectorScreenKeepsTheScalarScreensPoints) {
   if (kernels::ScreenLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
   std::mt19937 rng(5);
@@ -182,6 +184,7 @@ TEST(PairContacts, VectorScreenKeepsTheScalarScreensPoints) {
   for (uint32_t from = 0; from <= 8; ++from) {
     for (uint32_t len = 0; len <= 40; ++len) {
       uint32_t a[64], b[64];
+      std::fill(b, b + 64, 0xdeadbeefu);
       const uint32_t na = kernels::ScreenCandidates(kernels::Kernel::kScalar, x.data(), from,
                                                     from + len, p, 0.25, a);
       const uint32_t nb =
@@ -190,6 +193,9 @@ TEST(PairContacts, VectorScreenKeepsTheScalarScreensPoints) {
                         << " kept by the scalar screen, " << nb << " by the vector one";
       for (uint32_t k = 0; k < na; ++k)
         ASSERT_EQ(a[k], b[k]) << "points [" << from << ", " << from + len << "), place " << k;
+      for (uint32_t k = len; k < 64; ++k)
+        ASSERT_EQ(b[k], 0xdeadbeefu) << "points [" << from << ", " << from + len
+                                     << "): the vector screen wrote place " << k << " of out";
       kept += int(na);
     }
   }
