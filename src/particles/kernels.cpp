@@ -260,19 +260,18 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     size_t j[4];
     for (int l = 0; l < 4; ++l) j[l] = idx[std::min(k0 + size_t(l), count - 1)];
     const bool run = j[3] == j[0] + 3 && k0 + 4 <= count;
-    auto load = [&](const float* base) { return Lanes(base, j, run); };
     __m256d a[3], va[3], x[3], v[3];
     for (int c = 0; c < 3; ++c) {
-      a[c] = load(old[c]);
-      va[c] = load(old[3 + c]);
+      a[c] = Lanes(old[c], j, run);
+      va[c] = Lanes(old[3 + c], j, run);
     }
     const float* const now[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
                                  ar.vx + begin, ar.vy + begin, ar.vz + begin};
     for (int c = 0; c < 3; ++c) {
-      x[c] = load(now[c]);
-      v[c] = load(now[3 + c]);
+      x[c] = Lanes(now[c], j, run);
+      v[c] = Lanes(now[3 + c], j, run);
     }
-    const __m256d r = load(radius + begin);
+    const __m256d r = Lanes(radius + begin, j, run);
     __m256d dv[3], A[3], u[3], ap[3];
     for (int c = 0; c < 3; ++c) {
       dv[c] = _mm256_sub_pd(v[c], va[c]);
