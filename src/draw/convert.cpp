@@ -90,6 +90,27 @@ Expected<std::vector<Instance>> FacingInstances(std::span<const Vec3> positions,
   return out;
 }
 
+Expected<Lines> Trails(std::span<const Vec3> positions, std::span<const Vec3> velocities,
+                       double seconds, std::span<const Vec3f> colors, const Vec3f& color,
+                       float tailShade, std::string name) {
+  if (velocities.size() != positions.size())
+    return Bad("velocities has " + std::to_string(velocities.size()) + " entries for " +
+               std::to_string(positions.size()) + " positions");
+  if (Status st = Matches("colors", colors.size(), positions.size()); !st.ok()) return st.error();
+  Lines l;
+  l.name = std::move(name);
+  l.points.reserve(2 * positions.size());
+  l.colors.reserve(2 * positions.size());
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const Vec3f head = colors.empty() ? color : colors[i];
+    l.points.push_back((positions[i] - seconds * velocities[i]).cast<float>());
+    l.points.push_back(positions[i].cast<float>());
+    l.colors.push_back(tailShade * head);
+    l.colors.push_back(head);
+  }
+  return l;
+}
+
 Expected<mesh::TriangleMesh> SheetMesh(std::span<const Vec3> x,
                                        std::span<const std::array<uint32_t, 3>> triangles,
                                        std::span<const uint16_t> materials) {

@@ -1,5 +1,5 @@
 // Conversions from simulation data to parts of a DrawList: particles to a
-// batch of sprites or to mesh instances, a triangulated sheet (a cloth) to
+// batch of sprites, to mesh instances or to streaks, a triangulated sheet (a cloth) to
 // a mesh with smooth normals. They take plain arrays (a
 // particles::ParticleState's fields, a BulkState's coordinate arrays, a
 // Cloth's positions and triangles), so the draw library depends on no
@@ -22,6 +22,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
 
 #include "core/status.h"
 #include "draw/draw_list.h"
@@ -60,6 +61,15 @@ Expected<std::vector<Instance>> FacingInstances(std::span<const Vec3> positions,
                                                 std::span<const Vec3> velocities, double scale,
                                                 const Vec3f& tint = Vec3f(1, 1, 1));
 
+// Streaks: one line segment per particle, from where it was `seconds` ago
+// along its velocity (positions[i] - seconds velocities[i]) to where it
+// is, coloured colors[i] at the head (or `color`) and `tailShade` times
+// that at the tail (a fading streak). velocities must have one entry per
+// position, colors one or none; seconds and tailShade are taken as given.
+Expected<Lines> Trails(std::span<const Vec3> positions, std::span<const Vec3> velocities,
+                       double seconds, std::span<const Vec3f> colors = {},
+                       const Vec3f& color = Vec3f(1, 1, 1), float tailShade = 0.3f,
+                       std::string name = {});
 // A mesh of a triangulated sheet: the vertices at `positions`, the
 // triangles as given (each index below positions.size(), else a
 // Diagnostic naming the triangle), smooth normals (area-weighted sums of

@@ -276,15 +276,15 @@ void PlanChain(const PlantGeometry& g, std::span<const uint32_t> chain, ChainFra
     // frame only down to what a tolerance kHysteresis tighter keeps, and
     // between the two the fewest rings at least as many as last frame's,
     // by bisection on the tolerance. Never more error than eps / 2.
-    const size_t last = *lastRings;
-    if (last > coarse) {
+    const size_t lastCount = *lastRings;
+    if (lastCount > coarse) {
       std::vector<uint32_t> fine, mid;
       const size_t most = keep(budget / (1 + kHysteresis), fine);
-      if (last < most) {
-        double lo = 0, hi = 1;  // exponents of the tightening; count(lo) < last <= count(hi)
+      if (lastCount < most) {
+        double lo = 0, hi = 1;  // exponents of the tightening; count(lo) < lastCount <= count(hi)
         for (int k = 0; k < 8; ++k) {
           const double t = (lo + hi) / 2;
-          if (keep(budget / std::pow(1 + kHysteresis, t), mid) >= last) {
+          if (keep(budget / std::pow(1 + kHysteresis, t), mid) >= lastCount) {
             hi = t;
             fine = mid;
           } else {

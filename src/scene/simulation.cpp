@@ -1447,16 +1447,12 @@ void Simulation::AddToDrawList(draw::DrawList& list) const {
       continue;
     }
     if (d.as == DrawAs::kTrails) {
-      draw::Lines l;
-      l.name = p.id;
-      for (size_t i = 0; i < st.size(); ++i) {
-        const mesh::Vec3f c = ColorAt(d, st.age[i], st.lifetime[i]).cast<float>();
-        l.points.push_back((st.position[i] - st.velocity[i] * 0.06).cast<float>());
-        l.points.push_back(st.position[i].cast<float>());
-        l.colors.push_back(c * 0.3f);
-        l.colors.push_back(c);
-      }
-      list.lines.push_back(std::move(l));
+      std::vector<mesh::Vec3f> colors(st.size());
+      for (size_t i = 0; i < st.size(); ++i)
+        colors[i] = ColorAt(d, st.age[i], st.lifetime[i]).cast<float>();
+      auto trails = draw::Trails(st.position, st.velocity, 0.06, colors, {}, 0.3f, p.id);
+      SYLVA_ASSERT(trails.ok());  // one velocity and one colour a particle
+      list.lines.push_back(std::move(*trails));
       continue;
     }
     draw::PointStyle style;

@@ -92,6 +92,36 @@ TEST(FacingInstances, TurnPlusZToTheVelocityAndScale) {
       << bad.error().message;
 }
 
+// A streak per particle from seconds back along its velocity to where it
+// is, the tail shaded; colours per particle or one; lengths checked.
+TEST(Trails, RunBackAlongTheVelocityWithAShadedTail) {
+  const std::vector<Vec3> x = {Vec3(1, 2, 3), Vec3(0, 0, 0)};
+  const std::vector<Vec3> v = {Vec3(10, 0, -5), Vec3(0, 0, 0)};
+  const std::vector<Vec3f> c = {Vec3f(1, 0.5f, 0), Vec3f(0, 0, 1)};
+  auto t = Trails(x, v, 0.1, c, Vec3f(1, 1, 1), 0.25f, "sparks");
+  ASSERT_TRUE(t.ok()) << t.error().message;
+  ASSERT_EQ(t->points.size(), 4u);
+  ASSERT_EQ(t->colors.size(), 4u);
+  EXPECT_EQ(t->name, "sparks");
+  EXPECT_LT((t->points[0] - Vec3f(0, 2, 3.5f)).norm(), 1e-6f) << t->points[0].transpose();
+  EXPECT_EQ(t->points[1], Vec3f(1, 2, 3));
+  EXPECT_EQ(t->points[2], t->points[3]) << "a particle at rest is a point";
+  EXPECT_EQ(t->colors[0], Vec3f(0.25f, 0.125f, 0));
+  EXPECT_EQ(t->colors[1], c[0]);
+  auto one = Trails(x, v, 0.1, {}, Vec3f(0, 1, 0));
+  ASSERT_TRUE(one.ok()) << one.error().message;
+  EXPECT_EQ(one->colors[3], Vec3f(0, 1, 0));
+  EXPECT_EQ(one->colors[2], Vec3f(0, 0.3f, 0));
+  auto badV = Trails(x, std::span<const Vec3>(v.data(), 1), 0.1);
+  ASSERT_FALSE(badV.ok());
+  EXPECT_NE(badV.error().message.find("velocities has 1 entries for 2"), std::string::npos)
+      << badV.error().message;
+  auto badC = Trails(x, v, 0.1, std::span<const Vec3f>(c.data(), 1));
+  ASSERT_FALSE(badC.ok());
+  EXPECT_NE(badC.error().message.find("colors has 1 entries for 2"), std::string::npos)
+      << badC.error().message;
+}
+
 TEST(SheetMesh, SmoothNormalsAreTheAreaWeightedFaceNormals) {
   // A unit square in z = 0 (two counter-clockwise triangles seen from +Z)
   // and a third triangle folded up at 90 degrees along the edge 1-2.
