@@ -832,6 +832,9 @@ void System::SupportSweep(const Vec3& up, double h) {
     reach = pw.sweepReach.data();
     for (size_t k = 0; k < n; ++k) reach[k] = uint32_t(k);
   }
+  size_t total = 0;
+  for (size_t c = 0; c < chunks; ++c) total += pw.nearChunks[c].size() / 2;
+  SYLVA_ASSERT(total <= UINT32_MAX);  // the lists' places are 32-bit
   for (size_t c = 0; c < chunks; ++c) {
     const std::vector<uint32_t>& pairs = pw.nearChunks[c];
     for (size_t i = 0; i < pairs.size(); i += 2) {
