@@ -48,7 +48,7 @@
 // two corners stretches past 20 %); strain limiting after each step
 // (implicitStrainLimit, Provot, "Deformation constraints in a mass-spring
 // model to describe rigid cloth behavior", Graphics Interface 1995), on
-// coarser grids of the cloth and then on its own links, holds 32 x 32,
+// the cloth's own links and then on coarser grids of it, holds 32 x 32,
 // 64 x 64 and 100 x 100 sheets hanging from two corners at 1/10 s to the
 // default 10 % (ClothImplicit.StrainLimitingHoldsTenPercent*).
 #pragma once
@@ -116,8 +116,8 @@ struct ClothDef {
   int implicitSubsteps = 1;         // backward-Euler steps per Step, 1..10000
   // Strain limiting after each implicit step (Provot 1995): structural
   // constraints stretched more than this fraction are shortened (to 80 %
-  // of it), on coarser grids of the cloth first and then on its own links
-  // (see LimitStrain in cloth.cpp), in cycles until a pass finds none past
+  // of it), on the cloth's own links first and then on coarser grids of
+  // it (see LimitStrain in cloth.cpp), in cycles until a pass finds none past
   // the limit, at most `implicitStrainIterations` cycles; the velocities
   // take the correction. 0..1e6; 0 = off.
   double implicitStrainLimit = 0.1;

@@ -262,7 +262,7 @@ Status Emitter::Emit(ParticleState& s, double h, std::span<const Collider> colli
   const double due = carry_ + def_.rate * h;
   if (!(due < 2147483647.0)) {
     return Error("Emitter.Emit: rate " + Num(def_.rate) + " particles/s for h " + Num(h) +
-                 " s is " + Num(due) + " particles, more than 2^31 - 1 in one call");
+                 " s is " + Num(due) + " particles due, 2^31 - 1 or more in one call");
   }
   const uint64_t n = uint64_t(std::floor(due + 1e-9));
   // Birth j of this call comes when the running count reaches the next

@@ -149,6 +149,8 @@ TEST(Springs, FollowTheirParticlesThroughRemoveDead) {
   auto springs = std::make_shared<Springs>();
   for (uint32_t i = 0; i + 1 < 5; ++i) ASSERT_OK(springs->Add(i, i + 1, 0.5, 10, 0));
   auto penalty = std::make_shared<Penalty>();
+  penalty->Anchor(1, Vec3(1, 1, 0), 7, 0);  // goes with id 1
+  penalty->Distance(1, 3, 0.5, 3, 0);       // goes with id 1
   penalty->Anchor(4, Vec3(4, 1, 0), 5, 0);
   s.AddForce(springs);
   s.AddForce(penalty);
@@ -178,6 +180,8 @@ TEST(Springs, FollowTheirParticlesThroughRemoveDead) {
   for (size_t i = 0; i < 4; ++i)
     EXPECT_EQ(a[i], b[i]) << "particle " << i << ": " << a[i].transpose() << " against "
                           << b[i].transpose();
+  EXPECT_EQ(penalty->Energy(s.state.position.data()), p2->Energy(s.state.position.data()))
+      << "the penalty terms of id 1 go, the anchor of id 4 follows it to index 3";
   STEP_OK(s, 0.1, Integrator::kImplicitEuler);
 }
 

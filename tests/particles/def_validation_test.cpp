@@ -48,6 +48,7 @@ TEST(EmitterDef, RejectsEveryOutOfRangeField) {
   bad([](EmitterDef& d) { d.rate = kNaN; }, "EmitterDef.rate", "nan");
   bad([](EmitterDef& d) { d.size.z() = kNaN; }, "EmitterDef.size", "nan");
   bad([](EmitterDef& d) { d.size.y() = -1; }, "EmitterDef.size", "-1");
+  bad([](EmitterDef& d) { d.size.x() = 2e6; }, "EmitterDef.size", "2e+06");
   bad([](EmitterDef& d) { d.spreadDegrees = 190; }, "EmitterDef.spreadDegrees", "190");
   bad([](EmitterDef& d) { d.shape = EmitterShape::kMesh; }, "EmitterDef.mesh", "empty");
   bad([](EmitterDef& d) { d.shape = EmitterShape::kFunction; }, "EmitterDef.place", "empty");
@@ -79,6 +80,7 @@ TEST(EmitterDef, RejectsEveryOutOfRangeField) {
       },
       "EmitterDef.mesh position 2", "nan");
   bad([](EmitterDef& d) { d.maxAlive = 0; }, "EmitterDef.maxAlive", "0");
+  bad([](EmitterDef& d) { d.maxBirths = 0; }, "EmitterDef.maxBirths", "0");
   bad([](EmitterDef& d) { d.position.z() = kNaN; }, "EmitterDef.position", "nan");
   bad([](EmitterDef& d) { d.velocity.y() = kNaN; }, "EmitterDef.velocity", "nan");
   bad([](EmitterDef& d) { d.positionRadius = -0.5; }, "EmitterDef.positionRadius", "-0.5");

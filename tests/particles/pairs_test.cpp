@@ -111,10 +111,11 @@ TEST(PairContacts, PipelinedSweepsGiveTheSameBitsOnOneThreeAndFourThreads) {
 }
 
 // Issue 17's target: after 5 s every ball's velocity is under 0.05 m/s (a
-// ball in resting contact that moves at less than half what its forces
-// gave it in a step is at rest: pairs.cpp), and the positions agree: no
-// ball moved more than 0.05 m over the last second (a mean speed under
-// 0.05 m/s), so the pile is still, not only its velocities zeroed.
+// ball in resting contact that moves at less than 0.9 of what its forces
+// gave it in a step is at rest: kRestFraction, pairs.cpp), and the
+// positions agree: no ball moved more than 0.05 m over the last second (a
+// mean speed under 0.05 m/s), so the pile is still, not only its
+// velocities zeroed.
 TEST(PairContacts, APileOf2880BallsComesToRest) {
   double speed, lowest, drift;
   Pile(1, &speed, &lowest, &drift);
