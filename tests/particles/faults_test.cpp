@@ -116,6 +116,70 @@ TEST(Faults, ImplicitSolveReportsANonPositiveDefiniteSystem) {
   EXPECT_OK(t.Step(1e-3, Integrator::kImplicitEuler));
 }
 
+// A force whose Jacobian is broken one way at particle index `at`: a
+// diagonal that h^2 df/dx turns negative, a NaN diagonal, a NaN in the
+// right-hand side's product (cv = 0) or in the conjugate gradients' (cv != 0).
+class BrokenJacobian : public Force {
+ public:
+  enum Kind { kNegativeDiagonal, kNaNDiagonal, kNaNRightHandSide, kNaNProduct };
+  BrokenJacobian(Kind kind, size_t at) : kind_(kind), at_(at) {}
+  void Accumulate(const ParticleState&, const Vec3*, const Vec3*, Vec3* f) const override {
+    f[at_] += Vec3(0, 1, 0);  // a right-hand side that is not zero
+  }
+  void AddJacobianProduct(const ParticleState&, const Vec3*, const Vec3*, double, double cv,
+                          const Vec3*, Vec3* y) const override {
+    if ((kind_ == kNaNRightHandSide && cv == 0) || (kind_ == kNaNProduct && cv != 0))
+      y[at_].z() = std::numeric_limits<double>::quiet_NaN();
+  }
+  void AddJacobianDiagonal(const ParticleState&, const Vec3*, const Vec3*, double cx, double,
+                           Vec3* diag) const override {
+    if (kind_ == kNegativeDiagonal) diag[at_].y() += cx * 1e4;  // 1 - 0.01 * 1e4 < 0
+    if (kind_ == kNaNDiagonal) diag[at_].x() = std::numeric_limits<double>::quiet_NaN();
+  }
+
+ private:
+  Kind kind_;
+  size_t at_;
+};
+
+// Each way the implicit solve can fail is reported with the particle, and
+// nothing moves; a solve that met a number that is not finite faults the
+// system (its next step reports the same), an indefinite one does not (a
+// smaller step may work).
+TEST(Faults, ImplicitSolveReportsABadDiagonalAndABadProductAtTheirParticle) {
+  struct Case {
+    BrokenJacobian::Kind kind;
+    std::vector<const char*> parts;
+    bool latched;
+  };
+  const Case cases[] = {
+      {BrokenJacobian::kNegativeDiagonal,
+       {"step 0", "not positive definite", "diagonal at particle id 2"},
+       false},
+      {BrokenJacobian::kNaNDiagonal, {"step 0", "diagonal is not finite", "particle id 2"}, true},
+      {BrokenJacobian::kNaNRightHandSide,
+       {"step 0", "right-hand side h (f + h df/dx v) is not finite", "particle id 2"},
+       true},
+      {BrokenJacobian::kNaNProduct, {"step 0", "product A p is not finite", "particle id 2"}, true},
+  };
+  for (const Case& c : cases) {
+    System s;
+    for (int i = 0; i < 4; ++i) s.state.Add(Vec3(i, 1, 0), Vec3::Zero(), 1);
+    s.AddForce(std::make_shared<BrokenJacobian>(c.kind, 2));
+    const std::vector<Vec3> before = s.state.position;
+    const Status st = s.Step(0.1, Integrator::kImplicitEuler);
+    ASSERT_FALSE(st.ok()) << "kind " << c.kind << ": the broken solve was accepted";
+    for (const char* part : c.parts)
+      EXPECT_NE(st.error().message.find(part), std::string::npos)
+          << "kind " << c.kind << ": no \"" << part << "\" in: " << st.error().message;
+    EXPECT_EQ(s.state.position, before) << "kind " << c.kind << ": a failed solve moved particles";
+    EXPECT_EQ(s.steps, 0u) << "kind " << c.kind << ": a failed solve counted as a step";
+    const Status next = s.Step(0.1, Integrator::kSymplecticEuler);
+    EXPECT_EQ(!next.ok(), c.latched)
+        << "kind " << c.kind << ": the next step " << (next.ok() ? "ran" : next.error().message);
+  }
+}
+
 TEST(Faults, BulkReportsNonFiniteInAnyComponent) {
   for (int a = 0; a < 6; ++a) {
     for (float bad : {std::nanf(""), std::numeric_limits<float>::infinity()}) {
