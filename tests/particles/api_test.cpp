@@ -102,6 +102,47 @@ TEST(Forces, ASharedForceOutlivesItsSystem) {
   EXPECT_LT(sum.norm(), 1e-9 * largest * kN) << "forces do not cancel: " << sum.transpose();
 }
 
+// One force shared by two live systems that step in turn, one of them
+// changing its threads and the other destroyed while the force holds its
+// pool: each system's steps equal those of a system with a force of its
+// own (the same bits), and the force never keeps a pool that is gone.
+TEST(Forces, ASharedForceServesTwoSystemsThroughAThreadChange) {
+  constexpr int kN = 20000;
+  auto chain = [] {
+    auto springs = std::make_shared<Springs>();
+    for (int i = 0; i + 1 < kN; ++i)
+      EXPECT_OK(springs->Add(uint32_t(i), uint32_t(i + 1), 0.5, 100, 1));
+    return springs;
+  };
+  auto fill = [](System& s, double y) {
+    for (int i = 0; i < kN; ++i) s.state.Add(Vec3(0.6 * i, y + 0.01 * (i % 7), 0), Vec3::Zero());
+  };
+  const auto shared = chain();
+  System a(4), ownA(1), ownB(1);
+  fill(a, 0), fill(ownA, 0), fill(ownB, 1);
+  a.AddForce(shared);
+  ownA.AddForce(chain());
+  ownB.AddForce(chain());
+  {
+    System b(2);
+    fill(b, 1);
+    b.AddForce(shared);
+    for (int k = 0; k < 3; ++k) {
+      STEP_OK(a, 1e-3, Integrator::kSymplecticEuler);
+      STEP_OK(ownA, 1e-3, Integrator::kSymplecticEuler);
+      if (k == 1) a.SetThreads(3);
+      STEP_OK(b, 1e-3, Integrator::kImplicitEuler);
+      STEP_OK(ownB, 1e-3, Integrator::kImplicitEuler);
+    }
+    EXPECT_NE(shared->pool(), nullptr) << "b's pool was not lent for its step";
+    EXPECT_EQ(b.state.position, ownB.state.position) << "b's steps differ from its own force's";
+  }
+  EXPECT_EQ(shared->pool(), nullptr) << "the destroyed b's pool is still held by the force";
+  STEP_OK(a, 1e-3, Integrator::kSymplecticEuler);
+  STEP_OK(ownA, 1e-3, Integrator::kSymplecticEuler);
+  EXPECT_EQ(a.state.position, ownA.state.position) << "a's steps differ from its own force's";
+}
+
 TEST(State, ZeroMassIsAnErrorNotAPin) {
   for (double bad : {0.0, -1.0, std::nan(""), 1e31}) {
     System s;
