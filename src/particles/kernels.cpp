@@ -399,7 +399,7 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
 
 // The plane and the step on eight lanes, for RestGroupsAvx512.
 struct Rest8 {
-  __m512d n[3], p[3], h, mh, half, mu, zero, one, tiny, tol, mtol, limit2;
+  __m512d n[3], p[3], h, mh, half, mu, zero, one, tiny, tol, mtol, limit2, sign;
 };
 
 // The resting kernel on the candidates of G groups of eight consecutive
@@ -411,7 +411,29 @@ struct Rest8 {
 // are interleaved, statement by statement, for the vector units to work
 // on G chains at once. Writes the particles it resolves to the arrays and
 // appends the other candidates' offsets (at[g] + lane) to idx.
-template <int G>
+//
+// kUp: the plane's normal is (+0, 1, +0) exactly (a floor in a y-up
+// world), and the kernel skips the products by 0 and 1, the same bits. A
+// candidate's inputs are finite (its advanced position is: the candidate
+// test takes n . x with every component, and a non-finite start state or
+// velocity makes it non-finite). For finite y, 0 y is a zero with y's
+// sign, Z(y) = y & -0.0, and 1 y = y, so a dot product n . y is y_1
+// where y_1 is not zero, and a zero of some sign where it is. Where a dot
+// product only meets a comparison, the sign of a zero is irrelevant and
+// y_1 serves; where its sign can reach a stored bit, the kernel takes the
+// exact operations, or leaves the lane to the general path:
+//   en = n . v: v_1 where v_1 is not -0 (a lane with v_1 = -0 is left:
+//     there en's sign is that of all three components), so
+//   vt = v - en n is (v_0 - Z(v_1), +0, v_2 - Z(v_1)) (v_1 - v_1 = +0),
+//   |vt|^2 = vt_0^2 + vt_2^2 (adding +0 to a square changes nothing),
+//   up = max(en, 0) is +0 or positive, so out = f + up n is
+//   (f_0 + 0, up, f_2 + 0) (f_1 = +0 vt_1 keep = +0): never -0;
+//   d0 = n . (a - p) - r: (a_1 - p_1) - r, whose zero may have another sign
+//   than the general path's, and so may the point, a - d0 n (a_1 - d0, and
+//   a_c - Z(d0) on the other two); but the end, point + h out, adds to it
+//   h out, which is +0 where it is a zero, so no sign of a zero of the
+//   point reaches it.
+template <int G, bool kUp>
 [[SYLVA_AVX512]] void RestGroupsAvx512(const Rest8& k, const BulkArrays& ar, const float* radius,
                                        const float* const* old, size_t first, const uint16_t* at,
                                        const __mmask8* cand, uint16_t* idx, size_t* listed) {
@@ -427,13 +449,12 @@ template <int G>
     }
     r[g] = _mm512_cvtps_pd(_mm256_loadu_ps(radius + first + at[g]));
   }
-  __m512d dv[G][3], A[G][3], u[G][3], ap[G][3];
+  __m512d dv[G][3], A[G][3], u[G][3];
   for (int g = 0; g < G; ++g) {
     for (int c = 0; c < 3; ++c) {
       dv[g][c] = _mm512_sub_pd(v[g][c], va[g][c]);
       A[g][c] = _mm512_mul_pd(k.h, dv[g][c]);
       u[g][c] = _mm512_sub_pd(_mm512_sub_pd(x[g][c], a[g][c]), _mm512_mul_pd(k.half, A[g][c]));
-      ap[g][c] = _mm512_sub_pd(a[g][c], k.p[c]);
     }
   }
   // The plane's contact at the start (a candidate ends the step inside:
@@ -441,13 +462,28 @@ template <int G>
   __m512d d0[G], point[G][3], un[G];
   __mmask8 ok[G], along[G], grazes = 0;
   for (int g = 0; g < G; ++g) {
-    d0[g] = _mm512_sub_pd(Dot3(k.n, ap[g][0], ap[g][1], ap[g][2]), r[g]);
-    ok[g] = _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ);
-    for (int c = 0; c < 3; ++c) point[g][c] = _mm512_sub_pd(a[g][c], _mm512_mul_pd(d0[g], k.n[c]));
+    if constexpr (kUp) {
+      d0[g] = _mm512_sub_pd(_mm512_sub_pd(a[g][1], k.p[1]), r[g]);
+      // (fpclass 0x04: -0.)
+      ok[g] =
+          _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ) & ~_mm512_fpclass_pd_mask(v[g][1], 0x04);
+      const __m512d z = _mm512_and_pd(d0[g], k.sign);
+      point[g][0] = _mm512_sub_pd(a[g][0], z);
+      point[g][1] = _mm512_sub_pd(a[g][1], d0[g]);
+      point[g][2] = _mm512_sub_pd(a[g][2], z);
+      un[g] = u[g][1];
+    } else {
+      __m512d ap[3];
+      for (int c = 0; c < 3; ++c) ap[c] = _mm512_sub_pd(a[g][c], k.p[c]);
+      d0[g] = _mm512_sub_pd(Dot3(k.n, ap[0], ap[1], ap[2]), r[g]);
+      ok[g] = _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ);
+      for (int c = 0; c < 3; ++c)
+        point[g][c] = _mm512_sub_pd(a[g][c], _mm512_mul_pd(d0[g], k.n[c]));
+      un[g] = Dot3(k.n, u[g][0], u[g][1], u[g][2]);
+    }
     // Not a graze (sliding along the plane within rounding): a path not
     // into the plane (rare for a candidate), ending on it.
     const __m512d umax = Max(k.tiny, Max(Max(Abs(u[g][0]), Abs(u[g][1])), Abs(u[g][2])));
-    un[g] = Dot3(k.n, u[g][0], u[g][1], u[g][2]);
     along[g] = _mm512_cmp_pd_mask(un[g], _mm512_mul_pd(k.mtol, umax), _CMP_GE_OQ);
     grazes |= along[g] & ok[g];
   }
@@ -456,40 +492,58 @@ template <int G>
       __m512d px[3];
       for (int c = 0; c < 3; ++c) px[c] = _mm512_sub_pd(point[g][c], x[g][c]);
       const __m512d xmax = Max(k.one, Max(Max(Abs(x[g][0]), Abs(x[g][1])), Abs(x[g][2])));
-      ok[g] &= ~(_mm512_cmp_pd_mask(Dot3(k.n, px[0], px[1], px[2]), _mm512_mul_pd(k.tol, xmax),
-                                    _CMP_LE_OQ) &
-                 along[g]);
+      const __m512d pn = kUp ? px[1] : Dot3(k.n, px[0], px[1], px[2]);
+      ok[g] &= ~(_mm512_cmp_pd_mask(pn, _mm512_mul_pd(k.tol, xmax), _CMP_LE_OQ) & along[g]);
     }
   }
   // Resting: no faster toward the plane than the step's forces made it.
   // The response.
   __m512d en[G], vt[G][3], change[G], len[G];
   for (int g = 0; g < G; ++g) {
-    const __m512d gained =
-        Max(k.zero, _mm512_mul_pd(k.mh, Dot3(k.n, dv[g][0], dv[g][1], dv[g][2])));
+    const __m512d dn = kUp ? dv[g][1] : Dot3(k.n, dv[g][0], dv[g][1], dv[g][2]);
+    const __m512d gained = Max(k.zero, _mm512_mul_pd(k.mh, dn));
     ok[g] &= ~_mm512_cmp_pd_mask(Neg(un[g]), gained, _CMP_GT_OQ);
-    en[g] = Dot3(k.n, v[g][0], v[g][1], v[g][2]);
-    for (int c = 0; c < 3; ++c) vt[g][c] = _mm512_sub_pd(v[g][c], _mm512_mul_pd(en[g], k.n[c]));
+    if constexpr (kUp) {
+      en[g] = v[g][1];
+      const __m512d z = _mm512_and_pd(en[g], k.sign);
+      vt[g][0] = _mm512_sub_pd(v[g][0], z);
+      vt[g][1] = k.zero;
+      vt[g][2] = _mm512_sub_pd(v[g][2], z);
+      len[g] = _mm512_sqrt_pd(
+          _mm512_add_pd(_mm512_mul_pd(vt[g][0], vt[g][0]), _mm512_mul_pd(vt[g][2], vt[g][2])));
+    } else {
+      en[g] = Dot3(k.n, v[g][0], v[g][1], v[g][2]);
+      for (int c = 0; c < 3; ++c) vt[g][c] = _mm512_sub_pd(v[g][c], _mm512_mul_pd(en[g], k.n[c]));
+      len[g] = _mm512_sqrt_pd(_mm512_add_pd(
+          _mm512_add_pd(_mm512_mul_pd(vt[g][0], vt[g][0]), _mm512_mul_pd(vt[g][1], vt[g][1])),
+          _mm512_mul_pd(vt[g][2], vt[g][2])));
+    }
     change[g] = _mm512_mul_pd(k.mu, Max(k.zero, Neg(en[g])));
-    len[g] = _mm512_sqrt_pd(_mm512_add_pd(
-        _mm512_add_pd(_mm512_mul_pd(vt[g][0], vt[g][0]), _mm512_mul_pd(vt[g][1], vt[g][1])),
-        _mm512_mul_pd(vt[g][2], vt[g][2])));
   }
   __m512d out[G][3], x1[G][3];
   for (int g = 0; g < G; ++g) {
     const __mmask8 stops = _mm512_cmp_pd_mask(len[g], change[g], _CMP_LE_OQ);
     const __m512d keep = _mm512_sub_pd(k.one, _mm512_div_pd(change[g], len[g]));
     const __m512d up = Max(en[g], k.zero);
-    __m512d x1p[3];
     for (int c = 0; c < 3; ++c) {
-      const __m512d f = _mm512_maskz_mul_pd(__mmask8(~stops), vt[g][c], keep);  // 0 where stops
-      out[g][c] = _mm512_add_pd(f, _mm512_mul_pd(up, k.n[c]));
+      if (kUp && c == 1) {
+        out[g][c] = up;
+      } else {
+        const __m512d f = _mm512_maskz_mul_pd(__mmask8(~stops), vt[g][c], keep);  // 0 where stops
+        out[g][c] = _mm512_add_pd(f, kUp ? k.zero : _mm512_mul_pd(up, k.n[c]));
+      }
       x1[g][c] = _mm512_add_pd(point[g][c], _mm512_mul_pd(k.h, out[g][c]));
-      x1p[c] = _mm512_sub_pd(x1[g][c], k.p[c]);
     }
     // Ends on the plane: no second contact, nothing to project.
-    ok[g] &= _mm512_cmp_pd_mask(_mm512_sub_pd(Dot3(k.n, x1p[0], x1p[1], x1p[2]), r[g]), k.zero,
-                                _CMP_GE_OQ);
+    __m512d x1n;
+    if constexpr (kUp) {
+      x1n = _mm512_sub_pd(x1[g][1], k.p[1]);
+    } else {
+      __m512d x1p[3];
+      for (int c = 0; c < 3; ++c) x1p[c] = _mm512_sub_pd(x1[g][c], k.p[c]);
+      x1n = Dot3(k.n, x1p[0], x1p[1], x1p[2]);
+    }
+    ok[g] &= _mm512_cmp_pd_mask(_mm512_sub_pd(x1n, r[g]), k.zero, _CMP_GE_OQ);
   }
   for (int g = 0; g < G; ++g) {
     // Rounded to floats on the plane's side: a rounding's displacement,
@@ -500,10 +554,11 @@ template <int G>
     for (int c = 0; c < 3; ++c) {
       xf[c] = _mm512_cvtpd_ps(x1[g][c]);
       rx[c] = _mm512_cvtps_pd(xf[c]);
-      by[c] = _mm512_sub_pd(_mm512_add_pd(rx[c], _mm512_sub_pd(rx[c], x1[g][c])), k.p[c]);
+      if (!kUp || c == 1)
+        by[c] = _mm512_sub_pd(_mm512_add_pd(rx[c], _mm512_sub_pd(rx[c], x1[g][c])), k.p[c]);
     }
-    const __m512d db = _mm512_sub_pd(Dot3(k.n, by[0], by[1], by[2]), r[g]);
-    ok[g] &= _mm512_cmp_pd_mask(db, k.zero, _CMP_GE_OQ);
+    const __m512d bn = kUp ? by[1] : Dot3(k.n, by[0], by[1], by[2]);
+    ok[g] &= _mm512_cmp_pd_mask(_mm512_sub_pd(bn, r[g]), k.zero, _CMP_GE_OQ);
     // Within the magnitude limit.
     const __m512d xx =
         _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(rx[0], rx[0]), _mm512_mul_pd(rx[1], rx[1])),
@@ -601,12 +656,22 @@ template <int G>
   const Rest8 k{{n[0], n[1], n[2]},    {p[0], p[1], p[2]},     _mm512_set1_pd(rq.h),
                 _mm512_set1_pd(-q.h),  _mm512_set1_pd(0.5),    _mm512_set1_pd(rq.friction),
                 _mm512_setzero_pd(),   _mm512_set1_pd(1.0),    _mm512_set1_pd(1e-300),
-                _mm512_set1_pd(1e-12), _mm512_set1_pd(-1e-12), _mm512_set1_pd(rq.limit2)};
+                _mm512_set1_pd(1e-12), _mm512_set1_pd(-1e-12), _mm512_set1_pd(rq.limit2),
+                _mm512_set1_pd(-0.0)};
+  // The floor of a y-up world, (+0, 1, +0) to the bit: RestGroupsAvx512's kUp.
+  const double up[3] = {0.0, 1.0, 0.0};
   size_t g = 0;
+  if (std::memcmp(rq.n, up, sizeof up) == 0) {
+    for (; g + 4 <= groups; g += 4)
+      RestGroupsAvx512<4, true>(k, ar, radius, old, first, at + g, cand + g, idx, count);
+    for (; g < groups; ++g)
+      RestGroupsAvx512<1, true>(k, ar, radius, old, first, at + g, cand + g, idx, count);
+    return i;
+  }
   for (; g + 4 <= groups; g += 4)
-    RestGroupsAvx512<4>(k, ar, radius, old, first, at + g, cand + g, idx, count);
+    RestGroupsAvx512<4, false>(k, ar, radius, old, first, at + g, cand + g, idx, count);
   for (; g < groups; ++g)
-    RestGroupsAvx512<1>(k, ar, radius, old, first, at + g, cand + g, idx, count);
+    RestGroupsAvx512<1, false>(k, ar, radius, old, first, at + g, cand + g, idx, count);
   return i;
 }
 

@@ -263,6 +263,49 @@ TEST(Bulk, RestingFloorGroupsInAnyNumberMatchTheScalarPath) {
   }
 }
 
+TEST(Bulk, UpFloorKernelKeepsTheSignsOfZeros) {
+  if (kernels::RestLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  // The floor y = 0 with normal (+0, 1, +0) takes the 8-lane kernel that
+  // skips the products by 0 and 1 (kUp): there a zero's sign depends on
+  // operations the kernel does not take, so it must leave those lanes to
+  // the general path or take the exact ones. Starts at y = -0 and +0 on
+  // the floor (a distance of -0 or +0 for radius 0) and a little inside it,
+  // velocities of zeros of every sign, gravity and wind with a y of -0 (the
+  // advance then leaves a vertical velocity of -0: a particle inside with it
+  // is the kernel's) and of -9.81, slow and fast friction: the same bits as
+  // the scalar path, every step.
+  const float zeros[2] = {0.0f, -0.0f};
+  for (double gy : {-0.0, -kG}) {
+    for (double mu : {0.1, 3.0}) {
+      BulkSystem avx, scalar;
+      for (BulkSystem* b : {&avx, &scalar}) {
+        for (int i = 0; i < 1031; ++i) {
+          const int bits = i % 64;
+          const double x = (bits & 1) ? double(zeros[(bits >> 1) & 1]) : 0.01 * (i % 7) - 0.03;
+          const double y = (i / 256) % 2 ? -1e-3 * ((i / 512) + 1) : double(zeros[(bits >> 2) & 1]);
+          const double vx = (bits & 8) ? double(zeros[(bits >> 4) & 1]) : 0.3 * ((i % 5) - 2);
+          const double vy = double(zeros[(bits >> 5) & 1]);
+          const double vz = (i / 64) % 2 ? double(zeros[(i / 128) % 2]) : 0.2;
+          b->state.Add(Vec3(x, y, 0.5 * x), Vec3(vx, vy, vz));
+        }
+        b->fields.gravity = Vec3(0, gy, 0);
+        b->fields.wind = Vec3(0, -0.0, 0);
+        b->fields.linearDrag = 0.1;
+        EXPECT_OK(b->AddCollider(
+            Collider::Plane(Vec3(0, 0, 0), Vec3(0, 1, 0)).Restitution(0.5).Friction(mu)));
+      }
+      avx.SetKernel(kernels::Kernel::kAvx, 8);
+      scalar.SetKernel(kernels::Kernel::kScalar);
+      for (int k = 0; k < 30; ++k) {
+        BULK_STEP_OK(avx, 1.0 / 240);
+        BULK_STEP_OK(scalar, 1.0 / 240);
+        ASSERT_EQ(avx.Hash(), scalar.Hash())
+            << "gravity y " << gy << ", mu " << mu << ": states differ after step " << k;
+      }
+    }
+  }
+}
+
 TEST(Bulk, PlaneCandidatesAreExactlyTheColliderTest) {
   if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
   // Points on, just above and just below a tilted plane through a point
