@@ -24,7 +24,15 @@ Vec3f Round(const Vec3& x) {
 // How many single-precision roundings of the largest coordinate a
 // resting particle's start may lie from the exact answer and be kept
 // (RoundOutside).
-constexpr double kRestRoundings = 16;
+using kernels::kRestRoundings;
+
+// How far above a plane a particle's start still rests on it
+// (RespondToContacts' skin): kRestSkin of its largest coordinate, at least
+// 1; twice RoundOutside's push, so that a particle the push left above a
+// plane rests on it the next step (the floor's kernel takes the same).
+double StartSkin(const Vec3& a) {
+  return kernels::kRestSkin * std::max(1.0, a.cwiseAbs().maxCoeff());
+}
 
 // Whether the rounded point r lies across, or on, a collider as seen from x:
 // the rounding's displacement, doubled (a rounded point exactly on a thin
@@ -289,9 +297,10 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       Vec3 x = s.position(i), v = s.velocity(i);
       const double r = double(s.radius[i]);
       MeshMemo* const memo = memos_.empty() ? nullptr : &memos_[i];
+      const Vec3 start(old[0][j], old[1][j], old[2][j]);
       const ContactOutcome out =
-          RespondToContacts(colliders_, Vec3(old[0][j], old[1][j], old[2][j]),
-                            Vec3(old[3][j], old[4][j], old[5][j]), x, v, h, r, memo);
+          RespondToContacts(colliders_, start, Vec3(old[3][j], old[4][j], old[5][j]), x, v, h, r,
+                            memo, StartSkin(start));
       if (out == ContactOutcome::kNone) continue;
       if (out == ContactOutcome::kKilled) {
         // Dies at its age at the start of the step (rounded down), so it is
@@ -305,9 +314,9 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       if (out == ContactOutcome::kUnresolved) faults_.Unresolved(i);
       // At rest after a resting contact (see RoundOutside): the start's
       // floats where they round x as well.
-      const Vec3f start(old[0][j], old[1][j], old[2][j]);
+      const Vec3f startf(old[0][j], old[1][j], old[2][j]);
       const bool rest = out == ContactOutcome::kResponded && v == Vec3::Zero();
-      const Vec3f xf = RoundOutside(colliders_, x, r, h, memo, rest ? &start : nullptr);
+      const Vec3f xf = RoundOutside(colliders_, x, r, h, memo, rest ? &startf : nullptr);
       s.px[i] = xf.x(), s.py[i] = xf.y(), s.pz[i] = xf.z();
       s.SetVelocity(i, v);
       const bool within = MaybeWithinLimit(xf.cast<double>(), v, faults_.limit2());

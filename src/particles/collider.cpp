@@ -921,20 +921,29 @@ namespace {
 // crease; *grazed is set, and the final projection puts its end exactly on
 // the surface), and a sphere the particle rests on this step (the path left
 // along its tangent, which the surface bends away from; the projection puts
-// the end back on it). u is h times the path's velocity at a.
-[[gnu::always_inline]] inline const Collider* FindContact(const std::vector<Collider>& colliders,
-                                                          const Vec3& a, const Vec3& x,
-                                                          const Vec3& u,
-                                                          const Collider* const* restingOn,
-                                                          Contact* best, bool* grazed, double r,
-                                                          double e, double h, MeshMemo* memo) {
+// the end back on it). u is h times the path's velocity at a. A path
+// that starts at most `skin` above a static plane and ends behind it meets
+// it at its start (s = 0, at a's projection onto it; see RespondToContacts).
+[[gnu::always_inline]] inline const Collider* FindContact(
+    const std::vector<Collider>& colliders, const Vec3& a, const Vec3& x, const Vec3& u,
+    const Collider* const* restingOn, Contact* best, bool* grazed, double r, double e, double h,
+    MeshMemo* memo, double skin = 0) {
   best->s = 2;
   const Collider* hit = nullptr;
   for (const Collider& c : colliders) {
     Contact ct;
     bool sliding;
     if (!c.moving()) [[likely]] {
-      if (!c.Intersect(a, x, &ct, r, memo) || ct.s >= best->s) continue;
+      if (!c.Intersect(a, x, &ct, r, memo)) continue;
+      if (ct.s > 0 && skin > 0 && c.kind == Collider::Kind::kPlane) {
+        // (The plane's d0, as Intersect takes it.)
+        const double d0 = c.normal.dot(a - c.point) - r;
+        if (d0 <= skin) {
+          ct.s = 0;
+          ct.point = a - d0 * c.normal;
+        }
+      }
+      if (ct.s >= best->s) continue;
       sliding = ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&
                 u.dot(ct.normal) >= -1e-12 * std::max(1e-300, u.cwiseAbs().maxCoeff());
     } else {
@@ -990,7 +999,7 @@ namespace {
 
 [[SYLVA_FLATTEN]] ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a,
                                                    Vec3 va, Vec3& x, Vec3& v, double h,
-                                                   double radius, MeshMemo* memo) {
+                                                   double radius, MeshMemo* memo, double skin) {
   // The step as a path of constant acceleration from a, through x at its
   // end: p(tau) = a + tau u + tau^2 A / 2 for tau = t / h in [0, 1], with
   // u = h w (w the path's velocity at a) and A = h^2 acc, so that nothing
@@ -1011,7 +1020,8 @@ namespace {
     const Collider* none[2] = {nullptr, nullptr};
     Contact c0;
     bool grazed0 = false;
-    const Collider* hit = FindContact(colliders, a, x, u, none, &c0, &grazed0, radius, 0, h, memo);
+    const Collider* hit =
+        FindContact(colliders, a, x, u, none, &c0, &grazed0, radius, 0, h, memo, skin);
     if (!hit) {
       if (!grazed0) return ContactOutcome::kNone;
       ProjectOut(colliders, x, v, radius, h);
@@ -1047,8 +1057,8 @@ namespace {
   for (;;) {
     Contact best;
     const double e = 1 - rem;  // of the step, at a
-    const Collider* hit =
-        FindContact(colliders, a, x, u, restingOn, &best, &grazed, radius, e, h, memo);
+    const Collider* hit = FindContact(colliders, a, x, u, restingOn, &best, &grazed, radius, e, h,
+                                      memo, contacts == 0 ? skin : 0);
     if (!hit) break;
     const Vec3& n = best.normal;
     if (++contacts > kMaxContacts) [[unlikely]] {

@@ -3,6 +3,7 @@
 #include <immintrin.h>
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 
@@ -400,7 +401,24 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
 // The plane and the step on eight lanes, for RestGroupsAvx512.
 struct Rest8 {
   __m512d n[3], p[3], h, mh, half, mu, zero, one, tiny, tol, mtol, limit2, sign;
+  __m512d skin, eps, four, sixteen;  // kRestSkin, FLT_EPSILON, 4, kRestRoundings
 };
+
+// Where the rounded points rx, seen from x, do not cross the plane
+// (RoundOutside's Crosses): rx + (rx - x) on the plane's side, radius r
+// out. Only a comparison reads the dot product, so with kUp (see
+// RestGroupsAvx512) its second component serves.
+template <bool kUp>
+[[SYLVA_AVX512]] inline __mmask8 OnPlaneSide(const Rest8& k, const __m512d x[3],
+                                             const __m512d rx[3], __m512d r) {
+  __m512d by[3];
+  for (int c = 0; c < 3; ++c) {
+    if (!kUp || c == 1)
+      by[c] = _mm512_sub_pd(_mm512_add_pd(rx[c], _mm512_sub_pd(rx[c], x[c])), k.p[c]);
+  }
+  const __m512d bn = kUp ? by[1] : Dot3(k.n, by[0], by[1], by[2]);
+  return _mm512_cmp_pd_mask(_mm512_sub_pd(bn, r), k.zero, _CMP_GE_OQ);
+}
 
 // The resting kernel on the candidates of G groups of eight consecutive
 // particles, group g starting at first + at[g] (its start state in
@@ -458,15 +476,18 @@ template <int G, bool kUp>
     }
   }
   // The plane's contact at the start (a candidate ends the step inside:
-  // d1 < 0): d0 <= 0 (s = 0).
+  // d1 < 0): d0 <= skin (s = 0).
   __m512d d0[G], point[G][3], un[G];
   __mmask8 ok[G], along[G], grazes = 0;
   for (int g = 0; g < G; ++g) {
+    // Starts at most kRestSkin of its largest coordinate above (see
+    // PlaneRest).
+    const __m512d skin =
+        _mm512_mul_pd(k.skin, Max(k.one, Max(Max(Abs(a[g][0]), Abs(a[g][1])), Abs(a[g][2]))));
     if constexpr (kUp) {
       d0[g] = _mm512_sub_pd(_mm512_sub_pd(a[g][1], k.p[1]), r[g]);
       // (fpclass 0x04: -0.)
-      ok[g] =
-          _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ) & ~_mm512_fpclass_pd_mask(v[g][1], 0x04);
+      ok[g] = _mm512_cmp_pd_mask(d0[g], skin, _CMP_LE_OQ) & ~_mm512_fpclass_pd_mask(v[g][1], 0x04);
       const __m512d z = _mm512_and_pd(d0[g], k.sign);
       point[g][0] = _mm512_sub_pd(a[g][0], z);
       point[g][1] = _mm512_sub_pd(a[g][1], d0[g]);
@@ -476,7 +497,7 @@ template <int G, bool kUp>
       __m512d ap[3];
       for (int c = 0; c < 3; ++c) ap[c] = _mm512_sub_pd(a[g][c], k.p[c]);
       d0[g] = _mm512_sub_pd(Dot3(k.n, ap[0], ap[1], ap[2]), r[g]);
-      ok[g] = _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ);
+      ok[g] = _mm512_cmp_pd_mask(d0[g], skin, _CMP_LE_OQ);
       for (int c = 0; c < 3; ++c)
         point[g][c] = _mm512_sub_pd(a[g][c], _mm512_mul_pd(d0[g], k.n[c]));
       un[g] = Dot3(k.n, u[g][0], u[g][1], u[g][2]);
@@ -546,19 +567,52 @@ template <int G, bool kUp>
     ok[g] &= _mm512_cmp_pd_mask(_mm512_sub_pd(x1n, r[g]), k.zero, _CMP_GE_OQ);
   }
   for (int g = 0; g < G; ++g) {
-    // Rounded to floats on the plane's side: a rounding's displacement,
-    // doubled, must not cross it. (A rounding that changes nothing passes
-    // here too: its doubled displacement is 0, the test above.)
+    // Rounded to floats on the plane's side (RoundOutside): a rounding's
+    // displacement, doubled, must not cross it. (A rounding that changes
+    // nothing passes here too: its doubled displacement is 0, the test
+    // above.)
     __m256 xf[3];
-    __m512d rx[3], by[3];
+    __m512d rx[3];
     for (int c = 0; c < 3; ++c) {
       xf[c] = _mm512_cvtpd_ps(x1[g][c]);
       rx[c] = _mm512_cvtps_pd(xf[c]);
-      if (!kUp || c == 1)
-        by[c] = _mm512_sub_pd(_mm512_add_pd(rx[c], _mm512_sub_pd(rx[c], x1[g][c])), k.p[c]);
     }
-    const __m512d bn = kUp ? by[1] : Dot3(k.n, by[0], by[1], by[2]);
-    ok[g] &= _mm512_cmp_pd_mask(_mm512_sub_pd(bn, r[g]), k.zero, _CMP_GE_OQ);
+    const __mmask8 crosses = ~OnPlaneSide<kUp>(k, x1[g], rx, r[g]) & ok[g] & cand[g];
+    if (crosses) {
+      // Where it crosses: a particle the response stopped (out = 0) keeps
+      // its start's floats if they lie within kRestRoundings ulps of x1's
+      // largest coordinate and on its side; any other is pushed off along
+      // the normal by 4 such ulps and rounded again, which must not cross
+      // (else the general path pushes again).
+      const __m512d scale =
+          _mm512_mul_pd(k.eps, Max(k.one, Max(Max(Abs(x1[g][0]), Abs(x1[g][1])), Abs(x1[g][2]))));
+      const __mmask8 rest = _mm512_cmp_pd_mask(out[g][0], k.zero, _CMP_EQ_OQ) &
+                            _mm512_cmp_pd_mask(out[g][1], k.zero, _CMP_EQ_OQ) &
+                            _mm512_cmp_pd_mask(out[g][2], k.zero, _CMP_EQ_OQ);
+      const __m512d apart =
+          Max(Max(Abs(_mm512_sub_pd(a[g][0], x1[g][0])), Abs(_mm512_sub_pd(a[g][1], x1[g][1]))),
+              Abs(_mm512_sub_pd(a[g][2], x1[g][2])));
+      const __mmask8 keeps =
+          crosses & rest & _mm512_cmp_pd_mask(apart, _mm512_mul_pd(k.sixteen, scale), _CMP_LE_OQ) &
+          OnPlaneSide<kUp>(k, x1[g], a[g], r[g]);
+      const __m512d push = _mm512_mul_pd(k.four, scale);
+      __m256 pf[3];
+      __m512d pr[3];
+      for (int c = 0; c < 3; ++c) {
+        const __m512d base =
+            _mm512_add_pd(x1[g][c], kUp ? (c == 1 ? push : k.zero) : _mm512_mul_pd(push, k.n[c]));
+        pf[c] = _mm512_cvtpd_ps(base);
+        pr[c] = _mm512_cvtps_pd(pf[c]);
+      }
+      const __mmask8 pushed = crosses & ~keeps & OnPlaneSide<kUp>(k, x1[g], pr, r[g]);
+      for (int c = 0; c < 3; ++c) {
+        xf[c] = _mm256_mask_mov_ps(xf[c], keeps, _mm512_cvtpd_ps(a[g][c]));
+        xf[c] = _mm256_mask_mov_ps(xf[c], pushed, pf[c]);
+        rx[c] = _mm512_mask_mov_pd(rx[c], keeps, a[g][c]);
+        rx[c] = _mm512_mask_mov_pd(rx[c], pushed, pr[c]);
+      }
+      ok[g] &= ~crosses | keeps | pushed;
+    }
     // Within the magnitude limit.
     const __m512d xx =
         _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(rx[0], rx[0]), _mm512_mul_pd(rx[1], rx[1])),
@@ -653,11 +707,23 @@ template <int G, bool kUp>
   }
   *good = *good && _mm256_movemask_ps(within) == 0xff;
   // The resting kernel on the listed groups.
-  const Rest8 k{{n[0], n[1], n[2]},    {p[0], p[1], p[2]},     _mm512_set1_pd(rq.h),
-                _mm512_set1_pd(-q.h),  _mm512_set1_pd(0.5),    _mm512_set1_pd(rq.friction),
-                _mm512_setzero_pd(),   _mm512_set1_pd(1.0),    _mm512_set1_pd(1e-300),
-                _mm512_set1_pd(1e-12), _mm512_set1_pd(-1e-12), _mm512_set1_pd(rq.limit2),
-                _mm512_set1_pd(-0.0)};
+  const Rest8 k{{n[0], n[1], n[2]},
+                {p[0], p[1], p[2]},
+                _mm512_set1_pd(rq.h),
+                _mm512_set1_pd(-q.h),
+                _mm512_set1_pd(0.5),
+                _mm512_set1_pd(rq.friction),
+                _mm512_setzero_pd(),
+                _mm512_set1_pd(1.0),
+                _mm512_set1_pd(1e-300),
+                _mm512_set1_pd(1e-12),
+                _mm512_set1_pd(-1e-12),
+                _mm512_set1_pd(rq.limit2),
+                _mm512_set1_pd(-0.0),
+                _mm512_set1_pd(kRestSkin),
+                _mm512_set1_pd(double(FLT_EPSILON)),
+                _mm512_set1_pd(4.0),
+                _mm512_set1_pd(kRestRoundings)};
   // The floor of a y-up world, (+0, 1, +0) to the bit: RestGroupsAvx512's kUp.
   const double up[3] = {0.0, 1.0, 0.0};
   size_t g = 0;

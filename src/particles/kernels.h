@@ -12,6 +12,7 @@
 // processor has it, and the binary still runs where it does not.
 #pragma once
 
+#include <cfloat>
 #include <cstddef>
 #include <cstdint>
 
@@ -121,6 +122,17 @@ size_t BulkPlaneCandidateList(Kernel kernel, const double* n, const double* p, c
 // cross the plane) and within the magnitude limit (x.x + v.v <= limit2).
 // Every other particle (a faster approach, a start above the plane, a
 // graze, a crossing after rounding, a NaN) is left for the general path.
+//
+// A particle that starts up to kRestSkin of its largest coordinate (at
+// least 1) above the plane counts as on it (RespondToContacts' skin, which
+// BulkSystem passes), and the rounding to floats is RoundOutside's: where
+// it would cross the plane, a particle the response stopped keeps its
+// start's floats if they lie within kRestRoundings ulps and on its side,
+// and any other is pushed off along the normal by 4 ulps of x1's largest
+// coordinate (at least 1) and rounded again; a second crossing is left for
+// the general path.
+constexpr double kRestSkin = 8 * double(FLT_EPSILON);  // twice the push
+constexpr double kRestRoundings = 16;
 struct PlaneRest {
   double n[3], p[3];
   double friction, h, limit2;

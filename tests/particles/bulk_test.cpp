@@ -194,7 +194,8 @@ void FillGroups(BulkState& s, int chunks) {
           if (group % 2 == 0) {  // a ball resting at its radius, exactly
             s.Add(Vec3(x, -1 + 0.0078125, z), Vec3(vx, 0, vz));
             s.radius.back() = 0.0078125f;
-          } else {  // a hair inside (in floats): its rounding goes back inside
+          } else {  // a hair inside (in floats): its rounding goes back inside,
+                    // so the kernel pushes it off (RoundOutside)
             s.Add(Vec3(x, -0.99, z), Vec3(vx, 0, vz));
             s.radius.back() = 0.01f;
           }
@@ -226,8 +227,8 @@ TEST(Bulk, RestingFloorGroupsInAnyNumberMatchTheScalarPath) {
           Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.8).Friction(mu)));
     }
     // The kernel itself, on the first step of each chunk: it resolves every
-    // resting lane and leaves to the general path each group's bounce, and
-    // the ball whose rounding would put it inside (every other group).
+    // resting lane, the ball whose rounding would put it inside too (pushed
+    // off), and leaves to the general path each group's bounce.
     {
       BulkState s = avx.state;
       const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
@@ -247,7 +248,6 @@ TEST(Bulk, RestingFloorGroupsInAnyNumberMatchTheScalarPath) {
         std::vector<uint16_t> expected;
         for (int g = 0; g <= 7 * c; g += 7) {
           expected.push_back(uint16_t(8 * g + 3));
-          if (g % 2) expected.push_back(uint16_t(8 * g + 6));
         }
         EXPECT_EQ(std::vector<uint16_t>(idx.begin(), idx.begin() + ptrdiff_t(left)), expected)
             << "mu " << mu << ", chunk " << c << ": the candidates left";
@@ -302,6 +302,85 @@ TEST(Bulk, UpFloorKernelKeepsTheSignsOfZeros) {
         ASSERT_EQ(avx.Hash(), scalar.Hash())
             << "gravity y " << gy << ", mu " << mu << ": states differ after step " << k;
       }
+    }
+  }
+}
+
+TEST(Bulk, BallsRestingWhereFloatsCannotStayOnTheFloorKernel) {
+  if (kernels::RestLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  // Balls of radius 0.01 m and more rest on a floor where the height of
+  // their centre has no float: rounded, it lies inside, so each step
+  // RoundOutside pushes them a few ulps off, and the next step they start
+  // that far above. They rest on it all the same (RespondToContacts' skin),
+  // and the 8-lane kernel serves them: after the first steps it leaves none
+  // of them to the general path on the floor y = -1, and fewer than 60 % on
+  // the tilted one (it left all of them: a resting step took 12.8 times the
+  // step in the air). Sliding and stopping (friction 0.1 and
+  // 3), on the floor y = -1 and a tilted one through a point floats cannot
+  // represent: the same bits as the scalar path every step, every centre
+  // outside the floor and within a few ulps of it.
+  for (const Vec3 n : {Vec3(0, 1, 0), Vec3(0.1, 1, -0.05).normalized()}) {
+    const Vec3 p = n.y() == 1 ? Vec3(0, -1, 0) : Vec3(0.1, -0.7, 0.3);
+    for (double mu : {0.1, 3.0}) {
+      BulkSystem avx, scalar;
+      for (BulkSystem* b : {&avx, &scalar}) {
+        std::mt19937 rng(5);
+        std::uniform_real_distribution<double> u(-1, 1);
+        for (int i = 0; i < 2051; ++i) {
+          const float r = i % 3 == 0 ? 0.01f : i % 3 == 1 ? 0.05f : 0.003f;
+          Vec3 x(u(rng), 0, u(rng));
+          x -= (n.dot(x - p) - double(r)) * n;  // on the floor, then rounded
+          const Vec3 v = 0.5 * Vec3(u(rng), 0, u(rng));
+          b->state.Add(x, v - n.dot(v) * n);
+          b->state.radius.back() = r;
+        }
+        b->fields.gravity = Vec3(0, -kG, 0);
+        b->fields.linearDrag = 0.1;
+        EXPECT_OK(b->AddCollider(Collider::Plane(p, n).Restitution(0.5).Friction(mu)));
+      }
+      avx.SetKernel(kernels::Kernel::kAvx, 8);
+      scalar.SetKernel(kernels::Kernel::kScalar);
+      const double h = double(float(1.0 / 240));
+      for (int k = 0; k < 60; ++k) {
+        if (k >= 2) {
+          // What the kernel leaves of this step, on a copy.
+          BulkState s = avx.state;
+          const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
+                                      s.vy.data(), s.vz.data(), s.invMass.data()};
+          const kernels::BulkParams q{0, float(-kG), 0, 0, 0, 0, 0.1f, 0, float(h), 3e38f};
+          const kernels::PlaneRest rest{{n.x(), n.y(), n.z()}, {p.x(), p.y(), p.z()}, mu, h, 1e300};
+          std::vector<float> old(6 * 512);
+          float* const olds[6] = {&old[0],    &old[512],  &old[1024],
+                                  &old[1536], &old[2048], &old[2560]};
+          std::vector<uint16_t> idx(512 + 4);
+          size_t left = 0;
+          for (size_t c = 0; c + 512 <= s.size(); c += 512) {
+            bool ok = true;
+            left += kernels::BulkAdvanceRestOnPlane(q, rest, a, s.radius.data(), c, c + 512, olds,
+                                                    idx.data(), &ok);
+          }
+          // On the tilted floor about half are left: the end's test, n . (x1
+          // - p) >= r in doubles, fails within rounding for them (for the
+          // floor y = -1 it is exact).
+          ASSERT_LE(double(left), n.y() == 1 ? 0.0 : 0.6 * double(s.size()))
+              << "normal " << n.transpose() << ", mu " << mu << ", step " << k
+              << ": balls the kernel left to the general path";
+        }
+        BULK_STEP_OK(avx, 1.0 / 240);
+        BULK_STEP_OK(scalar, 1.0 / 240);
+        ASSERT_EQ(avx.Hash(), scalar.Hash())
+            << "normal " << n.transpose() << ", mu " << mu << ": states differ after step " << k;
+      }
+      double lowest = 1, highest = -1;
+      for (size_t i = 0; i < avx.state.size(); ++i) {
+        const double d = n.dot(avx.state.position(i) - p) - double(avx.state.radius[i]);
+        lowest = std::min(lowest, d);
+        highest = std::max(highest, d);
+      }
+      EXPECT_GE(lowest, 0.0) << "normal " << n.transpose() << ", mu " << mu
+                             << ": a centre below the floor by " << -lowest << " m";
+      EXPECT_LT(highest, 2e-6) << "normal " << n.transpose() << ", mu " << mu
+                               << ": a ball above the floor by " << highest << " m";
     }
   }
 }
