@@ -64,8 +64,11 @@ BENCHMARK_CAPTURE(BM_Step, rk4, particles::Integrator::kRK4)
 
 // The same scene for BulkSystem (single precision, structure of arrays).
 // restLanes: the resting-floor path's lanes (0: the widest this processor
-// runs; see BulkSystem::SetKernel).
-void BulkStep(benchmark::State& state, int restLanes) {
+// runs; see BulkSystem::SetKernel). radius: every particle's (m); the
+// resting ones lie on the floor at it, and with settle, the timed step
+// starts from the state two steps on (a ball's height on the floor has no
+// float: the first step pushes it a few ulps off, where it then rests).
+void BulkStep(benchmark::State& state, int restLanes, float radius = 0, bool settle = false) {
   particles::BulkSystem sys(int(state.range(1)));
   sys.SetKernel(particles::kernels::Kernel::kAvx, restLanes);
   const int n = int(state.range(0));
@@ -75,10 +78,11 @@ void BulkStep(benchmark::State& state, int restLanes) {
   s.Reserve(size_t(n));
   for (int i = 0; i < n; ++i) {
     if (i % 100 < state.range(2)) {
-      s.Add(Vec3(u(rng), -1, u(rng)), Vec3(u(rng), 0, u(rng)));
+      s.Add(Vec3(u(rng), -1 + double(radius), u(rng)), Vec3(u(rng), 0, u(rng)));
     } else {
       s.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)));
     }
+    s.radius.back() = radius;
   }
   sys.fields.gravity = Vec3(0, -9.81, 0);
   sys.fields.linearDrag = 0.1;
@@ -89,6 +93,9 @@ void BulkStep(benchmark::State& state, int restLanes) {
            .ok()) {
     state.SkipWithError("bad plane");
     return;
+  }
+  for (int k = 0; settle && k < 2; ++k) {
+    if (!sys.Step(1.0 / 240).ok()) state.SkipWithError("step failed");
   }
   const particles::BulkState s0 = s;
   for (auto _ : state) {
@@ -120,6 +127,16 @@ void BM_BulkStepFourLanes(benchmark::State& state) {
 }
 BENCHMARK(BM_BulkStepFourLanes)
     ->ArgsProduct({{1000000}, {1, 2}, {0, 50}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+// Balls of radius 10 mm: their resting height, -0.99, has no float. From
+// the state two steps on (settled a few ulps above the floor), and from
+// the start (argument 3 = 0: inside by the rounding, each pushed off).
+void BM_BulkStepBalls(benchmark::State& state) {
+  BulkStep(state, 0, 0.01f, state.range(3) != 0);
+}
+BENCHMARK(BM_BulkStepBalls)
+    ->ArgsProduct({{1000000}, {2}, {0, 50}, {1, 0}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

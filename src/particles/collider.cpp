@@ -923,7 +923,7 @@ namespace {
 // along its tangent, which the surface bends away from; the projection puts
 // the end back on it). u is h times the path's velocity at a. A path
 // that starts at most `skin` above a static plane and ends behind it meets
-// it at its start (s = 0, at a's projection onto it; see RespondToContacts).
+// it at its start (s = 0, at a itself; see RespondToContacts).
 [[gnu::always_inline]] inline const Collider* FindContact(
     const std::vector<Collider>& colliders, const Vec3& a, const Vec3& x, const Vec3& u,
     const Collider* const* restingOn, Contact* best, bool* grazed, double r, double e, double h,
@@ -935,13 +935,10 @@ namespace {
     bool sliding;
     if (!c.moving()) [[likely]] {
       if (!c.Intersect(a, x, &ct, r, memo)) continue;
-      if (ct.s > 0 && skin > 0 && c.kind == Collider::Kind::kPlane) {
-        // (The plane's d0, as Intersect takes it.)
-        const double d0 = c.normal.dot(a - c.point) - r;
-        if (d0 <= skin) {
-          ct.s = 0;
-          ct.point = a - d0 * c.normal;
-        }
+      if (ct.s > 0 && skin > 0 && c.kind == Collider::Kind::kPlane &&
+          c.normal.dot(a - c.point) - r <= skin) {  // (the plane's d0, as Intersect takes it)
+        ct.s = 0;
+        ct.point = a;  // where it is: in the skin
       }
       if (ct.s >= best->s) continue;
       sliding = ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&

@@ -323,12 +323,14 @@ constexpr int kInelasticContacts = 16;
 // stays at least that far from every surface.
 // `memo`: the particle's MeshMemo (or null), for its mesh queries.
 // `skin` (m, >= 0): a particle that starts at most this far above a static
-// plane and ends the step behind it rests on it from the start (its contact
-// at the start of the step, at the start's projection onto the plane),
-// where it would otherwise land on it a moment into the step. BulkSystem
-// passes the reach of its rounding to single precision (RoundOutside leaves
-// a particle a few ulps above a plane whose height with the radius floats
-// cannot represent, and it starts the next step there); System, 0.
+// plane and ends the step behind it rests on it from the start, where it
+// is (its contact at the start of the step, at the start itself: the skin
+// is the contact), where it would otherwise land on it a moment into the
+// step. BulkSystem passes the reach of its rounding to single precision
+// (RoundOutside leaves a particle a few ulps above a plane whose height
+// with the radius floats cannot represent, and it starts the next step
+// there: it then slides at that height, which is a float, with no rounding
+// to push it off again); System, 0.
 ContactOutcome RespondToContacts(const std::vector<Collider>& colliders, Vec3 a, Vec3 va, Vec3& x,
                                  Vec3& v, double h, double radius = 0, MeshMemo* memo = nullptr,
                                  double skin = 0);

@@ -488,9 +488,12 @@ template <int G, bool kUp>
       d0[g] = _mm512_sub_pd(_mm512_sub_pd(a[g][1], k.p[1]), r[g]);
       // (fpclass 0x04: -0.)
       ok[g] = _mm512_cmp_pd_mask(d0[g], skin, _CMP_LE_OQ) & ~_mm512_fpclass_pd_mask(v[g][1], 0x04);
+      const __mmask8 below = _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ);
+      // On or below: a - d0 n; in the skin above: a (a_c - Z(d0) is a_c
+      // there, d0 > 0).
       const __m512d z = _mm512_and_pd(d0[g], k.sign);
       point[g][0] = _mm512_sub_pd(a[g][0], z);
-      point[g][1] = _mm512_sub_pd(a[g][1], d0[g]);
+      point[g][1] = _mm512_mask_sub_pd(a[g][1], below, a[g][1], d0[g]);
       point[g][2] = _mm512_sub_pd(a[g][2], z);
       un[g] = u[g][1];
     } else {
@@ -498,8 +501,9 @@ template <int G, bool kUp>
       for (int c = 0; c < 3; ++c) ap[c] = _mm512_sub_pd(a[g][c], k.p[c]);
       d0[g] = _mm512_sub_pd(Dot3(k.n, ap[0], ap[1], ap[2]), r[g]);
       ok[g] = _mm512_cmp_pd_mask(d0[g], skin, _CMP_LE_OQ);
+      const __mmask8 below = _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ);
       for (int c = 0; c < 3; ++c)
-        point[g][c] = _mm512_sub_pd(a[g][c], _mm512_mul_pd(d0[g], k.n[c]));
+        point[g][c] = _mm512_mask_sub_pd(a[g][c], below, a[g][c], _mm512_mul_pd(d0[g], k.n[c]));
       un[g] = Dot3(k.n, u[g][0], u[g][1], u[g][2]);
     }
     // Not a graze (sliding along the plane within rounding): a path not
