@@ -402,7 +402,23 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
 struct Rest8 {
   __m512d n[3], p[3], h, mh, half, mu, zero, one, tiny, tol, mtol, limit2, sign;
   __m512d skin, eps, four, sixteen;  // kRestSkin, FLT_EPSILON, 4, kRestRoundings
+  // A magnitude that six coordinates and speeds may each reach (in floats)
+  // with x.x + v.v <= limit2 certain (see RestGroupsAvx512).
+  __m256 small;
 };
+
+// Where the start a, d0 from the plane (radius out), lies at most kRestSkin
+// of its largest coordinate (at least 1) above it (see PlaneRest). Most
+// lie within kRestSkin (a resting particle, which the push left at most
+// half as far), which needs no largest coordinate; the others of the
+// candidates cand take it.
+[[SYLVA_AVX512]] inline __mmask8 StartsInSkin(const Rest8& k, const __m512d a[3], __m512d d0,
+                                              __mmask8 cand) {
+  const __mmask8 near = _mm512_cmp_pd_mask(d0, k.skin, _CMP_LE_OQ);
+  if (!(cand & ~near)) return near;
+  const __m512d skin = _mm512_mul_pd(k.skin, Max(k.one, Max(Max(Abs(a[0]), Abs(a[1])), Abs(a[2]))));
+  return _mm512_cmp_pd_mask(d0, skin, _CMP_LE_OQ);
+}
 
 // Where the rounded points rx, seen from x, do not cross the plane
 // (RoundOutside's Crosses): rx + (rx - x) on the plane's side, radius r
@@ -480,14 +496,10 @@ template <int G, bool kUp>
   __m512d d0[G], point[G][3], un[G];
   __mmask8 ok[G], along[G], grazes = 0;
   for (int g = 0; g < G; ++g) {
-    // Starts at most kRestSkin of its largest coordinate above (see
-    // PlaneRest).
-    const __m512d skin =
-        _mm512_mul_pd(k.skin, Max(k.one, Max(Max(Abs(a[g][0]), Abs(a[g][1])), Abs(a[g][2]))));
     if constexpr (kUp) {
       d0[g] = _mm512_sub_pd(_mm512_sub_pd(a[g][1], k.p[1]), r[g]);
       // (fpclass 0x04: -0.)
-      ok[g] = _mm512_cmp_pd_mask(d0[g], skin, _CMP_LE_OQ) & ~_mm512_fpclass_pd_mask(v[g][1], 0x04);
+      ok[g] = StartsInSkin(k, a[g], d0[g], cand[g]) & ~_mm512_fpclass_pd_mask(v[g][1], 0x04);
       const __mmask8 below = _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ);
       // On or below: a - d0 n; in the skin above: a (a_c - Z(d0) is a_c
       // there, d0 > 0).
@@ -500,7 +512,7 @@ template <int G, bool kUp>
       __m512d ap[3];
       for (int c = 0; c < 3; ++c) ap[c] = _mm512_sub_pd(a[g][c], k.p[c]);
       d0[g] = _mm512_sub_pd(Dot3(k.n, ap[0], ap[1], ap[2]), r[g]);
-      ok[g] = _mm512_cmp_pd_mask(d0[g], skin, _CMP_LE_OQ);
+      ok[g] = StartsInSkin(k, a[g], d0[g], cand[g]);
       const __mmask8 below = _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ);
       for (int c = 0; c < 3; ++c)
         point[g][c] = _mm512_mask_sub_pd(a[g][c], below, a[g][c], _mm512_mul_pd(d0[g], k.n[c]));
@@ -617,23 +629,45 @@ template <int G, bool kUp>
       }
       ok[g] &= ~crosses | keeps | pushed;
     }
-    // Within the magnitude limit.
-    const __m512d xx =
-        _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(rx[0], rx[0]), _mm512_mul_pd(rx[1], rx[1])),
-                      _mm512_mul_pd(rx[2], rx[2]));
-    const __m512d vv = _mm512_add_pd(
-        _mm512_add_pd(_mm512_mul_pd(out[g][0], out[g][0]), _mm512_mul_pd(out[g][1], out[g][1])),
-        _mm512_mul_pd(out[g][2], out[g][2]));
-    ok[g] &= _mm512_cmp_pd_mask(_mm512_add_pd(xx, vv), k.limit2, _CMP_LE_OQ);
+    // Within the magnitude limit: x.x + v.v <= limit2, certain where the
+    // six floats stored are each within k.small (|v_c| is at most its
+    // float's, times 1 + 2^-24), else taken.
+    __m256 of[3];
+    __mmask8 small = 0xff;
+    const __m256 absf = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    for (int c = 0; c < 3; ++c) {
+      of[c] = _mm512_cvtpd_ps(out[g][c]);
+      small &= _mm256_cmp_ps_mask(_mm256_and_ps(xf[c], absf), k.small, _CMP_LE_OQ) &
+               _mm256_cmp_ps_mask(_mm256_and_ps(of[c], absf), k.small, _CMP_LE_OQ);
+    }
+    if (ok[g] & cand[g] & ~small) {
+      const __m512d xx =
+          _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(rx[0], rx[0]), _mm512_mul_pd(rx[1], rx[1])),
+                        _mm512_mul_pd(rx[2], rx[2]));
+      const __m512d vv = _mm512_add_pd(
+          _mm512_add_pd(_mm512_mul_pd(out[g][0], out[g][0]), _mm512_mul_pd(out[g][1], out[g][1])),
+          _mm512_mul_pd(out[g][2], out[g][2]));
+      ok[g] &= _mm512_cmp_pd_mask(_mm512_add_pd(xx, vv), k.limit2, _CMP_LE_OQ);
+    }
     const __mmask8 done = ok[g] & cand[g];
     for (int c = 0; c < 3; ++c) {
       _mm256_mask_storeu_ps(to[c] + at[g], done, xf[c]);
-      _mm256_mask_storeu_ps(to[3 + c] + at[g], done, _mm512_cvtpd_ps(out[g][c]));
+      _mm256_mask_storeu_ps(to[3 + c] + at[g], done, of[c]);
     }
     // The rest to the general path.
     for (unsigned left = unsigned(cand[g] & ~done); left; left &= left - 1)
       idx[(*listed)++] = uint16_t(at[g] + unsigned(__builtin_ctz(left)));
   }
+}
+
+// A float L with 6 (L (1 + 2^-24))^2 (1 + 2^-50) <= limit2: six
+// coordinates and speeds each within L (the speeds' floats within L) have
+// x.x + v.v <= limit2 in doubles.
+float SmallEnough(double limit2) {
+  const double l = std::sqrt(limit2 / 6) * (1 - 0x1p-20);
+  float f = float(std::min(l, double(FLT_MAX)));
+  if (double(f) > l) f = std::nextafter(f, 0.0f);
+  return f;
 }
 
 // BulkAdvanceAvx's step, the plane's candidate test (PlaneListAvx's) and
@@ -727,7 +761,8 @@ template <int G, bool kUp>
                 _mm512_set1_pd(kRestSkin),
                 _mm512_set1_pd(double(FLT_EPSILON)),
                 _mm512_set1_pd(4.0),
-                _mm512_set1_pd(kRestRoundings)};
+                _mm512_set1_pd(kRestRoundings),
+                _mm256_set1_ps(SmallEnough(rq.limit2))};
   // The floor of a y-up world, (+0, 1, +0) to the bit: RestGroupsAvx512's kUp.
   const double up[3] = {0.0, 1.0, 0.0};
   size_t g = 0;
