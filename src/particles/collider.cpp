@@ -935,10 +935,14 @@ namespace {
     bool sliding;
     if (!c.moving()) [[likely]] {
       if (!c.Intersect(a, x, &ct, r, memo)) continue;
-      if (ct.s > 0 && skin > 0 && c.kind == Collider::Kind::kPlane &&
-          c.normal.dot(a - c.point) - r <= skin) {  // (the plane's d0, as Intersect takes it)
-        ct.s = 0;
-        ct.point = a;  // where it is: in the skin
+      if (skin > 0 && c.kind == Collider::Kind::kPlane) {
+        // Above by d0 (the plane's, as Intersect takes it; its s may have
+        // underflowed to 0 for a tiny d0), but within the skin.
+        const double d0 = c.normal.dot(a - c.point) - r;
+        if (d0 > 0 && d0 <= skin) {
+          ct.s = 0;
+          ct.point = a;  // where it is: in the skin
+        }
       }
       if (ct.s >= best->s) continue;
       sliding = ct.normal.dot(ct.point - x) <= 1e-12 * std::max(1.0, x.cwiseAbs().maxCoeff()) &&

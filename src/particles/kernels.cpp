@@ -447,15 +447,22 @@ template <bool kUp>
 // appends the other candidates' offsets (at[g] + lane) to idx.
 //
 // kUp: the plane's normal is (+0, 1, +0) exactly (a floor in a y-up
-// world), and the kernel skips the products by 0 and 1, the same bits. A
-// candidate's inputs are finite (its advanced position is: the candidate
-// test takes n . x with every component, and a non-finite start state or
-// velocity makes it non-finite). For finite y, 0 y is a zero with y's
-// sign, Z(y) = y & -0.0, and 1 y = y, so a dot product n . y is y_1
-// where y_1 is not zero, and a zero of some sign where it is. Where a dot
-// product only meets a comparison, the sign of a zero is irrelevant and
-// y_1 serves; where its sign can reach a stored bit, the kernel takes the
-// exact operations, or leaves the lane to the general path:
+// world), and the kernel skips the products by 0 and 1, the same bits.
+// A candidate's inputs are finite but for their second components: the
+// candidate test takes n . x with every component, so an infinite or NaN
+// x_0 or x_2 (which a non-finite start or velocity across the normal
+// makes) is no candidate; but 0 x_0 + x_1 + 0 x_2 is -infinity for an
+// overflowed x_1, where the general path's 0 times an infinity is NaN. A
+// lane with v_1 infinite is left to the general path (below); one with a
+// non-finite a_1 ends at a NaN, one with x_1 infinite and v_1 finite
+// approaches faster than its forces could make it: both fail a test and
+// are left too (found by fuzzing against the scalar path). For finite y,
+// 0 y is a zero with y's sign, Z(y) = y & -0.0, and 1 y = y, so a dot
+// product n . y is y_1 where y_1 is not zero, and a zero of some sign
+// where it is. Where a dot product only meets a comparison, the sign of a
+// zero is irrelevant and y_1 serves; where its sign can reach a stored
+// bit, the kernel takes the exact operations, or leaves the lane to the
+// general path:
 //   en = n . v: v_1 where v_1 is not -0 (a lane with v_1 = -0 is left:
 //     there en's sign is that of all three components), so
 //   vt = v - en n is (v_0 - Z(v_1), +0, v_2 - Z(v_1)) (v_1 - v_1 = +0),
@@ -498,8 +505,8 @@ template <int G, bool kUp>
   for (int g = 0; g < G; ++g) {
     if constexpr (kUp) {
       d0[g] = _mm512_sub_pd(_mm512_sub_pd(a[g][1], k.p[1]), r[g]);
-      // (fpclass 0x04: -0.)
-      ok[g] = StartsInSkin(k, a[g], d0[g], cand[g]) & ~_mm512_fpclass_pd_mask(v[g][1], 0x04);
+      // (fpclass 0x04 | 0x08 | 0x10: -0, +infinity, -infinity.)
+      ok[g] = StartsInSkin(k, a[g], d0[g], cand[g]) & ~_mm512_fpclass_pd_mask(v[g][1], 0x1c);
       const __mmask8 below = _mm512_cmp_pd_mask(d0[g], k.zero, _CMP_LE_OQ);
       // On or below: a - d0 n; in the skin above: a (a_c - Z(d0) is a_c
       // there, d0 > 0).

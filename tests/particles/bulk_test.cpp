@@ -439,6 +439,48 @@ TEST(Bulk, FloorKernelLeavesWhatEndsBeyondTheMagnitudeLimit) {
   }
 }
 
+// Two cases a fuzzer against the scalar path found (eight copies of one
+// particle, a full group of the 8-lane kernel).
+TEST(Bulk, FloorKernelAgreesOnATinyPlanePointAndAnOverflow) {
+  if (kernels::RestLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  struct Case {
+    const char* what;
+    Vec3 point, velocity, gravity;
+    double quadraticDrag, maxMagnitude, h;
+  };
+  // A start 2^-1074 above the floor y = -2^-1074 that ends inside: the
+  // plane's time of impact underflows to 0, and the skin must still place
+  // the contact at the start (the scalar path projected it and stored a y
+  // of -0 where the kernel stored +0). An upward speed of 1e18 against a
+  // quadratic drag of 1e3: the advance overflows to a y and a vertical
+  // velocity of -infinity, a candidate of the floor y = 0; the general path
+  // reports its contact unresolved, and the kernel (which took 0 times
+  // -infinity as -0) must leave it to it, not hide the explosion.
+  const Case cases[] = {
+      {"tiny plane point", Vec3(0, -0x1p-1074, 0), Vec3::Zero(), Vec3(0, -kG, 0), 0, 1e12, 1.0},
+      {"overflow", Vec3::Zero(), Vec3(0, 1e18, 0), Vec3::Zero(), 1e3, 1e30, 1.0 / 60}};
+  for (const Case& c : cases) {
+    BulkSystem avx(1), scalar(1);
+    for (BulkSystem* b : {&avx, &scalar}) {
+      for (int i = 0; i < 8; ++i) b->state.Add(Vec3::Zero(), c.velocity);
+      b->fields.gravity = c.gravity;
+      b->fields.quadraticDrag = c.quadraticDrag;
+      b->maxMagnitude = c.maxMagnitude;
+      EXPECT_OK(b->AddCollider(Collider::Plane(c.point, Vec3(0, 1, 0)).Friction(0.5)));
+    }
+    avx.SetKernel(kernels::Kernel::kAvx, 8);
+    scalar.SetKernel(kernels::Kernel::kScalar);
+    const Status sa = avx.Step(c.h), ss = scalar.Step(c.h);
+    ASSERT_EQ(sa.ok(), ss.ok()) << c.what << ": 8 lanes " << (sa.ok() ? "ok" : sa.error().message)
+                                << ", scalar " << (ss.ok() ? "ok" : ss.error().message);
+    if (!sa.ok()) EXPECT_EQ(sa.error().message, ss.error().message) << c.what;
+    EXPECT_EQ(avx.Hash(), scalar.Hash())
+        << c.what << ": y " << avx.state.py[0] << " (8 lanes) against " << scalar.state.py[0]
+        << " (signbits " << std::signbit(avx.state.py[0]) << ", "
+        << std::signbit(scalar.state.py[0]) << ")";
+  }
+}
+
 TEST(Bulk, PlaneCandidatesAreExactlyTheColliderTest) {
   if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
   // Points on, just above and just below a tilted plane through a point
