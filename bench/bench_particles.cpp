@@ -139,6 +139,14 @@ BENCHMARK(BM_BulkStepBalls)
     ->ArgsProduct({{1000000}, {2}, {0, 50}, {1, 0}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+// The same balls on the four-lane path (a processor without AVX-512).
+void BM_BulkStepBallsFourLanes(benchmark::State& state) {
+  BulkStep(state, 4, 0.01f, state.range(3) != 0);
+}
+BENCHMARK(BM_BulkStepBallsFourLanes)
+    ->ArgsProduct({{1000000}, {2}, {0, 50}, {1, 0}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Issue 17's snow on terrain: 100,000 flakes (radius argument 2 in mm: 0, a
 // point, or 10; builds before particles had a radius see points; friction 0.8,

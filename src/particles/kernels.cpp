@@ -244,6 +244,27 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   return _mm256_cvtps_pd(_mm_set_ps(base[j[3]], base[j[2]], base[j[1]], base[j[0]]));
 }
 
+// The 4 lanes of a double-precision mask as a single-precision one (the
+// high half of each lane's bits).
+[[gnu::target("avx")]] inline __m128 Narrow(__m256d m) {
+  const __m128 lo = _mm_castpd_ps(_mm256_castpd256_pd128(m));
+  const __m128 hi = _mm_castpd_ps(_mm256_extractf128_pd(m, 1));
+  return _mm_shuffle_ps(lo, hi, _MM_SHUFFLE(3, 1, 3, 1));
+}
+
+// Where y + (y - x) lies on the plane's side, radius r out (RoundOutside's
+// Crosses for a rounded or kept point y seen from x; OnPlaneSide below on
+// eight lanes).
+[[gnu::target("avx")]] inline __m256d OnPlaneSide4(const __m256d n[3], const __m256d p[3],
+                                                   const __m256d x[3], const __m256d y[3],
+                                                   __m256d r) {
+  __m256d by[3];
+  for (int c = 0; c < 3; ++c)
+    by[c] = _mm256_sub_pd(_mm256_add_pd(y[c], _mm256_sub_pd(y[c], x[c])), p[c]);
+  return _mm256_cmp_pd(_mm256_sub_pd(Dot3(n, by[0], by[1], by[2]), r), _mm256_setzero_pd(),
+                       _CMP_GE_OQ);
+}
+
 [[gnu::target("avx")]] void RestOnPlaneAvx(const PlaneRest& q, const BulkArrays& ar,
                                            const float* radius, const float* const* old,
                                            size_t begin, const uint16_t* idx, size_t count,
@@ -255,6 +276,8 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   const __m256d one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(1e-300);
   const __m256d tol = _mm256_set1_pd(1e-12), mtol = _mm256_set1_pd(-1e-12);
   const __m256d limit2 = _mm256_set1_pd(q.limit2);
+  const __m256d skin = _mm256_set1_pd(kRestSkin), eps = _mm256_set1_pd(double(FLT_EPSILON));
+  const __m256d four = _mm256_set1_pd(4.0), sixteen = _mm256_set1_pd(kRestRoundings);
   for (size_t k0 = 0; k0 < count; k0 += 4) {
     // Four lanes (the last repeated past the end): one load an array where
     // they are consecutive, the common case.
@@ -281,12 +304,15 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
       ap[c] = _mm256_sub_pd(a[c], p[c]);
     }
     // The plane's contact at the start (a candidate ends the step inside:
-    // d1 < 0): d0 <= 0 (s = 0).
+    // d1 < 0): d0 <= the skin (s = 0); on or below, at a - d0 n, and in the
+    // skin above, at a itself.
     const __m256d d0 = _mm256_sub_pd(Dot3(n, ap[0], ap[1], ap[2]), r);
-    __m256d ok = _mm256_cmp_pd(d0, zero, _CMP_LE_OQ);
+    const __m256d amax = Max(one, Max(Max(Abs(a[0]), Abs(a[1])), Abs(a[2])));
+    __m256d ok = _mm256_cmp_pd(d0, _mm256_mul_pd(skin, amax), _CMP_LE_OQ);
+    const __m256d below = _mm256_cmp_pd(d0, zero, _CMP_LE_OQ);
     __m256d point[3], px[3];
     for (int c = 0; c < 3; ++c) {
-      point[c] = _mm256_sub_pd(a[c], _mm256_mul_pd(d0, n[c]));
+      point[c] = _mm256_blendv_pd(a[c], _mm256_sub_pd(a[c], _mm256_mul_pd(d0, n[c])), below);
       px[c] = _mm256_sub_pd(point[c], x[c]);
     }
     // Not a graze (sliding along the plane within rounding).
@@ -323,19 +349,53 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     // Ends on the plane: no second contact, nothing to project.
     ok = _mm256_and_pd(
         ok, _mm256_cmp_pd(_mm256_sub_pd(Dot3(n, x1p[0], x1p[1], x1p[2]), r), zero, _CMP_GE_OQ));
-    // Rounded to floats on the plane's side: a rounding's displacement,
-    // doubled, must not cross it (else RoundOutside's push is needed). A
-    // rounding that changes nothing passes too: its doubled point is x1
-    // itself, on the plane's side by the test above.
+    // Rounded to floats on the plane's side (RoundOutside): a rounding's
+    // displacement, doubled, must not cross it. A rounding that changes
+    // nothing passes too: its doubled point is x1 itself, on the plane's
+    // side by the test above.
     __m128 xf[3];
-    __m256d rx[3], by[3];
+    __m256d rx[3];
     for (int c = 0; c < 3; ++c) {
       xf[c] = _mm256_cvtpd_ps(x1[c]);
       rx[c] = _mm256_cvtps_pd(xf[c]);
-      by[c] = _mm256_sub_pd(_mm256_add_pd(rx[c], _mm256_sub_pd(rx[c], x1[c])), p[c]);
     }
-    const __m256d db = _mm256_sub_pd(Dot3(n, by[0], by[1], by[2]), r);
-    ok = _mm256_and_pd(ok, _mm256_cmp_pd(db, zero, _CMP_GE_OQ));
+    const __m256d crosses = _mm256_andnot_pd(OnPlaneSide4(n, p, x1, rx, r), ok);
+    if (_mm256_movemask_pd(crosses)) {
+      // Where it crosses: a particle the response stopped (out = 0) keeps
+      // its start's floats if they lie within kRestRoundings ulps of x1's
+      // largest coordinate and on its side; any other is pushed off along
+      // the normal by 4 such ulps and rounded again, which must not cross
+      // (else the general path pushes again).
+      const __m256d scale =
+          _mm256_mul_pd(eps, Max(one, Max(Max(Abs(x1[0]), Abs(x1[1])), Abs(x1[2]))));
+      const __m256d rest = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(out[0], zero, _CMP_EQ_OQ),
+                                                       _mm256_cmp_pd(out[1], zero, _CMP_EQ_OQ)),
+                                         _mm256_cmp_pd(out[2], zero, _CMP_EQ_OQ));
+      const __m256d apart =
+          Max(Max(Abs(_mm256_sub_pd(a[0], x1[0])), Abs(_mm256_sub_pd(a[1], x1[1]))),
+              Abs(_mm256_sub_pd(a[2], x1[2])));
+      const __m256d keeps = _mm256_and_pd(
+          _mm256_and_pd(crosses, rest),
+          _mm256_and_pd(_mm256_cmp_pd(apart, _mm256_mul_pd(sixteen, scale), _CMP_LE_OQ),
+                        OnPlaneSide4(n, p, x1, a, r)));
+      const __m256d push = _mm256_mul_pd(four, scale);
+      __m128 pf[3];
+      __m256d pr[3];
+      for (int c = 0; c < 3; ++c) {
+        pf[c] = _mm256_cvtpd_ps(_mm256_add_pd(x1[c], _mm256_mul_pd(push, n[c])));
+        pr[c] = _mm256_cvtps_pd(pf[c]);
+      }
+      const __m256d pushed =
+          _mm256_andnot_pd(keeps, _mm256_and_pd(crosses, OnPlaneSide4(n, p, x1, pr, r)));
+      const __m128 keepsf = Narrow(keeps), pushedf = Narrow(pushed);
+      for (int c = 0; c < 3; ++c) {
+        xf[c] = _mm_blendv_ps(xf[c], _mm256_cvtpd_ps(a[c]), keepsf);
+        xf[c] = _mm_blendv_ps(xf[c], pf[c], pushedf);
+        rx[c] = _mm256_blendv_pd(rx[c], a[c], keeps);
+        rx[c] = _mm256_blendv_pd(rx[c], pr[c], pushed);
+      }
+      ok = _mm256_andnot_pd(_mm256_andnot_pd(_mm256_or_pd(keeps, pushed), crosses), ok);
+    }
     // Within the magnitude limit.
     const __m256d xx =
         _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(rx[0], rx[0]), _mm256_mul_pd(rx[1], rx[1])),

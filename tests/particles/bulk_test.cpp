@@ -306,83 +306,117 @@ TEST(Bulk, UpFloorKernelKeepsTheSignsOfZeros) {
   }
 }
 
+// The candidates that the floor's resting kernel of `lanes` lanes leaves to
+// the general path in a step of h from the state s (on a copy): 8 lanes
+// take BulkAdvanceRestOnPlane, 4 take BulkAdvance, BulkPlaneCandidateList
+// and BulkRestOnPlane, each whole chunk of 512 as the bulk step does (the
+// 8-lane path leaves a ragged tail to the general path). Whether particle i
+// was left in (*left)[i] where left is given.
+size_t LeftByFloorKernel(BulkState s, int lanes, const kernels::BulkParams& q,
+                         const kernels::PlaneRest& rest, std::vector<bool>* left = nullptr) {
+  const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
+                              s.vy.data(), s.vz.data(), s.invMass.data()};
+  std::vector<float> old(6 * 512);
+  float* const olds[6] = {&old[0], &old[512], &old[1024], &old[1536], &old[2048], &old[2560]};
+  std::vector<uint16_t> idx(512 + 4);
+  std::vector<uint8_t> done(512);
+  if (left) left->assign(s.size(), false);
+  size_t total = 0;
+  for (size_t c = 0; c + 512 <= s.size(); c += 512) {
+    const size_t e = c + 512;
+    bool ok = true;
+    if (lanes == 8) {
+      const size_t m =
+          kernels::BulkAdvanceRestOnPlane(q, rest, a, s.radius.data(), c, e, olds, idx.data(), &ok);
+      total += m;
+      if (left)
+        for (size_t k = 0; k < m; ++k) (*left)[c + idx[k]] = true;
+      continue;
+    }
+    kernels::BulkAdvance(kernels::Kernel::kAvx, q, a, c, e, olds);
+    const size_t m = kernels::BulkPlaneCandidateList(kernels::Kernel::kAvx, rest.n, rest.p, a,
+                                                     s.radius.data(), c, e, idx.data());
+    kernels::BulkRestOnPlane(rest, a, s.radius.data(), olds, c, idx.data(), m, done.data());
+    for (size_t k = 0; k < m; ++k) {
+      if (done[k]) continue;
+      ++total;
+      if (left) (*left)[c + idx[k]] = true;
+    }
+  }
+  return total;
+}
+
 TEST(Bulk, BallsRestingWhereFloatsCannotStayOnTheFloorKernel) {
-  if (kernels::RestLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
   // Balls of radius 0.01 m and more rest on a floor where the height of
   // their centre has no float: rounded, it lies inside, so each step
   // RoundOutside pushes them a few ulps off, and the next step they start
   // that far above. They rest on it all the same (RespondToContacts' skin),
-  // and the 8-lane kernel serves them: after the first steps it leaves none
-  // of them to the general path on the floor y = -1, and fewer than 60 % on
-  // the tilted one (it left all of them: a resting step took 12.8 times the
-  // step in the air). Sliding and stopping (friction 0.1 and
-  // 3), on the floor y = -1 and a tilted one through a point floats cannot
-  // represent: the same bits as the scalar path every step, every centre
-  // outside the floor and within a few ulps of it.
-  for (const Vec3 n : {Vec3(0, 1, 0), Vec3(0.1, 1, -0.05).normalized()}) {
-    const Vec3 p = n.y() == 1 ? Vec3(0, -1, 0) : Vec3(0.1, -0.7, 0.3);
-    for (double mu : {0.1, 3.0}) {
-      BulkSystem avx, scalar;
-      for (BulkSystem* b : {&avx, &scalar}) {
-        std::mt19937 rng(5);
-        std::uniform_real_distribution<double> u(-1, 1);
-        for (int i = 0; i < 2051; ++i) {
-          const float r = i % 3 == 0 ? 0.01f : i % 3 == 1 ? 0.05f : 0.003f;
-          Vec3 x(u(rng), 0, u(rng));
-          x -= (n.dot(x - p) - double(r)) * n;  // on the floor, then rounded
-          const Vec3 v = 0.5 * Vec3(u(rng), 0, u(rng));
-          b->state.Add(x, v - n.dot(v) * n);
-          b->state.radius.back() = r;
-        }
-        b->fields.gravity = Vec3(0, -kG, 0);
-        b->fields.linearDrag = 0.1;
-        EXPECT_OK(b->AddCollider(Collider::Plane(p, n).Restitution(0.5).Friction(mu)));
-      }
-      avx.SetKernel(kernels::Kernel::kAvx, 8);
-      scalar.SetKernel(kernels::Kernel::kScalar);
-      const double h = double(float(1.0 / 240));
-      for (int k = 0; k < 60; ++k) {
-        if (k >= 2) {
-          // What the kernel leaves of this step, on a copy.
-          BulkState s = avx.state;
-          const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
-                                      s.vy.data(), s.vz.data(), s.invMass.data()};
-          const kernels::BulkParams q{0, float(-kG), 0, 0, 0, 0, 0.1f, 0, float(h), 3e38f};
-          const kernels::PlaneRest rest{{n.x(), n.y(), n.z()}, {p.x(), p.y(), p.z()}, mu, h, 1e300};
-          std::vector<float> old(6 * 512);
-          float* const olds[6] = {&old[0],    &old[512],  &old[1024],
-                                  &old[1536], &old[2048], &old[2560]};
-          std::vector<uint16_t> idx(512 + 4);
-          size_t left = 0;
-          for (size_t c = 0; c + 512 <= s.size(); c += 512) {
-            bool ok = true;
-            left += kernels::BulkAdvanceRestOnPlane(q, rest, a, s.radius.data(), c, c + 512, olds,
-                                                    idx.data(), &ok);
+  // and the floor's kernel serves them, on 4 lanes and (where the processor
+  // has AVX-512) 8: after the first steps it leaves none of them to the
+  // general path on the floor y = -1, and fewer than 60 % on the tilted one
+  // (it left all of them: a resting step took 12.8 times the step in the
+  // air). Sliding and stopping (friction 0.1 and 3), on the floor y = -1 and
+  // a tilted one through a point floats cannot represent: the same bits as
+  // the scalar path every step, every centre outside the floor and within a
+  // few ulps of it.
+  std::vector<int> widths = {4};
+  if (kernels::RestLanes() == 8) widths.push_back(8);
+  for (int lanes : widths)
+    for (const Vec3& n : {Vec3(0, 1, 0), Vec3(0.1, 1, -0.05).normalized()}) {
+      const Vec3 p = n.y() == 1 ? Vec3(0, -1, 0) : Vec3(0.1, -0.7, 0.3);
+      for (double mu : {0.1, 3.0}) {
+        BulkSystem avx, scalar;
+        for (BulkSystem* b : {&avx, &scalar}) {
+          std::mt19937 rng(5);
+          std::uniform_real_distribution<double> u(-1, 1);
+          for (int i = 0; i < 2051; ++i) {
+            const float r = i % 3 == 0 ? 0.01f : i % 3 == 1 ? 0.05f : 0.003f;
+            Vec3 x(u(rng), 0, u(rng));
+            x -= (n.dot(x - p) - double(r)) * n;  // on the floor, then rounded
+            const Vec3 v = 0.5 * Vec3(u(rng), 0, u(rng));
+            b->state.Add(x, v - n.dot(v) * n);
+            b->state.radius.back() = r;
           }
-          // On the tilted floor about half are left: the end's test, n . (x1
-          // - p) >= r in doubles, fails within rounding for them (for the
-          // floor y = -1 it is exact).
-          ASSERT_LE(double(left), n.y() == 1 ? 0.0 : 0.6 * double(s.size()))
-              << "normal " << n.transpose() << ", mu " << mu << ", step " << k
-              << ": balls the kernel left to the general path";
+          b->fields.gravity = Vec3(0, -kG, 0);
+          b->fields.linearDrag = 0.1;
+          EXPECT_OK(b->AddCollider(Collider::Plane(p, n).Restitution(0.5).Friction(mu)));
         }
-        BULK_STEP_OK(avx, 1.0 / 240);
-        BULK_STEP_OK(scalar, 1.0 / 240);
-        ASSERT_EQ(avx.Hash(), scalar.Hash())
-            << "normal " << n.transpose() << ", mu " << mu << ": states differ after step " << k;
+        avx.SetKernel(kernels::Kernel::kAvx, lanes);
+        scalar.SetKernel(kernels::Kernel::kScalar);
+        const double h = double(float(1.0 / 240));
+        for (int k = 0; k < 60; ++k) {
+          if (k >= 2) {
+            // What the kernel leaves of this step, on a copy.
+            const kernels::BulkParams q{0, float(-kG), 0, 0, 0, 0, 0.1f, 0, float(h), 3e38f};
+            const kernels::PlaneRest rest{
+                {n.x(), n.y(), n.z()}, {p.x(), p.y(), p.z()}, mu, h, 1e300};
+            const size_t left = LeftByFloorKernel(avx.state, lanes, q, rest);
+            // On the tilted floor about half are left: the end's test, n . (x1
+            // - p) >= r in doubles, fails within rounding for them (for the
+            // floor y = -1 it is exact).
+            ASSERT_LE(double(left), n.y() == 1 ? 0.0 : 0.6 * double(avx.state.size()))
+                << lanes << " lanes, normal " << n.transpose() << ", mu " << mu << ", step " << k
+                << ": balls the kernel left to the general path";
+          }
+          BULK_STEP_OK(avx, 1.0 / 240);
+          BULK_STEP_OK(scalar, 1.0 / 240);
+          ASSERT_EQ(avx.Hash(), scalar.Hash())
+              << lanes << " lanes, normal " << n.transpose() << ", mu " << mu
+              << ": states differ after step " << k;
+        }
+        double lowest = 1, highest = -1;
+        for (size_t i = 0; i < avx.state.size(); ++i) {
+          const double d = n.dot(avx.state.position(i) - p) - double(avx.state.radius[i]);
+          lowest = std::min(lowest, d);
+          highest = std::max(highest, d);
+        }
+        EXPECT_GE(lowest, 0.0) << "normal " << n.transpose() << ", mu " << mu
+                               << ": a centre below the floor by " << -lowest << " m";
+        EXPECT_LT(highest, 2e-6) << "normal " << n.transpose() << ", mu " << mu
+                                 << ": a ball above the floor by " << highest << " m";
       }
-      double lowest = 1, highest = -1;
-      for (size_t i = 0; i < avx.state.size(); ++i) {
-        const double d = n.dot(avx.state.position(i) - p) - double(avx.state.radius[i]);
-        lowest = std::min(lowest, d);
-        highest = std::max(highest, d);
-      }
-      EXPECT_GE(lowest, 0.0) << "normal " << n.transpose() << ", mu " << mu
-                             << ": a centre below the floor by " << -lowest << " m";
-      EXPECT_LT(highest, 2e-6) << "normal " << n.transpose() << ", mu " << mu
-                               << ": a ball above the floor by " << highest << " m";
     }
-  }
 }
 
 TEST(Bulk, FloorKernelLeavesWhatEndsBeyondTheMagnitudeLimit) {
@@ -393,7 +427,7 @@ TEST(Bulk, FloorKernelLeavesWhatEndsBeyondTheMagnitudeLimit) {
   // Resting particles spread over |x|, |z| <= 2 under a limit2 of 4: none
   // ending beyond it is resolved, on the floor y = 0 and a tilted one, and
   // on the floor y = 0 every one left ends beyond it.
-  for (const Vec3 n : {Vec3(0, 1, 0), Vec3(0.1, 1, -0.05).normalized()}) {
+  for (const Vec3& n : {Vec3(0, 1, 0), Vec3(0.1, 1, -0.05).normalized()}) {
     BulkState s;
     std::mt19937 rng(9);
     std::uniform_real_distribution<double> u(-2, 2);
@@ -425,9 +459,10 @@ TEST(Bulk, FloorKernelLeavesWhatEndsBeyondTheMagnitudeLimit) {
         beyond += e > limit2;
         // (On the tilted floor about half are left for the end's test as
         // well: see BallsRestingWhereFloatsCannotStayOnTheFloorKernel.)
-        if (n.y() == 1)
+        if (n.y() == 1) {
           EXPECT_GT(e, 0.999 * limit2) << "normal " << n.transpose() << ": particle " << i
                                        << " left to the general path within the limit: " << e;
+        }
       } else {
         ++resolved;
         ASSERT_LE(e, limit2 * (1 + 1e-6)) << "normal " << n.transpose() << ": particle " << i
@@ -440,9 +475,9 @@ TEST(Bulk, FloorKernelLeavesWhatEndsBeyondTheMagnitudeLimit) {
 }
 
 // Two cases a fuzzer against the scalar path found (eight copies of one
-// particle, a full group of the 8-lane kernel).
+// particle, a full group of the 8-lane kernel), on both widths.
 TEST(Bulk, FloorKernelAgreesOnATinyPlanePointAndAnOverflow) {
-  if (kernels::RestLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
   struct Case {
     const char* what;
     Vec3 point, velocity, gravity;
@@ -459,26 +494,32 @@ TEST(Bulk, FloorKernelAgreesOnATinyPlanePointAndAnOverflow) {
   const Case cases[] = {
       {"tiny plane point", Vec3(0, -0x1p-1074, 0), Vec3::Zero(), Vec3(0, -kG, 0), 0, 1e12, 1.0},
       {"overflow", Vec3::Zero(), Vec3(0, 1e18, 0), Vec3::Zero(), 1e3, 1e30, 1.0 / 60}};
-  for (const Case& c : cases) {
-    BulkSystem avx(1), scalar(1);
-    for (BulkSystem* b : {&avx, &scalar}) {
-      for (int i = 0; i < 8; ++i) b->state.Add(Vec3::Zero(), c.velocity);
-      b->fields.gravity = c.gravity;
-      b->fields.quadraticDrag = c.quadraticDrag;
-      b->maxMagnitude = c.maxMagnitude;
-      EXPECT_OK(b->AddCollider(Collider::Plane(c.point, Vec3(0, 1, 0)).Friction(0.5)));
+  std::vector<int> widths = {4};
+  if (kernels::RestLanes() == 8) widths.push_back(8);
+  for (int lanes : widths)
+    for (const Case& c : cases) {
+      BulkSystem avx(1), scalar(1);
+      for (BulkSystem* b : {&avx, &scalar}) {
+        for (int i = 0; i < 8; ++i) b->state.Add(Vec3::Zero(), c.velocity);
+        b->fields.gravity = c.gravity;
+        b->fields.quadraticDrag = c.quadraticDrag;
+        b->maxMagnitude = c.maxMagnitude;
+        EXPECT_OK(b->AddCollider(Collider::Plane(c.point, Vec3(0, 1, 0)).Friction(0.5)));
+      }
+      avx.SetKernel(kernels::Kernel::kAvx, lanes);
+      scalar.SetKernel(kernels::Kernel::kScalar);
+      const Status sa = avx.Step(c.h), ss = scalar.Step(c.h);
+      ASSERT_EQ(sa.ok(), ss.ok()) << c.what << ": " << lanes << " lanes "
+                                  << (sa.ok() ? "ok" : sa.error().message) << ", scalar "
+                                  << (ss.ok() ? "ok" : ss.error().message);
+      if (!sa.ok()) {
+        EXPECT_EQ(sa.error().message, ss.error().message) << c.what;
+      }
+      EXPECT_EQ(avx.Hash(), scalar.Hash())
+          << c.what << ": y " << avx.state.py[0] << " (" << lanes << " lanes) against "
+          << scalar.state.py[0] << " (signbits " << std::signbit(avx.state.py[0]) << ", "
+          << std::signbit(scalar.state.py[0]) << ")";
     }
-    avx.SetKernel(kernels::Kernel::kAvx, 8);
-    scalar.SetKernel(kernels::Kernel::kScalar);
-    const Status sa = avx.Step(c.h), ss = scalar.Step(c.h);
-    ASSERT_EQ(sa.ok(), ss.ok()) << c.what << ": 8 lanes " << (sa.ok() ? "ok" : sa.error().message)
-                                << ", scalar " << (ss.ok() ? "ok" : ss.error().message);
-    if (!sa.ok()) EXPECT_EQ(sa.error().message, ss.error().message) << c.what;
-    EXPECT_EQ(avx.Hash(), scalar.Hash())
-        << c.what << ": y " << avx.state.py[0] << " (8 lanes) against " << scalar.state.py[0]
-        << " (signbits " << std::signbit(avx.state.py[0]) << ", "
-        << std::signbit(scalar.state.py[0]) << ")";
-  }
 }
 
 TEST(Bulk, PlaneCandidatesAreExactlyTheColliderTest) {
