@@ -162,7 +162,6 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
   alignas(32) float old[6][kChunk];
   float* const olds[6] = {old[0], old[1], old[2], old[3], old[4], old[5]};
   alignas(32) uint8_t flags[kChunk];
-  uint8_t done[kChunk];
   uint16_t idx[kChunk + 4];
   uint16_t near[kChunk];
   // The vector path for resting contact: one static plane that bounces.
@@ -192,17 +191,17 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
       if (const size_t i = BadRadiusIn(s.radius.data(), c, ce, faults_.limit2()); i != SIZE_MAX)
         faults_.BadRadius(i);
     };
-    if (floor && restLanes_ == 8) {
-      // A lone static floor on eight lanes: the advance and the floor's
-      // candidates, then its resting contacts, over the chunk; what is
-      // left of the candidates to the general path below.
+    if (floor) {
+      // A lone static floor: the advance and the floor's candidates, then
+      // its resting contacts, over the chunk; what is left of the
+      // candidates to the general path below.
       bool ok = true;
-      count = kernels::BulkAdvanceRestOnPlane(q, *floor, a, s.radius.data(), c, ce, olds, idx, &ok);
+      count = kernels::BulkAdvanceRestOnPlane(restLanes_, q, *floor, a, s.radius.data(), c, ce,
+                                              olds, idx, &ok);
       if (!ok) {
         faults_.Flag();
         checkRadii();
       }
-      std::memset(done, 0, count);
     } else {
       if (!kernels::BulkAdvance(kernel_, q, a, c, ce, olds)) faults_.Flag();
       if (colliders_.empty()) continue;  // no contact reads a radius
@@ -283,16 +282,8 @@ void BulkSystem::StepRange(size_t begin, size_t end, double h, const kernels::Bu
           if (flags[j] == 1 && s.invMass[c + j] != 0) idx[count++] = uint16_t(j);
         }
       }
-      // A lone static floor: its resting contacts four at a time (the same
-      // bits as the path below).
-      if (floor) {
-        kernels::BulkRestOnPlane(*floor, a, s.radius.data(), olds, c, idx, count, done);
-      } else {
-        std::memset(done, 0, count);
-      }
     }
     for (size_t k = 0; k < count; ++k) {
-      if (done[k]) continue;
       const size_t j = idx[k], i = c + j;
       Vec3 x = s.position(i), v = s.velocity(i);
       const double r = double(s.radius[i]);

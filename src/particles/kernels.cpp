@@ -238,10 +238,11 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   return _mm256_max_pd(b, a);
 }
 
-// base[j[0..3]] as doubles; one load when they are consecutive (run).
-[[gnu::target("avx")]] inline __m256d Lanes(const float* base, const size_t j[4], bool run) {
-  if (run) return _mm256_cvtps_pd(_mm_loadu_ps(base + j[0]));
-  return _mm256_cvtps_pd(_mm_set_ps(base[j[3]], base[j[2]], base[j[1]], base[j[0]]));
+// m ? b : a, lane by lane, for a mask m of all-ones or zero lanes, by bit
+// operations: GCC turns blendv_pd on a comparison's mask into scalar code
+// without AVX2 (it compares the mask's lanes as 64-bit integers).
+[[gnu::target("avx")]] inline __m256d Select(__m256d m, __m256d a, __m256d b) {
+  return _mm256_or_pd(_mm256_and_pd(m, b), _mm256_andnot_pd(m, a));
 }
 
 // The 4 lanes of a double-precision mask as a single-precision one (the
@@ -265,90 +266,111 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
                        _CMP_GE_OQ);
 }
 
-[[gnu::target("avx")]] void RestOnPlaneAvx(const PlaneRest& q, const BulkArrays& ar,
-                                           const float* radius, const float* const* old,
-                                           size_t begin, const uint16_t* idx, size_t count,
-                                           uint8_t* done) {
-  const __m256d n[3] = {_mm256_set1_pd(q.n[0]), _mm256_set1_pd(q.n[1]), _mm256_set1_pd(q.n[2])};
-  const __m256d p[3] = {_mm256_set1_pd(q.p[0]), _mm256_set1_pd(q.p[1]), _mm256_set1_pd(q.p[2])};
-  const __m256d h = _mm256_set1_pd(q.h), mh = _mm256_set1_pd(-q.h), half = _mm256_set1_pd(0.5);
-  const __m256d mu = _mm256_set1_pd(q.friction), zero = _mm256_setzero_pd();
-  const __m256d one = _mm256_set1_pd(1.0), tiny = _mm256_set1_pd(1e-300);
-  const __m256d tol = _mm256_set1_pd(1e-12), mtol = _mm256_set1_pd(-1e-12);
-  const __m256d limit2 = _mm256_set1_pd(q.limit2);
-  const __m256d skin = _mm256_set1_pd(kRestSkin), eps = _mm256_set1_pd(double(FLT_EPSILON));
-  const __m256d four = _mm256_set1_pd(4.0), sixteen = _mm256_set1_pd(kRestRoundings);
-  for (size_t k0 = 0; k0 < count; k0 += 4) {
-    // Four lanes (the last repeated past the end): one load an array where
-    // they are consecutive, the common case.
-    size_t j[4];
-    for (int l = 0; l < 4; ++l) j[l] = idx[std::min(k0 + size_t(l), count - 1)];
-    const bool run = j[3] == j[0] + 3 && k0 + 4 <= count;
-    __m256d a[3], va[3], x[3], v[3];
+// The plane and the step on four lanes, for RestRunsAvx.
+struct Rest4 {
+  __m256d n[3], p[3], h, mh, half, mu, zero, one, tiny, tol, mtol, limit2;
+  __m256d skin, eps, four, sixteen;  // kRestSkin, FLT_EPSILON, 4, kRestRoundings
+};
+
+// The resting kernel (see PlaneRest) on the candidates of G runs of four
+// consecutive particles, run g starting at first + at[g] (its start state
+// in old[..][at[g]], its advanced state in the arrays, its candidates the
+// lanes of cand[g]), in double precision. As in RestGroupsAvx512, the
+// runs' chains of dependent operations are interleaved statement by
+// statement (one chain is longer than the processor looks ahead). Writes
+// the particles it resolves to the arrays and appends the other
+// candidates' offsets (at[g] + lane) to idx.
+template <int G>
+[[gnu::target("avx")]] void RestRunsAvx(const Rest4& k, const BulkArrays& ar, const float* radius,
+                                        const float* const* old, size_t first, const uint16_t* at,
+                                        const uint8_t* cand, uint16_t* idx, size_t* listed) {
+  float* const to[6] = {ar.px + first, ar.py + first, ar.pz + first,
+                        ar.vx + first, ar.vy + first, ar.vz + first};
+  __m256d a[G][3], va[G][3], x[G][3], v[G][3], r[G];
+  for (int g = 0; g < G; ++g) {
     for (int c = 0; c < 3; ++c) {
-      a[c] = Lanes(old[c], j, run);
-      va[c] = Lanes(old[3 + c], j, run);
+      a[g][c] = _mm256_cvtps_pd(_mm_loadu_ps(old[c] + at[g]));
+      va[g][c] = _mm256_cvtps_pd(_mm_loadu_ps(old[3 + c] + at[g]));
+      x[g][c] = _mm256_cvtps_pd(_mm_loadu_ps(to[c] + at[g]));
+      v[g][c] = _mm256_cvtps_pd(_mm_loadu_ps(to[3 + c] + at[g]));
     }
-    const float* const now[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
-                                 ar.vx + begin, ar.vy + begin, ar.vz + begin};
+    r[g] = _mm256_cvtps_pd(_mm_loadu_ps(radius + first + at[g]));
+  }
+  __m256d dv[G][3], u[G][3], d0[G], ok[G];
+  for (int g = 0; g < G; ++g) {
+    __m256d ap[3];
     for (int c = 0; c < 3; ++c) {
-      x[c] = Lanes(now[c], j, run);
-      v[c] = Lanes(now[3 + c], j, run);
-    }
-    const __m256d r = Lanes(radius + begin, j, run);
-    __m256d dv[3], A[3], u[3], ap[3];
-    for (int c = 0; c < 3; ++c) {
-      dv[c] = _mm256_sub_pd(v[c], va[c]);
-      A[c] = _mm256_mul_pd(h, dv[c]);
-      u[c] = _mm256_sub_pd(_mm256_sub_pd(x[c], a[c]), _mm256_mul_pd(half, A[c]));
-      ap[c] = _mm256_sub_pd(a[c], p[c]);
+      dv[g][c] = _mm256_sub_pd(v[g][c], va[g][c]);
+      const __m256d A = _mm256_mul_pd(k.h, dv[g][c]);
+      u[g][c] = _mm256_sub_pd(_mm256_sub_pd(x[g][c], a[g][c]), _mm256_mul_pd(k.half, A));
+      ap[c] = _mm256_sub_pd(a[g][c], k.p[c]);
     }
     // The plane's contact at the start (a candidate ends the step inside:
-    // d1 < 0): d0 <= the skin (s = 0); on or below, at a - d0 n, and in the
-    // skin above, at a itself.
-    const __m256d d0 = _mm256_sub_pd(Dot3(n, ap[0], ap[1], ap[2]), r);
-    const __m256d amax = Max(one, Max(Max(Abs(a[0]), Abs(a[1])), Abs(a[2])));
-    __m256d ok = _mm256_cmp_pd(d0, _mm256_mul_pd(skin, amax), _CMP_LE_OQ);
-    const __m256d below = _mm256_cmp_pd(d0, zero, _CMP_LE_OQ);
-    __m256d point[3], px[3];
+    // d1 < 0): d0 <= the skin (s = 0); on or below, at a - d0 n, and in
+    // the skin above, at a itself. (Most lie within kRestSkin, which needs
+    // no largest coordinate: see StartsInSkin.)
+    d0[g] = _mm256_sub_pd(Dot3(k.n, ap[0], ap[1], ap[2]), r[g]);
+    ok[g] = _mm256_cmp_pd(d0[g], k.skin, _CMP_LE_OQ);
+  }
+  int far = 0;
+  for (int g = 0; g < G; ++g) far |= _mm256_movemask_pd(ok[g]) ^ 0xf;
+  if (far) {
+    for (int g = 0; g < G; ++g) {
+      const __m256d amax = Max(k.one, Max(Max(Abs(a[g][0]), Abs(a[g][1])), Abs(a[g][2])));
+      ok[g] = _mm256_cmp_pd(d0[g], _mm256_mul_pd(k.skin, amax), _CMP_LE_OQ);
+    }
+  }
+  __m256d point[G][3], un[G];
+  for (int g = 0; g < G; ++g) {
+    const __m256d below = _mm256_cmp_pd(d0[g], k.zero, _CMP_LE_OQ);
+    __m256d px[3];
     for (int c = 0; c < 3; ++c) {
-      point[c] = _mm256_blendv_pd(a[c], _mm256_sub_pd(a[c], _mm256_mul_pd(d0, n[c])), below);
-      px[c] = _mm256_sub_pd(point[c], x[c]);
+      point[g][c] = Select(below, a[g][c], _mm256_sub_pd(a[g][c], _mm256_mul_pd(d0[g], k.n[c])));
+      px[c] = _mm256_sub_pd(point[g][c], x[g][c]);
     }
     // Not a graze (sliding along the plane within rounding).
-    const __m256d xmax = Max(one, Max(Max(Abs(x[0]), Abs(x[1])), Abs(x[2])));
-    const __m256d umax = Max(tiny, Max(Max(Abs(u[0]), Abs(u[1])), Abs(u[2])));
-    const __m256d un = Dot3(n, u[0], u[1], u[2]);
+    const __m256d xmax = Max(k.one, Max(Max(Abs(x[g][0]), Abs(x[g][1])), Abs(x[g][2])));
+    const __m256d umax = Max(k.tiny, Max(Max(Abs(u[g][0]), Abs(u[g][1])), Abs(u[g][2])));
+    un[g] = Dot3(k.n, u[g][0], u[g][1], u[g][2]);
     const __m256d slides = _mm256_and_pd(
-        _mm256_cmp_pd(Dot3(n, px[0], px[1], px[2]), _mm256_mul_pd(tol, xmax), _CMP_LE_OQ),
-        _mm256_cmp_pd(un, _mm256_mul_pd(mtol, umax), _CMP_GE_OQ));
-    ok = _mm256_andnot_pd(slides, ok);
-    // Resting: no faster toward the plane than the step's forces made it.
-    const __m256d gained = Max(zero, _mm256_mul_pd(mh, Dot3(n, dv[0], dv[1], dv[2])));
-    ok = _mm256_andnot_pd(
-        _mm256_cmp_pd(_mm256_xor_pd(un, _mm256_set1_pd(-0.0)), gained, _CMP_GT_OQ), ok);
-    // The response.
-    const __m256d en = Dot3(n, v[0], v[1], v[2]);
-    const __m256d jn = Max(zero, _mm256_xor_pd(en, _mm256_set1_pd(-0.0)));
-    __m256d vt[3];
-    for (int c = 0; c < 3; ++c) vt[c] = _mm256_sub_pd(v[c], _mm256_mul_pd(en, n[c]));
-    const __m256d change = _mm256_mul_pd(mu, jn);
-    const __m256d len = _mm256_sqrt_pd(
-        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(vt[0], vt[0]), _mm256_mul_pd(vt[1], vt[1])),
-                      _mm256_mul_pd(vt[2], vt[2])));
-    const __m256d stops = _mm256_cmp_pd(len, change, _CMP_LE_OQ);
-    const __m256d keep = _mm256_sub_pd(one, _mm256_div_pd(change, len));
-    const __m256d up = Max(en, zero);
-    __m256d out[3], x1[3], x1p[3];
+        _mm256_cmp_pd(Dot3(k.n, px[0], px[1], px[2]), _mm256_mul_pd(k.tol, xmax), _CMP_LE_OQ),
+        _mm256_cmp_pd(un[g], _mm256_mul_pd(k.mtol, umax), _CMP_GE_OQ));
+    ok[g] = _mm256_andnot_pd(slides, ok[g]);
+  }
+  // Resting: no faster toward the plane than the step's forces made it.
+  // The response.
+  __m256d en[G], vt[G][3], change[G], len[G];
+  for (int g = 0; g < G; ++g) {
+    const __m256d gained =
+        Max(k.zero, _mm256_mul_pd(k.mh, Dot3(k.n, dv[g][0], dv[g][1], dv[g][2])));
+    ok[g] = _mm256_andnot_pd(
+        _mm256_cmp_pd(_mm256_xor_pd(un[g], _mm256_set1_pd(-0.0)), gained, _CMP_GT_OQ), ok[g]);
+    en[g] = Dot3(k.n, v[g][0], v[g][1], v[g][2]);
+    const __m256d jn = Max(k.zero, _mm256_xor_pd(en[g], _mm256_set1_pd(-0.0)));
+    for (int c = 0; c < 3; ++c) vt[g][c] = _mm256_sub_pd(v[g][c], _mm256_mul_pd(en[g], k.n[c]));
+    change[g] = _mm256_mul_pd(k.mu, jn);
+    len[g] = _mm256_sqrt_pd(_mm256_add_pd(
+        _mm256_add_pd(_mm256_mul_pd(vt[g][0], vt[g][0]), _mm256_mul_pd(vt[g][1], vt[g][1])),
+        _mm256_mul_pd(vt[g][2], vt[g][2])));
+  }
+  __m256d out[G][3], x1[G][3];
+  for (int g = 0; g < G; ++g) {
+    const __m256d stops = _mm256_cmp_pd(len[g], change[g], _CMP_LE_OQ);
+    const __m256d keep = _mm256_sub_pd(k.one, _mm256_div_pd(change[g], len[g]));
+    const __m256d up = Max(en[g], k.zero);
+    __m256d x1p[3];
     for (int c = 0; c < 3; ++c) {
-      const __m256d f = _mm256_blendv_pd(_mm256_mul_pd(vt[c], keep), zero, stops);
-      out[c] = _mm256_add_pd(f, _mm256_mul_pd(up, n[c]));
-      x1[c] = _mm256_add_pd(point[c], _mm256_mul_pd(h, out[c]));
-      x1p[c] = _mm256_sub_pd(x1[c], p[c]);
+      const __m256d f = _mm256_andnot_pd(stops, _mm256_mul_pd(vt[g][c], keep));  // 0 where stops
+      out[g][c] = _mm256_add_pd(f, _mm256_mul_pd(up, k.n[c]));
+      x1[g][c] = _mm256_add_pd(point[g][c], _mm256_mul_pd(k.h, out[g][c]));
+      x1p[c] = _mm256_sub_pd(x1[g][c], k.p[c]);
     }
     // Ends on the plane: no second contact, nothing to project.
-    ok = _mm256_and_pd(
-        ok, _mm256_cmp_pd(_mm256_sub_pd(Dot3(n, x1p[0], x1p[1], x1p[2]), r), zero, _CMP_GE_OQ));
+    ok[g] = _mm256_and_pd(
+        ok[g],
+        _mm256_cmp_pd(_mm256_sub_pd(Dot3(k.n, x1p[0], x1p[1], x1p[2]), r[g]), k.zero, _CMP_GE_OQ));
+  }
+  for (int g = 0; g < G; ++g) {
     // Rounded to floats on the plane's side (RoundOutside): a rounding's
     // displacement, doubled, must not cross it. A rounding that changes
     // nothing passes too: its doubled point is x1 itself, on the plane's
@@ -356,79 +378,141 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     __m128 xf[3];
     __m256d rx[3];
     for (int c = 0; c < 3; ++c) {
-      xf[c] = _mm256_cvtpd_ps(x1[c]);
+      xf[c] = _mm256_cvtpd_ps(x1[g][c]);
       rx[c] = _mm256_cvtps_pd(xf[c]);
     }
-    const __m256d crosses = _mm256_andnot_pd(OnPlaneSide4(n, p, x1, rx, r), ok);
-    if (_mm256_movemask_pd(crosses)) {
+    const __m256d crosses = _mm256_andnot_pd(OnPlaneSide4(k.n, k.p, x1[g], rx, r[g]), ok[g]);
+    if (_mm256_movemask_pd(crosses) & cand[g]) {
       // Where it crosses: a particle the response stopped (out = 0) keeps
       // its start's floats if they lie within kRestRoundings ulps of x1's
       // largest coordinate and on its side; any other is pushed off along
       // the normal by 4 such ulps and rounded again, which must not cross
       // (else the general path pushes again).
       const __m256d scale =
-          _mm256_mul_pd(eps, Max(one, Max(Max(Abs(x1[0]), Abs(x1[1])), Abs(x1[2]))));
-      const __m256d rest = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(out[0], zero, _CMP_EQ_OQ),
-                                                       _mm256_cmp_pd(out[1], zero, _CMP_EQ_OQ)),
-                                         _mm256_cmp_pd(out[2], zero, _CMP_EQ_OQ));
+          _mm256_mul_pd(k.eps, Max(k.one, Max(Max(Abs(x1[g][0]), Abs(x1[g][1])), Abs(x1[g][2]))));
+      const __m256d rest =
+          _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(out[g][0], k.zero, _CMP_EQ_OQ),
+                                      _mm256_cmp_pd(out[g][1], k.zero, _CMP_EQ_OQ)),
+                        _mm256_cmp_pd(out[g][2], k.zero, _CMP_EQ_OQ));
       const __m256d apart =
-          Max(Max(Abs(_mm256_sub_pd(a[0], x1[0])), Abs(_mm256_sub_pd(a[1], x1[1]))),
-              Abs(_mm256_sub_pd(a[2], x1[2])));
+          Max(Max(Abs(_mm256_sub_pd(a[g][0], x1[g][0])), Abs(_mm256_sub_pd(a[g][1], x1[g][1]))),
+              Abs(_mm256_sub_pd(a[g][2], x1[g][2])));
       const __m256d keeps = _mm256_and_pd(
           _mm256_and_pd(crosses, rest),
-          _mm256_and_pd(_mm256_cmp_pd(apart, _mm256_mul_pd(sixteen, scale), _CMP_LE_OQ),
-                        OnPlaneSide4(n, p, x1, a, r)));
-      const __m256d push = _mm256_mul_pd(four, scale);
+          _mm256_and_pd(_mm256_cmp_pd(apart, _mm256_mul_pd(k.sixteen, scale), _CMP_LE_OQ),
+                        OnPlaneSide4(k.n, k.p, x1[g], a[g], r[g])));
+      const __m256d push = _mm256_mul_pd(k.four, scale);
       __m128 pf[3];
       __m256d pr[3];
       for (int c = 0; c < 3; ++c) {
-        pf[c] = _mm256_cvtpd_ps(_mm256_add_pd(x1[c], _mm256_mul_pd(push, n[c])));
+        pf[c] = _mm256_cvtpd_ps(_mm256_add_pd(x1[g][c], _mm256_mul_pd(push, k.n[c])));
         pr[c] = _mm256_cvtps_pd(pf[c]);
       }
       const __m256d pushed =
-          _mm256_andnot_pd(keeps, _mm256_and_pd(crosses, OnPlaneSide4(n, p, x1, pr, r)));
+          _mm256_andnot_pd(keeps, _mm256_and_pd(crosses, OnPlaneSide4(k.n, k.p, x1[g], pr, r[g])));
       const __m128 keepsf = Narrow(keeps), pushedf = Narrow(pushed);
       for (int c = 0; c < 3; ++c) {
-        xf[c] = _mm_blendv_ps(xf[c], _mm256_cvtpd_ps(a[c]), keepsf);
+        xf[c] = _mm_blendv_ps(xf[c], _mm256_cvtpd_ps(a[g][c]), keepsf);
         xf[c] = _mm_blendv_ps(xf[c], pf[c], pushedf);
-        rx[c] = _mm256_blendv_pd(rx[c], a[c], keeps);
-        rx[c] = _mm256_blendv_pd(rx[c], pr[c], pushed);
+        rx[c] = Select(keeps, rx[c], a[g][c]);
+        rx[c] = Select(pushed, rx[c], pr[c]);
       }
-      ok = _mm256_andnot_pd(_mm256_andnot_pd(_mm256_or_pd(keeps, pushed), crosses), ok);
+      ok[g] = _mm256_andnot_pd(_mm256_andnot_pd(_mm256_or_pd(keeps, pushed), crosses), ok[g]);
     }
     // Within the magnitude limit.
     const __m256d xx =
         _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(rx[0], rx[0]), _mm256_mul_pd(rx[1], rx[1])),
                       _mm256_mul_pd(rx[2], rx[2]));
-    const __m256d vv =
-        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(out[0], out[0]), _mm256_mul_pd(out[1], out[1])),
-                      _mm256_mul_pd(out[2], out[2]));
-    ok = _mm256_and_pd(ok, _mm256_cmp_pd(_mm256_add_pd(xx, vv), limit2, _CMP_LE_OQ));
-    const int mask = _mm256_movemask_pd(ok);
+    const __m256d vv = _mm256_add_pd(
+        _mm256_add_pd(_mm256_mul_pd(out[g][0], out[g][0]), _mm256_mul_pd(out[g][1], out[g][1])),
+        _mm256_mul_pd(out[g][2], out[g][2]));
+    ok[g] = _mm256_and_pd(ok[g], _mm256_cmp_pd(_mm256_add_pd(xx, vv), k.limit2, _CMP_LE_OQ));
     __m128 fv[3];
-    for (int c = 0; c < 3; ++c) fv[c] = _mm256_cvtpd_ps(out[c]);
-    float* const to[6] = {ar.px + begin, ar.py + begin, ar.pz + begin,
-                          ar.vx + begin, ar.vy + begin, ar.vz + begin};
-    if (run && mask == 0xf) {
+    for (int c = 0; c < 3; ++c) fv[c] = _mm256_cvtpd_ps(out[g][c]);
+    const int done = _mm256_movemask_pd(ok[g]) & cand[g];
+    if (done == 0xf) {
       for (int c = 0; c < 3; ++c) {
-        _mm_storeu_ps(to[c] + j[0], xf[c]);
-        _mm_storeu_ps(to[3 + c] + j[0], fv[c]);
+        _mm_storeu_ps(to[c] + at[g], xf[c]);
+        _mm_storeu_ps(to[3 + c] + at[g], fv[c]);
       }
-      std::memset(done + k0, 1, 4);
       continue;
     }
-    alignas(16) float fx[6][4];
-    for (int c = 0; c < 3; ++c) {
-      _mm_store_ps(fx[c], xf[c]);
-      _mm_store_ps(fx[3 + c], fv[c]);
+    if (done) {
+      // The resolved lanes over the others' floats (the same values back).
+      const __m128i bit = _mm_setr_epi32(1, 2, 4, 8);
+      const __m128 m =
+          _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(done), bit), bit));
+      for (int c = 0; c < 6; ++c) {
+        const __m128 now = _mm_loadu_ps(to[c] + at[g]);
+        _mm_storeu_ps(to[c] + at[g], _mm_blendv_ps(now, c < 3 ? xf[c] : fv[c - 3], m));
+      }
     }
-    for (int l = 0; l < 4 && k0 + size_t(l) < count; ++l) {
-      const bool d = (mask >> l) & 1;
-      done[k0 + l] = d;
-      if (!d) continue;
-      for (int c = 0; c < 6; ++c) to[c][j[l]] = fx[c][l];
-    }
+    // The rest to the general path.
+    for (unsigned left = unsigned(cand[g] & ~done); left; left &= left - 1)
+      idx[(*listed)++] = uint16_t(at[g] + unsigned(__builtin_ctz(left)));
   }
+}
+
+// BulkAdvanceAvx's step, the plane's candidate test (PlaneListAvx's) and
+// the resting kernel over [i, e), as AdvanceRestAvx512 below on four lanes,
+// in three passes over that range (at most a chunk, which stays in L1): the
+// advance; the candidate test four at a time, listing the runs of four with
+// candidates; the resting kernel on those runs. (Fused, the advance and the
+// test need more than AVX's 16 registers and were slower.) Returns the
+// first index it did not do; the candidates the resting kernel leaves go
+// to idx (relative to first), in order, *count counting them.
+[[gnu::target("avx")]] size_t AdvanceRestAvx(const BulkParams& q, const PlaneRest& rq,
+                                             const BulkArrays& ar, const float* radius, size_t i,
+                                             size_t e, size_t first, float* const* old,
+                                             uint16_t* idx, size_t* count, bool* good) {
+  SYLVA_ASSERT(e - i <= kRestRange);
+  const size_t begin = i;
+  i = BulkAdvanceAvx(q, ar, i, e, old, i - first, good);
+  const Rest4 k{{_mm256_set1_pd(rq.n[0]), _mm256_set1_pd(rq.n[1]), _mm256_set1_pd(rq.n[2])},
+                {_mm256_set1_pd(rq.p[0]), _mm256_set1_pd(rq.p[1]), _mm256_set1_pd(rq.p[2])},
+                _mm256_set1_pd(rq.h),
+                _mm256_set1_pd(-rq.h),
+                _mm256_set1_pd(0.5),
+                _mm256_set1_pd(rq.friction),
+                _mm256_setzero_pd(),
+                _mm256_set1_pd(1.0),
+                _mm256_set1_pd(1e-300),
+                _mm256_set1_pd(1e-12),
+                _mm256_set1_pd(-1e-12),
+                _mm256_set1_pd(rq.limit2),
+                _mm256_set1_pd(kRestSkin),
+                _mm256_set1_pd(double(FLT_EPSILON)),
+                _mm256_set1_pd(4.0),
+                _mm256_set1_pd(kRestRoundings)};
+  // The candidates (PlaneListAvx): movable particles that end behind the
+  // plane; a run of four listed if it has any (without a branch). The
+  // radius, in [0, limit] (a bad one clears *good: see BadRadiusIn).
+  uint16_t at[kRestRange / 4];
+  uint8_t cand[kRestRange / 4];
+  size_t runs = 0;
+  const __m128 zerof = _mm_setzero_ps(), limit = _mm_set1_ps(q.limit);
+  __m128 radii = _mm_castsi128_ps(_mm_set1_epi32(-1));
+  for (size_t j = begin; j < i; j += 4) {
+    const __m128 rf = _mm_loadu_ps(radius + j);
+    radii = _mm_and_ps(
+        radii, _mm_and_ps(_mm_cmp_ps(rf, zerof, _CMP_GE_OQ), _mm_cmp_ps(rf, limit, _CMP_LE_OQ)));
+    const __m256d d = Dot3(k.n, _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(ar.px + j)), k.p[0]),
+                           _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(ar.py + j)), k.p[1]),
+                           _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(ar.pz + j)), k.p[2]));
+    const int candidates =
+        _mm256_movemask_pd(_mm256_cmp_pd(d, _mm256_cvtps_pd(rf), _CMP_LT_OQ)) &
+        _mm_movemask_ps(_mm_cmp_ps(_mm_loadu_ps(ar.invMass + j), zerof, _CMP_NEQ_UQ));
+    at[runs] = uint16_t(j - first);
+    cand[runs] = uint8_t(candidates);
+    runs += candidates != 0;
+  }
+  *good = *good && _mm_movemask_ps(radii) == 0xf;
+  // The resting kernel on the listed runs.
+  size_t g = 0;
+  for (; g + 2 <= runs; g += 2)
+    RestRunsAvx<2>(k, ar, radius, old, first, at + g, cand + g, idx, count);
+  for (; g < runs; ++g) RestRunsAvx<1>(k, ar, radius, old, first, at + g, cand + g, idx, count);
+  return i;
 }
 
 // --- The same resting kernel on eight lanes (AVX-512 F, DQ and VL) ---
@@ -996,12 +1080,14 @@ size_t BulkPlaneCandidateList(Kernel kernel, const double* n, const double* p, c
   return count;
 }
 
-size_t BulkAdvanceRestOnPlane(const BulkParams& q, const PlaneRest& rest, const BulkArrays& a,
-                              const float* radius, size_t begin, size_t end, float* const* old,
-                              uint16_t* idx, bool* ok) {
+size_t BulkAdvanceRestOnPlane(int lanes, const BulkParams& q, const PlaneRest& rest,
+                              const BulkArrays& a, const float* radius, size_t begin, size_t end,
+                              float* const* old, uint16_t* idx, bool* ok) {
+  SYLVA_ASSERT((lanes == 4 || lanes == 8) && lanes <= RestLanes());
   size_t count = 0;
   const size_t tail =
-      AdvanceRestAvx512(q, rest, a, radius, begin, end, begin, old, idx, &count, ok);
+      lanes == 8 ? AdvanceRestAvx512(q, rest, a, radius, begin, end, begin, old, idx, &count, ok)
+                 : AdvanceRestAvx(q, rest, a, radius, begin, end, begin, old, idx, &count, ok);
   // The tail (fewer than eight): the advance, and its candidates to the
   // general path.
   for (size_t i = tail; i < end; ++i) *ok &= BulkOne(q, a, i, old, i - begin);
@@ -1013,12 +1099,6 @@ size_t BulkAdvanceRestOnPlane(const BulkParams& q, const PlaneRest& rest, const 
     if (d < double(radius[i]) && a.invMass[i] != 0) idx[count++] = uint16_t(i - begin);
   }
   return count;
-}
-
-void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radius,
-                     const float* const* old, size_t begin, const uint16_t* idx, size_t count,
-                     uint8_t* done) {
-  RestOnPlaneAvx(q, a, radius, old, begin, idx, count, done);
 }
 
 int ScreenLanes() {

@@ -109,8 +109,8 @@ void BulkPlaneCandidates(Kernel kernel, const double* n, const double* p, const 
 size_t BulkPlaneCandidateList(Kernel kernel, const double* n, const double* p, const BulkArrays& a,
                               const float* radius, size_t begin, size_t end, uint16_t* idx);
 
-// Resting contact on a single static plane (the bulk step's floor), four
-// particles at a time in double precision: the operations, in the same order,
+// Resting contact on a single static plane (the bulk step's floor), four or
+// eight particles at a time in double precision: the operations, in the same order,
 // that RespondToContacts (its fast path for one resting contact at the start
 // of the step), ProjectOut and the bulk step's rounding take for a particle
 // that starts on or below the plane (d0 = n . (a - p) - r <= 0), approaches
@@ -137,29 +137,25 @@ struct PlaneRest {
   double n[3], p[3];
   double friction, h, limit2;
 };
-// For the candidates idx[0..count) (indices into [begin, begin + kChunk) of
-// the arrays, increasing, each a movable particle that ends the step inside
-// the plane: the plane's candidates; `old` holds the step's start state by
-// chunk index as in BulkAdvance): writes the particles it resolves into the arrays and
-// sets done[k] to 1 for them, 0 for the rest. AVX, four lanes.
-void BulkRestOnPlane(const PlaneRest& q, const BulkArrays& a, const float* radius,
-                     const float* const* old, size_t begin, const uint16_t* idx, size_t count,
-                     uint8_t* done);
-// BulkAdvance (AVX), BulkPlaneCandidateList and BulkRestOnPlane over
-// [begin, end), at most kRestRange particles (8 lanes; only where
-// RestLanes() is 8): the same bits as the three in turn. Two passes over
-// the range, which stays in L1: the advance and the candidate test, then
-// the resting kernel on the groups of eight with candidates, four groups
-// at a time. Writes to idx the candidates the resting kernel leaves (for the
-// general path), as BulkPlaneCandidateList, and returns their count; ANDs
-// BulkAdvance's check and the radii's (each in [0, q.limit]) into *ok.
+//
+// BulkAdvance (AVX), BulkPlaneCandidateList and that resting kernel over
+// [begin, end), at most kRestRange particles, on `lanes` lanes (4, or 8
+// where RestLanes() is 8): the same bits as BulkAdvance and
+// BulkPlaneCandidateList, then the general path's response to each
+// candidate. Two passes over the range, which stays in L1: the advance
+// and the candidate test eight particles at a time, then the resting
+// kernel on the runs of four (4 lanes) or groups of eight (8 lanes, four
+// groups at a time) with candidates. Writes to idx the candidates the
+// resting kernel leaves (for the general path), as
+// BulkPlaneCandidateList, and returns their count; a tail of fewer than
+// eight is advanced and its candidates listed. ANDs BulkAdvance's check
+// and the radii's (each in [0, q.limit]) into *ok.
 constexpr size_t kRestRange = 512;
-size_t BulkAdvanceRestOnPlane(const BulkParams& q, const PlaneRest& rest, const BulkArrays& a,
-                              const float* radius, size_t begin, size_t end, float* const* old,
-                              uint16_t* idx, bool* ok);
-// The widest resting-floor path this processor runs: 8 lanes
-// (BulkAdvanceRestOnPlane) with AVX-512 (F, DQ, VL) and BMI2, 4
-// (BulkRestOnPlane) with AVX, 0 without AVX (no vector path).
+size_t BulkAdvanceRestOnPlane(int lanes, const BulkParams& q, const PlaneRest& rest,
+                              const BulkArrays& a, const float* radius, size_t begin, size_t end,
+                              float* const* old, uint16_t* idx, bool* ok);
+// The widest resting-floor path this processor runs: 8 lanes with AVX-512
+// (F, DQ, VL) and BMI2, 4 with AVX, 0 without AVX (no vector path).
 int RestLanes();
 
 // --- System's particle-particle contacts (pairs.cpp) ---

@@ -209,62 +209,66 @@ void FillGroups(BulkState& s, int chunks) {
 }
 
 TEST(Bulk, RestingFloorGroupsInAnyNumberMatchTheScalarPath) {
-  if (kernels::RestLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
-  // The 8-lane path lists a chunk's groups of eight with candidates and
-  // resolves them four at a time, then one at a time: chunks with 1 to 9
-  // such groups (every remainder), on an axis-aligned floor, each group
-  // mixing resting, sliding and stopping lanes, a bounce, an immovable lane
-  // and one in the air.
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
+  // The fused path lists a chunk's groups of eight (8 lanes) or runs of four
+  // (4 lanes) with candidates; 8 lanes resolve them four groups at a time,
+  // then one at a time: chunks with 1 to 9 such groups (every remainder),
+  // on an axis-aligned floor, each group mixing resting, sliding and
+  // stopping lanes, a bounce, an immovable lane and one in the air.
   constexpr int kChunks = 9;
-  for (double mu : {0.1, 3.0}) {
-    BulkSystem avx, scalar;
-    for (BulkSystem* b : {&avx, &scalar}) {
-      FillGroups(b->state, kChunks);
-      b->fields.gravity = Vec3(0, -kG, 0);
-      b->fields.linearDrag = 0.1;
-      b->fields.quadraticDrag = 0.01;
-      EXPECT_OK(b->AddCollider(
-          Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.8).Friction(mu)));
-    }
-    // The kernel itself, on the first step of each chunk: it resolves every
-    // resting lane, the ball whose rounding would put it inside too (pushed
-    // off), and leaves to the general path each group's bounce.
-    {
-      BulkState s = avx.state;
-      const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
-                                  s.vy.data(), s.vz.data(), s.invMass.data()};
-      const double h = double(float(1.0 / 240));
-      const kernels::BulkParams q{0, float(-kG), 0, 0, 0, 0, 0.1f, 0.01f, float(h), 1e30f};
-      const kernels::PlaneRest rest{{0, 1, 0}, {0, -1, 0}, mu, h, 1e300};
-      std::vector<float> old(6 * 512);
-      float* const olds[6] = {&old[0], &old[512], &old[1024], &old[1536], &old[2048], &old[2560]};
-      std::vector<uint16_t> idx(512 + 4);
-      for (int c = 0; c < kChunks; ++c) {
-        bool ok = true;
-        const size_t left =
-            kernels::BulkAdvanceRestOnPlane(q, rest, a, s.radius.data(), size_t(512 * c),
-                                            size_t(512 * (c + 1)), olds, idx.data(), &ok);
-        EXPECT_TRUE(ok);
-        std::vector<uint16_t> expected;
-        for (int g = 0; g <= 7 * c; g += 7) {
-          expected.push_back(uint16_t(8 * g + 3));
+  std::vector<int> widths = {4};
+  if (kernels::RestLanes() == 8) widths.push_back(8);
+  for (int lanes : widths)
+    for (double mu : {0.1, 3.0}) {
+      BulkSystem avx, scalar;
+      for (BulkSystem* b : {&avx, &scalar}) {
+        FillGroups(b->state, kChunks);
+        b->fields.gravity = Vec3(0, -kG, 0);
+        b->fields.linearDrag = 0.1;
+        b->fields.quadraticDrag = 0.01;
+        EXPECT_OK(b->AddCollider(
+            Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0)).Restitution(0.8).Friction(mu)));
+      }
+      // The kernel itself, on the first step of each chunk: it resolves every
+      // resting lane, the ball whose rounding would put it inside too (pushed
+      // off), and leaves to the general path each group's bounce.
+      {
+        BulkState s = avx.state;
+        const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
+                                    s.vy.data(), s.vz.data(), s.invMass.data()};
+        const double h = double(float(1.0 / 240));
+        const kernels::BulkParams q{0, float(-kG), 0, 0, 0, 0, 0.1f, 0.01f, float(h), 1e30f};
+        const kernels::PlaneRest rest{{0, 1, 0}, {0, -1, 0}, mu, h, 1e300};
+        std::vector<float> old(6 * 512);
+        float* const olds[6] = {&old[0], &old[512], &old[1024], &old[1536], &old[2048], &old[2560]};
+        std::vector<uint16_t> idx(512 + 4);
+        for (int c = 0; c < kChunks; ++c) {
+          bool ok = true;
+          const size_t left =
+              kernels::BulkAdvanceRestOnPlane(lanes, q, rest, a, s.radius.data(), size_t(512 * c),
+                                              size_t(512 * (c + 1)), olds, idx.data(), &ok);
+          EXPECT_TRUE(ok);
+          std::vector<uint16_t> expected;
+          for (int g = 0; g <= 7 * c; g += 7) {
+            expected.push_back(uint16_t(8 * g + 3));
+          }
+          EXPECT_EQ(std::vector<uint16_t>(idx.begin(), idx.begin() + ptrdiff_t(left)), expected)
+              << lanes << " lanes, mu " << mu << ", chunk " << c << ": the candidates left";
         }
-        EXPECT_EQ(std::vector<uint16_t>(idx.begin(), idx.begin() + ptrdiff_t(left)), expected)
-            << "mu " << mu << ", chunk " << c << ": the candidates left";
+      }
+      avx.SetKernel(kernels::Kernel::kAvx, lanes);
+      scalar.SetKernel(kernels::Kernel::kScalar);
+      for (int k = 0; k < 60; ++k) {
+        BULK_STEP_OK(avx, 1.0 / 240);
+        BULK_STEP_OK(scalar, 1.0 / 240);
+        ASSERT_EQ(avx.Hash(), scalar.Hash())
+            << lanes << " lanes, mu " << mu << ": states differ after step " << k;
       }
     }
-    avx.SetKernel(kernels::Kernel::kAvx, 8);
-    scalar.SetKernel(kernels::Kernel::kScalar);
-    for (int k = 0; k < 60; ++k) {
-      BULK_STEP_OK(avx, 1.0 / 240);
-      BULK_STEP_OK(scalar, 1.0 / 240);
-      ASSERT_EQ(avx.Hash(), scalar.Hash()) << "mu " << mu << ": states differ after step " << k;
-    }
-  }
 }
 
 TEST(Bulk, UpFloorKernelKeepsTheSignsOfZeros) {
-  if (kernels::RestLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
   // The floor y = 0 with normal (+0, 1, +0) takes the 8-lane kernel that
   // skips the products by 0 and 1 (kUp): there a zero's sign depends on
   // operations the kernel does not take, so it must leave those lanes to
@@ -273,76 +277,69 @@ TEST(Bulk, UpFloorKernelKeepsTheSignsOfZeros) {
   // velocities of zeros of every sign, gravity and wind with a y of -0 (the
   // advance then leaves a vertical velocity of -0: a particle inside with it
   // is the kernel's) and of -9.81, slow and fast friction: the same bits as
-  // the scalar path, every step.
+  // the scalar path, every step. (The 4-lane kernel, which takes every
+  // product, too.)
   const float zeros[2] = {0.0f, -0.0f};
-  for (double gy : {-0.0, -kG}) {
-    for (double mu : {0.1, 3.0}) {
-      BulkSystem avx, scalar;
-      for (BulkSystem* b : {&avx, &scalar}) {
-        for (int i = 0; i < 1031; ++i) {
-          const int bits = i % 64;
-          const double x = (bits & 1) ? double(zeros[(bits >> 1) & 1]) : 0.01 * (i % 7) - 0.03;
-          const double y = (i / 256) % 2 ? -1e-3 * ((i / 512) + 1) : double(zeros[(bits >> 2) & 1]);
-          const double vx = (bits & 8) ? double(zeros[(bits >> 4) & 1]) : 0.3 * ((i % 5) - 2);
-          const double vy = double(zeros[(bits >> 5) & 1]);
-          const double vz = (i / 64) % 2 ? double(zeros[(i / 128) % 2]) : 0.2;
-          b->state.Add(Vec3(x, y, 0.5 * x), Vec3(vx, vy, vz));
+  std::vector<int> widths = {4};
+  if (kernels::RestLanes() == 8) widths.push_back(8);
+  for (int lanes : widths)
+    for (double gy : {-0.0, -kG}) {
+      for (double mu : {0.1, 3.0}) {
+        BulkSystem avx, scalar;
+        for (BulkSystem* b : {&avx, &scalar}) {
+          for (int i = 0; i < 1031; ++i) {
+            const int bits = i % 64;
+            const double x = (bits & 1) ? double(zeros[(bits >> 1) & 1]) : 0.01 * (i % 7) - 0.03;
+            const double y =
+                (i / 256) % 2 ? -1e-3 * ((i / 512) + 1) : double(zeros[(bits >> 2) & 1]);
+            const double vx = (bits & 8) ? double(zeros[(bits >> 4) & 1]) : 0.3 * ((i % 5) - 2);
+            const double vy = double(zeros[(bits >> 5) & 1]);
+            const double vz = (i / 64) % 2 ? double(zeros[(i / 128) % 2]) : 0.2;
+            b->state.Add(Vec3(x, y, 0.5 * x), Vec3(vx, vy, vz));
+          }
+          b->fields.gravity = Vec3(0, gy, 0);
+          b->fields.wind = Vec3(0, -0.0, 0);
+          b->fields.linearDrag = 0.1;
+          EXPECT_OK(b->AddCollider(
+              Collider::Plane(Vec3(0, 0, 0), Vec3(0, 1, 0)).Restitution(0.5).Friction(mu)));
         }
-        b->fields.gravity = Vec3(0, gy, 0);
-        b->fields.wind = Vec3(0, -0.0, 0);
-        b->fields.linearDrag = 0.1;
-        EXPECT_OK(b->AddCollider(
-            Collider::Plane(Vec3(0, 0, 0), Vec3(0, 1, 0)).Restitution(0.5).Friction(mu)));
-      }
-      avx.SetKernel(kernels::Kernel::kAvx, 8);
-      scalar.SetKernel(kernels::Kernel::kScalar);
-      for (int k = 0; k < 30; ++k) {
-        BULK_STEP_OK(avx, 1.0 / 240);
-        BULK_STEP_OK(scalar, 1.0 / 240);
-        ASSERT_EQ(avx.Hash(), scalar.Hash())
-            << "gravity y " << gy << ", mu " << mu << ": states differ after step " << k;
+        avx.SetKernel(kernels::Kernel::kAvx, lanes);
+        scalar.SetKernel(kernels::Kernel::kScalar);
+        for (int k = 0; k < 30; ++k) {
+          BULK_STEP_OK(avx, 1.0 / 240);
+          BULK_STEP_OK(scalar, 1.0 / 240);
+          ASSERT_EQ(avx.Hash(), scalar.Hash()) << lanes << " lanes, gravity y " << gy << ", mu "
+                                               << mu << ": states differ after step " << k;
+        }
       }
     }
-  }
 }
 
-// The candidates that the floor's resting kernel of `lanes` lanes leaves to
-// the general path in a step of h from the state s (on a copy): 8 lanes
-// take BulkAdvanceRestOnPlane, 4 take BulkAdvance, BulkPlaneCandidateList
-// and BulkRestOnPlane, each whole chunk of 512 as the bulk step does (the
-// 8-lane path leaves a ragged tail to the general path). Whether particle i
-// was left in (*left)[i] where left is given.
+// The candidates that the floor's resting kernel of `lanes` lanes
+// (BulkAdvanceRestOnPlane) leaves to the general path in a step of h from
+// the state s, each whole chunk of 512 as the bulk step does (a ragged
+// tail goes to the general path). The state after the step in *after and
+// whether particle i was left in (*left)[i] where they are given.
 size_t LeftByFloorKernel(BulkState s, int lanes, const kernels::BulkParams& q,
-                         const kernels::PlaneRest& rest, std::vector<bool>* left = nullptr) {
+                         const kernels::PlaneRest& rest, std::vector<bool>* left = nullptr,
+                         BulkState* after = nullptr) {
   const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
                               s.vy.data(), s.vz.data(), s.invMass.data()};
   std::vector<float> old(6 * 512);
   float* const olds[6] = {&old[0], &old[512], &old[1024], &old[1536], &old[2048], &old[2560]};
   std::vector<uint16_t> idx(512 + 4);
-  std::vector<uint8_t> done(512);
   if (left) left->assign(s.size(), false);
   size_t total = 0;
   for (size_t c = 0; c + 512 <= s.size(); c += 512) {
-    const size_t e = c + 512;
     bool ok = true;
-    if (lanes == 8) {
-      const size_t m =
-          kernels::BulkAdvanceRestOnPlane(q, rest, a, s.radius.data(), c, e, olds, idx.data(), &ok);
-      total += m;
-      if (left)
-        for (size_t k = 0; k < m; ++k) (*left)[c + idx[k]] = true;
-      continue;
-    }
-    kernels::BulkAdvance(kernels::Kernel::kAvx, q, a, c, e, olds);
-    const size_t m = kernels::BulkPlaneCandidateList(kernels::Kernel::kAvx, rest.n, rest.p, a,
-                                                     s.radius.data(), c, e, idx.data());
-    kernels::BulkRestOnPlane(rest, a, s.radius.data(), olds, c, idx.data(), m, done.data());
-    for (size_t k = 0; k < m; ++k) {
-      if (done[k]) continue;
-      ++total;
-      if (left) (*left)[c + idx[k]] = true;
+    const size_t m = kernels::BulkAdvanceRestOnPlane(lanes, q, rest, a, s.radius.data(), c, c + 512,
+                                                     olds, idx.data(), &ok);
+    total += m;
+    if (left) {
+      for (size_t k = 0; k < m; ++k) (*left)[c + idx[k]] = true;
     }
   }
+  if (after) *after = std::move(s);
   return total;
 }
 
@@ -362,9 +359,18 @@ TEST(Bulk, BallsRestingWhereFloatsCannotStayOnTheFloorKernel) {
   // few ulps of it.
   std::vector<int> widths = {4};
   if (kernels::RestLanes() == 8) widths.push_back(8);
+  // The third floor spreads the balls over 40 m: there the push is 4 ulps
+  // of 40 (beyond kRestSkin, within the skin of their largest coordinate).
+  struct Floor {
+    Vec3 n, p;
+    double spread;
+  };
+  const Floor floors[] = {{Vec3(0, 1, 0), Vec3(0, -1, 0), 1},
+                          {Vec3(0.1, 1, -0.05).normalized(), Vec3(0.1, -0.7, 0.3), 1},
+                          {Vec3(0, 1, 0), Vec3(0, -1, 0), 40}};
   for (int lanes : widths)
-    for (const Vec3& n : {Vec3(0, 1, 0), Vec3(0.1, 1, -0.05).normalized()}) {
-      const Vec3 p = n.y() == 1 ? Vec3(0, -1, 0) : Vec3(0.1, -0.7, 0.3);
+    for (const Floor& floor : floors) {
+      const Vec3 n = floor.n, p = floor.p;
       for (double mu : {0.1, 3.0}) {
         BulkSystem avx, scalar;
         for (BulkSystem* b : {&avx, &scalar}) {
@@ -372,7 +378,7 @@ TEST(Bulk, BallsRestingWhereFloatsCannotStayOnTheFloorKernel) {
           std::uniform_real_distribution<double> u(-1, 1);
           for (int i = 0; i < 2051; ++i) {
             const float r = i % 3 == 0 ? 0.01f : i % 3 == 1 ? 0.05f : 0.003f;
-            Vec3 x(u(rng), 0, u(rng));
+            Vec3 x(floor.spread * u(rng), 0, floor.spread * u(rng));
             x -= (n.dot(x - p) - double(r)) * n;  // on the floor, then rounded
             const Vec3 v = 0.5 * Vec3(u(rng), 0, u(rng));
             b->state.Add(x, v - n.dot(v) * n);
@@ -396,14 +402,14 @@ TEST(Bulk, BallsRestingWhereFloatsCannotStayOnTheFloorKernel) {
             // - p) >= r in doubles, fails within rounding for them (for the
             // floor y = -1 it is exact).
             ASSERT_LE(double(left), n.y() == 1 ? 0.0 : 0.6 * double(avx.state.size()))
-                << lanes << " lanes, normal " << n.transpose() << ", mu " << mu << ", step " << k
-                << ": balls the kernel left to the general path";
+                << lanes << " lanes, normal " << n.transpose() << ", spread " << floor.spread
+                << ", mu " << mu << ", step " << k << ": balls the kernel left to the general path";
           }
           BULK_STEP_OK(avx, 1.0 / 240);
           BULK_STEP_OK(scalar, 1.0 / 240);
           ASSERT_EQ(avx.Hash(), scalar.Hash())
-              << lanes << " lanes, normal " << n.transpose() << ", mu " << mu
-              << ": states differ after step " << k;
+              << lanes << " lanes, normal " << n.transpose() << ", spread " << floor.spread
+              << ", mu " << mu << ": states differ after step " << k;
         }
         double lowest = 1, highest = -1;
         for (size_t i = 0; i < avx.state.size(); ++i) {
@@ -413,65 +419,62 @@ TEST(Bulk, BallsRestingWhereFloatsCannotStayOnTheFloorKernel) {
         }
         EXPECT_GE(lowest, 0.0) << "normal " << n.transpose() << ", mu " << mu
                                << ": a centre below the floor by " << -lowest << " m";
-        EXPECT_LT(highest, 2e-6) << "normal " << n.transpose() << ", mu " << mu
-                                 << ": a ball above the floor by " << highest << " m";
+        EXPECT_LT(highest, 2e-6 * floor.spread)
+            << "normal " << n.transpose() << ", spread " << floor.spread << ", mu " << mu
+            << ": a ball above the floor by " << highest << " m";
       }
     }
 }
 
 TEST(Bulk, FloorKernelLeavesWhatEndsBeyondTheMagnitudeLimit) {
-  if (kernels::RestLanes() != 8) GTEST_SKIP() << "no AVX-512 on this processor";
+  if (kernels::Best() != kernels::Kernel::kAvx) GTEST_SKIP() << "no AVX on this processor";
   // The kernel resolves a resting particle only where x.x + v.v <= limit2
   // after the step (the general path then flags it: MaybeWithinLimit); it
   // skips that sum where all six floats are small enough for it to hold.
   // Resting particles spread over |x|, |z| <= 2 under a limit2 of 4: none
   // ending beyond it is resolved, on the floor y = 0 and a tilted one, and
-  // on the floor y = 0 every one left ends beyond it.
-  for (const Vec3& n : {Vec3(0, 1, 0), Vec3(0.1, 1, -0.05).normalized()}) {
-    BulkState s;
-    std::mt19937 rng(9);
-    std::uniform_real_distribution<double> u(-2, 2);
-    for (int i = 0; i < 2048; ++i) {
-      Vec3 x(u(rng), 0, u(rng));
-      x -= n.dot(x) * n;
-      s.Add(x, 0.1 * Vec3(u(rng), 0, u(rng)));
-    }
-    const double limit2 = 4;
-    const kernels::BulkArrays a{s.px.data(), s.py.data(), s.pz.data(),     s.vx.data(),
-                                s.vy.data(), s.vz.data(), s.invMass.data()};
-    const double h = double(float(1.0 / 240));
-    const kernels::BulkParams q{0, float(-kG), 0, 0, 0, 0, 0, 0, float(h), 3e38f};
-    const kernels::PlaneRest rest{{n.x(), n.y(), n.z()}, {0, 0, 0}, 0.1, h, limit2};
-    std::vector<float> old(6 * 512);
-    float* const olds[6] = {&old[0], &old[512], &old[1024], &old[1536], &old[2048], &old[2560]};
-    std::vector<uint16_t> idx(512 + 4);
-    std::vector<bool> left(s.size(), false);
-    for (size_t c = 0; c < s.size(); c += 512) {
-      bool ok = true;
-      const size_t m = kernels::BulkAdvanceRestOnPlane(q, rest, a, s.radius.data(), c, c + 512,
-                                                       olds, idx.data(), &ok);
-      for (size_t k = 0; k < m; ++k) left[c + idx[k]] = true;
-    }
-    int resolved = 0, beyond = 0;
-    for (size_t i = 0; i < s.size(); ++i) {
-      const double e = s.position(i).squaredNorm() + s.velocity(i).squaredNorm();
-      if (left[i]) {
-        beyond += e > limit2;
-        // (On the tilted floor about half are left for the end's test as
-        // well: see BallsRestingWhereFloatsCannotStayOnTheFloorKernel.)
-        if (n.y() == 1) {
-          EXPECT_GT(e, 0.999 * limit2) << "normal " << n.transpose() << ": particle " << i
-                                       << " left to the general path within the limit: " << e;
-        }
-      } else {
-        ++resolved;
-        ASSERT_LE(e, limit2 * (1 + 1e-6)) << "normal " << n.transpose() << ": particle " << i
-                                          << " resolved beyond the limit: " << e;
+  // on the floor y = 0 every one left ends beyond it. On both widths (4
+  // lanes always take the sum).
+  std::vector<int> widths = {4};
+  if (kernels::RestLanes() == 8) widths.push_back(8);
+  for (int lanes : widths)
+    for (const Vec3& n : {Vec3(0, 1, 0), Vec3(0.1, 1, -0.05).normalized()}) {
+      BulkState s;
+      std::mt19937 rng(9);
+      std::uniform_real_distribution<double> u(-2, 2);
+      for (int i = 0; i < 2048; ++i) {
+        Vec3 x(u(rng), 0, u(rng));
+        x -= n.dot(x) * n;
+        s.Add(x, 0.1 * Vec3(u(rng), 0, u(rng)));
       }
+      const double limit2 = 4;
+      const double h = double(float(1.0 / 240));
+      const kernels::BulkParams q{0, float(-kG), 0, 0, 0, 0, 0, 0, float(h), 3e38f};
+      const kernels::PlaneRest rest{{n.x(), n.y(), n.z()}, {0, 0, 0}, 0.1, h, limit2};
+      std::vector<bool> left;
+      LeftByFloorKernel(s, lanes, q, rest, &left, &s);
+      int resolved = 0, beyond = 0;
+      for (size_t i = 0; i < s.size(); ++i) {
+        const double e = s.position(i).squaredNorm() + s.velocity(i).squaredNorm();
+        if (left[i]) {
+          beyond += e > limit2;
+          // (On the tilted floor about half are left for the end's test as
+          // well: see BallsRestingWhereFloatsCannotStayOnTheFloorKernel.)
+          if (n.y() == 1) {
+            EXPECT_GT(e, 0.999 * limit2)
+                << lanes << " lanes, normal " << n.transpose() << ": particle " << i
+                << " left to the general path within the limit: " << e;
+          }
+        } else {
+          ++resolved;
+          ASSERT_LE(e, limit2 * (1 + 1e-6))
+              << lanes << " lanes, normal " << n.transpose() << ": particle " << i
+              << " resolved beyond the limit: " << e;
+        }
+      }
+      EXPECT_GT(resolved, 500) << lanes << " lanes, normal " << n.transpose();
+      EXPECT_GT(beyond, 300) << lanes << " lanes, normal " << n.transpose();
     }
-    EXPECT_GT(resolved, 500) << "normal " << n.transpose();
-    EXPECT_GT(beyond, 300) << "normal " << n.transpose();
-  }
 }
 
 // Two cases a fuzzer against the scalar path found (eight copies of one
