@@ -68,7 +68,12 @@ BENCHMARK_CAPTURE(BM_Step, rk4, particles::Integrator::kRK4)
 // resting ones lie on the floor at it, and with settle, the timed step
 // starts from the state two steps on (a ball's height on the floor has no
 // float: the first step pushes it a few ulps off, where it then rests).
-void BulkStep(benchmark::State& state, int restLanes, float radius = 0, bool settle = false) {
+// tilted: the floor through (0, -1, 0) has the normal (0.1, 1, -0.05),
+// normalized (a point's height on it has no float either), the resting
+// particles lie on it sliding along it, those in the air start at heights
+// in [-0.8, 1] (above it).
+void BulkStep(benchmark::State& state, int restLanes, float radius = 0, bool settle = false,
+              bool tilted = false) {
   particles::BulkSystem sys(int(state.range(1)));
   sys.SetKernel(particles::kernels::Kernel::kAvx, restLanes);
   const int n = int(state.range(0));
@@ -76,8 +81,17 @@ void BulkStep(benchmark::State& state, int restLanes, float radius = 0, bool set
   std::uniform_real_distribution<double> u(-1, 1);
   auto& s = sys.state;
   s.Reserve(size_t(n));
+  const Vec3 normal = tilted ? Vec3(0.1, 1, -0.05).normalized() : Vec3(0, 1, 0);
+  const Vec3 point(0, -1, 0);
   for (int i = 0; i < n; ++i) {
-    if (i % 100 < state.range(2)) {
+    if (tilted && i % 100 < state.range(2)) {
+      Vec3 x(u(rng), 0, u(rng));
+      x -= (normal.dot(x - point) - double(radius)) * normal;
+      const Vec3 v(u(rng), 0, u(rng));
+      s.Add(x, v - normal.dot(v) * normal);
+    } else if (tilted) {
+      s.Add(Vec3(u(rng), 0.1 + 0.9 * u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)));
+    } else if (i % 100 < state.range(2)) {
       s.Add(Vec3(u(rng), -1 + double(radius), u(rng)), Vec3(u(rng), 0, u(rng)));
     } else {
       s.Add(Vec3(u(rng), u(rng), u(rng)), Vec3(u(rng), u(rng), u(rng)));
@@ -87,9 +101,7 @@ void BulkStep(benchmark::State& state, int restLanes, float radius = 0, bool set
   sys.fields.gravity = Vec3(0, -9.81, 0);
   sys.fields.linearDrag = 0.1;
   sys.fields.quadraticDrag = 0.01;
-  if (!sys.AddCollider(particles::Collider::Plane(Vec3(0, -1, 0), Vec3(0, 1, 0))
-                           .Restitution(0.8)
-                           .Friction(0.1))
+  if (!sys.AddCollider(particles::Collider::Plane(point, normal).Restitution(0.8).Friction(0.1))
            .ok()) {
     state.SkipWithError("bad plane");
     return;
@@ -145,6 +157,15 @@ void BM_BulkStepBallsFourLanes(benchmark::State& state) {
 }
 BENCHMARK(BM_BulkStepBallsFourLanes)
     ->ArgsProduct({{1000000}, {2}, {0, 50}, {1, 0}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+// Points (argument 3 = 0) and balls of 10 mm (10) on a tilted floor,
+// settled two steps, on the widest path (argument 4 = 0) and four lanes (4).
+void BM_BulkStepTilted(benchmark::State& state) {
+  BulkStep(state, int(state.range(4)), float(state.range(3)) * 1e-3f, true, true);
+}
+BENCHMARK(BM_BulkStepTilted)
+    ->ArgsProduct({{1000000}, {2}, {0, 50}, {0, 10}, {0, 4}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
