@@ -142,10 +142,12 @@ struct PlaneRest {
 // [begin, end), at most kRestRange particles, on `lanes` lanes (4, or 8
 // where RestLanes() is 8): the same bits as BulkAdvance and
 // BulkPlaneCandidateList, then the general path's response to each
-// candidate. Two passes over the range, which stays in L1: the advance
-// and the candidate test eight particles at a time, then the resting
-// kernel on the runs of four (4 lanes) or groups of eight (8 lanes, four
-// groups at a time) with candidates. Writes to idx the candidates the
+// candidate. Passes over the range, which stays in L1: on 8 lanes two,
+// the advance and the candidate test eight particles at a time, then the
+// resting kernel on the groups of eight with candidates, four groups at a
+// time; on 4 lanes three, the advance, the candidate test four at a time,
+// then the resting kernel on the runs of four with candidates, two at a
+// time. Writes to idx the candidates the
 // resting kernel leaves (for the general path), as
 // BulkPlaneCandidateList, and returns their count; a tail of fewer than
 // eight is advanced and its candidates listed. ANDs BulkAdvance's check

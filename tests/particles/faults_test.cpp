@@ -225,45 +225,50 @@ TEST(Faults, BulkReportsAComponentJustBeyondALimitThatFloatRoundsUp) {
 // anywhere, without a word. In a step with colliders (or particle
 // collisions) a radius that is negative, not finite or beyond maxMagnitude
 // is reported with the step and the particle id, by both systems and on
-// every contact path (a lone plane's vector path, the general one); a
-// system without colliders reads no radius and steps on.
+// every contact path (a lone plane's vector path on the widest lanes and on
+// four, the general one); a system without colliders reads no radius and
+// steps on.
 TEST(Faults, ABadRadiusIsReportedWhereContactsWouldReadIt) {
   const float bads[] = {-1.0f, -1e-30f, std::nanf(""), std::numeric_limits<float>::infinity(),
                         2e12f};
-  for (float bad : bads) {
-    for (int colliders = 1; colliders <= 2; ++colliders) {
-      const std::string ctx =
-          "radius " + std::to_string(bad) + ", " + std::to_string(colliders) + " collider(s)";
-      BulkSystem b;
-      for (int i = 0; i < 40; ++i) b.state.Add(Vec3(i, 0.2, 0), Vec3::Zero());
-      for (float& r : b.state.radius) r = 0.1f;
-      b.fields.gravity = Vec3(0, -9.81, 0);
-      ASSERT_OK(b.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0))));
-      if (colliders == 2) ASSERT_OK(b.AddCollider(Collider::Sphere(Vec3(0, -5, 0), 1)));
-      for (int i = 0; i < 2; ++i) ASSERT_OK(b.Step(0.01));
-      b.state.radius[13] = bad;
-      b.state.radius[29] = bad;  // the lowest index is named
-      ExpectError(b.Step(0.01), {"step 2", "particle id 13", "radius"}, "BulkSystem, " + ctx);
-      EXPECT_FALSE(b.Step(0.01).ok()) << ctx << ": a faulted system steps again";
+  std::vector<int> widths = {0};  // the widest this processor runs
+  if (kernels::RestLanes() == 8) widths.push_back(4);
+  for (int lanes : widths)
+    for (float bad : bads) {
+      for (int colliders = 1; colliders <= 2; ++colliders) {
+        const std::string ctx = "radius " + std::to_string(bad) + ", " + std::to_string(colliders) +
+                                " collider(s), lanes " + std::to_string(lanes);
+        BulkSystem b;
+        if (lanes) b.SetKernel(kernels::Kernel::kAvx, lanes);
+        for (int i = 0; i < 40; ++i) b.state.Add(Vec3(i, 0.2, 0), Vec3::Zero());
+        for (float& r : b.state.radius) r = 0.1f;
+        b.fields.gravity = Vec3(0, -9.81, 0);
+        ASSERT_OK(b.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0))));
+        if (colliders == 2) ASSERT_OK(b.AddCollider(Collider::Sphere(Vec3(0, -5, 0), 1)));
+        for (int i = 0; i < 2; ++i) ASSERT_OK(b.Step(0.01));
+        b.state.radius[13] = bad;
+        b.state.radius[29] = bad;  // the lowest index is named
+        ExpectError(b.Step(0.01), {"step 2", "particle id 13", "radius"}, "BulkSystem, " + ctx);
+        EXPECT_FALSE(b.Step(0.01).ok()) << ctx << ": a faulted system steps again";
 
-      System s(2);
-      for (int i = 0; i < 40; ++i) s.state.Add(Vec3(i, 0.2, 0), Vec3::Zero());
-      for (float& r : s.state.radius) r = 0.1f;
-      s.AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
-      if (colliders == 1) {
-        ASSERT_OK(s.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0))));
-      } else {
-        ASSERT_OK(s.EnableParticleCollisions(0.1, 0.5));  // particle collisions alone
+        System s(2);
+        for (int i = 0; i < 40; ++i) s.state.Add(Vec3(i, 0.2, 0), Vec3::Zero());
+        for (float& r : s.state.radius) r = 0.1f;
+        s.AddForce(std::make_shared<Gravity>(Vec3(0, -9.81, 0)));
+        if (colliders == 1) {
+          ASSERT_OK(s.AddCollider(Collider::Plane(Vec3::Zero(), Vec3(0, 1, 0))));
+        } else {
+          ASSERT_OK(s.EnableParticleCollisions(0.1, 0.5));  // particle collisions alone
+        }
+        for (int i = 0; i < 2; ++i) ASSERT_OK(s.Step(0.01, Integrator::kSymplecticEuler));
+        s.state.radius[13] = bad;
+        s.state.radius[29] = bad;
+        ExpectError(s.Step(0.01, Integrator::kSymplecticEuler),
+                    {"step 2", "particle id 13", "radius"}, "System, " + ctx);
+        EXPECT_FALSE(s.Step(0.01, Integrator::kSymplecticEuler).ok())
+            << ctx << ": a faulted system steps again";
       }
-      for (int i = 0; i < 2; ++i) ASSERT_OK(s.Step(0.01, Integrator::kSymplecticEuler));
-      s.state.radius[13] = bad;
-      s.state.radius[29] = bad;
-      ExpectError(s.Step(0.01, Integrator::kSymplecticEuler),
-                  {"step 2", "particle id 13", "radius"}, "System, " + ctx);
-      EXPECT_FALSE(s.Step(0.01, Integrator::kSymplecticEuler).ok())
-          << ctx << ": a faulted system steps again";
     }
-  }
   // Without colliders no radius is read: the step is taken.
   BulkSystem b;
   b.state.Add(Vec3::Zero(), Vec3::Zero());
