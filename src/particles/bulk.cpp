@@ -24,6 +24,7 @@ Vec3f Round(const Vec3& x) {
 // How many single-precision roundings of the largest coordinate a
 // resting particle's start may lie from the exact answer and be kept
 // (RoundOutside).
+using kernels::kRestPush;
 using kernels::kRestRoundings;
 
 // How far above a plane a particle's start still rests on it
@@ -75,7 +76,7 @@ Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double
                    MeshMemo* memo, const Vec3f* start) {
   const double scale = double(FLT_EPSILON) * std::max(1.0, x.cwiseAbs().maxCoeff());
   Vec3f xf = Round(x);
-  const double skin = 4 * scale;
+  const double push = kRestPush * scale;
   Vec3 base = x, normal;
   for (int tries = 0; tries < 4; ++tries) {
     const Vec3 r = xf.cast<double>();
@@ -89,7 +90,7 @@ Vec3f RoundOutside(const std::vector<Collider>& colliders, const Vec3& x, double
         return *start;
       }
     }
-    base += skin * normal;
+    base += push * normal;
     xf = Round(base);
   }
   return xf;

@@ -157,6 +157,21 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   return i;
 }
 
+// (n0 y0 + n1 y1) + n2 y2, Eigen's order for a Vec3 dot product.
+[[gnu::target("avx")]] inline __m256d Dot3(const __m256d n[3], __m256d y0, __m256d y1, __m256d y2) {
+  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n[0], y0), _mm256_mul_pd(n[1], y1)),
+                       _mm256_mul_pd(n[2], y2));
+}
+
+// n . (b - p) for the four positions b from i: the plane's candidate test
+// (a candidate ends the step behind the plane moved out by its radius).
+[[gnu::target("avx")]] inline __m256d PlaneDistance4(const __m256d n[3], const __m256d p[3],
+                                                     const BulkArrays& a, size_t i) {
+  return Dot3(n, _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(a.px + i)), p[0]),
+              _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(a.py + i)), p[1]),
+              _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(a.pz + i)), p[2]));
+}
+
 [[gnu::target("avx")]] size_t BulkPlaneAvx(const double* n, const double* p, const BulkArrays& a,
                                            const float* radius, size_t i, size_t e,
                                            uint8_t* flags) {
@@ -165,16 +180,11 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
                                           0x00010000, 0x00010001, 0x00010100, 0x00010101,
                                           0x01000000, 0x01000001, 0x01000100, 0x01000101,
                                           0x01010000, 0x01010001, 0x01010100, 0x01010101};
-  const __m256d n0 = _mm256_set1_pd(n[0]), n1 = _mm256_set1_pd(n[1]), n2 = _mm256_set1_pd(n[2]);
-  const __m256d p0 = _mm256_set1_pd(p[0]), p1 = _mm256_set1_pd(p[1]), p2 = _mm256_set1_pd(p[2]);
+  const __m256d nv[3] = {_mm256_set1_pd(n[0]), _mm256_set1_pd(n[1]), _mm256_set1_pd(n[2])};
+  const __m256d pv[3] = {_mm256_set1_pd(p[0]), _mm256_set1_pd(p[1]), _mm256_set1_pd(p[2])};
   uint8_t* f = flags;
   for (; i + 4 <= e; i += 4, f += 4) {
-    const __m256d b0 = _mm256_cvtps_pd(_mm_loadu_ps(a.px + i));
-    const __m256d b1 = _mm256_cvtps_pd(_mm_loadu_ps(a.py + i));
-    const __m256d b2 = _mm256_cvtps_pd(_mm_loadu_ps(a.pz + i));
-    const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, _mm256_sub_pd(b0, p0)),
-                                                  _mm256_mul_pd(n1, _mm256_sub_pd(b1, p1))),
-                                    _mm256_mul_pd(n2, _mm256_sub_pd(b2, p2)));
+    const __m256d d = PlaneDistance4(nv, pv, a, i);
     const __m256d r = _mm256_cvtps_pd(_mm_loadu_ps(radius + i));
     const int mask = _mm256_movemask_pd(_mm256_cmp_pd(d, r, _CMP_LT_OQ));
     if (mask) {
@@ -196,16 +206,11 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
   static constexpr uint64_t kOffsets[16] = {
       0x0, 0x0,     0x1,     0x10000,     0x2,     0x20000,     0x20001,     0x200010000,
       0x3, 0x30000, 0x30001, 0x300010000, 0x30002, 0x300020000, 0x300020001, 0x3000200010000};
-  const __m256d n0 = _mm256_set1_pd(n[0]), n1 = _mm256_set1_pd(n[1]), n2 = _mm256_set1_pd(n[2]);
-  const __m256d p0 = _mm256_set1_pd(p[0]), p1 = _mm256_set1_pd(p[1]), p2 = _mm256_set1_pd(p[2]);
+  const __m256d nv[3] = {_mm256_set1_pd(n[0]), _mm256_set1_pd(n[1]), _mm256_set1_pd(n[2])};
+  const __m256d pv[3] = {_mm256_set1_pd(p[0]), _mm256_set1_pd(p[1]), _mm256_set1_pd(p[2])};
   size_t count = 0;
   for (; i + 4 <= e; i += 4) {
-    const __m256d b0 = _mm256_cvtps_pd(_mm_loadu_ps(a.px + i));
-    const __m256d b1 = _mm256_cvtps_pd(_mm_loadu_ps(a.py + i));
-    const __m256d b2 = _mm256_cvtps_pd(_mm_loadu_ps(a.pz + i));
-    const __m256d d = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n0, _mm256_sub_pd(b0, p0)),
-                                                  _mm256_mul_pd(n1, _mm256_sub_pd(b1, p1))),
-                                    _mm256_mul_pd(n2, _mm256_sub_pd(b2, p2)));
+    const __m256d d = PlaneDistance4(nv, pv, a, i);
     const __m256d r = _mm256_cvtps_pd(_mm_loadu_ps(radius + i));
     const int below = _mm256_movemask_pd(_mm256_cmp_pd(d, r, _CMP_LT_OQ));
     if (!below) continue;
@@ -220,12 +225,6 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
     count += size_t(__builtin_popcount(unsigned(mask)));
   }
   return count;
-}
-
-// (n0 y0 + n1 y1) + n2 y2, Eigen's order for a Vec3 dot product.
-[[gnu::target("avx")]] inline __m256d Dot3(const __m256d n[3], __m256d y0, __m256d y1, __m256d y2) {
-  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(n[0], y0), _mm256_mul_pd(n[1], y1)),
-                       _mm256_mul_pd(n[2], y2));
 }
 
 [[gnu::target("avx")]] inline __m256d Abs(__m256d x) {
@@ -269,7 +268,7 @@ CgSums CgStepScalar(double alpha, const double* __restrict p, const double* __re
 // The plane and the step on four lanes, for RestRunsAvx.
 struct Rest4 {
   __m256d n[3], p[3], h, mh, half, mu, zero, one, tiny, tol, mtol, limit2;
-  __m256d skin, eps, four, sixteen;  // kRestSkin, FLT_EPSILON, 4, kRestRoundings
+  __m256d skin, eps, push, roundings;  // kRestSkin, FLT_EPSILON, kRestPush, kRestRoundings
 };
 
 // The resting kernel (see PlaneRest) on the candidates of G runs of four
@@ -386,7 +385,7 @@ template <int G>
       // Where it crosses: a particle the response stopped (out = 0) keeps
       // its start's floats if they lie within kRestRoundings ulps of x1's
       // largest coordinate and on its side; any other is pushed off along
-      // the normal by 4 such ulps and rounded again, which must not cross
+      // the normal by kRestPush such ulps and rounded again, which must not cross
       // (else the general path pushes again).
       const __m256d scale =
           _mm256_mul_pd(k.eps, Max(k.one, Max(Max(Abs(x1[g][0]), Abs(x1[g][1])), Abs(x1[g][2]))));
@@ -399,9 +398,9 @@ template <int G>
               Abs(_mm256_sub_pd(a[g][2], x1[g][2])));
       const __m256d keeps = _mm256_and_pd(
           _mm256_and_pd(crosses, rest),
-          _mm256_and_pd(_mm256_cmp_pd(apart, _mm256_mul_pd(k.sixteen, scale), _CMP_LE_OQ),
+          _mm256_and_pd(_mm256_cmp_pd(apart, _mm256_mul_pd(k.roundings, scale), _CMP_LE_OQ),
                         OnPlaneSide4(k.n, k.p, x1[g], a[g], r[g])));
-      const __m256d push = _mm256_mul_pd(k.four, scale);
+      const __m256d push = _mm256_mul_pd(k.push, scale);
       __m128 pf[3];
       __m256d pr[3];
       for (int c = 0; c < 3; ++c) {
@@ -482,7 +481,7 @@ template <int G>
                 _mm256_set1_pd(rq.limit2),
                 _mm256_set1_pd(kRestSkin),
                 _mm256_set1_pd(double(FLT_EPSILON)),
-                _mm256_set1_pd(4.0),
+                _mm256_set1_pd(kRestPush),
                 _mm256_set1_pd(kRestRoundings)};
   // The candidates (PlaneListAvx): movable particles that end behind the
   // plane; a run of four listed if it has any (without a branch). The
@@ -496,9 +495,7 @@ template <int G>
     const __m128 rf = _mm_loadu_ps(radius + j);
     radii = _mm_and_ps(
         radii, _mm_and_ps(_mm_cmp_ps(rf, zerof, _CMP_GE_OQ), _mm_cmp_ps(rf, limit, _CMP_LE_OQ)));
-    const __m256d d = Dot3(k.n, _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(ar.px + j)), k.p[0]),
-                           _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(ar.py + j)), k.p[1]),
-                           _mm256_sub_pd(_mm256_cvtps_pd(_mm_loadu_ps(ar.pz + j)), k.p[2]));
+    const __m256d d = PlaneDistance4(k.n, k.p, ar, j);
     const int candidates =
         _mm256_movemask_pd(_mm256_cmp_pd(d, _mm256_cvtps_pd(rf), _CMP_LT_OQ)) &
         _mm_movemask_ps(_mm_cmp_ps(_mm_loadu_ps(ar.invMass + j), zerof, _CMP_NEQ_UQ));
@@ -545,7 +542,7 @@ template <int G>
 // The plane and the step on eight lanes, for RestGroupsAvx512.
 struct Rest8 {
   __m512d n[3], p[3], h, mh, half, mu, zero, one, tiny, tol, mtol, limit2, sign;
-  __m512d skin, eps, four, sixteen;  // kRestSkin, FLT_EPSILON, 4, kRestRoundings
+  __m512d skin, eps, push, roundings;  // kRestSkin, FLT_EPSILON, kRestPush, kRestRoundings
   // A magnitude that six coordinates and speeds may each reach (in floats)
   // with x.x + v.v <= limit2 certain (see RestGroupsAvx512).
   __m256 small;
@@ -749,7 +746,7 @@ template <int G, bool kUp>
       // Where it crosses: a particle the response stopped (out = 0) keeps
       // its start's floats if they lie within kRestRoundings ulps of x1's
       // largest coordinate and on its side; any other is pushed off along
-      // the normal by 4 such ulps and rounded again, which must not cross
+      // the normal by kRestPush such ulps and rounded again, which must not cross
       // (else the general path pushes again).
       const __m512d scale =
           _mm512_mul_pd(k.eps, Max(k.one, Max(Max(Abs(x1[g][0]), Abs(x1[g][1])), Abs(x1[g][2]))));
@@ -760,9 +757,10 @@ template <int G, bool kUp>
           Max(Max(Abs(_mm512_sub_pd(a[g][0], x1[g][0])), Abs(_mm512_sub_pd(a[g][1], x1[g][1]))),
               Abs(_mm512_sub_pd(a[g][2], x1[g][2])));
       const __mmask8 keeps =
-          crosses & rest & _mm512_cmp_pd_mask(apart, _mm512_mul_pd(k.sixteen, scale), _CMP_LE_OQ) &
+          crosses & rest &
+          _mm512_cmp_pd_mask(apart, _mm512_mul_pd(k.roundings, scale), _CMP_LE_OQ) &
           OnPlaneSide<kUp>(k, x1[g], a[g], r[g]);
-      const __m512d push = _mm512_mul_pd(k.four, scale);
+      const __m512d push = _mm512_mul_pd(k.push, scale);
       __m256 pf[3];
       __m512d pr[3];
       for (int c = 0; c < 3; ++c) {
@@ -911,7 +909,7 @@ float SmallEnough(double limit2) {
                 _mm512_set1_pd(-0.0),
                 _mm512_set1_pd(kRestSkin),
                 _mm512_set1_pd(double(FLT_EPSILON)),
-                _mm512_set1_pd(4.0),
+                _mm512_set1_pd(kRestPush),
                 _mm512_set1_pd(kRestRoundings),
                 _mm256_set1_ps(SmallEnough(rq.limit2))};
   // The floor of a y-up world, (+0, 1, +0) to the bit: RestGroupsAvx512's kUp.

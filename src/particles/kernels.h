@@ -128,10 +128,11 @@ size_t BulkPlaneCandidateList(Kernel kernel, const double* n, const double* p, c
 // BulkSystem passes), and the rounding to floats is RoundOutside's: where
 // it would cross the plane, a particle the response stopped keeps its
 // start's floats if they lie within kRestRoundings ulps and on its side,
-// and any other is pushed off along the normal by 4 ulps of x1's largest
+// and any other is pushed off along the normal by kRestPush ulps of x1's largest
 // coordinate (at least 1) and rounded again; a second crossing is left for
 // the general path.
-constexpr double kRestSkin = 8 * double(FLT_EPSILON);  // twice the push
+constexpr double kRestPush = 4;  // RoundOutside's push, in ulps of the largest coordinate
+constexpr double kRestSkin = 2 * kRestPush * double(FLT_EPSILON);  // twice the push
 constexpr double kRestRoundings = 16;
 struct PlaneRest {
   double n[3], p[3];
